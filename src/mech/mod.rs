@@ -1,0 +1,26 @@
+//! The mechanics core: membrane finite elements with friction gap elements (the reference
+//! paper's method). It knows nothing of FMI, holds no global state and does no I/O.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`element`] | CST membrane triangle, eqs. (2.2)–(2.7) |
+//! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
+//! | [`model`] | model file format and validation |
+//! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
+//! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
+//! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
+//! | [`specimen`] | the parallel-arch specimens of §4 and every assumption about them |
+
+pub mod assembly;
+pub mod contact;
+pub mod element;
+pub mod linear;
+pub mod model;
+pub mod solver;
+pub mod specimen;
+
+pub use contact::{GapStatus, IterationMatrix};
+pub use element::Material;
+pub use model::{Model, ModelError};
+pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};
+pub use specimen::ParallelArch;

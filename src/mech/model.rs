@@ -1,0 +1,370 @@
+//! The model: mesh, material, constraints, gap elements and prescribed boundary groups, read
+//! from a JSON model file (format in `docs/model-format.md`) and validated before any analysis.
+//!
+//! Validation names the offending item: an unknown node index, a degenerate triangle, `E ≤ 0`,
+//! `ν` outside `[0, 0.5)`, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node that
+//! is both constrained and prescribed. Nothing here panics on user input.
+
+use std::collections::HashSet;
+use std::fmt;
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::contact::{GapFrame, GapLaw};
+use super::element::{Material, MembraneTriangle};
+
+/// A global axis, used for supports and symmetry planes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    /// Global X.
+    X,
+    /// Global Y.
+    Y,
+    /// Global Z.
+    Z,
+}
+
+impl Axis {
+    /// Component index 0, 1 or 2.
+    pub fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// Fixed DOFs of one node (displacement zero in the listed axes).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Support {
+    /// Node index.
+    pub node: usize,
+    /// Fixed components.
+    pub fixed: Vec<Axis>,
+}
+
+/// A symmetry plane normal to a global axis: the normal displacement of its nodes is zero.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Symmetry {
+    /// Name of the plane (for messages).
+    pub name: String,
+    /// Normal of the plane.
+    pub normal: Axis,
+    /// Nodes on the plane.
+    pub nodes: Vec<usize>,
+}
+
+/// What node B of a gap is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GapSupport {
+    /// A node of the model (its DOFs take part in the gap).
+    Node(usize),
+    /// A fixed point in space (a rigid support).
+    Point([f64; 3]),
+}
+
+/// A friction gap element as written in a model file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GapSpec {
+    /// Name (an identifier: it becomes the FMU variable prefix).
+    pub name: String,
+    /// Node A, on the film.
+    pub film_node: usize,
+    /// Node B: a support node or a fixed point.
+    pub support: GapSupport,
+    /// Local frame, fixed during the analysis (§4.3).
+    pub frame: GapFrame,
+    /// Initial gap `g0 ≥ 0` (m).
+    #[serde(default)]
+    pub initial_gap: f64,
+    /// Normal penalty `k_n` (N/m).
+    pub normal_stiffness: f64,
+    /// Tangential penalty `k_s` (N/m).
+    pub tangential_stiffness: f64,
+    /// Friction coefficient `μ ≥ 0`.
+    pub friction: f64,
+}
+
+impl GapSpec {
+    /// The constitutive constants of this gap.
+    pub fn law(&self) -> GapLaw {
+        GapLaw {
+            normal_stiffness: self.normal_stiffness,
+            tangential_stiffness: self.tangential_stiffness,
+            friction: self.friction,
+            initial_gap: self.initial_gap,
+        }
+    }
+}
+
+/// A named set of nodes that move together by an imposed displacement `(dx, dy, dz)`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoundaryGroup {
+    /// Name (an identifier: it becomes the FMU variable prefix).
+    pub name: String,
+    /// Nodes of the group.
+    pub nodes: Vec<usize>,
+    /// Target displacement of a standard run (m); the CLI and the FMU's default experiment use it.
+    #[serde(default)]
+    pub target: [f64; 3],
+}
+
+/// A complete membrane + gap model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Model {
+    /// Model name (an identifier: it becomes the FMU's model identifier).
+    pub name: String,
+    /// Free text.
+    #[serde(default)]
+    pub description: String,
+    /// Node coordinates (m).
+    pub nodes: Vec<[f64; 3]>,
+    /// Triangles as three node indices each.
+    pub triangles: Vec<[usize; 3]>,
+    /// Film material, thickness and prestress.
+    pub material: Material,
+    /// Fixed DOFs.
+    #[serde(default)]
+    pub supports: Vec<Support>,
+    /// Symmetry planes.
+    #[serde(default)]
+    pub symmetry: Vec<Symmetry>,
+    /// Friction gap elements.
+    #[serde(default)]
+    pub gaps: Vec<GapSpec>,
+    /// Prescribed boundary groups.
+    #[serde(default)]
+    pub groups: Vec<BoundaryGroup>,
+}
+
+/// Why a model is rejected. Every variant names the offending item.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelError {
+    /// The file is not valid JSON of the model format.
+    Syntax { message: String },
+    /// A reference to a node that does not exist.
+    UnknownNode { item: String, node: usize, node_count: usize },
+    /// A node coordinate or a number that must be finite is not.
+    NotFinite { item: String },
+    /// A triangle with (near) zero area or repeated nodes.
+    DegenerateTriangle { triangle: usize, nodes: [usize; 3] },
+    /// A material constant out of range.
+    Material { message: String },
+    /// A gap constant out of range.
+    Gap { gap: String, message: String },
+    /// A name that is empty, not an identifier, or used twice.
+    Name { item: String, message: String },
+    /// A DOF that is constrained and prescribed, or prescribed twice.
+    Conflict { node: usize, message: String },
+    /// A node with free DOFs that no triangle or gap holds.
+    Unconnected { node: usize },
+    /// Nothing to analyse.
+    Empty { message: String },
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Syntax { message } => write!(f, "model file: {message}"),
+            Self::UnknownNode { item, node, node_count } => {
+                write!(f, "{item}: node {node} does not exist (the model has {node_count} nodes, 0-based)")
+            }
+            Self::NotFinite { item } => write!(f, "{item}: value is not a finite number"),
+            Self::DegenerateTriangle { triangle, nodes } => {
+                write!(f, "triangle {triangle} {nodes:?} is degenerate (zero area or repeated node)")
+            }
+            Self::Material { message } => write!(f, "material: {message}"),
+            Self::Gap { gap, message } => write!(f, "gap '{gap}': {message}"),
+            Self::Name { item, message } => write!(f, "{item}: {message}"),
+            Self::Conflict { node, message } => write!(f, "node {node}: {message}"),
+            Self::Unconnected { node } => {
+                write!(f, "node {node} has free DOFs but belongs to no triangle or gap (singular system)")
+            }
+            Self::Empty { message } => write!(f, "model: {message}"),
+        }
+    }
+}
+
+impl std::error::Error for ModelError {}
+
+/// Whether `name` can be used as an FMU variable prefix and a C identifier.
+pub fn is_identifier(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+impl Model {
+    /// Parses and validates a JSON model file.
+    pub fn from_json(text: &str) -> Result<Self, ModelError> {
+        let model: Model =
+            serde_json::from_str(text).map_err(|e| ModelError::Syntax { message: e.to_string() })?;
+        model.validate()?;
+        Ok(model)
+    }
+
+    /// Serializes the model to pretty JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a model always serializes")
+    }
+
+    /// Checks every item; the first problem found is returned.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        let n = self.nodes.len();
+        if n == 0 || self.triangles.is_empty() {
+            return Err(ModelError::Empty { message: "needs at least one node and one triangle".into() });
+        }
+        if !is_identifier(&self.name) {
+            return Err(ModelError::Name {
+                item: format!("model name '{}'", self.name),
+                message: "must be an identifier ([A-Za-z_][A-Za-z0-9_]*)".into(),
+            });
+        }
+        for (i, p) in self.nodes.iter().enumerate() {
+            if p.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NotFinite { item: format!("node {i}") });
+            }
+        }
+        let check_node = |item: &dyn Fn() -> String, node: usize| {
+            if node < n { Ok(()) } else { Err(ModelError::UnknownNode { item: item(), node, node_count: n }) }
+        };
+        let m = &self.material;
+        if !(m.youngs_modulus > 0.0 && m.youngs_modulus.is_finite()) {
+            return Err(ModelError::Material { message: format!("E = {} must be > 0", m.youngs_modulus) });
+        }
+        if !(m.poisson_ratio >= 0.0 && m.poisson_ratio < 0.5) {
+            return Err(ModelError::Material { message: format!("ν = {} must lie in [0, 0.5)", m.poisson_ratio) });
+        }
+        if !(m.thickness > 0.0 && m.thickness.is_finite()) {
+            return Err(ModelError::Material { message: format!("thickness = {} must be > 0", m.thickness) });
+        }
+        if m.prestress.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::Material { message: "prestress must be finite".into() });
+        }
+        let mut connected = vec![false; n];
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for &v in tri {
+                check_node(&|| format!("triangle {t}"), v)?;
+                connected[v] = true;
+            }
+            let x = tri.map(|v| Vector3::from(self.nodes[v]));
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || MembraneTriangle::new(x).is_err() {
+                return Err(ModelError::DegenerateTriangle { triangle: t, nodes: *tri });
+            }
+        }
+        // Constrained DOFs: 0 free, 1 fixed (support or symmetry), 2 prescribed by a group.
+        let mut constrained = vec![[false; 3]; n];
+        for s in &self.supports {
+            check_node(&|| "support".to_string(), s.node)?;
+            for a in &s.fixed {
+                constrained[s.node][a.index()] = true;
+            }
+        }
+        for s in &self.symmetry {
+            for &v in &s.nodes {
+                check_node(&|| format!("symmetry plane '{}'", s.name), v)?;
+                constrained[v][s.normal.index()] = true;
+            }
+        }
+        let mut names = HashSet::new();
+        let mut in_group = vec![None::<&str>; n];
+        for g in &self.groups {
+            check_name(&mut names, "boundary group", &g.name)?;
+            if g.nodes.is_empty() {
+                return Err(ModelError::Name { item: format!("boundary group '{}'", g.name), message: "has no nodes".into() });
+            }
+            if g.target.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NotFinite { item: format!("boundary group '{}' target", g.name) });
+            }
+            for &v in &g.nodes {
+                check_node(&|| format!("boundary group '{}'", g.name), v)?;
+                if let Some(other) = in_group[v] {
+                    return Err(ModelError::Conflict {
+                        node: v,
+                        message: format!("is in boundary groups '{other}' and '{}'", g.name),
+                    });
+                }
+                if constrained[v].iter().any(|&c| c) {
+                    return Err(ModelError::Conflict {
+                        node: v,
+                        message: format!("is prescribed by group '{}' and also fixed by a support or symmetry plane", g.name),
+                    });
+                }
+                in_group[v] = Some(&g.name);
+            }
+        }
+        for gap in &self.gaps {
+            check_name(&mut names, "gap", &gap.name)?;
+            let bad = |message: String| ModelError::Gap { gap: gap.name.clone(), message };
+            check_node(&|| format!("gap '{}' film_node", gap.name), gap.film_node)?;
+            connected[gap.film_node] = true;
+            match &gap.support {
+                GapSupport::Node(b) => {
+                    check_node(&|| format!("gap '{}' support node", gap.name), *b)?;
+                    if *b == gap.film_node {
+                        return Err(bad("support node equals film node".into()));
+                    }
+                    connected[*b] = true;
+                }
+                GapSupport::Point(p) => {
+                    if p.iter().any(|v| !v.is_finite()) {
+                        return Err(bad("support point is not finite".into()));
+                    }
+                }
+            }
+            let frame_values = gap.frame.x.iter().chain(&gap.frame.y).chain(&gap.frame.z);
+            if frame_values.clone().any(|v| !v.is_finite()) || gap.frame.orthonormality_error() > 1e-6 {
+                return Err(bad(format!(
+                    "frame is not orthonormal and right-handed with y = z × x (error {:.2e})",
+                    gap.frame.orthonormality_error()
+                )));
+            }
+            let positive = |v: f64| v > 0.0 && v.is_finite();
+            if !positive(gap.normal_stiffness) {
+                return Err(bad(format!("normal_stiffness = {} must be > 0", gap.normal_stiffness)));
+            }
+            if !positive(gap.tangential_stiffness) {
+                return Err(bad(format!("tangential_stiffness = {} must be > 0", gap.tangential_stiffness)));
+            }
+            if !(gap.friction >= 0.0 && gap.friction.is_finite()) {
+                return Err(bad(format!("friction μ = {} must be ≥ 0", gap.friction)));
+            }
+            if !(gap.initial_gap >= 0.0 && gap.initial_gap.is_finite()) {
+                return Err(bad(format!("initial_gap = {} must be ≥ 0", gap.initial_gap)));
+            }
+        }
+        for (v, c) in constrained.iter().enumerate() {
+            let fully_held = in_group[v].is_some() || c.iter().all(|&x| x);
+            if !connected[v] && !fully_held {
+                return Err(ModelError::Unconnected { node: v });
+            }
+        }
+        Ok(())
+    }
+
+    /// Index of the gap named `name`.
+    pub fn gap_index(&self, name: &str) -> Option<usize> {
+        self.gaps.iter().position(|g| g.name == name)
+    }
+
+    /// Number of DOFs (three per node).
+    pub fn dof_count(&self) -> usize {
+        3 * self.nodes.len()
+    }
+}
+
+fn check_name(names: &mut HashSet<String>, kind: &str, name: &str) -> Result<(), ModelError> {
+    let item = format!("{kind} '{name}'");
+    if !is_identifier(name) {
+        return Err(ModelError::Name { item, message: "name must be an identifier ([A-Za-z_][A-Za-z0-9_]*)".into() });
+    }
+    if !names.insert(name.to_string()) {
+        return Err(ModelError::Name { item, message: "name is used twice (gap and group names share one namespace)".into() });
+    }
+    Ok(())
+}

@@ -1,0 +1,533 @@
+//! Newton–Raphson analysis with friction gaps (paper §2.3, eqs. 2.11–2.12, procedure §3).
+//!
+//! Prescribed boundary displacements are applied in increments. Each increment runs Newton on
+//! `(K_m + K_g) ΔU = −(R_m + R_g)` over the free DOFs; it converges when both the displacement
+//! correction (the paper's step (g)) and the residual force are small. A failed increment is
+//! halved, up to [`SolverSettings::max_cutbacks`] times; a step that still fails returns an error
+//! and leaves the last converged state untouched.
+
+use std::fmt;
+
+use nalgebra::{Vector2, Vector3};
+use serde::{Deserialize, Serialize};
+
+use super::assembly::{Dof, PatternError, System, node_vector};
+use super::contact::{GapLaw, GapResponse, GapStatus, IterationMatrix};
+use super::element::{ElementStress, ElementVector};
+use super::linear::LinearSolver;
+use super::model::{Model, ModelError};
+
+/// Newton and increment-control settings.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverSettings {
+    /// Which matrix drives the iterations.
+    pub iteration_matrix: IterationMatrix,
+    /// Converged when `‖ΔU‖∞ ≤ tol · max(‖U − U_start‖∞, 1 µm)` (paper §3(g)).
+    pub displacement_tolerance: f64,
+    /// … and `‖R_free‖∞ ≤ tol · max(‖R_all‖∞, 1 mN)` (residual against the reaction scale).
+    pub residual_tolerance: f64,
+    /// Newton iterations per increment before the increment is cut back.
+    pub max_iterations: usize,
+    /// How many times an increment may be halved before the step fails.
+    pub max_cutbacks: usize,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            iteration_matrix: IterationMatrix::default(),
+            displacement_tolerance: 1e-8,
+            residual_tolerance: 1e-8,
+            max_iterations: 40,
+            max_cutbacks: 10,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// Checks the settings (positive tolerances, at least one iteration).
+    pub fn validate(&self) -> Result<(), String> {
+        let ok = |v: f64| v > 0.0 && v.is_finite();
+        if !ok(self.displacement_tolerance) || !ok(self.residual_tolerance) {
+            return Err("tolerances must be positive and finite".into());
+        }
+        if self.max_iterations == 0 {
+            return Err("max_iterations must be at least 1".into());
+        }
+        if self.max_cutbacks > 60 {
+            return Err("max_cutbacks must be at most 60".into());
+        }
+        Ok(())
+    }
+}
+
+/// The converged state of an analysis: everything needed to continue it exactly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AnalysisState {
+    /// Nodal displacements, three per node (m).
+    pub displacement: Vec<f64>,
+    /// Slip history `s_p` of each gap (local x, y) (m).
+    pub plastic_slip: Vec<[f64; 2]>,
+    /// Current imposed displacement of each boundary group (m).
+    pub boundary: Vec<[f64; 3]>,
+    /// Friction coefficient of each gap.
+    pub friction: Vec<f64>,
+    /// Status of each gap at convergence.
+    pub status: Vec<GapStatus>,
+}
+
+/// Newton statistics of one step.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Newton iterations of each converged increment.
+    pub iterations: Vec<usize>,
+    /// Increments halved.
+    pub cutbacks: usize,
+    /// Final residual `‖R_free‖∞` (N).
+    pub residual: f64,
+}
+
+impl StepReport {
+    /// Total Newton iterations (converged increments only).
+    pub fn total_iterations(&self) -> usize {
+        self.iterations.iter().sum()
+    }
+}
+
+/// Why one increment failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum IncrementFailure {
+    /// No convergence within the iteration limit.
+    MaxIterations { residual: f64 },
+    /// NaN/Inf or runaway corrections.
+    Diverged { iteration: usize },
+    /// The Newton matrix could not be factorized.
+    Singular { message: String },
+}
+
+impl fmt::Display for IncrementFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::MaxIterations { residual } => write!(f, "no convergence (residual {residual:.3e} N)"),
+            Self::Diverged { iteration } => write!(f, "diverged at iteration {iteration}"),
+            Self::Singular { message } => write!(f, "singular Newton matrix ({message})"),
+        }
+    }
+}
+
+/// Why a step failed. The analysis keeps its last converged state.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepError {
+    /// A target that is not finite or has the wrong length.
+    InvalidInput { message: String },
+    /// The increment could not converge even after the allowed cut-backs.
+    NotConverged { fraction_done: f64, cutbacks: usize, last: IncrementFailure },
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::InvalidInput { message } => write!(f, "invalid step input: {message}"),
+            Self::NotConverged { fraction_done, cutbacks, last } => write!(
+                f,
+                "step did not converge after {cutbacks} cut-backs ({:.1}% of it reached, last increment: {last}); \
+                 the last converged state is kept",
+                100.0 * fraction_done
+            ),
+        }
+    }
+}
+
+impl std::error::Error for StepError {}
+
+/// Why an analysis cannot be set up.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SetupError {
+    /// The model is invalid.
+    Model(ModelError),
+    /// The settings are invalid.
+    Settings(String),
+    /// The system could not be built or analysed.
+    System(String),
+}
+
+impl fmt::Display for SetupError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Model(e) => write!(f, "{e}"),
+            Self::Settings(m) => write!(f, "solver settings: {m}"),
+            Self::System(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for SetupError {}
+
+impl From<PatternError> for SetupError {
+    fn from(e: PatternError) -> Self {
+        Self::System(e.0)
+    }
+}
+
+/// Converged results of one gap.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GapResult {
+    /// Tangential displacement of A relative to B since the start, local x (m).
+    pub slip_x: f64,
+    /// … local y (m).
+    pub slip_y: f64,
+    /// Normal contact force `N ≥ 0` (N).
+    pub normal_force: f64,
+    /// Friction force magnitude `|t| ≤ μN` (N).
+    pub friction_force: f64,
+    /// Friction force components (local x, y) on the film node (N).
+    pub friction: [f64; 2],
+    /// Status at convergence.
+    pub status: GapStatus,
+}
+
+/// Results of the current converged state.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Results {
+    /// One per gap.
+    pub gaps: Vec<GapResult>,
+    /// Total reaction of each boundary group (N), global axes.
+    pub reactions: Vec<[f64; 3]>,
+    /// Stress state of each triangle.
+    pub elements: Vec<ElementStress>,
+}
+
+impl Results {
+    /// Range `(min, max)` of the element von Mises stress (Pa).
+    pub fn von_mises_range(&self) -> (f64, f64) {
+        self.elements.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
+            (lo.min(e.von_mises), hi.max(e.von_mises))
+        })
+    }
+}
+
+/// A model under analysis: the system, its factorization and the last converged state.
+#[derive(Clone, Debug)]
+pub struct Analysis {
+    model: Model,
+    system: System,
+    laws: Vec<GapLaw>,
+    settings: SolverSettings,
+    linear: LinearSolver,
+    state: AnalysisState,
+    work: Workspace,
+}
+
+/// Buffers reused by every iteration.
+#[derive(Clone, Debug)]
+struct Workspace {
+    internal: Vec<f64>,
+    values: Vec<f64>,
+    rhs: Vec<f64>,
+    responses: Vec<GapResponse>,
+    latched: Vec<bool>,
+}
+
+impl Analysis {
+    /// Validates the model and settings, builds the pattern and the symbolic factorization.
+    pub fn new(model: Model, settings: SolverSettings) -> Result<Self, SetupError> {
+        model.validate().map_err(SetupError::Model)?;
+        settings.validate().map_err(SetupError::Settings)?;
+        let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
+        let system = System::new(&model, lower_only)?;
+        if system.free_count == 0 {
+            return Err(SetupError::System("the model has no free DOF".into()));
+        }
+        let linear = LinearSolver::new(&system).map_err(|e| SetupError::System(e.0))?;
+        let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
+        let state = AnalysisState {
+            displacement: vec![0.0; model.dof_count()],
+            plastic_slip: vec![[0.0; 2]; model.gaps.len()],
+            boundary: vec![[0.0; 3]; model.groups.len()],
+            friction: laws.iter().map(|l| l.friction).collect(),
+            status: laws.iter().map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status).collect(),
+        };
+        let idle = laws.first().map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()));
+        let work = Workspace {
+            internal: vec![0.0; model.dof_count()],
+            values: vec![0.0; system.nonzeros()],
+            rhs: vec![0.0; system.free_count],
+            responses: idle.map_or_else(Vec::new, |r| vec![r; laws.len()]),
+            latched: vec![false; laws.len()],
+        };
+        Ok(Self { model, system, laws, settings, linear, state, work })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The discretized system.
+    pub fn system(&self) -> &System {
+        &self.system
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &SolverSettings {
+        &self.settings
+    }
+
+    /// Changes tolerances and limits (not the iteration matrix, which fixes the pattern).
+    pub fn set_limits(&mut self, settings: SolverSettings) -> Result<(), String> {
+        settings.validate()?;
+        if settings.iteration_matrix != self.settings.iteration_matrix {
+            return Err("the iteration matrix is fixed when the analysis is created".into());
+        }
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// The last converged state.
+    pub fn state(&self) -> &AnalysisState {
+        &self.state
+    }
+
+    /// Replaces the state (e.g. a restored FMU state) after checking its sizes.
+    pub fn set_state(&mut self, state: AnalysisState) -> Result<(), String> {
+        let s = &self.state;
+        if state.displacement.len() != s.displacement.len()
+            || state.plastic_slip.len() != s.plastic_slip.len()
+            || state.boundary.len() != s.boundary.len()
+            || state.friction.len() != s.friction.len()
+            || state.status.len() != s.status.len()
+        {
+            return Err("state does not match this model's sizes".into());
+        }
+        let finite = state.displacement.iter().chain(state.plastic_slip.iter().flatten())
+            .chain(state.boundary.iter().flatten()).chain(&state.friction).all(|v| v.is_finite());
+        if !finite || state.friction.iter().any(|&m| m < 0.0) {
+            return Err("state holds non-finite values or a negative friction coefficient".into());
+        }
+        self.state = state;
+        Ok(())
+    }
+
+    /// Sets the friction coefficient `μ` of every gap for the following steps.
+    pub fn set_friction(&mut self, mu: f64) -> Result<(), String> {
+        if !(mu >= 0.0 && mu.is_finite()) {
+            return Err(format!("friction coefficient {mu} must be finite and ≥ 0"));
+        }
+        self.state.friction.iter_mut().for_each(|m| *m = mu);
+        Ok(())
+    }
+
+    /// Moves every boundary group to `target` (m) in `increments` equal increments, halving an
+    /// increment that does not converge (eq. 2.11–2.12 in each). On error the state is unchanged.
+    pub fn step_to(&mut self, target: &[[f64; 3]], increments: usize) -> Result<StepReport, StepError> {
+        if target.len() != self.state.boundary.len() {
+            return Err(StepError::InvalidInput {
+                message: format!("{} group targets given, the model has {}", target.len(), self.state.boundary.len()),
+            });
+        }
+        if target.iter().flatten().any(|v| !v.is_finite()) {
+            return Err(StepError::InvalidInput { message: "a boundary target is NaN or infinite".into() });
+        }
+        if increments == 0 {
+            return Err(StepError::InvalidInput { message: "increments must be at least 1".into() });
+        }
+        let base = self.state.boundary.clone();
+        let mut current = self.state.clone();
+        let mut report = StepReport::default();
+        let full = 1.0 / increments as f64;
+        let smallest = full / 2f64.powi(self.settings.max_cutbacks as i32);
+        let (mut done, mut size) = (0.0_f64, full);
+        while done < 1.0 {
+            let next = if done + size > 1.0 - 1e-12 { 1.0 } else { done + size };
+            let boundary: Vec<[f64; 3]> =
+                base.iter().zip(target).map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * next)).collect();
+            match self.solve_increment(&current, &boundary) {
+                Ok((state, iterations, residual)) => {
+                    current = state;
+                    done = next;
+                    report.iterations.push(iterations);
+                    report.residual = residual;
+                    size = (2.0 * size).min(full);
+                }
+                Err(last) => {
+                    if size / 2.0 < smallest * (1.0 - 1e-9) {
+                        return Err(StepError::NotConverged { fraction_done: done, cutbacks: report.cutbacks, last });
+                    }
+                    report.cutbacks += 1;
+                    size /= 2.0;
+                }
+            }
+        }
+        self.state = current;
+        Ok(report)
+    }
+
+    /// Newton–Raphson for one increment from the converged `start` to the boundary `boundary`.
+    fn solve_increment(
+        &mut self,
+        start: &AnalysisState,
+        boundary: &[[f64; 3]],
+    ) -> Result<(AnalysisState, usize, f64), IncrementFailure> {
+        let mut u = start.displacement.clone();
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Prescribed { group, component } = d {
+                u[i] = boundary[*group][*component];
+            }
+        }
+        let laws: Vec<GapLaw> =
+            self.laws.iter().zip(&start.friction).map(|(l, &mu)| GapLaw { friction: mu, ..*l }).collect();
+        let history: Vec<Vector2<f64>> = start.plastic_slip.iter().map(|s| Vector2::from(*s)).collect();
+        self.work.latched.iter_mut().for_each(|l| *l = false);
+        let mut correction_norm = f64::INFINITY;
+        let mut first_residual = None;
+        let s = self.settings;
+        for iteration in 0..=s.max_iterations {
+            let residual = self.assemble_at(&u, &laws, &history, Some(iteration));
+            if !residual.is_finite() {
+                return Err(IncrementFailure::Diverged { iteration });
+            }
+            let first = *first_residual.get_or_insert(residual);
+            let moved = u.iter().zip(&start.displacement).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            let force_scale = self.work.internal.iter().fold(1e-3_f64, |m, v| m.max(v.abs()));
+            let converged = iteration > 0
+                && correction_norm <= s.displacement_tolerance * moved.max(1e-6)
+                && residual <= s.residual_tolerance * force_scale;
+            if converged {
+                let state = AnalysisState {
+                    displacement: u,
+                    plastic_slip: self.work.responses.iter().map(|r| r.plastic_slip.into()).collect(),
+                    boundary: boundary.to_vec(),
+                    friction: start.friction.clone(),
+                    status: self.work.responses.iter().map(|r| r.status).collect(),
+                };
+                return Ok((state, iteration, residual));
+            }
+            if iteration == s.max_iterations {
+                return Err(IncrementFailure::MaxIterations { residual });
+            }
+            if iteration > 3 && residual > 1e8 * first.max(1e-3) {
+                return Err(IncrementFailure::Diverged { iteration });
+            }
+            for (i, d) in self.system.dofs.iter().enumerate() {
+                if let Dof::Free(eq) = d {
+                    self.work.rhs[*eq] = -self.work.internal[i];
+                }
+            }
+            let matrix = self.system.matrix(&self.work.values);
+            self.linear
+                .factorize_and_solve(matrix, &mut self.work.rhs)
+                .map_err(|e| IncrementFailure::Singular { message: e.0 })?;
+            correction_norm = self.work.rhs.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            if !correction_norm.is_finite() {
+                return Err(IncrementFailure::Diverged { iteration });
+            }
+            for (i, d) in self.system.dofs.iter().enumerate() {
+                if let Dof::Free(eq) = d {
+                    u[i] += self.work.rhs[*eq];
+                }
+            }
+        }
+        unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Assembles internal forces (and the Newton matrix when `iteration` is given) at `u`;
+    /// returns `‖R_free‖∞`. Gap responses are left in the workspace.
+    fn assemble_at(
+        &mut self,
+        u: &[f64],
+        laws: &[GapLaw],
+        history: &[Vector2<f64>],
+        iteration: Option<usize>,
+    ) -> f64 {
+        let mode = self.settings.iteration_matrix;
+        let Workspace { internal, values, responses, latched, .. } = &mut self.work;
+        let values = iteration.map(|_| values.as_mut_slice());
+        self.system.assemble(u, internal, values, |g, d| {
+            let law = &laws[g];
+            let response = law.evaluate(d, history[g]);
+            responses[g] = response;
+            let matrix = match mode {
+                IterationMatrix::Consistent => law.consistent_tangent(&response),
+                IterationMatrix::JuRowlands => {
+                    // §3(b): stick in the first iteration; §3(f): once slipping, slip until the loop ends.
+                    let status = match (response.status, iteration) {
+                        (GapStatus::Open, _) => GapStatus::Open,
+                        (_, Some(0)) => GapStatus::Stick,
+                        (GapStatus::Slip, _) => {
+                            latched[g] = true;
+                            GapStatus::Slip
+                        }
+                        (GapStatus::Stick, _) if latched[g] => GapStatus::Slip,
+                        _ => GapStatus::Stick,
+                    };
+                    law.ju_rowlands_matrix(status, response.direction)
+                }
+            };
+            (response.force, matrix)
+        });
+        self.system.dofs.iter().zip(internal.iter()).fold(0.0_f64, |m, (d, r)| match d {
+            Dof::Free(_) => m.max(r.abs()),
+            _ => m,
+        })
+    }
+
+    /// Gap results, group reactions and element stresses at the converged state.
+    pub fn results(&mut self) -> Results {
+        let laws: Vec<GapLaw> =
+            self.laws.iter().zip(&self.state.friction).map(|(l, &mu)| GapLaw { friction: mu, ..*l }).collect();
+        let history: Vec<Vector2<f64>> = self.state.plastic_slip.iter().map(|s| Vector2::from(*s)).collect();
+        let u = std::mem::take(&mut self.state.displacement);
+        self.assemble_at(&u, &laws, &history, None);
+        self.state.displacement = u;
+        // The law at the converged point with the updated history gives the same forces; the
+        // status is the one found when the increment converged.
+        let gaps = self
+            .work
+            .responses
+            .iter()
+            .zip(&self.state.status)
+            .map(|(r, &status)| GapResult {
+                slip_x: r.relative.x,
+                slip_y: r.relative.y,
+                normal_force: r.normal_force,
+                friction_force: (r.force.x.powi(2) + r.force.y.powi(2)).sqrt(),
+                friction: [r.force.x, r.force.y],
+                status,
+            })
+            .collect();
+        let mut reactions = vec![[0.0; 3]; self.model.groups.len()];
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Prescribed { group, component } = d {
+                reactions[*group][*component] += self.work.internal[i];
+            }
+        }
+        let u = &self.state.displacement;
+        let elements = self
+            .system
+            .triangles
+            .iter()
+            .map(|(nodes, tri)| {
+                let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
+                tri.stress_state(&self.system.material, &ue)
+            })
+            .collect();
+        Results { gaps, reactions, elements }
+    }
+
+    /// Displacement of node `v` (m).
+    pub fn node_displacement(&self, v: usize) -> Vector3<f64> {
+        node_vector(&self.state.displacement, v)
+    }
+
+    /// Internal-force residual `R_free` at the current state, and its `‖·‖∞` (for checks).
+    pub fn residual(&mut self) -> (Vec<f64>, f64) {
+        let laws: Vec<GapLaw> =
+            self.laws.iter().zip(&self.state.friction).map(|(l, &mu)| GapLaw { friction: mu, ..*l }).collect();
+        let history: Vec<Vector2<f64>> = self.state.plastic_slip.iter().map(|s| Vector2::from(*s)).collect();
+        let u = std::mem::take(&mut self.state.displacement);
+        let norm = self.assemble_at(&u, &laws, &history, None);
+        self.state.displacement = u;
+        (self.work.internal.clone(), norm)
+    }
+}
