@@ -1,14 +1,291 @@
-use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
-fn main() {
-    for (h, f) in [(0.3, -1.0), (0.3, -1.5), (0.2,-1.5), (0.4,-1.5)] {
-        let spec = ParallelArch { target_dz_per_height: f, ..ParallelArch::with_height(h) };
-        let model = spec.model().unwrap();
-        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
-        let t = std::time::Instant::now();
-        let rep = a.step_to(&[spec.target()], 20);
-        println!("{h}: {:?} {:?}", rep, t.elapsed());
-        let r = a.results();
-        for g in &r.gaps { println!("  slip {:8.3} mm  N {:9.3}  T {:9.3} {:?}", g.slip_x*1e3, g.normal_force, g.friction_force, g.status); }
-        println!("  vm range {:?} reactions {:?}", r.von_mises_range(), r.reactions);
+//! `membrane-contact`: runs a parallel-arch specimen or a model file through the core solver,
+//! stepping the forced displacement to its target, and prints the slip at every gap beside the
+//! paper's Table 1, the equivalent-stress range and the Newton statistics.
+
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+
+use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
+use membrane_contact::mech::{
+    Analysis, IterationMatrix, Model, ParallelArch, Results, SolverSettings,
+};
+
+const USAGE: &str = "\
+usage: membrane-contact specimen [--height MM] [options]
+       membrane-contact model FILE.json [options]
+       membrane-contact export-specimen [--height MM] [--refine N]   (prints the model JSON)
+
+Runs the analysis: every boundary group is moved to its target displacement in --steps steps.
+
+options:
+  --height MM        arch height of the specimen in mm (200, 300, 400; default 300)
+  --refine N         mesh refinement factor of the specimen (default 1: 200 triangles)
+  --mu X             friction coefficient of every gap (default: the model's, 0.2 for specimens)
+  --steps N          load steps to the target (default 20)
+  --matrix M         consistent (default) or ju-rowlands
+  --csv FILE         write the gap results of every step as CSV
+  --quiet            no progress indicator
+  -h, --help         this text";
+
+struct Options {
+    command: String,
+    file: Option<String>,
+    height_mm: f64,
+    refine: usize,
+    mu: Option<f64>,
+    steps: usize,
+    matrix: IterationMatrix,
+    csv: Option<String>,
+    quiet: bool,
+}
+
+fn parse(args: &[String]) -> Result<Options, String> {
+    let mut o = Options {
+        command: String::new(),
+        file: None,
+        height_mm: 300.0,
+        refine: 1,
+        mu: None,
+        steps: 20,
+        matrix: IterationMatrix::Consistent,
+        csv: None,
+        quiet: false,
+    };
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = |name: &str| {
+            it.next()
+                .cloned()
+                .ok_or_else(|| format!("{name} needs a value"))
+        };
+        let number = |name: &str, v: String| {
+            v.parse::<f64>()
+                .map_err(|_| format!("{name}: '{v}' is not a number"))
+        };
+        match a.as_str() {
+            "-h" | "--help" => return Err(String::new()),
+            "--height" => o.height_mm = number("--height", value("--height")?)?,
+            "--refine" => {
+                o.refine = value("--refine")?
+                    .parse()
+                    .map_err(|_| "--refine needs a positive integer".to_string())?
+            }
+            "--mu" => o.mu = Some(number("--mu", value("--mu")?)?),
+            "--steps" => {
+                o.steps = value("--steps")?
+                    .parse()
+                    .map_err(|_| "--steps needs a positive integer".to_string())?;
+                if o.steps == 0 {
+                    return Err("--steps must be at least 1".into());
+                }
+            }
+            "--matrix" => {
+                o.matrix = match value("--matrix")?.as_str() {
+                    "consistent" => IterationMatrix::Consistent,
+                    "ju-rowlands" | "jr" => IterationMatrix::JuRowlands,
+                    other => {
+                        return Err(format!(
+                            "--matrix: unknown '{other}' (consistent or ju-rowlands)"
+                        ));
+                    }
+                }
+            }
+            "--csv" => o.csv = Some(value("--csv")?),
+            "--quiet" => o.quiet = true,
+            s if s.starts_with('-') => return Err(format!("unknown option {s}")),
+            s if o.command.is_empty() => o.command = s.to_string(),
+            s if o.command == "model" && o.file.is_none() => o.file = Some(s.to_string()),
+            s => return Err(format!("unexpected argument '{s}'")),
+        }
+    }
+    Ok(o)
+}
+
+fn specimen(o: &Options) -> Result<ParallelArch, String> {
+    let spec = ParallelArch {
+        refinement: o.refine,
+        ..ParallelArch::with_height(o.height_mm / 1000.0)
+    };
+    spec.check()?;
+    Ok(spec)
+}
+
+fn run(o: &Options) -> Result<(), String> {
+    let model = match o.command.as_str() {
+        "specimen" => specimen(o)?.model()?,
+        "export-specimen" => {
+            println!("{}", specimen(o)?.model()?.to_json());
+            return Ok(());
+        }
+        "model" => {
+            let file = o.file.as_deref().ok_or("model: give the model file")?;
+            let text = std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"))?;
+            Model::from_json(&text).map_err(|e| format!("{file}: {e}"))?
+        }
+        "" => return Err(String::new()),
+        other => return Err(format!("unknown command '{other}'")),
+    };
+    let settings = SolverSettings {
+        iteration_matrix: o.matrix,
+        ..SolverSettings::default()
+    };
+    let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
+    if let Some(mu) = o.mu {
+        analysis.set_friction(mu)?;
+    }
+    let targets: Vec<[f64; 3]> = analysis.model().groups.iter().map(|g| g.target).collect();
+    let mut csv = match &o.csv {
+        Some(path) => {
+            let mut f = std::fs::File::create(path).map_err(|e| format!("{path}: {e}"))?;
+            writeln!(
+                f,
+                "step,fraction,gap,slip_x_mm,slip_y_mm,normal_force_N,friction_force_N,status"
+            )
+            .map_err(|e| e.to_string())?;
+            Some((f, path.clone()))
+        }
+        None => None,
+    };
+    let progress = !o.quiet && std::io::stderr().is_terminal();
+    let started = std::time::Instant::now();
+    let (mut iterations, mut cutbacks, mut increments) = (Vec::new(), 0, 0);
+    for step in 1..=o.steps {
+        let fraction = step as f64 / o.steps as f64;
+        let target: Vec<[f64; 3]> = targets.iter().map(|t| t.map(|v| v * fraction)).collect();
+        let report = analysis
+            .step_to(&target, 1)
+            .map_err(|e| format!("step {step}/{}: {e}", o.steps))?;
+        cutbacks += report.cutbacks;
+        increments += report.iterations.len();
+        iterations.push(report.total_iterations());
+        if progress {
+            eprint!("\rstep {step}/{} ({:.0}%)", o.steps, 100.0 * fraction);
+        }
+        if let Some((f, path)) = csv.as_mut() {
+            let results = analysis.results();
+            for (g, r) in analysis.model().gaps.iter().zip(&results.gaps) {
+                writeln!(
+                    f,
+                    "{step},{fraction},{},{:.6},{:.6},{:.6},{:.6},{:?}",
+                    g.name,
+                    r.slip_x * 1e3,
+                    r.slip_y * 1e3,
+                    r.normal_force,
+                    r.friction_force,
+                    r.status
+                )
+                .map_err(|e| format!("{path}: {e}"))?;
+            }
+        }
+    }
+    if progress {
+        eprintln!();
+    }
+    let elapsed = started.elapsed();
+    let results = analysis.results();
+    report(o, &analysis, &results);
+    let total: usize = iterations.iter().sum();
+    println!(
+        "\nNewton: {} steps, {increments} increments, {cutbacks} cut-backs, {total} iterations \
+         ({:.1} per increment), iterations per step {:?}; {:.1} ms",
+        o.steps,
+        total as f64 / increments.max(1) as f64,
+        iterations,
+        elapsed.as_secs_f64() * 1e3
+    );
+    Ok(())
+}
+
+fn report(o: &Options, analysis: &Analysis, results: &Results) {
+    let model = analysis.model();
+    println!(
+        "{}: {} nodes, {} triangles, {} gaps",
+        model.name,
+        model.nodes.len(),
+        model.triangles.len(),
+        model.gaps.len()
+    );
+    println!(
+        "\n{:<8} {:>11} {:>11} {:>10} {:>10}  status",
+        "gap", "slip x mm", "slip y mm", "N (N)", "|T| (N)"
+    );
+    for (g, r) in model.gaps.iter().zip(&results.gaps) {
+        println!(
+            "{:<8} {:>11.3} {:>11.3} {:>10.3} {:>10.3}  {:?}",
+            g.name,
+            r.slip_x * 1e3,
+            r.slip_y * 1e3,
+            r.normal_force,
+            r.friction_force,
+            r.status
+        );
+    }
+    for (g, r) in model.groups.iter().zip(&results.reactions) {
+        println!(
+            "reaction of group {}: ({:.3}, {:.3}, {:.3}) N",
+            g.name, r[0], r[1], r[2]
+        );
+    }
+    let (lo, hi) = results.von_mises_range();
+    println!(
+        "equivalent (von Mises) stress: {:.3} … {:.3} MPa",
+        lo / 1e6,
+        hi / 1e6
+    );
+    if o.command == "specimen" {
+        let measured = table1()
+            .into_iter()
+            .find(|m| (m.arch_height_mm - o.height_mm).abs() < 1e-9);
+        println!("\nobserved points (paper §4.4: points 2–5 = G2, G4, G6, G8):");
+        println!(
+            "{:<6} {:<5} {:>14} {:>14} {:>10}",
+            "point", "gap", "analysis mm", "Table 1 mm", "diff mm"
+        );
+        for (p, name) in OBSERVED_GAPS.iter().enumerate() {
+            let Some(i) = model.gap_index(name) else {
+                continue;
+            };
+            let slip = results.gaps[i].slip_x * 1e3;
+            match &measured {
+                Some(m) => println!(
+                    "{:<6} {:<5} {:>14.2} {:>14.1} {:>10.2}",
+                    p + 1,
+                    name,
+                    slip,
+                    m.points[p],
+                    slip - m.points[p]
+                ),
+                None => println!(
+                    "{:<6} {:<5} {:>14.2} {:>14} {:>10}",
+                    p + 1,
+                    name,
+                    slip,
+                    "-",
+                    "-"
+                ),
+            }
+        }
+        if measured.is_none() {
+            println!("(Table 1 has only the 200, 300 and 400 mm specimens)");
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match parse(&args).and_then(|o| run(&o)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) if message.is_empty() => {
+            println!("{USAGE}");
+            if args.iter().any(|a| a == "-h" || a == "--help") {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(2)
+            }
+        }
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
     }
 }

@@ -7,7 +7,7 @@
 //! slot in the CSC value array, so an iteration only zeroes and adds values (top88's
 //! `iK/jK` vs `sK`). A symmetric pattern keeps the lower triangle only.
 
-use faer::sparse::{Pair, SymbolicSparseColMat, SymbolicSparseColMatRef, SparseColMatRef};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
 
 use super::element::{ElementVector, Material, MembraneTriangle};
@@ -98,7 +98,9 @@ impl System {
             .iter()
             .map(|t| {
                 let x = t.map(|v| Vector3::from(model.nodes[v]));
-                MembraneTriangle::new(x).map(|e| (*t, e)).map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
+                MembraneTriangle::new(x)
+                    .map(|e| (*t, e))
+                    .map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
             })
             .collect::<Result<Vec<_>, _>>()?;
         let gaps: Vec<GapGeometry> = model
@@ -115,7 +117,8 @@ impl System {
             .collect();
 
         // Pattern: one pair per element-matrix entry between free DOFs, in assembly order.
-        let mut pairs: Vec<Pair<usize, usize>> = Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
+        let mut pairs: Vec<Pair<usize, usize>> =
+            Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
         let mut entry_rows: Vec<Option<(usize, usize)>> = Vec::with_capacity(pairs.capacity());
         let mut push_block = |global: &[usize]| {
             for &gi in global {
@@ -146,8 +149,9 @@ impl System {
         for i in 0..free_count {
             pairs.push(Pair::new(i, i));
         }
-        let (symbolic, _) = SymbolicSparseColMat::try_new_from_indices(free_count, free_count, &pairs)
-            .map_err(|e| PatternError(format!("sparsity pattern: {e:?}")))?;
+        let (symbolic, _) =
+            SymbolicSparseColMat::try_new_from_indices(free_count, free_count, &pairs)
+                .map_err(|e| PatternError(format!("sparsity pattern: {e:?}")))?;
         if symbolic.compute_nnz() >= NO_SLOT as usize {
             return Err(PatternError("more than 2^32 nonzeros".into()));
         }
@@ -163,7 +167,17 @@ impl System {
                 }
             })
             .collect();
-        Ok(Self { dofs, free_count, triangles, gaps, material: model.material, symbolic, slots, gap_offsets, lower_only })
+        Ok(Self {
+            dofs,
+            free_count,
+            triangles,
+            gaps,
+            material: model.material,
+            symbolic,
+            slots,
+            gap_offsets,
+            lower_only,
+        })
     }
 
     /// The symbolic structure of the free–free tangent.
@@ -190,7 +204,9 @@ impl System {
     pub fn gap_relative(&self, g: usize, u: &[f64]) -> Vector3<f64> {
         let gap = &self.gaps[g];
         let ua = node_vector(u, gap.film_node);
-        let ub = gap.support_node.map_or(Vector3::zeros(), |b| node_vector(u, b));
+        let ub = gap
+            .support_node
+            .map_or(Vector3::zeros(), |b| node_vector(u, b));
         gap.rotation * (ua - ub)
     }
 

@@ -64,7 +64,11 @@ impl GapFrame {
     pub fn from_x_and_z(x: Vector3<f64>, z: Vector3<f64>) -> Self {
         let (x, z) = (x.normalize(), z.normalize());
         let y = z.cross(&x);
-        Self { x: x.into(), y: y.into(), z: z.into() }
+        Self {
+            x: x.into(),
+            y: y.into(),
+            z: z.into(),
+        }
     }
 
     /// Rotation `R` whose rows are `x, y, z` (local ← global).
@@ -79,7 +83,11 @@ impl GapFrame {
     /// Largest deviation from an orthonormal frame with `y = z × x`.
     pub fn orthonormality_error(&self) -> f64 {
         let r = self.rotation();
-        let (x, y, z) = (Vector3::from(self.x), Vector3::from(self.y), Vector3::from(self.z));
+        let (x, y, z) = (
+            Vector3::from(self.x),
+            Vector3::from(self.y),
+            Vector3::from(self.z),
+        );
         let gram = (r * r.transpose() - Matrix3::identity()).amax();
         gram.max((z.cross(&x) - y).amax())
     }
@@ -140,7 +148,11 @@ impl GapLaw {
         let trial_magnitude = trial.norm();
         let limit = self.friction * normal_force;
         // Eq. (2.13): sqrt(rx² + ry²) − μ|rz| with the stick (trial) forces.
-        let direction = if trial_magnitude > 0.0 { trial / trial_magnitude } else { Vector2::zeros() };
+        let direction = if trial_magnitude > 0.0 {
+            trial / trial_magnitude
+        } else {
+            Vector2::zeros()
+        };
         if trial_magnitude - limit <= 0.0 {
             GapResponse {
                 status: GapStatus::Stick,
@@ -167,7 +179,11 @@ impl GapLaw {
 
     /// Consistent tangent `∂r_A/∂d` of [`GapLaw::evaluate`] in the local frame.
     pub fn consistent_tangent(&self, response: &GapResponse) -> Matrix3<f64> {
-        let (kn, ks, mu) = (self.normal_stiffness, self.tangential_stiffness, self.friction);
+        let (kn, ks, mu) = (
+            self.normal_stiffness,
+            self.tangential_stiffness,
+            self.friction,
+        );
         match response.status {
             GapStatus::Open => Matrix3::zeros(),
             GapStatus::Stick => Matrix3::from_diagonal(&Vector3::new(ks, ks, kn)),
@@ -192,7 +208,11 @@ impl GapLaw {
 
     /// The paper's symmetric matrix `k` of eq. (2.9) for a status and slip direction `n`.
     pub fn ju_rowlands_matrix(&self, status: GapStatus, direction: Vector2<f64>) -> Matrix3<f64> {
-        let (kn, ks, mu) = (self.normal_stiffness, self.tangential_stiffness, self.friction);
+        let (kn, ks, mu) = (
+            self.normal_stiffness,
+            self.tangential_stiffness,
+            self.friction,
+        );
         match status {
             GapStatus::Open => Matrix3::zeros(),
             GapStatus::Stick => Matrix3::from_diagonal(&Vector3::new(ks, ks, kn)),
@@ -210,7 +230,12 @@ mod tests {
     use super::*;
 
     fn law() -> GapLaw {
-        GapLaw { normal_stiffness: 2.5e8, tangential_stiffness: 2.5e7, friction: 0.2, initial_gap: 0.0 }
+        GapLaw {
+            normal_stiffness: 2.5e8,
+            tangential_stiffness: 2.5e7,
+            friction: 0.2,
+            initial_gap: 0.0,
+        }
     }
 
     #[test]
@@ -218,9 +243,9 @@ mod tests {
         let law = law();
         let history = Vector2::new(1e-5, -2e-5);
         for d in [
-            Vector3::new(3e-6, 1e-6, 4e-6),  // open
+            Vector3::new(3e-6, 1e-6, 4e-6),   // open
             Vector3::new(2e-5, -2e-5, -1e-4), // stick
-            Vector3::new(3e-4, 1e-4, -1e-4), // slip
+            Vector3::new(3e-4, 1e-4, -1e-4),  // slip
         ] {
             let response = law.evaluate(d, history);
             let k = law.consistent_tangent(&response);
@@ -230,9 +255,14 @@ mod tests {
                 let mut dm = d;
                 dp[j] += h;
                 dm[j] -= h;
-                let column = (law.evaluate(dp, history).force - law.evaluate(dm, history).force) / (2.0 * h);
+                let column =
+                    (law.evaluate(dp, history).force - law.evaluate(dm, history).force) / (2.0 * h);
                 let err = (column - k.column(j)).amax();
-                assert!(err < 1e-6 * law.normal_stiffness, "{:?} col {j}: {err:e}", response.status);
+                assert!(
+                    err < 1e-6 * law.normal_stiffness,
+                    "{:?} col {j}: {err:e}",
+                    response.status
+                );
             }
         }
     }

@@ -46,7 +46,17 @@ impl Material {
     pub fn elasticity(&self) -> Matrix3<f64> {
         let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
         let c = e / (1.0 - nu * nu);
-        Matrix3::new(c, c * nu, 0.0, c * nu, c, 0.0, 0.0, 0.0, c * (1.0 - nu) / 2.0)
+        Matrix3::new(
+            c,
+            c * nu,
+            0.0,
+            c * nu,
+            c,
+            0.0,
+            0.0,
+            0.0,
+            c * (1.0 - nu) / 2.0,
+        )
     }
 
     /// Stress `σ = D ε + σ0` (eq. 2.3) for a Voigt strain `[εx, εy, γxy]`.
@@ -102,7 +112,11 @@ impl MembraneTriangle {
             return Err(DegenerateTriangle { doubled_area });
         }
         let e3 = normal / doubled_area;
-        let reference = if e3.x.abs() < 0.9 { Vector3::x() } else { Vector3::y() };
+        let reference = if e3.x.abs() < 0.9 {
+            Vector3::x()
+        } else {
+            Vector3::y()
+        };
         let e1 = (reference - e3 * e3.dot(&reference)).normalize();
         let e2 = e3.cross(&e1);
         let local = |p: Vector3<f64>| Vector2::new(p.dot(&e1), p.dot(&e2));
@@ -126,7 +140,10 @@ impl MembraneTriangle {
 
     /// Unit vectors `(e1, e2)` of the local frame the strains and stresses are given in.
     pub fn local_axes(&self) -> (Vector3<f64>, Vector3<f64>) {
-        (self.initial_frame.column(0).into(), self.initial_frame.column(1).into())
+        (
+            self.initial_frame.column(0).into(),
+            self.initial_frame.column(1).into(),
+        )
     }
 
     /// Deformation gradient `F = F0 + Σ u_k ∇N_kᵀ` (3×2, global ← local).
@@ -180,7 +197,8 @@ impl MembraneTriangle {
         let FS = f * S;
         let mut r = ElementVector::zeros();
         for k in 0..3 {
-            r.fixed_rows_mut::<3>(3 * k).copy_from(&(FS * self.gradients[k] * volume));
+            r.fixed_rows_mut::<3>(3 * k)
+                .copy_from(&(FS * self.gradients[k] * volume));
         }
         let mut kt = ElementMatrix::zeros();
         if with_tangent {
@@ -190,7 +208,8 @@ impl MembraneTriangle {
             for k in 0..3 {
                 for l in 0..3 {
                     let geometric = (self.gradients[k].transpose() * S * self.gradients[l])[0];
-                    let block = (B[k].transpose() * DB[l] + Matrix3::identity() * geometric) * volume;
+                    let block =
+                        (B[k].transpose() * DB[l] + Matrix3::identity() * geometric) * volume;
                     kt.fixed_view_mut::<3, 3>(3 * k, 3 * l).copy_from(&block);
                 }
             }
@@ -225,7 +244,12 @@ mod tests {
     use super::*;
 
     fn etfe() -> Material {
-        Material { youngs_modulus: 1.0e9, poisson_ratio: 0.43, thickness: 250e-6, prestress: [1.0e6, 0.5e6, 0.2e6] }
+        Material {
+            youngs_modulus: 1.0e9,
+            poisson_ratio: 0.43,
+            thickness: 250e-6,
+            prestress: [1.0e6, 0.5e6, 0.2e6],
+        }
     }
 
     fn skew_triangle() -> MembraneTriangle {
@@ -253,10 +277,15 @@ mod tests {
             let mut um = u;
             up[j] += h;
             um[j] -= h;
-            let column = (tri.internal_force(&mat, &up) - tri.internal_force(&mat, &um)) / (2.0 * h);
+            let column =
+                (tri.internal_force(&mat, &up) - tri.internal_force(&mat, &um)) / (2.0 * h);
             worst = worst.max((column - k.column(j)).amax());
         }
-        assert!(worst < 1e-6 * k.amax(), "worst {worst:e} vs scale {:e}", k.amax());
+        assert!(
+            worst < 1e-6 * k.amax(),
+            "worst {worst:e} vs scale {:e}",
+            k.amax()
+        );
     }
 
     #[test]
@@ -276,7 +305,11 @@ mod tests {
             up[j] += h;
             um[j] -= h;
             let d = (energy(&up) - energy(&um)) / (2.0 * h);
-            assert!((d - r[j]).abs() < 1e-6 * r.amax(), "dof {j}: {d} vs {}", r[j]);
+            assert!(
+                (d - r[j]).abs() < 1e-6 * r.amax(),
+                "dof {j}: {d} vs {}",
+                r[j]
+            );
         }
     }
 

@@ -148,7 +148,11 @@ pub enum ModelError {
     /// The file is not valid JSON of the model format.
     Syntax { message: String },
     /// A reference to a node that does not exist.
-    UnknownNode { item: String, node: usize, node_count: usize },
+    UnknownNode {
+        item: String,
+        node: usize,
+        node_count: usize,
+    },
     /// A node coordinate or a number that must be finite is not.
     NotFinite { item: String },
     /// A triangle with (near) zero area or repeated nodes.
@@ -171,19 +175,32 @@ impl fmt::Display for ModelError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Syntax { message } => write!(f, "model file: {message}"),
-            Self::UnknownNode { item, node, node_count } => {
-                write!(f, "{item}: node {node} does not exist (the model has {node_count} nodes, 0-based)")
+            Self::UnknownNode {
+                item,
+                node,
+                node_count,
+            } => {
+                write!(
+                    f,
+                    "{item}: node {node} does not exist (the model has {node_count} nodes, 0-based)"
+                )
             }
             Self::NotFinite { item } => write!(f, "{item}: value is not a finite number"),
             Self::DegenerateTriangle { triangle, nodes } => {
-                write!(f, "triangle {triangle} {nodes:?} is degenerate (zero area or repeated node)")
+                write!(
+                    f,
+                    "triangle {triangle} {nodes:?} is degenerate (zero area or repeated node)"
+                )
             }
             Self::Material { message } => write!(f, "material: {message}"),
             Self::Gap { gap, message } => write!(f, "gap '{gap}': {message}"),
             Self::Name { item, message } => write!(f, "{item}: {message}"),
             Self::Conflict { node, message } => write!(f, "node {node}: {message}"),
             Self::Unconnected { node } => {
-                write!(f, "node {node} has free DOFs but belongs to no triangle or gap (singular system)")
+                write!(
+                    f,
+                    "node {node} has free DOFs but belongs to no triangle or gap (singular system)"
+                )
             }
             Self::Empty { message } => write!(f, "model: {message}"),
         }
@@ -202,8 +219,9 @@ pub fn is_identifier(name: &str) -> bool {
 impl Model {
     /// Parses and validates a JSON model file.
     pub fn from_json(text: &str) -> Result<Self, ModelError> {
-        let model: Model =
-            serde_json::from_str(text).map_err(|e| ModelError::Syntax { message: e.to_string() })?;
+        let model: Model = serde_json::from_str(text).map_err(|e| ModelError::Syntax {
+            message: e.to_string(),
+        })?;
         model.validate()?;
         Ok(model)
     }
@@ -217,7 +235,9 @@ impl Model {
     pub fn validate(&self) -> Result<(), ModelError> {
         let n = self.nodes.len();
         if n == 0 || self.triangles.is_empty() {
-            return Err(ModelError::Empty { message: "needs at least one node and one triangle".into() });
+            return Err(ModelError::Empty {
+                message: "needs at least one node and one triangle".into(),
+            });
         }
         if !is_identifier(&self.name) {
             return Err(ModelError::Name {
@@ -227,24 +247,42 @@ impl Model {
         }
         for (i, p) in self.nodes.iter().enumerate() {
             if p.iter().any(|v| !v.is_finite()) {
-                return Err(ModelError::NotFinite { item: format!("node {i}") });
+                return Err(ModelError::NotFinite {
+                    item: format!("node {i}"),
+                });
             }
         }
         let check_node = |item: &dyn Fn() -> String, node: usize| {
-            if node < n { Ok(()) } else { Err(ModelError::UnknownNode { item: item(), node, node_count: n }) }
+            if node < n {
+                Ok(())
+            } else {
+                Err(ModelError::UnknownNode {
+                    item: item(),
+                    node,
+                    node_count: n,
+                })
+            }
         };
         let m = &self.material;
         if !(m.youngs_modulus > 0.0 && m.youngs_modulus.is_finite()) {
-            return Err(ModelError::Material { message: format!("E = {} must be > 0", m.youngs_modulus) });
+            return Err(ModelError::Material {
+                message: format!("E = {} must be > 0", m.youngs_modulus),
+            });
         }
         if !(m.poisson_ratio >= 0.0 && m.poisson_ratio < 0.5) {
-            return Err(ModelError::Material { message: format!("ν = {} must lie in [0, 0.5)", m.poisson_ratio) });
+            return Err(ModelError::Material {
+                message: format!("ν = {} must lie in [0, 0.5)", m.poisson_ratio),
+            });
         }
         if !(m.thickness > 0.0 && m.thickness.is_finite()) {
-            return Err(ModelError::Material { message: format!("thickness = {} must be > 0", m.thickness) });
+            return Err(ModelError::Material {
+                message: format!("thickness = {} must be > 0", m.thickness),
+            });
         }
         if m.prestress.iter().any(|v| !v.is_finite()) {
-            return Err(ModelError::Material { message: "prestress must be finite".into() });
+            return Err(ModelError::Material {
+                message: "prestress must be finite".into(),
+            });
         }
         let mut connected = vec![false; n];
         for (t, tri) in self.triangles.iter().enumerate() {
@@ -253,8 +291,15 @@ impl Model {
                 connected[v] = true;
             }
             let x = tri.map(|v| Vector3::from(self.nodes[v]));
-            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] || MembraneTriangle::new(x).is_err() {
-                return Err(ModelError::DegenerateTriangle { triangle: t, nodes: *tri });
+            if tri[0] == tri[1]
+                || tri[1] == tri[2]
+                || tri[0] == tri[2]
+                || MembraneTriangle::new(x).is_err()
+            {
+                return Err(ModelError::DegenerateTriangle {
+                    triangle: t,
+                    nodes: *tri,
+                });
             }
         }
         // Constrained DOFs: 0 free, 1 fixed (support or symmetry), 2 prescribed by a group.
@@ -276,10 +321,15 @@ impl Model {
         for g in &self.groups {
             check_name(&mut names, "boundary group", &g.name)?;
             if g.nodes.is_empty() {
-                return Err(ModelError::Name { item: format!("boundary group '{}'", g.name), message: "has no nodes".into() });
+                return Err(ModelError::Name {
+                    item: format!("boundary group '{}'", g.name),
+                    message: "has no nodes".into(),
+                });
             }
             if g.target.iter().any(|v| !v.is_finite()) {
-                return Err(ModelError::NotFinite { item: format!("boundary group '{}' target", g.name) });
+                return Err(ModelError::NotFinite {
+                    item: format!("boundary group '{}' target", g.name),
+                });
             }
             for &v in &g.nodes {
                 check_node(&|| format!("boundary group '{}'", g.name), v)?;
@@ -292,7 +342,10 @@ impl Model {
                 if constrained[v].iter().any(|&c| c) {
                     return Err(ModelError::Conflict {
                         node: v,
-                        message: format!("is prescribed by group '{}' and also fixed by a support or symmetry plane", g.name),
+                        message: format!(
+                            "is prescribed by group '{}' and also fixed by a support or symmetry plane",
+                            g.name
+                        ),
                     });
                 }
                 in_group[v] = Some(&g.name);
@@ -300,7 +353,10 @@ impl Model {
         }
         for gap in &self.gaps {
             check_name(&mut names, "gap", &gap.name)?;
-            let bad = |message: String| ModelError::Gap { gap: gap.name.clone(), message };
+            let bad = |message: String| ModelError::Gap {
+                gap: gap.name.clone(),
+                message,
+            };
             check_node(&|| format!("gap '{}' film_node", gap.name), gap.film_node)?;
             connected[gap.film_node] = true;
             match &gap.support {
@@ -318,7 +374,9 @@ impl Model {
                 }
             }
             let frame_values = gap.frame.x.iter().chain(&gap.frame.y).chain(&gap.frame.z);
-            if frame_values.clone().any(|v| !v.is_finite()) || gap.frame.orthonormality_error() > 1e-6 {
+            if frame_values.clone().any(|v| !v.is_finite())
+                || gap.frame.orthonormality_error() > 1e-6
+            {
                 return Err(bad(format!(
                     "frame is not orthonormal and right-handed with y = z × x (error {:.2e})",
                     gap.frame.orthonormality_error()
@@ -326,16 +384,25 @@ impl Model {
             }
             let positive = |v: f64| v > 0.0 && v.is_finite();
             if !positive(gap.normal_stiffness) {
-                return Err(bad(format!("normal_stiffness = {} must be > 0", gap.normal_stiffness)));
+                return Err(bad(format!(
+                    "normal_stiffness = {} must be > 0",
+                    gap.normal_stiffness
+                )));
             }
             if !positive(gap.tangential_stiffness) {
-                return Err(bad(format!("tangential_stiffness = {} must be > 0", gap.tangential_stiffness)));
+                return Err(bad(format!(
+                    "tangential_stiffness = {} must be > 0",
+                    gap.tangential_stiffness
+                )));
             }
             if !(gap.friction >= 0.0 && gap.friction.is_finite()) {
                 return Err(bad(format!("friction μ = {} must be ≥ 0", gap.friction)));
             }
             if !(gap.initial_gap >= 0.0 && gap.initial_gap.is_finite()) {
-                return Err(bad(format!("initial_gap = {} must be ≥ 0", gap.initial_gap)));
+                return Err(bad(format!(
+                    "initial_gap = {} must be ≥ 0",
+                    gap.initial_gap
+                )));
             }
         }
         for (v, c) in constrained.iter().enumerate() {
@@ -361,10 +428,16 @@ impl Model {
 fn check_name(names: &mut HashSet<String>, kind: &str, name: &str) -> Result<(), ModelError> {
     let item = format!("{kind} '{name}'");
     if !is_identifier(name) {
-        return Err(ModelError::Name { item, message: "name must be an identifier ([A-Za-z_][A-Za-z0-9_]*)".into() });
+        return Err(ModelError::Name {
+            item,
+            message: "name must be an identifier ([A-Za-z_][A-Za-z0-9_]*)".into(),
+        });
     }
     if !names.insert(name.to_string()) {
-        return Err(ModelError::Name { item, message: "name is used twice (gap and group names share one namespace)".into() });
+        return Err(ModelError::Name {
+            item,
+            message: "name is used twice (gap and group names share one namespace)".into(),
+        });
     }
     Ok(())
 }

@@ -31,6 +31,8 @@ pub struct SolverSettings {
     pub max_iterations: usize,
     /// How many times an increment may be halved before the step fails.
     pub max_cutbacks: usize,
+    /// Backtracking on `‖R‖₂` along each Newton correction (see `Analysis::line_search`).
+    pub line_search: bool,
 }
 
 impl Default for SolverSettings {
@@ -41,6 +43,7 @@ impl Default for SolverSettings {
             residual_tolerance: 1e-8,
             max_iterations: 40,
             max_cutbacks: 10,
+            line_search: true,
         }
     }
 }
@@ -109,7 +112,9 @@ pub enum IncrementFailure {
 impl fmt::Display for IncrementFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::MaxIterations { residual } => write!(f, "no convergence (residual {residual:.3e} N)"),
+            Self::MaxIterations { residual } => {
+                write!(f, "no convergence (residual {residual:.3e} N)")
+            }
             Self::Diverged { iteration } => write!(f, "diverged at iteration {iteration}"),
             Self::Singular { message } => write!(f, "singular Newton matrix ({message})"),
         }
@@ -122,14 +127,22 @@ pub enum StepError {
     /// A target that is not finite or has the wrong length.
     InvalidInput { message: String },
     /// The increment could not converge even after the allowed cut-backs.
-    NotConverged { fraction_done: f64, cutbacks: usize, last: IncrementFailure },
+    NotConverged {
+        fraction_done: f64,
+        cutbacks: usize,
+        last: IncrementFailure,
+    },
 }
 
 impl fmt::Display for StepError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::InvalidInput { message } => write!(f, "invalid step input: {message}"),
-            Self::NotConverged { fraction_done, cutbacks, last } => write!(
+            Self::NotConverged {
+                fraction_done,
+                cutbacks,
+                last,
+            } => write!(
                 f,
                 "step did not converge after {cutbacks} cut-backs ({:.1}% of it reached, last increment: {last}); \
                  the last converged state is kept",
@@ -201,9 +214,11 @@ pub struct Results {
 impl Results {
     /// Range `(min, max)` of the element von Mises stress (Pa).
     pub fn von_mises_range(&self) -> (f64, f64) {
-        self.elements.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
-            (lo.min(e.von_mises), hi.max(e.von_mises))
-        })
+        self.elements
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
+                (lo.min(e.von_mises), hi.max(e.von_mises))
+            })
     }
 }
 
@@ -226,7 +241,10 @@ struct Workspace {
     values: Vec<f64>,
     rhs: Vec<f64>,
     responses: Vec<GapResponse>,
-    latched: Vec<bool>,
+    /// Gaps latched in slip for the rest of the Newton loop (§3(f)) with their slip direction.
+    latched: Vec<Option<Vector2<f64>>>,
+    /// Gaps found closed at some iteration of the current Newton loop.
+    closed: Vec<bool>,
 }
 
 impl Analysis {
@@ -246,17 +264,31 @@ impl Analysis {
             plastic_slip: vec![[0.0; 2]; model.gaps.len()],
             boundary: vec![[0.0; 3]; model.groups.len()],
             friction: laws.iter().map(|l| l.friction).collect(),
-            status: laws.iter().map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status).collect(),
+            status: laws
+                .iter()
+                .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
+                .collect(),
         };
-        let idle = laws.first().map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()));
+        let idle = laws
+            .first()
+            .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()));
         let work = Workspace {
             internal: vec![0.0; model.dof_count()],
             values: vec![0.0; system.nonzeros()],
             rhs: vec![0.0; system.free_count],
             responses: idle.map_or_else(Vec::new, |r| vec![r; laws.len()]),
-            latched: vec![false; laws.len()],
+            latched: vec![None; laws.len()],
+            closed: vec![false; laws.len()],
         };
-        Ok(Self { model, system, laws, settings, linear, state, work })
+        Ok(Self {
+            model,
+            system,
+            laws,
+            settings,
+            linear,
+            state,
+            work,
+        })
     }
 
     /// The model.
@@ -300,8 +332,13 @@ impl Analysis {
         {
             return Err("state does not match this model's sizes".into());
         }
-        let finite = state.displacement.iter().chain(state.plastic_slip.iter().flatten())
-            .chain(state.boundary.iter().flatten()).chain(&state.friction).all(|v| v.is_finite());
+        let finite = state
+            .displacement
+            .iter()
+            .chain(state.plastic_slip.iter().flatten())
+            .chain(state.boundary.iter().flatten())
+            .chain(&state.friction)
+            .all(|v| v.is_finite());
         if !finite || state.friction.iter().any(|&m| m < 0.0) {
             return Err("state holds non-finite values or a negative friction coefficient".into());
         }
@@ -320,17 +357,29 @@ impl Analysis {
 
     /// Moves every boundary group to `target` (m) in `increments` equal increments, halving an
     /// increment that does not converge (eq. 2.11–2.12 in each). On error the state is unchanged.
-    pub fn step_to(&mut self, target: &[[f64; 3]], increments: usize) -> Result<StepReport, StepError> {
+    pub fn step_to(
+        &mut self,
+        target: &[[f64; 3]],
+        increments: usize,
+    ) -> Result<StepReport, StepError> {
         if target.len() != self.state.boundary.len() {
             return Err(StepError::InvalidInput {
-                message: format!("{} group targets given, the model has {}", target.len(), self.state.boundary.len()),
+                message: format!(
+                    "{} group targets given, the model has {}",
+                    target.len(),
+                    self.state.boundary.len()
+                ),
             });
         }
         if target.iter().flatten().any(|v| !v.is_finite()) {
-            return Err(StepError::InvalidInput { message: "a boundary target is NaN or infinite".into() });
+            return Err(StepError::InvalidInput {
+                message: "a boundary target is NaN or infinite".into(),
+            });
         }
         if increments == 0 {
-            return Err(StepError::InvalidInput { message: "increments must be at least 1".into() });
+            return Err(StepError::InvalidInput {
+                message: "increments must be at least 1".into(),
+            });
         }
         let base = self.state.boundary.clone();
         let mut current = self.state.clone();
@@ -339,9 +388,16 @@ impl Analysis {
         let smallest = full / 2f64.powi(self.settings.max_cutbacks as i32);
         let (mut done, mut size) = (0.0_f64, full);
         while done < 1.0 {
-            let next = if done + size > 1.0 - 1e-12 { 1.0 } else { done + size };
-            let boundary: Vec<[f64; 3]> =
-                base.iter().zip(target).map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * next)).collect();
+            let next = if done + size > 1.0 - 1e-12 {
+                1.0
+            } else {
+                done + size
+            };
+            let boundary: Vec<[f64; 3]> = base
+                .iter()
+                .zip(target)
+                .map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * next))
+                .collect();
             match self.solve_increment(&current, &boundary) {
                 Ok((state, iterations, residual)) => {
                     current = state;
@@ -352,7 +408,11 @@ impl Analysis {
                 }
                 Err(last) => {
                     if size / 2.0 < smallest * (1.0 - 1e-9) {
-                        return Err(StepError::NotConverged { fraction_done: done, cutbacks: report.cutbacks, last });
+                        return Err(StepError::NotConverged {
+                            fraction_done: done,
+                            cutbacks: report.cutbacks,
+                            last,
+                        });
                     }
                     report.cutbacks += 1;
                     size /= 2.0;
@@ -375,10 +435,19 @@ impl Analysis {
                 u[i] = boundary[*group][*component];
             }
         }
-        let laws: Vec<GapLaw> =
-            self.laws.iter().zip(&start.friction).map(|(l, &mu)| GapLaw { friction: mu, ..*l }).collect();
-        let history: Vec<Vector2<f64>> = start.plastic_slip.iter().map(|s| Vector2::from(*s)).collect();
-        self.work.latched.iter_mut().for_each(|l| *l = false);
+        let laws: Vec<GapLaw> = self
+            .laws
+            .iter()
+            .zip(&start.friction)
+            .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
+            .collect();
+        let history: Vec<Vector2<f64>> = start
+            .plastic_slip
+            .iter()
+            .map(|s| Vector2::from(*s))
+            .collect();
+        self.work.latched.iter_mut().for_each(|l| *l = None);
+        self.work.closed.iter_mut().for_each(|c| *c = false);
         let mut correction_norm = f64::INFINITY;
         let mut first_residual = None;
         let s = self.settings;
@@ -388,15 +457,27 @@ impl Analysis {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             let first = *first_residual.get_or_insert(residual);
-            let moved = u.iter().zip(&start.displacement).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
-            let force_scale = self.work.internal.iter().fold(1e-3_f64, |m, v| m.max(v.abs()));
+            let moved = u
+                .iter()
+                .zip(&start.displacement)
+                .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+            let force_scale = self
+                .work
+                .internal
+                .iter()
+                .fold(1e-3_f64, |m, v| m.max(v.abs()));
             let converged = iteration > 0
                 && correction_norm <= s.displacement_tolerance * moved.max(1e-6)
                 && residual <= s.residual_tolerance * force_scale;
             if converged {
                 let state = AnalysisState {
                     displacement: u,
-                    plastic_slip: self.work.responses.iter().map(|r| r.plastic_slip.into()).collect(),
+                    plastic_slip: self
+                        .work
+                        .responses
+                        .iter()
+                        .map(|r| r.plastic_slip.into())
+                        .collect(),
                     boundary: boundary.to_vec(),
                     friction: start.friction.clone(),
                     status: self.work.responses.iter().map(|r| r.status).collect(),
@@ -406,7 +487,7 @@ impl Analysis {
             if iteration == s.max_iterations {
                 return Err(IncrementFailure::MaxIterations { residual });
             }
-            if iteration > 3 && residual > 1e8 * first.max(1e-3) {
+            if iteration > 3 && residual > 1e6 * first.max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             for (i, d) in self.system.dofs.iter().enumerate() {
@@ -422,13 +503,62 @@ impl Analysis {
             if !correction_norm.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            for (i, d) in self.system.dofs.iter().enumerate() {
-                if let Dof::Free(eq) = d {
-                    u[i] += self.work.rhs[*eq];
-                }
-            }
+            let step = self.line_search(&mut u, &laws, &history);
+            correction_norm *= step;
         }
         unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Applies the Newton correction held in `work.rhs` to `u`, scaled by the first of
+    /// `1, ½, ¼, ⅛` that lowers `‖R_free‖₂` (or the best of them when none does, and the full
+    /// step when line search is off). Returns the scale used. Opening/closing gaps make the
+    /// residual non-smooth; the backtracking stops the open ↔ closed chatter of a full step.
+    fn line_search(&mut self, u: &mut [f64], laws: &[GapLaw], history: &[Vector2<f64>]) -> f64 {
+        let apply = |u: &mut [f64], dofs: &[Dof], delta: &[f64], scale: f64| {
+            for (i, d) in dofs.iter().enumerate() {
+                if let Dof::Free(eq) = d {
+                    u[i] += scale * delta[*eq];
+                }
+            }
+        };
+        let delta = std::mem::take(&mut self.work.rhs);
+        if !self.settings.line_search {
+            apply(u, &self.system.dofs, &delta, 1.0);
+            self.work.rhs = delta;
+            return 1.0;
+        }
+        let start = self.free_norm2();
+        let (mut best, mut best_norm, mut applied) = (1.0, f64::INFINITY, 0.0);
+        let mut scale = 1.0;
+        for _ in 0..4 {
+            apply(u, &self.system.dofs, &delta, scale - applied);
+            applied = scale;
+            self.assemble_at(u, laws, history, None);
+            let norm = self.free_norm2();
+            if norm < start {
+                self.work.rhs = delta;
+                return scale;
+            }
+            if norm < best_norm {
+                (best, best_norm) = (scale, norm);
+            }
+            scale *= 0.5;
+        }
+        apply(u, &self.system.dofs, &delta, best - applied);
+        self.work.rhs = delta;
+        best
+    }
+
+    /// `‖R_free‖₂` of the last assembly.
+    fn free_norm2(&self) -> f64 {
+        self.system
+            .dofs
+            .iter()
+            .zip(&self.work.internal)
+            .filter(|(d, _)| matches!(d, Dof::Free(_)))
+            .map(|(_, r)| r * r)
+            .sum::<f64>()
+            .sqrt()
     }
 
     /// Assembles internal forces (and the Newton matrix when `iteration` is given) at `u`;
@@ -441,7 +571,14 @@ impl Analysis {
         iteration: Option<usize>,
     ) -> f64 {
         let mode = self.settings.iteration_matrix;
-        let Workspace { internal, values, responses, latched, .. } = &mut self.work;
+        let Workspace {
+            internal,
+            values,
+            responses,
+            latched,
+            closed,
+            ..
+        } = &mut self.work;
         let values = iteration.map(|_| values.as_mut_slice());
         self.system.assemble(u, internal, values, |g, d| {
             let law = &laws[g];
@@ -450,33 +587,58 @@ impl Analysis {
             let matrix = match mode {
                 IterationMatrix::Consistent => law.consistent_tangent(&response),
                 IterationMatrix::JuRowlands => {
-                    // §3(b): stick in the first iteration; §3(f): once slipping, slip until the loop ends.
-                    let status = match (response.status, iteration) {
-                        (GapStatus::Open, _) => GapStatus::Open,
-                        (_, Some(0)) => GapStatus::Stick,
-                        (GapStatus::Slip, _) => {
-                            latched[g] = true;
-                            GapStatus::Slip
+                    // §3(b): stick in the first iteration; §3(f): once slipping, the slip matrix is
+                    // kept, with the slip direction (and its sign) found when the gap started
+                    // slipping, until the loop ends.
+                    // A latched gap keeps the slip matrix even if the law finds it open, and a gap
+                    // that has closed in this loop keeps at least the stick matrix: both stop the
+                    // open ↔ closed chatter of a symmetric matrix that has no cone direction.
+                    closed[g] |= response.status != GapStatus::Open;
+                    if response.status == GapStatus::Slip
+                        && iteration != Some(0)
+                        && latched[g].is_none()
+                    {
+                        latched[g] = Some(response.direction);
+                    }
+                    match (latched[g], response.status, iteration) {
+                        (Some(direction), _, _) => {
+                            law.ju_rowlands_matrix(GapStatus::Slip, direction)
                         }
-                        (GapStatus::Stick, _) if latched[g] => GapStatus::Slip,
-                        _ => GapStatus::Stick,
-                    };
-                    law.ju_rowlands_matrix(status, response.direction)
+                        (None, GapStatus::Open, _) if !closed[g] => {
+                            law.ju_rowlands_matrix(GapStatus::Open, response.direction)
+                        }
+                        (None, _, _) => {
+                            law.ju_rowlands_matrix(GapStatus::Stick, response.direction)
+                        }
+                    }
                 }
             };
             (response.force, matrix)
         });
-        self.system.dofs.iter().zip(internal.iter()).fold(0.0_f64, |m, (d, r)| match d {
-            Dof::Free(_) => m.max(r.abs()),
-            _ => m,
-        })
+        self.system
+            .dofs
+            .iter()
+            .zip(internal.iter())
+            .fold(0.0_f64, |m, (d, r)| match d {
+                Dof::Free(_) => m.max(r.abs()),
+                _ => m,
+            })
     }
 
     /// Gap results, group reactions and element stresses at the converged state.
     pub fn results(&mut self) -> Results {
-        let laws: Vec<GapLaw> =
-            self.laws.iter().zip(&self.state.friction).map(|(l, &mu)| GapLaw { friction: mu, ..*l }).collect();
-        let history: Vec<Vector2<f64>> = self.state.plastic_slip.iter().map(|s| Vector2::from(*s)).collect();
+        let laws: Vec<GapLaw> = self
+            .laws
+            .iter()
+            .zip(&self.state.friction)
+            .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
+            .collect();
+        let history: Vec<Vector2<f64>> = self
+            .state
+            .plastic_slip
+            .iter()
+            .map(|s| Vector2::from(*s))
+            .collect();
         let u = std::mem::take(&mut self.state.displacement);
         self.assemble_at(&u, &laws, &history, None);
         self.state.displacement = u;
@@ -512,7 +674,11 @@ impl Analysis {
                 tri.stress_state(&self.system.material, &ue)
             })
             .collect();
-        Results { gaps, reactions, elements }
+        Results {
+            gaps,
+            reactions,
+            elements,
+        }
     }
 
     /// Displacement of node `v` (m).
@@ -522,9 +688,18 @@ impl Analysis {
 
     /// Internal-force residual `R_free` at the current state, and its `‖·‖∞` (for checks).
     pub fn residual(&mut self) -> (Vec<f64>, f64) {
-        let laws: Vec<GapLaw> =
-            self.laws.iter().zip(&self.state.friction).map(|(l, &mu)| GapLaw { friction: mu, ..*l }).collect();
-        let history: Vec<Vector2<f64>> = self.state.plastic_slip.iter().map(|s| Vector2::from(*s)).collect();
+        let laws: Vec<GapLaw> = self
+            .laws
+            .iter()
+            .zip(&self.state.friction)
+            .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
+            .collect();
+        let history: Vec<Vector2<f64>> = self
+            .state
+            .plastic_slip
+            .iter()
+            .map(|s| Vector2::from(*s))
+            .collect();
         let u = std::mem::take(&mut self.state.displacement);
         let norm = self.assemble_at(&u, &laws, &history, None);
         self.state.displacement = u;

@@ -75,7 +75,12 @@ impl Default for ParallelArch {
             arch_offset: 0.4,
             frame_half_x: 1.0,
             frame_half_y: 1.0,
-            material: Material { youngs_modulus: 1.0e9, poisson_ratio: 0.43, thickness: 250e-6, prestress: [0.5e6, 0.5e6, 0.0] },
+            material: Material {
+                youngs_modulus: 1.0e9,
+                poisson_ratio: 0.43,
+                thickness: 250e-6,
+                prestress: [0.5e6, 0.5e6, 0.0],
+            },
             normal_penalty_factor: 1000.0,
             tangential_penalty_ratio: 0.1,
             friction: 0.2,
@@ -92,7 +97,10 @@ const CELLS: usize = 10;
 impl ParallelArch {
     /// The default specimen with arch rise `height` (m).
     pub fn with_height(height: f64) -> Self {
-        Self { arch_height: height, ..Self::default() }
+        Self {
+            arch_height: height,
+            ..Self::default()
+        }
     }
 
     /// Arch radius `R = (H² + (S/2)²) / 2H`.
@@ -109,10 +117,15 @@ impl ParallelArch {
     pub fn check(&self) -> Result<(), String> {
         let positive = |v: f64| v > 0.0 && v.is_finite();
         if !positive(self.arch_height) || !positive(self.arch_half_span) {
-            return Err(format!("arch height {} and half span {} must be > 0", self.arch_height, self.arch_half_span));
+            return Err(format!(
+                "arch height {} and half span {} must be > 0",
+                self.arch_height, self.arch_half_span
+            ));
         }
         if self.arch_height > self.arch_half_span {
-            return Err("arch height larger than the half span: not a shallow circular arch".into());
+            return Err(
+                "arch height larger than the half span: not a shallow circular arch".into(),
+            );
         }
         let dy = self.frame_half_y / CELLS as f64;
         if ((GAP_COUNT - 1) as f64 * dy - self.arch_half_span).abs() > 1e-9 * self.frame_half_y {
@@ -123,7 +136,10 @@ impl ParallelArch {
             return Err("arch_offset must fall on an interior grid line of the frame (a multiple of frame_half_x/10)".into());
         }
         if !(1..=400).contains(&self.refinement) {
-            return Err(format!("refinement {} must lie in 1..=400", self.refinement));
+            return Err(format!(
+                "refinement {} must lie in 1..=400",
+                self.refinement
+            ));
         }
         if !(self.friction >= 0.0 && self.friction.is_finite()) {
             return Err(format!("friction {} must be ≥ 0", self.friction));
@@ -154,12 +170,24 @@ impl ParallelArch {
             }
         }
         let on = |pred: &dyn Fn(usize, usize) -> bool| -> Vec<usize> {
-            (0..=n).flat_map(|j| (0..=n).map(move |i| (i, j))).filter(|&(i, j)| pred(i, j)).map(|(i, j)| id(i, j)).collect()
+            (0..=n)
+                .flat_map(|j| (0..=n).map(move |i| (i, j)))
+                .filter(|&(i, j)| pred(i, j))
+                .map(|(i, j)| id(i, j))
+                .collect()
         };
         let frame = on(&|i, j| i == n || j == n);
         let symmetry = vec![
-            Symmetry { name: "x0".into(), normal: Axis::X, nodes: on(&|i, j| i == 0 && j < n) },
-            Symmetry { name: "y0".into(), normal: Axis::Y, nodes: on(&|i, j| j == 0 && i < n) },
+            Symmetry {
+                name: "x0".into(),
+                normal: Axis::X,
+                nodes: on(&|i, j| i == 0 && j < n),
+            },
+            Symmetry {
+                name: "y0".into(),
+                normal: Axis::Y,
+                nodes: on(&|i, j| j == 0 && i < n),
+            },
         ];
         let radius = self.arch_radius();
         let column = (self.arch_offset / dx).round() as usize;
@@ -197,7 +225,11 @@ impl ParallelArch {
             supports: vec![],
             symmetry,
             gaps,
-            groups: vec![BoundaryGroup { name: "frame".into(), nodes: frame, target: self.target() }],
+            groups: vec![BoundaryGroup {
+                name: "frame".into(),
+                nodes: frame,
+                target: self.target(),
+            }],
         };
         model.validate().map_err(|e| e.to_string())?;
         Ok(model)
