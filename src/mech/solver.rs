@@ -89,6 +89,8 @@ pub struct StepReport {
     pub cutbacks: usize,
     /// Final residual `‖R_free‖∞` (N).
     pub residual: f64,
+    /// `‖R_free‖∞` at every iteration of the last converged increment (N).
+    pub residual_history: Vec<f64>,
 }
 
 impl StepReport {
@@ -399,11 +401,12 @@ impl Analysis {
                 .map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * next))
                 .collect();
             match self.solve_increment(&current, &boundary) {
-                Ok((state, iterations, residual)) => {
+                Ok((state, history)) => {
                     current = state;
                     done = next;
-                    report.iterations.push(iterations);
-                    report.residual = residual;
+                    report.iterations.push(history.len() - 1);
+                    report.residual = *history.last().unwrap_or(&0.0);
+                    report.residual_history = history;
                     size = (2.0 * size).min(full);
                 }
                 Err(last) => {
@@ -428,7 +431,7 @@ impl Analysis {
         &mut self,
         start: &AnalysisState,
         boundary: &[[f64; 3]],
-    ) -> Result<(AnalysisState, usize, f64), IncrementFailure> {
+    ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
         let mut u = start.displacement.clone();
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { group, component } = d {
@@ -449,14 +452,15 @@ impl Analysis {
         self.work.latched.iter_mut().for_each(|l| *l = None);
         self.work.closed.iter_mut().for_each(|c| *c = false);
         let mut correction_norm = f64::INFINITY;
-        let mut first_residual = None;
+        let mut residuals = Vec::new();
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
             let residual = self.assemble_at(&u, &laws, &history, Some(iteration));
             if !residual.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            let first = *first_residual.get_or_insert(residual);
+            residuals.push(residual);
+            let first = residuals[0];
             let moved = u
                 .iter()
                 .zip(&start.displacement)
@@ -482,7 +486,7 @@ impl Analysis {
                     friction: start.friction.clone(),
                     status: self.work.responses.iter().map(|r| r.status).collect(),
                 };
-                return Ok((state, iteration, residual));
+                return Ok((state, residuals));
             }
             if iteration == s.max_iterations {
                 return Err(IncrementFailure::MaxIterations { residual });
