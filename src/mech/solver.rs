@@ -453,9 +453,14 @@ impl Analysis {
         self.work.closed.iter_mut().for_each(|c| *c = false);
         let mut correction_norm = f64::INFINITY;
         let mut residuals = Vec::new();
+        let mut assembled = false;
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
-            let residual = self.assemble_at(&u, &laws, &history, Some(iteration));
+            let residual = if assembled {
+                self.free_norm_inf()
+            } else {
+                self.assemble_at(&u, &laws, &history, Some(iteration))
+            };
             if !residual.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
@@ -507,7 +512,8 @@ impl Analysis {
             if !correction_norm.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            let step = self.line_search(&mut u, &laws, &history);
+            let (step, with_tangent) = self.line_search(&mut u, &laws, &history, iteration + 1);
+            assembled = with_tangent;
             correction_norm *= step;
         }
         unreachable!("the loop returns at max_iterations")
@@ -515,9 +521,16 @@ impl Analysis {
 
     /// Applies the Newton correction held in `work.rhs` to `u`, scaled by the first of
     /// `1, ½, ¼, ⅛` that lowers `‖R_free‖₂` (or the best of them when none does, and the full
-    /// step when line search is off). Returns the scale used. Opening/closing gaps make the
+    /// step when line search is off). Returns the scale used and whether the workspace now holds
+    /// the residual and Newton matrix at the new `u` (assembled for `next_iteration`). Opening/closing gaps make the
     /// residual non-smooth; the backtracking stops the open ↔ closed chatter of a full step.
-    fn line_search(&mut self, u: &mut [f64], laws: &[GapLaw], history: &[Vector2<f64>]) -> f64 {
+    fn line_search(
+        &mut self,
+        u: &mut [f64],
+        laws: &[GapLaw],
+        history: &[Vector2<f64>],
+        next_iteration: usize,
+    ) -> (f64, bool) {
         let apply = |u: &mut [f64], dofs: &[Dof], delta: &[f64], scale: f64| {
             for (i, d) in dofs.iter().enumerate() {
                 if let Dof::Free(eq) = d {
@@ -529,19 +542,21 @@ impl Analysis {
         if !self.settings.line_search {
             apply(u, &self.system.dofs, &delta, 1.0);
             self.work.rhs = delta;
-            return 1.0;
+            return (1.0, false);
         }
         let start = self.free_norm2();
         let (mut best, mut best_norm, mut applied) = (1.0, f64::INFINITY, 0.0);
         let mut scale = 1.0;
-        for _ in 0..4 {
+        for trial in 0..4 {
             apply(u, &self.system.dofs, &delta, scale - applied);
             applied = scale;
-            self.assemble_at(u, laws, history, None);
+            // The full step is usually accepted: assemble its tangent too, for the next iteration.
+            let tangent = (trial == 0).then_some(next_iteration);
+            self.assemble_at(u, laws, history, tangent);
             let norm = self.free_norm2();
             if norm < start {
                 self.work.rhs = delta;
-                return scale;
+                return (scale, trial == 0);
             }
             if norm < best_norm {
                 (best, best_norm) = (scale, norm);
@@ -550,7 +565,17 @@ impl Analysis {
         }
         apply(u, &self.system.dofs, &delta, best - applied);
         self.work.rhs = delta;
-        best
+        (best, false)
+    }
+
+    /// `‖R_free‖∞` of the last assembly.
+    fn free_norm_inf(&self) -> f64 {
+        self.system
+            .dofs
+            .iter()
+            .zip(&self.work.internal)
+            .filter(|(d, _)| matches!(d, Dof::Free(_)))
+            .fold(0.0_f64, |m, (_, r)| m.max(r.abs()))
     }
 
     /// `‖R_free‖₂` of the last assembly.
