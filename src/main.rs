@@ -6,6 +6,7 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
+use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
     Analysis, IterationMatrix, Model, ParallelArch, Results, SolverSettings,
 };
@@ -24,6 +25,7 @@ options:
   --steps N          load steps to the target (default 20)
   --matrix M         consistent (default) or ju-rowlands
   --csv FILE         write the gap results of every step as CSV
+  --vtk DIR          write the deformed film of every step as VTK (DIR/<model>_NNNN.vtu + .pvd)
   --quiet            no progress indicator
   -h, --help         this text";
 
@@ -36,6 +38,7 @@ struct Options {
     steps: usize,
     matrix: IterationMatrix,
     csv: Option<String>,
+    vtk: Option<String>,
     quiet: bool,
 }
 
@@ -49,6 +52,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         steps: 20,
         matrix: IterationMatrix::Consistent,
         csv: None,
+        vtk: None,
         quiet: false,
     };
     let mut it = args.iter();
@@ -91,6 +95,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
                 }
             }
             "--csv" => o.csv = Some(value("--csv")?),
+            "--vtk" => o.vtk = Some(value("--vtk")?),
             "--quiet" => o.quiet = true,
             s if s.starts_with('-') => return Err(format!("unknown option {s}")),
             s if o.command.is_empty() => o.command = s.to_string(),
@@ -146,6 +151,10 @@ fn run(o: &Options) -> Result<(), String> {
         }
         None => None,
     };
+    if let Some(dir) = &o.vtk {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{dir}: {e}"))?;
+    }
+    let mut vtk_files = Vec::new();
     let progress = !o.quiet && std::io::stderr().is_terminal();
     let started = std::time::Instant::now();
     let (mut iterations, mut cutbacks, mut increments) = (Vec::new(), 0, 0);
@@ -158,6 +167,18 @@ fn run(o: &Options) -> Result<(), String> {
         cutbacks += report.cutbacks;
         increments += report.iterations.len();
         iterations.push(report.total_iterations());
+        if let Some(dir) = &o.vtk {
+            let results = analysis.results();
+            let model = analysis.model();
+            let file = format!("{}_{step:04}.vtu", model.name);
+            let text = vtk::unstructured_grid(model, &analysis.state().displacement, &results);
+            std::fs::write(std::path::Path::new(dir).join(&file), text)
+                .map_err(|e| format!("{dir}/{file}: {e}"))?;
+            vtk_files.push((fraction, file));
+            let pvd = std::path::Path::new(dir).join(format!("{}.pvd", model.name));
+            std::fs::write(&pvd, vtk::collection(&vtk_files))
+                .map_err(|e| format!("{}: {e}", pvd.display()))?;
+        }
         if progress {
             eprint!("\rstep {step}/{} ({:.0}%)", o.steps, 100.0 * fraction);
         }

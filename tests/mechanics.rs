@@ -613,3 +613,60 @@ fn gap_frame_rotation_has_the_frame_as_rows() {
     assert!((r * Vector3::from(f.z) - Vector3::z()).amax() < 1e-15);
     assert!((Vector3::from(f.y) - Vector3::new(-1.0, 0.0, 0.0)).amax() < 1e-15);
 }
+
+#[test]
+fn vtk_output_is_well_formed_and_complete() {
+    use membrane_contact::mech::vtk;
+    let spec = ParallelArch::with_height(0.2);
+    let mut a = Analysis::new(spec.model().unwrap(), SolverSettings::default()).unwrap();
+    a.step_to(&[spec.target()], 4).unwrap();
+    let results = a.results();
+    let text = vtk::unstructured_grid(a.model(), &a.state().displacement, &results);
+    let (points, cells) = (121 + 9, 200 + 9);
+    assert!(text.contains(&format!(
+        "NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\""
+    )));
+    let mut reader = quick_xml::Reader::from_str(&text);
+    let mut arrays = std::collections::HashMap::new();
+    let mut current = None;
+    loop {
+        match reader.read_event().expect("well-formed XML") {
+            quick_xml::events::Event::Start(e) if e.name().0 == "DataArray" => {
+                let name = e
+                    .try_get_attribute("Name")
+                    .unwrap()
+                    .map(|a| a.value.to_string());
+                current = Some(name.unwrap_or_else(|| "points".into()));
+            }
+            quick_xml::events::Event::Text(t) => {
+                if let Some(name) = current.take() {
+                    let values: Vec<f64> = t
+                        .into_inner()
+                        .split_whitespace()
+                        .map(|v| v.parse().unwrap())
+                        .collect();
+                    assert!(values.iter().all(|v| v.is_finite()), "{name}");
+                    arrays.insert(name, values.len());
+                }
+            }
+            quick_xml::events::Event::Eof => break,
+            _ => {}
+        }
+    }
+    assert_eq!(arrays["points"], 3 * points);
+    assert_eq!(arrays["displacement"], 3 * points);
+    assert_eq!(arrays["connectivity"], 3 * 200 + 2 * 9);
+    for name in [
+        "von_mises",
+        "principal_1",
+        "principal_2",
+        "gap_slip_x",
+        "gap_normal_force",
+        "gap_status",
+        "types",
+        "offsets",
+    ] {
+        assert_eq!(arrays[name], cells, "{name}");
+    }
+    assert!(vtk::collection(&[(0.5, "a.vtu".into())]).contains("timestep=\"0.5\""));
+}

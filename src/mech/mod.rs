@@ -10,6 +10,7 @@
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
 //! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
 //! | [`specimen`] | the parallel-arch specimens of §4 and every assumption about them |
+//! | [`vtk`] | VTK text of the deformed film and its stresses (Fig. 6) |
 
 pub mod assembly;
 pub mod contact;
@@ -18,6 +19,7 @@ pub mod linear;
 pub mod model;
 pub mod solver;
 pub mod specimen;
+pub mod vtk;
 
 pub use contact::{GapStatus, IterationMatrix};
 pub use element::Material;
