@@ -16,7 +16,7 @@
 //!
 //! Writing `F` in global axes makes the rotation `T = diag(R, R, R)` of the paper unnecessary:
 //! `(B0 + AG)` expressed on global DOF is exactly `B_k` below, and `GᵀMG` is the isotropic
-//! `(∇N_kᵀ S ∇N_l) I3` block. `../docs/mechanics.md` has the derivation.
+//! `(∇N_kᵀ S ∇N_l) I3` block. `docs/mechanics.md` has the derivation.
 
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
