@@ -41,7 +41,7 @@ impl Default for SolverSettings {
             iteration_matrix: IterationMatrix::default(),
             displacement_tolerance: 1e-8,
             residual_tolerance: 1e-8,
-            max_iterations: 40,
+            max_iterations: 15,
             max_cutbacks: 10,
             line_search: true,
         }
@@ -78,6 +78,10 @@ pub struct AnalysisState {
     pub friction: Vec<f64>,
     /// Status of each gap at convergence.
     pub status: Vec<GapStatus>,
+    /// Displacement change of the last converged increment (empty before the first): the
+    /// predictor of the next increment when the boundary keeps moving the same way.
+    #[serde(default)]
+    pub last_increment: Vec<f64>,
 }
 
 /// Newton statistics of one step.
@@ -270,6 +274,7 @@ impl Analysis {
                 .iter()
                 .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
                 .collect(),
+            last_increment: Vec::new(),
         };
         let idle = laws
             .first()
@@ -331,6 +336,8 @@ impl Analysis {
             || state.boundary.len() != s.boundary.len()
             || state.friction.len() != s.friction.len()
             || state.status.len() != s.status.len()
+            || !(state.last_increment.is_empty()
+                || state.last_increment.len() == s.displacement.len())
         {
             return Err("state does not match this model's sizes".into());
         }
@@ -388,7 +395,7 @@ impl Analysis {
         let mut report = StepReport::default();
         let full = 1.0 / increments as f64;
         let smallest = full / 2f64.powi(self.settings.max_cutbacks as i32);
-        let (mut done, mut size) = (0.0_f64, full);
+        let (mut done, mut size, mut successes) = (0.0_f64, full, 0);
         while done < 1.0 {
             let next = if done + size > 1.0 - 1e-12 {
                 1.0
@@ -407,7 +414,12 @@ impl Analysis {
                     report.iterations.push(history.len() - 1);
                     report.residual = *history.last().unwrap_or(&0.0);
                     report.residual_history = history;
-                    size = (2.0 * size).min(full);
+                    // Grow a cut-back increment again only after two successes in a row.
+                    successes += 1;
+                    if successes >= 2 {
+                        size = (2.0 * size).min(full);
+                        successes = 0;
+                    }
                 }
                 Err(last) => {
                     if size / 2.0 < smallest * (1.0 - 1e-9) {
@@ -419,6 +431,7 @@ impl Analysis {
                     }
                     report.cutbacks += 1;
                     size /= 2.0;
+                    successes = 0;
                 }
             }
         }
@@ -433,9 +446,23 @@ impl Analysis {
         boundary: &[[f64; 3]],
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
         let mut u = start.displacement.clone();
+        // Predictor: when the boundary keeps moving the same way, extrapolate the free DOFs
+        // along the last converged increment (fewer iterations, same converged answer).
+        let (mut dot, mut old, mut new) = (0.0, 0.0, 0.0);
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { group, component } = d {
+                let step = boundary[*group][*component] - start.displacement[i];
+                let last = start.last_increment.get(i).copied().unwrap_or(0.0);
+                (dot, old, new) = (dot + step * last, old + last * last, new + step * step);
                 u[i] = boundary[*group][*component];
+            }
+        }
+        if old > 0.0 && dot > 0.99 * (old * new).sqrt() {
+            let ratio = dot / old;
+            for (i, d) in self.system.dofs.iter().enumerate() {
+                if let Dof::Free(_) = d {
+                    u[i] += ratio * start.last_increment[i];
+                }
             }
         }
         let laws: Vec<GapLaw> = self
@@ -480,7 +507,6 @@ impl Analysis {
                 && residual <= s.residual_tolerance * force_scale;
             if converged {
                 let state = AnalysisState {
-                    displacement: u,
                     plastic_slip: self
                         .work
                         .responses
@@ -490,6 +516,12 @@ impl Analysis {
                     boundary: boundary.to_vec(),
                     friction: start.friction.clone(),
                     status: self.work.responses.iter().map(|r| r.status).collect(),
+                    last_increment: u
+                        .iter()
+                        .zip(&start.displacement)
+                        .map(|(a, b)| a - b)
+                        .collect(),
+                    displacement: u,
                 };
                 return Ok((state, residuals));
             }
