@@ -465,17 +465,7 @@ impl Analysis {
                 }
             }
         }
-        let laws: Vec<GapLaw> = self
-            .laws
-            .iter()
-            .zip(&start.friction)
-            .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
-            .collect();
-        let history: Vec<Vector2<f64>> = start
-            .plastic_slip
-            .iter()
-            .map(|s| Vector2::from(*s))
-            .collect();
+        let (laws, history) = self.laws_and_history(start);
         self.work.latched.iter_mut().for_each(|l| *l = None);
         self.work.closed.iter_mut().for_each(|c| *c = false);
         let mut correction_norm = f64::INFINITY;
@@ -676,30 +666,28 @@ impl Analysis {
             };
             (response.force, matrix)
         });
-        self.system
-            .dofs
-            .iter()
-            .zip(internal.iter())
-            .fold(0.0_f64, |m, (d, r)| match d {
-                Dof::Free(_) => m.max(r.abs()),
-                _ => m,
-            })
+        self.free_norm_inf()
     }
 
-    /// Gap results, group reactions and element stresses at the converged state.
-    pub fn results(&mut self) -> Results {
-        let laws: Vec<GapLaw> = self
+    /// Gap laws with the friction coefficients of `state`, and its slip history.
+    fn laws_and_history(&self, state: &AnalysisState) -> (Vec<GapLaw>, Vec<Vector2<f64>>) {
+        let laws = self
             .laws
             .iter()
-            .zip(&self.state.friction)
+            .zip(&state.friction)
             .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
             .collect();
-        let history: Vec<Vector2<f64>> = self
-            .state
+        let history = state
             .plastic_slip
             .iter()
             .map(|s| Vector2::from(*s))
             .collect();
+        (laws, history)
+    }
+
+    /// Gap results, group reactions and element stresses at the converged state.
+    pub fn results(&mut self) -> Results {
+        let (laws, history) = self.laws_and_history(&self.state);
         let u = std::mem::take(&mut self.state.displacement);
         self.assemble_at(&u, &laws, &history, None);
         self.state.displacement = u;
@@ -745,25 +733,5 @@ impl Analysis {
     /// Displacement of node `v` (m).
     pub fn node_displacement(&self, v: usize) -> Vector3<f64> {
         node_vector(&self.state.displacement, v)
-    }
-
-    /// Internal-force residual `R_free` at the current state, and its `‖·‖∞` (for checks).
-    pub fn residual(&mut self) -> (Vec<f64>, f64) {
-        let laws: Vec<GapLaw> = self
-            .laws
-            .iter()
-            .zip(&self.state.friction)
-            .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
-            .collect();
-        let history: Vec<Vector2<f64>> = self
-            .state
-            .plastic_slip
-            .iter()
-            .map(|s| Vector2::from(*s))
-            .collect();
-        let u = std::mem::take(&mut self.state.displacement);
-        let norm = self.assemble_at(&u, &laws, &history, None);
-        self.state.displacement = u;
-        (self.work.internal.clone(), norm)
     }
 }

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Quick start, command 1: build and package the FMU, then run the main job through fmpy
+# (the 300 mm specimen stepped to its target, slip printed beside Table 1).
+# Extra arguments go to examples/run_specimen.py (e.g. --height 400 --mu 0.3).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release --locked
+cargo run --release --locked --quiet --bin fmu-pack
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+.venv/bin/pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
+.venv/bin/python examples/run_specimen.py "$@"
