@@ -2,7 +2,10 @@
 //! elements (Bui & Kawabata), and an FMI 2.0 Co-Simulation FMU around them.
 //!
 //! * [`mech`]: the mechanics core (no FMI, no `unsafe`);
-//! * `fmi2`: the FMI 2.0 glue, the only place with `unsafe`.
+//! * [`fmi2`]: the FMI 2.0 glue, the only place with `unsafe`.
 #![deny(unsafe_code)]
 
 pub mod mech;
+
+#[allow(unsafe_code)]
+pub mod fmi2;

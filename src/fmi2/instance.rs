@@ -1,0 +1,959 @@
+//! The FMU instance in safe Rust: the co-simulation state machine, the variable values, the
+//! analysis, and the saved FMU states.
+//!
+//! # State machine (FMI 2.0 §4.2.4)
+//!
+//! ```text
+//! Instantiate → Instantiated ─SetupExperiment, EnterInitializationMode→ Initialization
+//!   ─ExitInitializationMode (builds the Analysis)→ StepComplete ─DoStep ok→ StepComplete
+//!                                                    │  └DoStep Discard→ StepFailed
+//!   Terminate (StepComplete | StepFailed) → Terminated;  Reset (any) → Instantiated
+//!   a panic inside any call → Fatal (only fmi2FreeInstance is left)
+//! ```
+//! [`allowed`] holds one mask per function. Deviations from the standard's table, both so that
+//! a master can retry a step the FMU refused:
+//! * in `StepFailed` (after `fmi2Discard`), inputs may be set and `fmi2DoStep` called again from
+//!   the same time: the instance kept its last converged state and time;
+//! * a call that fails with `fmi2Error` (bad argument, unknown value reference, wrong state,
+//!   invalid parameters at `fmi2ExitInitializationMode`) has no effect and leaves the instance
+//!   in its state, instead of making it unusable.
+//!
+//! # Semantics
+//! * Parameters are fixed. The model is rebuilt from them (for `ParallelArch`, regenerated from
+//!   `archHeight`) when the analysis is built: at `fmi2ExitInitializationMode`, or earlier when an
+//!   output is read in initialization mode.
+//! * The initial outputs are those of the undeformed, prestressed film; inputs set during
+//!   initialization are reached by the first step.
+//! * `fmi2DoStep(t, h)` moves every group to its inputs in `solver.incrementsPerStep` increments
+//!   (`Analysis::step_to`). Time is a pseudo-time: only `t` = current time (to 1e-9 relative) and
+//!   `h > 0` are required, and time becomes `t + h`.
+
+use std::collections::HashMap;
+
+use super::description::{Description, describe};
+use super::logger::Logger;
+use super::resources::{Source, resource_dir};
+use super::state::{self, Snapshot};
+use super::types::{
+    FMI2_CO_SIMULATION, FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status,
+};
+use super::variables::{Binding, Causality, Value, VarType, Variable};
+use crate::mech::{
+    Analysis, GapStatus, IterationMatrix, ParallelArch, SolverSettings, StepError, StepReport,
+};
+use serde::{Deserialize, Serialize};
+
+/// Why a call failed: the status to return and the message to log.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Failure {
+    pub status: Status,
+    pub message: String,
+}
+
+impl Failure {
+    pub fn error(message: impl Into<String>) -> Self {
+        Self {
+            status: Status::Error,
+            message: message.into(),
+        }
+    }
+
+    pub fn discard(message: impl Into<String>) -> Self {
+        Self {
+            status: Status::Discard,
+            message: message.into(),
+        }
+    }
+}
+
+/// The result of an instance method.
+pub type Outcome<T = ()> = Result<T, Failure>;
+
+/// The states of the co-simulation state machine this FMU can be in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Phase {
+    Instantiated,
+    Initialization,
+    StepComplete,
+    StepFailed,
+    Terminated,
+    /// A call panicked: only `fmi2FreeInstance` is left.
+    Fatal,
+}
+
+impl Phase {
+    const fn bit(self) -> u8 {
+        1 << self as u8
+    }
+}
+
+/// A set of phases.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mask(u8);
+
+impl Mask {
+    const fn of(phases: &[Phase]) -> Self {
+        let mut bits = 0;
+        let mut i = 0;
+        while i < phases.len() {
+            bits |= phases[i].bit();
+            i += 1;
+        }
+        Self(bits)
+    }
+
+    pub fn allows(self, phase: Phase) -> bool {
+        self.0 & phase.bit() != 0
+    }
+}
+
+/// In which phases each function may be called.
+pub mod allowed {
+    use super::Mask;
+    use super::Phase::*;
+
+    pub const SET_DEBUG_LOGGING: Mask = Mask::of(&[
+        Instantiated,
+        Initialization,
+        StepComplete,
+        StepFailed,
+        Terminated,
+    ]);
+    pub const SETUP_EXPERIMENT: Mask = Mask::of(&[Instantiated]);
+    pub const ENTER_INITIALIZATION: Mask = Mask::of(&[Instantiated]);
+    pub const EXIT_INITIALIZATION: Mask = Mask::of(&[Initialization]);
+    pub const TERMINATE: Mask = Mask::of(&[StepComplete, StepFailed]);
+    pub const RESET: Mask = Mask::of(&[
+        Instantiated,
+        Initialization,
+        StepComplete,
+        StepFailed,
+        Terminated,
+    ]);
+    pub const GET: Mask = Mask::of(&[Initialization, StepComplete, StepFailed, Terminated]);
+    /// StepFailed: deviation, so that a refused step can be retried with other inputs.
+    pub const SET: Mask = Mask::of(&[Instantiated, Initialization, StepComplete, StepFailed]);
+    pub const FMU_STATE: Mask = Mask::of(&[
+        Instantiated,
+        Initialization,
+        StepComplete,
+        StepFailed,
+        Terminated,
+    ]);
+    pub const DIRECTIONAL_DERIVATIVE: Mask =
+        Mask::of(&[Initialization, StepComplete, StepFailed, Terminated]);
+    pub const SET_INPUT_DERIVATIVES: Mask = Mask::of(&[Instantiated, Initialization, StepComplete]);
+    pub const GET_OUTPUT_DERIVATIVES: Mask = Mask::of(&[StepComplete, StepFailed, Terminated]);
+    /// StepFailed: deviation (retry after fmi2Discard).
+    pub const DO_STEP: Mask = Mask::of(&[StepComplete, StepFailed]);
+    /// Only in stepInProgress, which this synchronous FMU never enters.
+    pub const CANCEL_STEP: Mask = Mask::of(&[]);
+    pub const STATUS: Mask = Mask::of(&[StepComplete, StepFailed, Terminated]);
+    /// Model Exchange stubs: any live instance gets the "not provided" error.
+    pub const ANY: Mask = Mask::of(&[
+        Instantiated,
+        Initialization,
+        StepComplete,
+        StepFailed,
+        Terminated,
+    ]);
+}
+
+/// The analysis and what it was built from.
+struct Built {
+    analysis: Analysis,
+    /// The parameter values it was built with (table order, parameters only).
+    parameters: Vec<Value>,
+    increments: usize,
+}
+
+/// One FMU instance.
+pub struct Instance {
+    pub(crate) logger: Logger,
+    source: Source,
+    description: Description,
+    phase: Phase,
+    values: Vec<Value>,
+    mu_set: bool,
+    time: f64,
+    start_time: f64,
+    stop_time: Option<f64>,
+    analysis: Option<Built>,
+    outputs_fresh: bool,
+    /// Saved FMU states; the key is the address of the boxed snapshot, handed out as the opaque
+    /// `fmi2FMUstate`. It is only ever used as a key, never dereferenced.
+    states: HashMap<usize, Box<Snapshot>>,
+}
+
+impl std::fmt::Debug for Instance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Instance")
+            .field("model", &self.description.model_identifier)
+            .field("phase", &self.phase)
+            .finish()
+    }
+}
+
+impl Instance {
+    /// `fmi2Instantiate`: reads the resources, rebuilds the interface and checks the GUID.
+    pub fn instantiate(
+        name: &str,
+        fmu_type: i32,
+        guid: Option<&str>,
+        resource_location: Option<&str>,
+        logger: Logger,
+    ) -> Result<Self, String> {
+        if name.trim().is_empty() {
+            return Err("instanceName is empty".into());
+        }
+        if fmu_type != FMI2_CO_SIMULATION {
+            return Err(format!(
+                "fmuType = {fmu_type}: this FMU provides Co-Simulation (1) only"
+            ));
+        }
+        let guid = guid.ok_or("fmuGUID is NULL")?;
+        let uri = resource_location
+            .filter(|u| !u.is_empty())
+            .ok_or("fmuResourceLocation is NULL or empty: the FMU needs its resources folder")?;
+        let source = Source::load(&resource_dir(uri)?)?;
+        let instance = Self::from_source(source, logger)?;
+        if instance.description.guid != guid {
+            return Err(format!(
+                "GUID mismatch: the importer passed {guid}, the FMU's resources give {} (modelDescription.xml and \
+                 resources/ are from different FMUs, or the binary is from another version)",
+                instance.description.guid
+            ));
+        }
+        Ok(instance)
+    }
+
+    /// An instance of `source` without the URI and GUID checks (tests, benchmarks).
+    pub fn from_source(source: Source, logger: Logger) -> Result<Self, String> {
+        let description = describe(&source)?;
+        let values = start_values(&description.variables);
+        let instance = Self {
+            logger,
+            source,
+            description,
+            phase: Phase::Instantiated,
+            values,
+            mu_set: false,
+            time: 0.0,
+            start_time: 0.0,
+            stop_time: None,
+            analysis: None,
+            outputs_fresh: false,
+            states: HashMap::new(),
+        };
+        instance.event(|| {
+            format!(
+                "instantiated {} (GUID {})",
+                instance.description.model_identifier, instance.description.guid
+            )
+        });
+        Ok(instance)
+    }
+
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    pub fn description(&self) -> &Description {
+        &self.description
+    }
+
+    /// After a panic: the instance must not be used any more.
+    pub(crate) fn mark_fatal(&mut self) {
+        self.phase = Phase::Fatal;
+    }
+
+    fn event(&self, message: impl FnOnce() -> String) {
+        if self.logger.is_enabled(Status::Ok) {
+            self.logger.log(Status::Ok, &message());
+        }
+    }
+
+    // ---------------------------------------------------------------- lifecycle
+
+    pub fn setup_experiment(&mut self, start_time: f64, stop_time: Option<f64>) -> Outcome {
+        if !start_time.is_finite() {
+            return Err(Failure::error(format!(
+                "startTime = {start_time} is not finite"
+            )));
+        }
+        if let Some(stop) = stop_time
+            && !(stop.is_finite() && stop >= start_time)
+        {
+            return Err(Failure::error(format!(
+                "stopTime = {stop} must be finite and ≥ startTime = {start_time}"
+            )));
+        }
+        self.start_time = start_time;
+        self.time = start_time;
+        self.stop_time = stop_time;
+        Ok(())
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> Outcome {
+        self.phase = Phase::Initialization;
+        self.time = self.start_time;
+        Ok(())
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Outcome {
+        self.initial_outputs()?;
+        self.phase = Phase::StepComplete;
+        self.event(|| {
+            let m = self.analysis.as_ref().map(|b| b.analysis.model());
+            let (nodes, gaps) = m.map_or((0, 0), |m| (m.nodes.len(), m.gaps.len()));
+            format!(
+                "initialized: {nodes} nodes, {gaps} gaps, start time {}",
+                self.time
+            )
+        });
+        Ok(())
+    }
+
+    pub fn terminate(&mut self) -> Outcome {
+        self.phase = Phase::Terminated;
+        Ok(())
+    }
+
+    /// Back to the state just after instantiation: start values, time 0, no analysis. Saved FMU
+    /// states and the logging settings stay.
+    pub fn reset(&mut self) -> Outcome {
+        self.phase = Phase::Instantiated;
+        self.values = start_values(&self.description.variables);
+        self.mu_set = false;
+        self.time = 0.0;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        self.analysis = None;
+        self.outputs_fresh = false;
+        Ok(())
+    }
+
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> Outcome {
+        self.logger
+            .set_debug_logging(on, categories)
+            .map_err(Failure::error)
+    }
+
+    // ---------------------------------------------------------------- variables
+
+    /// The variable with value reference `vr`, which must be of type `want`.
+    fn variable(&self, vr: u32, want: VarType) -> Outcome<&Variable> {
+        let table = &self.description.variables;
+        let v = table.get(vr as usize).ok_or_else(|| {
+            Failure::error(format!(
+                "value reference {vr} does not exist (this FMU has 0..{})",
+                table.len() - 1
+            ))
+        })?;
+        if v.var_type != want {
+            return Err(Failure::error(format!(
+                "value reference {vr} ({}) is a{} {}, not a{} {}",
+                v.name,
+                article(v.var_type),
+                v.var_type.name(),
+                article(want),
+                want.name()
+            )));
+        }
+        Ok(v)
+    }
+
+    /// Checks every value reference, computes the initial outputs if one is read in
+    /// initialization mode, and returns the table positions.
+    fn readable(&mut self, vrs: &[u32], want: VarType) -> Outcome<Vec<usize>> {
+        let mut needs_outputs = false;
+        for &vr in vrs {
+            needs_outputs |= self.variable(vr, want)?.causality == Causality::Output;
+        }
+        if needs_outputs && !self.outputs_fresh {
+            self.initial_outputs()?;
+        }
+        Ok(vrs.iter().map(|&vr| vr as usize).collect())
+    }
+
+    pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Outcome {
+        for (i, o) in self.readable(vrs, VarType::Real)?.into_iter().zip(out) {
+            *o = match (self.description.variables[i].binding, self.values[i]) {
+                (Binding::Time, _) => self.time,
+                (_, Value::Real(v)) => v,
+                _ => unreachable!("values follow the table's types"),
+            };
+        }
+        Ok(())
+    }
+
+    pub fn get_integer(&mut self, vrs: &[u32], out: &mut [i32]) -> Outcome {
+        for (i, o) in self.readable(vrs, VarType::Integer)?.into_iter().zip(out) {
+            let Value::Integer(v) = self.values[i] else {
+                unreachable!("values follow the table's types")
+            };
+            *o = v;
+        }
+        Ok(())
+    }
+
+    /// Booleans as C ints (1/0).
+    pub fn get_boolean(&mut self, vrs: &[u32], out: &mut [i32]) -> Outcome {
+        for (i, o) in self.readable(vrs, VarType::Boolean)?.into_iter().zip(out) {
+            let Value::Boolean(v) = self.values[i] else {
+                unreachable!("values follow the table's types")
+            };
+            *o = i32::from(v);
+        }
+        Ok(())
+    }
+
+    /// The FMU has no String variables: only an empty request succeeds.
+    pub fn get_string(&mut self, vrs: &[u32]) -> Outcome {
+        match vrs.first() {
+            None => Ok(()),
+            Some(vr) => Err(Failure::error(format!(
+                "value reference {vr}: this FMU has no String variables"
+            ))),
+        }
+    }
+
+    pub fn set_string(&mut self, vrs: &[u32]) -> Outcome {
+        self.get_string(vrs)
+    }
+
+    pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Outcome {
+        for (&vr, &x) in vrs.iter().zip(values) {
+            let v = self.settable(vr, VarType::Real)?;
+            if !x.is_finite() {
+                return Err(Failure::error(format!(
+                    "{} = {x}: values must be finite",
+                    v.name
+                )));
+            }
+            if v.binding == Binding::Friction && x < 0.0 {
+                return Err(Failure::error(format!(
+                    "mu = {x}: the friction coefficient must be ≥ 0"
+                )));
+            }
+        }
+        self.assign(vrs, values.iter().map(|&x| Value::Real(x)));
+        Ok(())
+    }
+
+    pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Outcome {
+        for &vr in vrs {
+            self.settable(vr, VarType::Integer)?;
+        }
+        self.assign(vrs, values.iter().map(|&x| Value::Integer(x)));
+        Ok(())
+    }
+
+    /// Booleans as C ints (any non-zero is true).
+    pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Outcome {
+        for &vr in vrs {
+            self.settable(vr, VarType::Boolean)?;
+        }
+        self.assign(vrs, values.iter().map(|&x| Value::Boolean(x != 0)));
+        Ok(())
+    }
+
+    /// Whether `vr` may be set now (FMI 2.0 §4.2.4 conditions (1), (3), (6)).
+    fn settable(&self, vr: u32, want: VarType) -> Outcome<&Variable> {
+        let v = self.variable(vr, want)?;
+        let before_init = matches!(self.phase, Phase::Instantiated | Phase::Initialization);
+        match v.causality {
+            Causality::Input => Ok(v),
+            Causality::Parameter if before_init => Ok(v),
+            Causality::Parameter => Err(Failure::error(format!(
+                "{} is a fixed parameter: set it before fmi2ExitInitializationMode (or after fmi2Reset)",
+                v.name
+            ))),
+            Causality::Output => Err(Failure::error(format!(
+                "{} is an output and cannot be set",
+                v.name
+            ))),
+            Causality::Independent => Err(Failure::error(
+                "time cannot be set: it advances with fmi2DoStep",
+            )),
+        }
+    }
+
+    /// Stores checked values; a changed parameter drops the analysis built from the old ones.
+    fn assign(&mut self, vrs: &[u32], values: impl Iterator<Item = Value>) {
+        for (&vr, value) in vrs.iter().zip(values) {
+            let i = vr as usize;
+            match self.description.variables[i].causality {
+                Causality::Parameter if self.values[i] != value => {
+                    self.analysis = None;
+                    self.outputs_fresh = false;
+                }
+                _ => {}
+            }
+            if self.description.variables[i].binding == Binding::Friction {
+                self.mu_set = true;
+            }
+            self.values[i] = value;
+        }
+    }
+
+    // ---------------------------------------------------------------- analysis
+
+    /// Builds the analysis from the current parameter values.
+    fn build(&self, values: &[Value]) -> Result<Built, String> {
+        let table = &self.description.variables;
+        let real = |b: Binding| {
+            table.iter().zip(values).find_map(|(v, x)| match x {
+                Value::Real(x) if v.binding == b => Some(*x),
+                _ => None,
+            })
+        };
+        let mut model = match &self.source {
+            Source::ParallelArch(spec) => {
+                let arch_height = real(Binding::ArchHeight).unwrap_or(spec.arch_height);
+                ParallelArch {
+                    arch_height,
+                    ..*spec
+                }
+                .model()
+                .map_err(|e| format!("archHeight = {arch_height}: {e}"))?
+            }
+            Source::Model(m) => m.clone(),
+        };
+        let base = &self.description.model;
+        let names = |m: &crate::mech::Model| -> Vec<String> {
+            m.gaps
+                .iter()
+                .map(|g| g.name.clone())
+                .chain(m.groups.iter().map(|g| g.name.clone()))
+                .collect()
+        };
+        if names(&model) != names(base) {
+            return Err(
+                "the regenerated model's gaps and groups differ from the FMU's variables".into(),
+            );
+        }
+        let mut settings = SolverSettings::default();
+        let mut increments = 1;
+        for (v, x) in table.iter().zip(values) {
+            if v.causality != Causality::Parameter {
+                continue;
+            }
+            let count = |x: i32, min: i32| {
+                usize::try_from(x)
+                    .ok()
+                    .filter(|_| x >= min)
+                    .ok_or_else(|| format!("{} = {x} must be ≥ {min}", v.name))
+            };
+            match (v.binding, *x) {
+                (Binding::ArchHeight, _) => {}
+                (Binding::YoungsModulus, Value::Real(x)) => model.material.youngs_modulus = x,
+                (Binding::PoissonRatio, Value::Real(x)) => model.material.poisson_ratio = x,
+                (Binding::Thickness, Value::Real(x)) => model.material.thickness = x,
+                (Binding::Prestress(c), Value::Real(x)) => model.material.prestress[c] = x,
+                (Binding::NormalStiffness(g), Value::Real(x)) => model.gaps[g].normal_stiffness = x,
+                (Binding::TangentialStiffness(g), Value::Real(x)) => {
+                    model.gaps[g].tangential_stiffness = x
+                }
+                (Binding::DisplacementTolerance, Value::Real(x)) => {
+                    settings.displacement_tolerance = x
+                }
+                (Binding::ResidualTolerance, Value::Real(x)) => settings.residual_tolerance = x,
+                (Binding::MaxIterations, Value::Integer(x)) => {
+                    settings.max_iterations = count(x, 1)?
+                }
+                (Binding::MaxCutbacks, Value::Integer(x)) => settings.max_cutbacks = count(x, 0)?,
+                (Binding::IncrementsPerStep, Value::Integer(x)) => increments = count(x, 1)?,
+                (Binding::UseJuRowlands, Value::Boolean(b)) => {
+                    settings.iteration_matrix = if b {
+                        IterationMatrix::JuRowlands
+                    } else {
+                        IterationMatrix::Consistent
+                    }
+                }
+                (b, x) => unreachable!("parameter {b:?} holds {x:?}"),
+            }
+        }
+        let analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
+        Ok(Built {
+            analysis,
+            parameters: parameters_of(table, values),
+            increments,
+        })
+    }
+
+    /// Builds the analysis if there is none (initialization) and computes the initial outputs.
+    fn initial_outputs(&mut self) -> Outcome {
+        if self.analysis.is_none() {
+            let built = self
+                .build(&self.values)
+                .map_err(|e| Failure::error(format!("invalid parameters: {e}")))?;
+            self.analysis = Some(built);
+        }
+        if !self.outputs_fresh {
+            self.refresh_outputs(None);
+        }
+        Ok(())
+    }
+
+    /// Writes the results of the converged state (and the step's statistics) into the outputs.
+    fn refresh_outputs(&mut self, report: Option<&StepReport>) {
+        let Some(built) = self.analysis.as_mut() else {
+            return;
+        };
+        let results = built.analysis.results();
+        let max_stress = results.von_mises_range().1;
+        let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
+        for (v, x) in self
+            .description
+            .variables
+            .iter()
+            .zip(self.values.iter_mut())
+        {
+            *x = match v.binding {
+                Binding::SlipX(g) => Value::Real(results.gaps[g].slip_x),
+                Binding::SlipY(g) => Value::Real(results.gaps[g].slip_y),
+                Binding::NormalForce(g) => Value::Real(results.gaps[g].normal_force),
+                Binding::FrictionForce(g) => Value::Real(results.gaps[g].friction_force),
+                Binding::GapStatus(g) => Value::Integer(match results.gaps[g].status {
+                    GapStatus::Open => 0,
+                    GapStatus::Stick => 1,
+                    GapStatus::Slip => 2,
+                }),
+                Binding::Reaction { group, axis } => Value::Real(results.reactions[group][axis]),
+                Binding::Iterations => count(report.map_or(0, StepReport::total_iterations)),
+                Binding::Cutbacks => count(report.map_or(0, |r| r.cutbacks)),
+                Binding::Residual => Value::Real(report.map_or(0.0, |r| r.residual)),
+                Binding::MaxEquivalentStress => Value::Real(max_stress),
+                _ => continue,
+            };
+        }
+        self.outputs_fresh = true;
+    }
+
+    /// `fmi2DoStep`: moves every group to its inputs over `[t, t + h]`.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Outcome {
+        if !(t.is_finite() && h.is_finite()) {
+            return Err(Failure::error(format!(
+                "currentCommunicationPoint = {t} and step size = {h} must be finite"
+            )));
+        }
+        if h <= 0.0 {
+            return Err(Failure::error(format!(
+                "communicationStepSize = {h} must be > 0"
+            )));
+        }
+        let tolerance = 1e-9 * t.abs().max(self.time.abs()).max(1.0);
+        if (t - self.time).abs() > tolerance {
+            return Err(Failure::error(format!(
+                "currentCommunicationPoint = {t} differs from the FMU's time {} (the last converged communication point)",
+                self.time
+            )));
+        }
+        if let Some(stop) = self.stop_time
+            && t + h > stop + tolerance
+        {
+            return Err(Failure::error(format!(
+                "a step to {} goes beyond stopTime = {stop}",
+                t + h
+            )));
+        }
+        let table = &self.description.variables;
+        let mut targets = vec![[0.0; 3]; self.description.model.groups.len()];
+        let mut mu = None;
+        for (v, x) in table.iter().zip(&self.values) {
+            match (v.binding, *x) {
+                (Binding::GroupDisplacement { group, axis }, Value::Real(x)) => {
+                    targets[group][axis] = x
+                }
+                (Binding::Friction, Value::Real(x)) if self.mu_set => mu = Some(x),
+                _ => {}
+            }
+        }
+        let built = self
+            .analysis
+            .as_mut()
+            .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
+        // μ changes the state's friction before the step; a refused step must not keep it.
+        let before = match mu {
+            Some(mu) if built.analysis.state().friction.iter().any(|&f| f != mu) => {
+                let before = built.analysis.state().clone();
+                built.analysis.set_friction(mu).map_err(Failure::error)?;
+                Some(before)
+            }
+            _ => None,
+        };
+        match built.analysis.step_to(&targets, built.increments) {
+            Ok(report) => {
+                self.time = t + h;
+                self.phase = Phase::StepComplete;
+                self.refresh_outputs(Some(&report));
+                self.event(|| {
+                    format!(
+                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N",
+                        self.time,
+                        report.iterations.len(),
+                        report.total_iterations(),
+                        report.cutbacks,
+                        report.residual
+                    )
+                });
+                Ok(())
+            }
+            Err(e) => {
+                if let Some(before) = before {
+                    built.analysis.set_state(before).map_err(Failure::error)?;
+                }
+                self.phase = Phase::StepFailed;
+                let message = format!("step from t = {t} to {}: {e}", t + h);
+                Err(match e {
+                    StepError::NotConverged { .. } => Failure::discard(format!(
+                        "{message}. Time stays {t}: set a smaller change of the inputs and call fmi2DoStep again"
+                    )),
+                    StepError::InvalidInput { .. } => Failure::error(message),
+                })
+            }
+        }
+    }
+
+    // ---------------------------------------------------------------- status
+
+    pub fn get_status(&self, kind: i32) -> Outcome<Status> {
+        match kind {
+            FMI2_DO_STEP_STATUS => Ok(if self.phase == Phase::StepFailed {
+                Status::Discard
+            } else {
+                Status::Ok
+            }),
+            _ => Err(unavailable_status(kind, "fmi2GetStatus")),
+        }
+    }
+
+    pub fn get_real_status(&self, kind: i32) -> Outcome<f64> {
+        match kind {
+            FMI2_LAST_SUCCESSFUL_TIME => Ok(self.time),
+            _ => Err(unavailable_status(kind, "fmi2GetRealStatus")),
+        }
+    }
+
+    pub fn get_integer_status(&self, kind: i32) -> Outcome<i32> {
+        Err(unavailable_status(kind, "fmi2GetIntegerStatus"))
+    }
+
+    /// `fmi2Terminated`: the FMU never asks the master to stop.
+    pub fn get_boolean_status(&self, kind: i32) -> Outcome<bool> {
+        match kind {
+            FMI2_TERMINATED => Ok(false),
+            _ => Err(unavailable_status(kind, "fmi2GetBooleanStatus")),
+        }
+    }
+
+    pub fn get_string_status(&self, kind: i32) -> Outcome {
+        Err(unavailable_status(kind, "fmi2GetStringStatus"))
+    }
+
+    // ---------------------------------------------------------------- FMU states
+
+    fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            phase: self.phase,
+            values: self.values.clone(),
+            mu_set: self.mu_set,
+            time: self.time,
+            start_time: self.start_time,
+            stop_time: self.stop_time,
+            outputs_fresh: self.outputs_fresh,
+            analysis: self.analysis.as_ref().map(|b| b.analysis.state().clone()),
+        }
+    }
+
+    /// Checks that a snapshot (maybe deserialized) fits this FMU.
+    fn check_snapshot(&self, s: &Snapshot) -> Result<(), String> {
+        let table = &self.description.variables;
+        if s.values.len() != table.len() {
+            return Err(format!(
+                "the state has {} variables, this FMU {}",
+                s.values.len(),
+                table.len()
+            ));
+        }
+        for (v, x) in table.iter().zip(&s.values) {
+            if x.var_type() != v.var_type || matches!(x, Value::Real(r) if !r.is_finite()) {
+                return Err(format!("the state's value of {} is {x:?}", v.name));
+            }
+        }
+        let times = [s.time, s.start_time, s.stop_time.unwrap_or(0.0)];
+        if times.iter().any(|t| !t.is_finite()) {
+            return Err("the state's times are not finite".into());
+        }
+        let needs_analysis = matches!(
+            s.phase,
+            Phase::StepComplete | Phase::StepFailed | Phase::Terminated
+        );
+        if s.phase == Phase::Fatal || (needs_analysis && s.analysis.is_none()) {
+            return Err(format!(
+                "the state's phase {:?} is not one to continue from",
+                s.phase
+            ));
+        }
+        Ok(())
+    }
+
+    /// Makes the instance continue from `s` exactly; on error nothing changes.
+    fn restore(&mut self, s: &Snapshot) -> Result<(), String> {
+        self.check_snapshot(s)?;
+        let parameters = parameters_of(&self.description.variables, &s.values);
+        let analysis = match &s.analysis {
+            None => None,
+            Some(state) => {
+                let reuse = matches!(&self.analysis, Some(b) if b.parameters == parameters);
+                let mut built = match self.analysis.take() {
+                    Some(b) if reuse => b,
+                    other => {
+                        self.analysis = other;
+                        self.build(&s.values)
+                            .map_err(|e| format!("the state's parameters: {e}"))?
+                    }
+                };
+                if let Err(e) = built.analysis.set_state(state.clone()) {
+                    if reuse {
+                        // set_state changed nothing: keep the analysis that was there.
+                        self.analysis = Some(built);
+                    }
+                    return Err(e);
+                }
+                Some(built)
+            }
+        };
+        self.analysis = analysis;
+        self.phase = s.phase;
+        self.values = s.values.clone();
+        self.mu_set = s.mu_set;
+        self.time = s.time;
+        self.start_time = s.start_time;
+        self.stop_time = s.stop_time;
+        self.outputs_fresh = s.outputs_fresh && self.analysis.is_some();
+        Ok(())
+    }
+
+    /// `fmi2GetFMUstate`: saves into a new state (`reuse` = 0) or over the state `reuse`.
+    pub fn get_fmu_state(&mut self, reuse: usize) -> Outcome<usize> {
+        let snapshot = self.snapshot();
+        self.store(snapshot, reuse)
+    }
+
+    fn store(&mut self, snapshot: Snapshot, reuse: usize) -> Outcome<usize> {
+        if reuse != 0 {
+            let slot = self
+                .states
+                .get_mut(&reuse)
+                .ok_or_else(|| unknown_state(reuse))?;
+            **slot = snapshot;
+            return Ok(reuse);
+        }
+        let boxed = Box::new(snapshot);
+        let handle = std::ptr::from_ref::<Snapshot>(&*boxed).addr();
+        self.states.insert(handle, boxed);
+        self.event(|| {
+            format!(
+                "FMU state saved at t = {} ({} states held)",
+                self.time,
+                self.states.len()
+            )
+        });
+        Ok(handle)
+    }
+
+    fn saved(&self, handle: usize) -> Outcome<&Snapshot> {
+        self.states
+            .get(&handle)
+            .map(|b| &**b)
+            .ok_or_else(|| unknown_state(handle))
+    }
+
+    pub fn set_fmu_state(&mut self, handle: usize) -> Outcome {
+        let snapshot = self.saved(handle)?.clone();
+        self.restore(&snapshot)
+            .map_err(|e| Failure::error(format!("cannot restore the FMU state: {e}")))?;
+        self.event(|| {
+            format!(
+                "FMU state restored: t = {}, phase {:?}",
+                self.time, self.phase
+            )
+        });
+        Ok(())
+    }
+
+    pub fn free_fmu_state(&mut self, handle: usize) -> Outcome {
+        self.states
+            .remove(&handle)
+            .map(drop)
+            .ok_or_else(|| unknown_state(handle))
+    }
+
+    /// The serialized form of a saved state.
+    pub fn serialize_fmu_state(&self, handle: usize) -> Outcome<Vec<u8>> {
+        Ok(state::serialize(
+            self.saved(handle)?,
+            &self.description.guid,
+        ))
+    }
+
+    /// Reads a serialized state into a new saved state (`reuse` = 0) or over `reuse`.
+    pub fn deserialize_fmu_state(&mut self, bytes: &[u8], reuse: usize) -> Outcome<usize> {
+        let snapshot = state::deserialize(bytes, &self.description.guid)
+            .and_then(|s| self.check_snapshot(&s).map(|()| s))
+            .map_err(|e| Failure::error(format!("refused: {e}")))?;
+        self.store(snapshot, reuse)
+    }
+
+    /// Number of saved states held.
+    pub fn saved_states(&self) -> usize {
+        self.states.len()
+    }
+}
+
+fn start_values(table: &[Variable]) -> Vec<Value> {
+    table
+        .iter()
+        .map(|v| {
+            v.start.unwrap_or(match v.var_type {
+                VarType::Real => Value::Real(0.0),
+                VarType::Integer => Value::Integer(0),
+                VarType::Boolean => Value::Boolean(false),
+            })
+        })
+        .collect()
+}
+
+fn parameters_of(table: &[Variable], values: &[Value]) -> Vec<Value> {
+    table
+        .iter()
+        .zip(values)
+        .filter(|(v, _)| v.causality == Causality::Parameter)
+        .map(|(_, x)| *x)
+        .collect()
+}
+
+fn article(t: VarType) -> &'static str {
+    if t == VarType::Integer { "n" } else { "" }
+}
+
+fn unavailable_status(kind: i32, function: &str) -> Failure {
+    let name = match kind {
+        0 => "fmi2DoStepStatus",
+        1 => "fmi2PendingStatus",
+        2 => "fmi2LastSuccessfulTime",
+        3 => "fmi2Terminated",
+        _ => "an unknown fmi2StatusKind",
+    };
+    Failure::discard(format!(
+        "{function}: {name} ({kind}) is not available from this synchronous FMU"
+    ))
+}
+
+fn unknown_state(handle: usize) -> Failure {
+    Failure::error(format!(
+        "FMU state {handle:#x} was not created by this instance or was already freed (pass NULL to get a new state)"
+    ))
+}

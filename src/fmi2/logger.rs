@@ -1,0 +1,198 @@
+//! Messages to the importer through the FMI logger callback.
+//!
+//! The C logger is variadic with printf semantics. Every message is formatted in Rust and passed
+//! as `logger(env, instanceName, status, category, "%s", message)`, so a `%` in a message (a path,
+//! a model name) can never act as a format directive.
+//!
+//! Categories are the ones declared in `modelDescription.xml` ([`CATEGORIES`], rendered from this
+//! table). A message goes out only when its category is enabled:
+//! * `fmi2Instantiate(loggingOn = true)` enables all of them;
+//! * `loggingOn = false` keeps only `logStatusDiscard`, `logStatusError` and `logStatusFatal`, so
+//!   that a failing call still explains itself (switch those off with `fmi2SetDebugLogging`);
+//! * `fmi2SetDebugLogging(on, 0, NULL)` switches all, `(on, n, names)` the named ones
+//!   (`logAll` stands for every category).
+
+use std::ffi::CString;
+
+use super::types::{Fmi2CallbackLogger, Fmi2ComponentEnvironment, Status};
+
+/// The declared log categories: name and description (`<LogCategories>`).
+pub const CATEGORIES: [(&str, &str); 6] = [
+    (
+        "logEvents",
+        "initialization, steps and their Newton statistics, state save/restore",
+    ),
+    ("logStatusWarning", "calls that return fmi2Warning"),
+    (
+        "logStatusDiscard",
+        "steps that did not converge (fmi2Discard): the last converged state is kept",
+    ),
+    (
+        "logStatusError",
+        "calls that return fmi2Error: bad arguments, wrong call order, invalid parameters",
+    ),
+    (
+        "logStatusFatal",
+        "internal errors (fmi2Fatal): the instance must be freed",
+    ),
+    ("logAll", "all of the above"),
+];
+
+const EVENTS: usize = 0;
+const ALL: usize = 5;
+
+/// The category a message of this status goes to.
+fn category_of(status: Status) -> usize {
+    match status {
+        Status::Ok | Status::Pending => EVENTS,
+        Status::Warning => 1,
+        Status::Discard => 2,
+        Status::Error => 3,
+        Status::Fatal => 4,
+    }
+}
+
+/// One instance's logger: a copy of the callback, the environment pointer, the instance name
+/// and the enabled categories.
+#[derive(Clone, Debug)]
+pub struct Logger {
+    callback: Fmi2CallbackLogger,
+    environment: Fmi2ComponentEnvironment,
+    instance_name: CString,
+    enabled: [bool; CATEGORIES.len()],
+}
+
+impl Logger {
+    /// A logger for `instance_name`; `callback` may be `None` (messages are then dropped).
+    pub fn new(
+        callback: Fmi2CallbackLogger,
+        environment: Fmi2ComponentEnvironment,
+        instance_name: &str,
+        logging_on: bool,
+    ) -> Self {
+        let mut enabled = [logging_on; CATEGORIES.len()];
+        for status in [Status::Discard, Status::Error, Status::Fatal] {
+            enabled[category_of(status)] = true;
+        }
+        Self {
+            callback,
+            environment,
+            instance_name: c_string(instance_name),
+            enabled,
+        }
+    }
+
+    /// A logger that drops every message.
+    pub fn silent() -> Self {
+        Self::new(None, std::ptr::null_mut(), "", false)
+    }
+
+    /// `fmi2SetDebugLogging`: switch all categories (`names` empty) or the named ones.
+    /// An unknown name changes nothing and is reported.
+    pub fn set_debug_logging(&mut self, on: bool, names: &[&str]) -> Result<(), String> {
+        if names.is_empty() {
+            self.enabled = [on; CATEGORIES.len()];
+            return Ok(());
+        }
+        let mut indices = Vec::with_capacity(names.len());
+        for name in names {
+            match CATEGORIES.iter().position(|(c, _)| c == name) {
+                Some(i) => indices.push(i),
+                None => {
+                    let known: Vec<&str> = CATEGORIES.iter().map(|(c, _)| *c).collect();
+                    return Err(format!(
+                        "unknown log category '{name}' (declared: {})",
+                        known.join(", ")
+                    ));
+                }
+            }
+        }
+        for i in indices {
+            if i == ALL {
+                self.enabled = [on; CATEGORIES.len()];
+            } else {
+                self.enabled[i] = on;
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether a message of `status` would be passed on.
+    pub fn is_enabled(&self, status: Status) -> bool {
+        self.callback.is_some() && self.enabled[category_of(status)]
+    }
+
+    /// Sends `message` with `status` to the importer if its category is enabled.
+    pub fn log(&self, status: Status, message: &str) {
+        let Some(callback) = self.callback else {
+            return;
+        };
+        let category = category_of(status);
+        if !self.enabled[category] {
+            return;
+        }
+        let category = c_string(CATEGORIES[category].0);
+        let message = c_string(message);
+        // SAFETY: `callback` is the importer's fmi2CallbackLogger, copied from the callbacks
+        // struct in fmi2Instantiate (FMI 2.0 §2.1.5 requires it to stay callable for the life of
+        // the instance). Every pointer passed is a NUL-terminated string that outlives the call,
+        // and the format "%s" consumes exactly the one vararg that follows it, a C string.
+        unsafe {
+            callback(
+                self.environment,
+                self.instance_name.as_ptr(),
+                status.raw(),
+                category.as_ptr(),
+                c"%s".as_ptr(),
+                message.as_ptr(),
+            )
+        };
+    }
+}
+
+/// A C string of `text`; an interior NUL (which C would read as the end) becomes U+FFFD.
+fn c_string(text: &str) -> CString {
+    CString::new(text.replace('\0', "\u{FFFD}")).expect("no NUL left")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_categories_follow_logging_on() {
+        let on = Logger::new(None, std::ptr::null_mut(), "a", true);
+        assert!(on.enabled.iter().all(|&e| e));
+        let off = Logger::new(None, std::ptr::null_mut(), "a", false);
+        assert!(!off.enabled[category_of(Status::Ok)]);
+        assert!(
+            off.enabled[category_of(Status::Error)] && off.enabled[category_of(Status::Discard)]
+        );
+        // Without a callback nothing is ever "enabled".
+        assert!(!on.is_enabled(Status::Error));
+    }
+
+    #[test]
+    fn set_debug_logging_by_name_and_all() {
+        let mut l = Logger::new(None, std::ptr::null_mut(), "a", false);
+        l.set_debug_logging(true, &["logEvents"]).unwrap();
+        assert!(l.enabled[EVENTS]);
+        l.set_debug_logging(false, &["logAll"]).unwrap();
+        assert!(l.enabled.iter().all(|&e| !e));
+        l.set_debug_logging(true, &[]).unwrap();
+        assert!(l.enabled.iter().all(|&e| e));
+        let err = l
+            .set_debug_logging(false, &["logStatusError", "nope"])
+            .unwrap_err();
+        assert!(err.contains("'nope'"), "{err}");
+        assert!(
+            l.enabled[category_of(Status::Error)],
+            "a failed call changes nothing"
+        );
+    }
+
+    #[test]
+    fn c_string_replaces_nul() {
+        assert_eq!(c_string("a\0b").to_str().unwrap(), "a\u{FFFD}b");
+    }
+}

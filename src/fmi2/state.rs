@@ -1,0 +1,189 @@
+//! FMU states: what `fmi2GetFMUstate` saves, and the byte format of `fmi2SerializeFMUstate`.
+//!
+//! A [`Snapshot`] holds everything a restored instance needs to continue exactly as the original
+//! would: the phase, every variable value (parameters, inputs, the last outputs and solver
+//! statistics), the time, the experiment setup and the converged [`AnalysisState`].
+//!
+//! Serialized form (little endian), version 1:
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `MCFMI2ST` |
+//! | 4 | format version |
+//! | 4 + n | GUID length and GUID (UTF-8): a state only goes back into the same FMU |
+//! | 8 | payload length |
+//! | 4 | CRC-32 of all preceding bytes and the payload |
+//! | payload | the snapshot as JSON (serde_json with exact float round trip) |
+
+use serde::{Deserialize, Serialize};
+
+use super::instance::Phase;
+use super::variables::Value;
+use crate::mech::AnalysisState;
+
+/// Everything needed to continue an instance exactly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Snapshot {
+    pub phase: Phase,
+    /// One value per variable of the table (outputs: the last computed ones).
+    pub values: Vec<Value>,
+    /// Whether `mu` has been set (only then does it override the model's friction).
+    pub mu_set: bool,
+    pub time: f64,
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
+    /// Whether the outputs in `values` belong to the current analysis state.
+    pub outputs_fresh: bool,
+    /// The converged state, when an analysis exists.
+    pub analysis: Option<AnalysisState>,
+}
+
+const MAGIC: &[u8; 8] = b"MCFMI2ST";
+const VERSION: u32 = 1;
+
+/// The serialized bytes of `snapshot` for the FMU with `guid`.
+pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
+    let payload =
+        serde_json::to_vec(snapshot).expect("a snapshot holds only finite numbers and serializes");
+    let mut out = Vec::with_capacity(payload.len() + guid.len() + 32);
+    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(&VERSION.to_le_bytes());
+    out.extend_from_slice(&(guid.len() as u32).to_le_bytes());
+    out.extend_from_slice(guid.as_bytes());
+    out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&out);
+    crc.update(&payload);
+    out.extend_from_slice(&crc.finalize().to_le_bytes());
+    out.extend_from_slice(&payload);
+    out
+}
+
+/// Reads serialized bytes back; refuses foreign, truncated or corrupt buffers with a message.
+pub fn deserialize(bytes: &[u8], guid: &str) -> Result<Snapshot, String> {
+    let mut r = Reader { bytes, at: 0 };
+    if r.take(MAGIC.len()).ok() != Some(MAGIC.as_slice()) {
+        return Err("not a serialized state of a membrane-contact FMU (wrong magic bytes)".into());
+    }
+    let version = r.u32()?;
+    if version != VERSION {
+        return Err(format!(
+            "serialized state format version {version}; this FMU reads version {VERSION}"
+        ));
+    }
+    let guid_len = r.u32()? as usize;
+    let their_guid = r.take(guid_len)?;
+    if their_guid != guid.as_bytes() {
+        return Err(format!(
+            "the state was serialized by another FMU (GUID {}); this one is {guid}",
+            String::from_utf8_lossy(their_guid)
+        ));
+    }
+    let payload_len = r.u64()?;
+    let header_end = r.at;
+    let stored_crc = r.u32()?;
+    let remaining = (bytes.len() - r.at) as u64;
+    if remaining != payload_len {
+        return Err(format!(
+            "serialized state has {remaining} payload bytes, its header says {payload_len}"
+        ));
+    }
+    let payload = &bytes[r.at..];
+    let mut crc = crc32fast::Hasher::new();
+    crc.update(&bytes[..header_end]);
+    crc.update(payload);
+    if crc.finalize() != stored_crc {
+        return Err("serialized state is corrupt (checksum mismatch)".into());
+    }
+    serde_json::from_slice(payload).map_err(|e| format!("serialized state payload: {e}"))
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    at: usize,
+}
+
+impl<'a> Reader<'a> {
+    fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
+        let end = self.at.checked_add(n).filter(|&e| e <= self.bytes.len());
+        let end = end
+            .ok_or_else(|| format!("serialized state is truncated ({} bytes)", self.bytes.len()))?;
+        let s = &self.bytes[self.at..end];
+        self.at = end;
+        Ok(s)
+    }
+
+    fn u32(&mut self) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(
+            self.take(4)?.try_into().expect("4 bytes"),
+        ))
+    }
+
+    fn u64(&mut self) -> Result<u64, String> {
+        Ok(u64::from_le_bytes(
+            self.take(8)?.try_into().expect("8 bytes"),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mech::{Analysis, ParallelArch};
+
+    /// A real converged state (one step of the specimen), whatever fields it has.
+    fn converged_state() -> AnalysisState {
+        let spec = ParallelArch::default();
+        let mut a = Analysis::new(spec.model().unwrap(), Default::default()).unwrap();
+        a.step_to(&[[0.0, 0.0, 0.1 * spec.target()[2]]], 1).unwrap();
+        a.state().clone()
+    }
+
+    fn snapshot() -> Snapshot {
+        Snapshot {
+            phase: Phase::StepComplete,
+            values: vec![
+                Value::Real(0.1 + 0.2),
+                Value::Integer(-3),
+                Value::Boolean(true),
+                Value::Real(1e-300),
+            ],
+            mu_set: true,
+            time: 0.35000000000000003,
+            start_time: 0.0,
+            stop_time: Some(1.0),
+            outputs_fresh: true,
+            analysis: Some(converged_state()),
+        }
+    }
+
+    const GUID: &str = "{00000000-0000-5000-8000-000000000000}";
+
+    #[test]
+    fn round_trip_is_exact() {
+        let s = snapshot();
+        let bytes = serialize(&s, GUID);
+        assert_eq!(deserialize(&bytes, GUID).unwrap(), s);
+    }
+
+    #[test]
+    fn foreign_and_corrupt_buffers_are_refused() {
+        let bytes = serialize(&snapshot(), GUID);
+        let check = |b: &[u8], expect: &str| {
+            let err = deserialize(b, GUID).unwrap_err();
+            assert!(err.contains(expect), "{expect}: {err}");
+        };
+        check(b"", "magic");
+        check(b"garbage garbage garbage", "magic");
+        check(&bytes[..bytes.len() - 1], "payload bytes");
+        check(&bytes[..20], "truncated");
+        let mut flipped = bytes.clone();
+        *flipped.last_mut().unwrap() ^= 1;
+        check(&flipped, "checksum");
+        let mut version = bytes.clone();
+        version[8] = 9;
+        check(&version, "version 9");
+        let other = serialize(&snapshot(), "{11111111-0000-5000-8000-000000000000}");
+        check(&other, "another FMU");
+    }
+}

@@ -1,0 +1,730 @@
+//! Tests of the glue through the exported functions, called as an importer calls them.
+//!
+//! TEST GOAL: the C boundary behaves as FMI 2.0 says (and as `instance.rs` documents where it
+//! deviates): lifecycle, value references, bad pointers and values, wrong call order, GUID check,
+//! Discard and retry, FMU state save/restore and (de)serialization, independent instances on
+//! several threads, a panic turned into fmi2Fatal.
+//!
+//! MODEL: the default ParallelArch specimen (1/4 model, 121 nodes, 200 triangles, gaps G1..G9,
+//! boundary group `frame`), written to a temporary `resources/` directory.
+//!
+//! BOUNDARY CONDITIONS: `frame.dz` ramped towards the specimen target −H/2 = −0.15 m.
+
+use std::ffi::{CStr, CString, c_char, c_int, c_void};
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+use super::description::describe;
+use super::exports::*;
+use super::instance::allowed;
+use super::resources::Source;
+use super::types::*;
+use super::variables::Variable;
+use crate::mech::ParallelArch;
+
+/// Messages received by the test logger: (status, category, message).
+#[derive(Default)]
+struct Log(Mutex<Vec<(c_int, String, String)>>);
+
+impl Log {
+    fn take(&self) -> Vec<(c_int, String, String)> {
+        std::mem::take(&mut *self.0.lock().unwrap())
+    }
+
+    fn contains(&self, status: Status, text: &str) -> bool {
+        self.0
+            .lock()
+            .unwrap()
+            .iter()
+            .any(|(s, _, m)| *s == status.raw() && m.contains(text))
+    }
+}
+
+/// Receives the logger call `(env, name, status, category, "%s", message)`.
+unsafe extern "C" fn capture(
+    env: *mut c_void,
+    _name: *const c_char,
+    status: c_int,
+    category: *const c_char,
+    format: *const c_char,
+    message: *const c_char,
+) {
+    // SAFETY: the FMU passes its NUL-terminated strings, and `env` is the `Log` given below.
+    let (log, category, format, message) = unsafe {
+        (
+            &*env.cast::<Log>(),
+            CStr::from_ptr(category),
+            CStr::from_ptr(format),
+            CStr::from_ptr(message),
+        )
+    };
+    assert_eq!(
+        format.to_bytes(),
+        b"%s",
+        "messages are never used as the format"
+    );
+    log.0.lock().unwrap().push((
+        status,
+        category.to_str().unwrap().into(),
+        message.to_str().unwrap().into(),
+    ));
+}
+
+fn callbacks(log: &Log) -> Fmi2CallbackFunctions {
+    let logger: unsafe extern "C" fn(
+        *mut c_void,
+        *const c_char,
+        c_int,
+        *const c_char,
+        *const c_char,
+        *const c_char,
+    ) = capture;
+    Fmi2CallbackFunctions {
+        // SAFETY (test only): on the Linux x86-64 and AArch64 C ABIs a variadic call whose six
+        // arguments are all integer-class is passed exactly like a call to a non-variadic
+        // function of those six parameters (the way ctypes loggers receive it). Stable Rust
+        // cannot define a variadic function, so the capture function is given this type.
+        logger: unsafe {
+            std::mem::transmute::<
+                unsafe extern "C" fn(
+                    *mut c_void,
+                    *const c_char,
+                    c_int,
+                    *const c_char,
+                    *const c_char,
+                    *const c_char,
+                ),
+                Fmi2CallbackLogger,
+            >(logger)
+        },
+        allocate_memory: None,
+        free_memory: None,
+        step_finished: None,
+        component_environment: std::ptr::from_ref(log).cast_mut().cast(),
+    }
+}
+
+/// A temporary unpacked FMU: `resources/` with the specimen, and its GUID and variables.
+struct Unpacked {
+    dir: PathBuf,
+    guid: CString,
+    uri: CString,
+    variables: Vec<Variable>,
+}
+
+impl Unpacked {
+    fn new(tag: &str, source: Source) -> Self {
+        let id = format!(
+            "mc fmi2 test {tag} {}-{:?}",
+            std::process::id(),
+            std::thread::current().id()
+        );
+        let dir = std::env::temp_dir()
+            .join(id.replace(['(', ')'], ""))
+            .join("resources");
+        std::fs::create_dir_all(&dir).unwrap();
+        source.save(&dir).unwrap();
+        let d = describe(&source).unwrap();
+        // Percent-encode the spaces, as fmpy does.
+        let uri = format!("file://{}", dir.display()).replace(' ', "%20");
+        Self {
+            dir,
+            guid: CString::new(d.guid).unwrap(),
+            uri: CString::new(uri).unwrap(),
+            variables: d.variables,
+        }
+    }
+
+    fn specimen(tag: &str) -> Self {
+        Self::new(tag, Source::ParallelArch(ParallelArch::default()))
+    }
+
+    fn vr(&self, name: &str) -> u32 {
+        self.variables
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap_or_else(|| panic!("no variable {name}"))
+            .value_reference
+    }
+}
+
+impl Drop for Unpacked {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(self.dir.parent().unwrap());
+    }
+}
+
+/// One instance, driven through the exported functions.
+struct Fmu<'a> {
+    c: Fmi2Component,
+    u: &'a Unpacked,
+    log: &'a Log,
+}
+
+impl<'a> Fmu<'a> {
+    fn new(u: &'a Unpacked, log: &'a Log) -> Self {
+        let f = callbacks(log);
+        // SAFETY: valid strings and callbacks for the duration of the call.
+        let c = unsafe {
+            fmi2_instantiate(
+                c"inst".as_ptr(),
+                FMI2_CO_SIMULATION,
+                u.guid.as_ptr(),
+                u.uri.as_ptr(),
+                &f,
+                0,
+                1,
+            )
+        };
+        assert!(!c.is_null(), "instantiate: {:?}", log.take());
+        Self { c, u, log }
+    }
+
+    /// Instantiated, parameters set, initialized.
+    fn initialized(
+        u: &'a Unpacked,
+        log: &'a Log,
+        reals: &[(&str, f64)],
+        integers: &[(&str, i32)],
+    ) -> Self {
+        let fmu = Self::new(u, log);
+        unsafe {
+            assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+        }
+        for (n, v) in reals {
+            assert_eq!(fmu.set_real(n, *v), 0, "{n}");
+        }
+        for (n, v) in integers {
+            assert_eq!(fmu.set_integer(n, *v), 0, "{n}");
+        }
+        assert_eq!(
+            unsafe { fmi2_exit_initialization_mode(fmu.c) },
+            0,
+            "{:?}",
+            log.take()
+        );
+        fmu
+    }
+
+    fn set_real(&self, name: &str, v: f64) -> c_int {
+        unsafe { fmi2_set_real(self.c, &self.u.vr(name), 1, &v) }
+    }
+
+    fn set_integer(&self, name: &str, v: i32) -> c_int {
+        unsafe { fmi2_set_integer(self.c, &self.u.vr(name), 1, &v) }
+    }
+
+    fn real(&self, name: &str) -> f64 {
+        let mut v = f64::NAN;
+        assert_eq!(
+            unsafe { fmi2_get_real(self.c, &self.u.vr(name), 1, &mut v) },
+            0,
+            "{name}"
+        );
+        v
+    }
+
+    fn integer(&self, name: &str) -> i32 {
+        let mut v = -1;
+        assert_eq!(
+            unsafe { fmi2_get_integer(self.c, &self.u.vr(name), 1, &mut v) },
+            0,
+            "{name}"
+        );
+        v
+    }
+
+    fn step(&self, t: f64, h: f64) -> c_int {
+        unsafe { fmi2_do_step(self.c, t, h, 1) }
+    }
+
+    /// Every Real and Integer variable, for exact comparisons.
+    fn all_values(&self) -> (Vec<f64>, Vec<i32>) {
+        let (mut reals, mut ints) = (Vec::new(), Vec::new());
+        for v in &self.u.variables {
+            match v.var_type {
+                super::variables::VarType::Real => reals.push(self.real(&v.name)),
+                super::variables::VarType::Integer => ints.push(self.integer(&v.name)),
+                super::variables::VarType::Boolean => {}
+            }
+        }
+        (reals, ints)
+    }
+
+    /// Steps `frame.dz` linearly to `fraction` of the target in `n` steps of the ramp over [0, 1].
+    fn ramp(&self, from_step: usize, to_step: usize, n: usize) {
+        let target = ParallelArch::default().target()[2];
+        for k in from_step..to_step {
+            let t = k as f64 / n as f64;
+            assert_eq!(
+                self.set_real("frame.dz", target * ((k + 1) as f64 / n as f64)),
+                0
+            );
+            assert_eq!(
+                self.step(t, 1.0 / n as f64),
+                0,
+                "step {k}: {:?}",
+                self.log.take()
+            );
+        }
+    }
+}
+
+impl Drop for Fmu<'_> {
+    fn drop(&mut self) {
+        unsafe { fmi2_free_instance(self.c) };
+    }
+}
+
+#[test]
+fn inquiry_functions() {
+    let s = |p: *const c_char| unsafe { CStr::from_ptr(p) }.to_str().unwrap().to_string();
+    assert_eq!(s(fmi2_get_types_platform()), "default");
+    assert_eq!(s(fmi2_get_version()), "2.0");
+}
+
+#[test]
+fn a_ramp_reaches_the_cores_result() {
+    let (u, log) = (Unpacked::specimen("ramp"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 1)]);
+    assert_eq!(fmu.real("time"), 0.0);
+    // Initial outputs: undeformed, prestressed film.
+    assert_eq!(fmu.real("G5.slip"), 0.0);
+    assert!((fmu.real("film.maxEquivalentStress") - 0.5e6).abs() < 1.0);
+    fmu.ramp(0, 10, 10);
+    assert!((fmu.real("time") - 1.0).abs() < 1e-12);
+    assert!(fmu.integer("solver.iterations") > 0);
+
+    // The same path through the core directly.
+    let spec = ParallelArch::default();
+    let mut a = crate::mech::Analysis::new(spec.model().unwrap(), Default::default()).unwrap();
+    for k in 1..=10 {
+        a.step_to(&[[0.0, 0.0, spec.target()[2] * (k as f64 / 10.0)]], 1)
+            .unwrap();
+    }
+    let r = a.results();
+    for (i, g) in r.gaps.iter().enumerate() {
+        let name = format!("G{}", i + 1);
+        assert_eq!(fmu.real(&format!("{name}.slip")), g.slip_x, "{name}");
+        assert_eq!(
+            fmu.real(&format!("{name}.normalForce")),
+            g.normal_force,
+            "{name}"
+        );
+        assert_eq!(
+            fmu.integer(&format!("{name}.status")),
+            g.status as i32,
+            "{name}"
+        );
+    }
+    assert_eq!(fmu.real("frame.Rz"), r.reactions[0][2]);
+    assert!(
+        fmu.real("G9.slip") > 0.01,
+        "the film slides towards the arch foot"
+    );
+}
+
+#[test]
+fn bad_guid_and_bad_arguments_to_instantiate() {
+    let (u, log) = (Unpacked::specimen("guid"), Log::default());
+    let f = callbacks(&log);
+    let bad = c"{00000000-0000-0000-0000-000000000000}";
+    let c = unsafe {
+        fmi2_instantiate(
+            c"x".as_ptr(),
+            FMI2_CO_SIMULATION,
+            bad.as_ptr(),
+            u.uri.as_ptr(),
+            &f,
+            0,
+            0,
+        )
+    };
+    assert!(c.is_null());
+    assert!(
+        log.contains(Status::Error, "GUID mismatch"),
+        "{:?}",
+        log.take()
+    );
+    let cases: [(Fmi2String, c_int, Fmi2String, Fmi2String, &str); 5] = [
+        (
+            std::ptr::null(),
+            1,
+            u.guid.as_ptr(),
+            u.uri.as_ptr(),
+            "instanceName is NULL",
+        ),
+        (
+            c" ".as_ptr(),
+            1,
+            u.guid.as_ptr(),
+            u.uri.as_ptr(),
+            "instanceName is empty",
+        ),
+        (
+            c"x".as_ptr(),
+            0,
+            u.guid.as_ptr(),
+            u.uri.as_ptr(),
+            "Co-Simulation (1) only",
+        ),
+        (
+            c"x".as_ptr(),
+            1,
+            u.guid.as_ptr(),
+            std::ptr::null(),
+            "fmuResourceLocation is NULL",
+        ),
+        (
+            c"x".as_ptr(),
+            1,
+            u.guid.as_ptr(),
+            c"file:///nonexistent/resources".as_ptr(),
+            "holds neither",
+        ),
+    ];
+    for (name, kind, guid, uri, expect) in cases {
+        let c = unsafe { fmi2_instantiate(name, kind, guid, uri, &f, 0, 0) };
+        assert!(c.is_null(), "{expect}");
+        assert!(
+            log.contains(Status::Error, expect),
+            "{expect}: {:?}",
+            log.take()
+        );
+    }
+    // No callbacks at all: still no crash.
+    let c = unsafe {
+        fmi2_instantiate(
+            c"x".as_ptr(),
+            1,
+            bad.as_ptr(),
+            u.uri.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+        )
+    };
+    assert!(c.is_null());
+    unsafe { fmi2_free_instance(std::ptr::null_mut()) };
+}
+
+#[test]
+fn bad_calls_return_error_with_a_message_and_change_nothing() {
+    let (u, log) = (Unpacked::specimen("bad"), Log::default());
+    let fmu = Fmu::new(&u, &log);
+    let c = fmu.c;
+    let err = Status::Error.raw();
+    unsafe {
+        // Wrong state.
+        assert_eq!(fmi2_do_step(c, 0.0, 0.1, 1), err);
+        assert!(log.contains(
+            Status::Error,
+            "fmi2DoStep must not be called in state Instantiated"
+        ));
+        let mut v = 0.0;
+        assert_eq!(
+            fmi2_get_real(c, &0, 1, &mut v),
+            err,
+            "no Get before initialization mode"
+        );
+        // NULL instance.
+        assert_eq!(fmi2_do_step(std::ptr::null_mut(), 0.0, 0.1, 1), err);
+        assert_eq!(fmi2_setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(c), 0);
+        // NULL arrays with n > 0.
+        assert_eq!(fmi2_get_real(c, std::ptr::null(), 1, &mut v), err);
+        assert!(log.contains(Status::Error, "vr is NULL"));
+        assert_eq!(fmi2_set_real(c, &u.vr("mu"), 1, std::ptr::null()), err);
+        assert!(log.contains(Status::Error, "value is NULL"));
+        // n = 0 with NULL is fine.
+        assert_eq!(
+            fmi2_get_real(c, std::ptr::null(), 0, std::ptr::null_mut()),
+            0
+        );
+        // Unknown value reference, wrong type.
+        assert_eq!(fmi2_get_real(c, &100_000, 1, &mut v), err);
+        assert!(log.contains(Status::Error, "value reference 100000 does not exist"));
+        let mut i = 0;
+        assert_eq!(fmi2_get_integer(c, &u.vr("mu"), 1, &mut i), err);
+        assert!(log.contains(Status::Error, "(mu) is a Real, not an Integer"));
+        let mut s: Fmi2String = std::ptr::null();
+        assert_eq!(fmi2_get_string(c, &0, 1, &mut s), err);
+        // Non-finite and out-of-range values; outputs and time cannot be set.
+        for (name, value, expect) in [
+            ("frame.dz", f64::NAN, "values must be finite"),
+            ("film.E", f64::INFINITY, "values must be finite"),
+            ("mu", -0.1, "must be ≥ 0"),
+            ("G1.slip", 1.0, "is an output"),
+            ("time", 1.0, "time cannot be set"),
+        ] {
+            assert_eq!(fmu.set_real(name, value), err, "{name}");
+            assert!(
+                log.contains(Status::Error, expect),
+                "{name}: {:?}",
+                log.take()
+            );
+        }
+        // A set with one bad element changes none of them.
+        let vrs = [u.vr("frame.dx"), u.vr("frame.dy")];
+        assert_eq!(
+            fmi2_set_real(c, vrs.as_ptr(), 2, [0.5, f64::NAN].as_ptr()),
+            err
+        );
+        assert_eq!(fmu.real("frame.dx"), 0.0);
+        // Unsupported functions.
+        assert_eq!(
+            fmi2_get_directional_derivative(c, &0, 1, &0, 1, &0.0, &mut v),
+            err
+        );
+        assert!(log.contains(Status::Error, "providesDirectionalDerivative"));
+        assert_eq!(fmi2_set_time(c, 0.0), err);
+        assert!(log.contains(Status::Error, "Model Exchange"));
+        // Unknown log category.
+        let names = [c"nope".as_ptr()];
+        assert_eq!(fmi2_set_debug_logging(c, 1, 1, names.as_ptr()), err);
+        assert!(log.contains(Status::Error, "unknown log category 'nope'"));
+        // A bad parameter fails ExitInitializationMode with the core's message; fixing it works.
+        assert_eq!(fmu.set_real("film.E", -1.0), 0);
+        assert_eq!(fmi2_exit_initialization_mode(c), err);
+        assert!(
+            log.contains(Status::Error, "E = -1 must be > 0"),
+            "{:?}",
+            log.take()
+        );
+        assert_eq!(fmu.set_integer("solver.incrementsPerStep", 0), 0);
+        assert_eq!(fmu.set_real("film.E", 1e9), 0);
+        assert_eq!(fmi2_exit_initialization_mode(c), err);
+        assert!(log.contains(Status::Error, "solver.incrementsPerStep = 0 must be ≥ 1"));
+        assert_eq!(fmu.set_integer("solver.incrementsPerStep", 2), 0);
+        assert_eq!(fmi2_exit_initialization_mode(c), 0);
+        // Parameters are fixed after initialization; steps check time and size.
+        assert_eq!(fmu.set_real("film.E", 2e9), err);
+        assert!(log.contains(Status::Error, "film.E is a fixed parameter"));
+        assert_eq!(fmu.step(0.5, 0.1), err);
+        assert!(log.contains(Status::Error, "differs from the FMU's time 0"));
+        assert_eq!(fmu.step(0.0, 0.0), err);
+        assert_eq!(fmu.step(0.0, f64::NAN), err);
+        // CancelStep: there is never a step in progress.
+        assert_eq!(fmi2_cancel_step(c), err);
+    }
+    assert_eq!(
+        fmu.step(0.0, 0.1),
+        0,
+        "the instance still works after all that"
+    );
+}
+
+#[test]
+fn logging_follows_the_categories() {
+    let (u, log) = (Unpacked::specimen("log"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    fmu.ramp(0, 1, 20);
+    let messages = log.take();
+    assert!(
+        messages
+            .iter()
+            .any(|(s, c, m)| *s == 0 && c == "logEvents" && m.contains("step to t = 0.05")),
+        "{messages:?}"
+    );
+    let off = [c"logEvents".as_ptr()];
+    assert_eq!(
+        unsafe { fmi2_set_debug_logging(fmu.c, 0, 1, off.as_ptr()) },
+        0
+    );
+    fmu.ramp(1, 2, 20);
+    assert!(log.take().is_empty());
+    assert_eq!(
+        unsafe { fmi2_set_debug_logging(fmu.c, 0, 0, std::ptr::null()) },
+        0
+    );
+    assert_eq!(fmu.step(0.0, 0.1), Status::Error.raw());
+    assert!(
+        log.take().is_empty(),
+        "all categories off: even errors are silent"
+    );
+}
+
+#[test]
+fn a_step_that_cannot_converge_is_discarded_and_can_be_retried() {
+    let (u, log) = (Unpacked::specimen("discard"), Log::default());
+    // Small steps converge in fewer than 10 iterations; a jump to the target in one increment
+    // does not, and no cut-back may rescue it.
+    let settings = [
+        ("solver.maxCutbacks", 0),
+        ("solver.maxIterations", 10),
+        ("solver.incrementsPerStep", 1),
+    ];
+    let fmu = Fmu::initialized(&u, &log, &[], &settings);
+    fmu.ramp(0, 3, 40);
+    let before = fmu.all_values();
+    assert_eq!(fmu.set_real("frame.dz", -0.15), 0);
+    assert_eq!(fmu.step(0.075, 0.925), Status::Discard.raw());
+    assert!(
+        log.contains(Status::Discard, "did not converge"),
+        "{:?}",
+        log.take()
+    );
+    let mut status = 0;
+    assert_eq!(
+        unsafe { fmi2_get_status(fmu.c, FMI2_DO_STEP_STATUS, &mut status) },
+        0
+    );
+    assert_eq!(status, Status::Discard.raw());
+    let mut last = f64::NAN;
+    assert_eq!(
+        unsafe { fmi2_get_real_status(fmu.c, FMI2_LAST_SUCCESSFUL_TIME, &mut last) },
+        0
+    );
+    assert!((last - 0.075).abs() < 1e-15, "{last}");
+    // Outputs and time are those of the last converged state (only the input changed).
+    let mut after = fmu.all_values();
+    let dz = u
+        .variables
+        .iter()
+        .filter(|v| v.var_type == super::variables::VarType::Real)
+        .position(|v| v.name == "frame.dz");
+    after.0[dz.unwrap()] = before.0[dz.unwrap()];
+    assert_eq!(after, before);
+    // Retry with a smaller change from the same time.
+    fmu.ramp(3, 4, 40);
+    assert!((fmu.real("time") - 0.1).abs() < 1e-15);
+    assert_eq!(
+        unsafe { fmi2_get_status(fmu.c, FMI2_DO_STEP_STATUS, &mut status) },
+        0
+    );
+    assert_eq!(status, 0);
+}
+
+#[test]
+fn saved_states_restore_and_continue_identically() {
+    let (u, log) = (Unpacked::specimen("state"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[("mu", 0.3)], &[("solver.incrementsPerStep", 2)]);
+    fmu.ramp(0, 4, 10);
+    let mut state: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+    assert!(!state.is_null());
+    let at_save = fmu.all_values();
+    fmu.ramp(4, 10, 10);
+    let reference = fmu.all_values();
+
+    // Restore in place and continue.
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, state) }, 0);
+    assert_eq!(fmu.all_values(), at_save);
+    fmu.ramp(4, 10, 10);
+    assert_eq!(fmu.all_values(), reference);
+
+    // Serialize, and continue in a fresh instance with other parameters set.
+    let mut size = 0;
+    assert_eq!(
+        unsafe { fmi2_serialized_fmu_state_size(fmu.c, state, &mut size) },
+        0
+    );
+    let mut bytes = vec![0 as Fmi2Byte; size];
+    assert_eq!(
+        unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size) },
+        0
+    );
+    assert_eq!(
+        unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size - 1) },
+        Status::Error.raw()
+    );
+    let other = Fmu::initialized(&u, &log, &[("film.E", 2e9)], &[]);
+    let mut restored: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(other.c, bytes.as_ptr(), size, &mut restored) },
+        0
+    );
+    assert_eq!(unsafe { fmi2_set_fmu_state(other.c, restored) }, 0);
+    assert_eq!(other.all_values(), at_save);
+    other.ramp(4, 10, 10);
+    assert_eq!(
+        other.all_values(),
+        reference,
+        "the deserialized state continues exactly"
+    );
+
+    // Corrupt and foreign buffers, unknown and freed handles.
+    bytes[size / 2] ^= 0x5a;
+    let mut s2: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(other.c, bytes.as_ptr(), size, &mut s2) },
+        Status::Error.raw()
+    );
+    assert!(log.contains(Status::Error, "checksum"), "{:?}", log.take());
+    assert!(s2.is_null());
+    let junk = [7 as Fmi2Byte; 64];
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(other.c, junk.as_ptr(), 64, &mut s2) },
+        Status::Error.raw()
+    );
+    assert!(log.contains(Status::Error, "magic"));
+    assert_eq!(
+        unsafe { fmi2_set_fmu_state(other.c, state) },
+        Status::Error.raw(),
+        "a state of another instance"
+    );
+    assert!(log.contains(Status::Error, "was not created by this instance"));
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
+    assert!(state.is_null());
+    assert_eq!(
+        unsafe { fmi2_free_fmu_state(fmu.c, &mut state) },
+        0,
+        "freeing NULL is ignored"
+    );
+    assert_eq!(unsafe { fmi2_free_fmu_state(other.c, &mut restored) }, 0);
+}
+
+#[test]
+fn reset_returns_to_the_instantiated_state() {
+    let (u, log) = (Unpacked::specimen("reset"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[("mu", 0.5), ("film.E", 2e9)], &[]);
+    fmu.ramp(0, 2, 20);
+    assert_eq!(unsafe { fmi2_reset(fmu.c) }, 0);
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(fmu.real("time"), 0.0);
+    assert_eq!(fmu.real("mu"), 0.2);
+    assert_eq!(fmu.real("film.E"), 1e9);
+    assert_eq!(fmu.real("frame.dz"), 0.0);
+    assert_eq!(fmu.real("G9.slip"), 0.0);
+    assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+    fmu.ramp(0, 1, 20);
+}
+
+#[test]
+fn instances_on_several_threads_are_independent() {
+    let u = Unpacked::specimen("threads");
+    let run = |mu: f64| {
+        let log = Log::default();
+        let fmu = Fmu::initialized(&u, &log, &[("mu", mu)], &[("solver.incrementsPerStep", 1)]);
+        fmu.ramp(0, 10, 10);
+        fmu.all_values()
+    };
+    let alone = [run(0.1), run(0.4)];
+    let together = std::thread::scope(|s| {
+        let a = s.spawn(|| run(0.1));
+        let b = s.spawn(|| run(0.4));
+        [a.join().unwrap(), b.join().unwrap()]
+    });
+    assert_eq!(alone, together);
+    assert_ne!(alone[0], alone[1]);
+}
+
+#[test]
+fn a_panic_becomes_fatal_and_the_instance_is_closed() {
+    let (u, log) = (Unpacked::specimen("panic"), Log::default());
+    let fmu = Fmu::new(&u, &log);
+    // SAFETY: `fmu.c` is a live instance used by this thread only.
+    let status =
+        unsafe { super::guard::with_instance(fmu.c, "fmi2Test", allowed::ANY, |_| panic!("boom")) };
+    assert_eq!(status, Status::Fatal.raw());
+    assert!(log.contains(Status::Fatal, "internal error (panic): boom"));
+    assert_eq!(
+        unsafe { fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0) },
+        Status::Error.raw()
+    );
+    assert!(log.contains(Status::Error, "an earlier call failed fatally"));
+}

@@ -1,0 +1,669 @@
+//! The variable table: the one description of the FMU's interface.
+//!
+//! [`variables`] derives it from the model (gap and group names become name prefixes). Both the
+//! C functions (value-reference lookup, in `instance.rs`) and `modelDescription.xml` (in
+//! `description.rs`) are built from it, when the FMU is packed and again when it is instantiated.
+//!
+//! Value references are the positions in the table (0-based), unique over all types; the
+//! ModelStructure `index` of a variable is its value reference + 1.
+//!
+//! | name | type | causality | unit | meaning |
+//! |---|---|---|---|---|
+//! | `time` | Real | independent | | pseudo-time of the load path |
+//! | `mu` | Real | input | 1 | friction coefficient of every gap (applied once set) |
+//! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step |
+//! | `archHeight` | Real | parameter | m | ParallelArch only: the model is regenerated from it |
+//! | `film.E`, `film.nu`, `film.thickness`, `film.prestressX/Y/XY` | Real | parameter | Pa, 1, m, Pa | film |
+//! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
+//! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
+//! | `<gap>.status` | Integer | output | | 0 open, 1 stick, 2 slip |
+//! | `<group>.Rx/.Ry/.Rz` | Real | output | N | total reaction of the group |
+//! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
+//! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
+
+use serde::{Deserialize, Serialize};
+
+use crate::mech::{Model, SolverSettings};
+
+/// What the FMU is built from, as far as the variable table is concerned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Kind {
+    /// The paper's parallel-arch specimen: adds the `archHeight` parameter.
+    ParallelArch { arch_height: f64 },
+    /// A user model file.
+    Model,
+}
+
+/// Base type of a variable.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarType {
+    Real,
+    Integer,
+    Boolean,
+}
+
+impl VarType {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Real => "Real",
+            Self::Integer => "Integer",
+            Self::Boolean => "Boolean",
+        }
+    }
+}
+
+/// `causality` (the ones this FMU uses).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Causality {
+    Parameter,
+    Input,
+    Output,
+    Independent,
+}
+
+impl Causality {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Parameter => "parameter",
+            Self::Input => "input",
+            Self::Output => "output",
+            Self::Independent => "independent",
+        }
+    }
+}
+
+/// `variability` (the ones this FMU uses).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variability {
+    Fixed,
+    Discrete,
+    Continuous,
+}
+
+impl Variability {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Fixed => "fixed",
+            Self::Discrete => "discrete",
+            Self::Continuous => "continuous",
+        }
+    }
+}
+
+/// A value of any of the types.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Value {
+    Real(f64),
+    Integer(i32),
+    Boolean(bool),
+}
+
+impl Value {
+    pub fn var_type(self) -> VarType {
+        match self {
+            Self::Real(_) => VarType::Real,
+            Self::Integer(_) => VarType::Integer,
+            Self::Boolean(_) => VarType::Boolean,
+        }
+    }
+
+    /// The value as written in a `start` attribute (shortest round-trip form for reals).
+    pub fn to_xml(self) -> String {
+        match self {
+            Self::Real(v) => format_real(v),
+            Self::Integer(v) => v.to_string(),
+            Self::Boolean(v) => v.to_string(),
+        }
+    }
+}
+
+/// A real in `xs:double` form that parses back to the same bits (Rust's `{:?}` is the shortest
+/// round-trip form; `1e-8` rather than `0.00000001`).
+pub fn format_real(v: f64) -> String {
+    format!("{v:?}")
+}
+
+/// What a variable stands for: the instance reads and writes the core through this.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Binding {
+    Time,
+    Friction,
+    /// Input displacement of a group along axis 0, 1, 2.
+    GroupDisplacement {
+        group: usize,
+        axis: usize,
+    },
+    ArchHeight,
+    YoungsModulus,
+    PoissonRatio,
+    Thickness,
+    /// Prestress component 0 (x), 1 (y), 2 (xy).
+    Prestress(usize),
+    NormalStiffness(usize),
+    TangentialStiffness(usize),
+    DisplacementTolerance,
+    ResidualTolerance,
+    MaxIterations,
+    MaxCutbacks,
+    IncrementsPerStep,
+    UseJuRowlands,
+    SlipX(usize),
+    SlipY(usize),
+    NormalForce(usize),
+    FrictionForce(usize),
+    GapStatus(usize),
+    /// Total reaction of a group along axis 0, 1, 2.
+    Reaction {
+        group: usize,
+        axis: usize,
+    },
+    Iterations,
+    Cutbacks,
+    Residual,
+    MaxEquivalentStress,
+}
+
+/// One ScalarVariable.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Variable {
+    pub name: String,
+    pub value_reference: u32,
+    pub var_type: VarType,
+    pub causality: Causality,
+    pub variability: Variability,
+    /// Start value: parameters and inputs have one, outputs and `time` none.
+    pub start: Option<Value>,
+    pub unit: Option<&'static str>,
+    pub description: String,
+    pub binding: Binding,
+}
+
+impl Variable {
+    /// `initial` as written in the XML (`None`: omitted, the default applies).
+    pub fn initial(&self) -> Option<&'static str> {
+        match self.causality {
+            Causality::Parameter => Some("exact"),
+            Causality::Output => Some("calculated"),
+            Causality::Input | Causality::Independent => None,
+        }
+    }
+
+    /// The ModelStructure index (1-based position in ModelVariables).
+    pub fn index(&self) -> usize {
+        self.value_reference as usize + 1
+    }
+}
+
+/// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
+pub const UNITS: [(&str, [i32; 3]); 5] = [
+    ("m", [0, 1, 0]),
+    ("N", [1, 1, -2]),
+    ("Pa", [1, -1, -2]),
+    ("N/m", [1, 0, -2]),
+    ("1", [0, 0, 0]),
+];
+
+/// Top-level names the table uses; gap and group names must differ from them.
+pub const RESERVED_NAMES: [&str; 5] = ["time", "mu", "archHeight", "film", "solver"];
+
+/// Default of `solver.incrementsPerStep`.
+pub const DEFAULT_INCREMENTS_PER_STEP: i32 = 10;
+
+/// Checks that the model's gap and group names can prefix variable names.
+pub fn check_names(model: &Model) -> Result<(), String> {
+    let names = model
+        .gaps
+        .iter()
+        .map(|g| ("gap", &g.name))
+        .chain(model.groups.iter().map(|g| ("boundary group", &g.name)));
+    for (kind, name) in names {
+        if RESERVED_NAMES.contains(&name.as_str()) {
+            return Err(format!(
+                "{kind} '{name}': the name is reserved for an FMU variable ({}); rename it",
+                RESERVED_NAMES.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The variable table of an FMU of `model`. Order: `time`, inputs, parameters, outputs.
+pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
+    let mut table = TableBuilder::default();
+    let solver = SolverSettings::default();
+    let mu = model.gaps.first().map_or(0.0, |g| g.friction);
+    let axes = ["x", "y", "z"];
+
+    table.push(
+        "time",
+        VarType::Real,
+        Causality::Independent,
+        None,
+        None,
+        "pseudo-time of the load path",
+        Binding::Time,
+    );
+    table.input(
+        "mu",
+        mu,
+        "1",
+        "friction coefficient of every gap; the model's own values apply until it is set",
+        Binding::Friction,
+    );
+    for (group, g) in model.groups.iter().enumerate() {
+        for (axis, a) in axes.iter().enumerate() {
+            table.input(
+                &format!("{}.d{a}", g.name),
+                0.0,
+                "m",
+                &format!(
+                    "displacement of boundary group '{}' along {a}, reached at the end of a step",
+                    g.name
+                ),
+                Binding::GroupDisplacement { group, axis },
+            );
+        }
+    }
+
+    if let Kind::ParallelArch { arch_height } = kind {
+        table.parameter(
+            "archHeight",
+            Value::Real(arch_height),
+            Some("m"),
+            "arch rise H; the specimen model is regenerated from it at initialization",
+            Binding::ArchHeight,
+        );
+    }
+    let m = &model.material;
+    let film: [(&str, f64, &str, &str, Binding); 6] = [
+        (
+            "E",
+            m.youngs_modulus,
+            "Pa",
+            "Young's modulus of the film",
+            Binding::YoungsModulus,
+        ),
+        (
+            "nu",
+            m.poisson_ratio,
+            "1",
+            "Poisson's ratio of the film",
+            Binding::PoissonRatio,
+        ),
+        (
+            "thickness",
+            m.thickness,
+            "m",
+            "film thickness",
+            Binding::Thickness,
+        ),
+        (
+            "prestressX",
+            m.prestress[0],
+            "Pa",
+            "initial stress σx of the film",
+            Binding::Prestress(0),
+        ),
+        (
+            "prestressY",
+            m.prestress[1],
+            "Pa",
+            "initial stress σy of the film",
+            Binding::Prestress(1),
+        ),
+        (
+            "prestressXY",
+            m.prestress[2],
+            "Pa",
+            "initial shear stress τxy of the film",
+            Binding::Prestress(2),
+        ),
+    ];
+    for (name, start, unit, description, binding) in film {
+        table.parameter(
+            &format!("film.{name}"),
+            Value::Real(start),
+            Some(unit),
+            description,
+            binding,
+        );
+    }
+    for (i, g) in model.gaps.iter().enumerate() {
+        table.parameter(
+            &format!("{}.kn", g.name),
+            Value::Real(g.normal_stiffness),
+            Some("N/m"),
+            &format!("normal penalty stiffness of gap '{}'", g.name),
+            Binding::NormalStiffness(i),
+        );
+        table.parameter(
+            &format!("{}.ks", g.name),
+            Value::Real(g.tangential_stiffness),
+            Some("N/m"),
+            &format!("tangential penalty stiffness of gap '{}'", g.name),
+            Binding::TangentialStiffness(i),
+        );
+    }
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 6] = [
+        (
+            "displacementTolerance",
+            Value::Real(solver.displacement_tolerance),
+            Some("1"),
+            "Newton converges when the correction is below this fraction of the increment's displacement",
+            Binding::DisplacementTolerance,
+        ),
+        (
+            "residualTolerance",
+            Value::Real(solver.residual_tolerance),
+            Some("1"),
+            "... and the free residual is below this fraction of the largest nodal force",
+            Binding::ResidualTolerance,
+        ),
+        (
+            "maxIterations",
+            Value::Integer(saturating_i32(solver.max_iterations)),
+            None,
+            "Newton iterations per increment before it is halved",
+            Binding::MaxIterations,
+        ),
+        (
+            "maxCutbacks",
+            Value::Integer(saturating_i32(solver.max_cutbacks)),
+            None,
+            "halvings of an increment before the step is discarded",
+            Binding::MaxCutbacks,
+        ),
+        (
+            "incrementsPerStep",
+            Value::Integer(DEFAULT_INCREMENTS_PER_STEP),
+            None,
+            "equal load increments per communication step",
+            Binding::IncrementsPerStep,
+        ),
+        (
+            "useJuRowlands",
+            Value::Boolean(false),
+            None,
+            "true: the paper's symmetric Ju-Rowlands iteration matrix; false: the consistent tangent",
+            Binding::UseJuRowlands,
+        ),
+    ];
+    for (name, start, unit, description, binding) in solver_parameters {
+        table.parameter(&format!("solver.{name}"), start, unit, description, binding);
+    }
+
+    for (i, g) in model.gaps.iter().enumerate() {
+        let n = &g.name;
+        table.output(
+            &format!("{n}.slip"),
+            "m",
+            &format!("slip of gap '{n}' along its local x (film relative to the support)"),
+            Binding::SlipX(i),
+        );
+        table.output(
+            &format!("{n}.slipY"),
+            "m",
+            &format!("slip of gap '{n}' along its local y"),
+            Binding::SlipY(i),
+        );
+        table.output(
+            &format!("{n}.normalForce"),
+            "N",
+            &format!("normal contact force of gap '{n}'"),
+            Binding::NormalForce(i),
+        );
+        table.output(
+            &format!("{n}.frictionForce"),
+            "N",
+            &format!("friction force magnitude of gap '{n}'"),
+            Binding::FrictionForce(i),
+        );
+        table.push(
+            &format!("{n}.status"),
+            VarType::Integer,
+            Causality::Output,
+            None,
+            None,
+            &format!("status of gap '{n}': 0 open, 1 stick, 2 slip"),
+            Binding::GapStatus(i),
+        );
+    }
+    for (group, g) in model.groups.iter().enumerate() {
+        for (axis, a) in ["Rx", "Ry", "Rz"].iter().enumerate() {
+            table.output(
+                &format!("{}.{a}", g.name),
+                "N",
+                &format!(
+                    "total reaction force of boundary group '{}' along {}",
+                    g.name, axes[axis]
+                ),
+                Binding::Reaction { group, axis },
+            );
+        }
+    }
+    let integer_output = |table: &mut TableBuilder, name: &str, description: &str, binding| {
+        table.push(
+            name,
+            VarType::Integer,
+            Causality::Output,
+            None,
+            None,
+            description,
+            binding,
+        )
+    };
+    integer_output(
+        &mut table,
+        "solver.iterations",
+        "Newton iterations of the last step (all increments)",
+        Binding::Iterations,
+    );
+    integer_output(
+        &mut table,
+        "solver.cutbacks",
+        "increments halved in the last step",
+        Binding::Cutbacks,
+    );
+    table.output(
+        "solver.residual",
+        "N",
+        "final free residual of the last step",
+        Binding::Residual,
+    );
+    table.output(
+        "film.maxEquivalentStress",
+        "Pa",
+        "largest von Mises stress of the film elements",
+        Binding::MaxEquivalentStress,
+    );
+    table.0
+}
+
+fn saturating_i32(v: usize) -> i32 {
+    i32::try_from(v).unwrap_or(i32::MAX)
+}
+
+#[derive(Default)]
+struct TableBuilder(Vec<Variable>);
+
+impl TableBuilder {
+    #[allow(clippy::too_many_arguments)]
+    fn push(
+        &mut self,
+        name: &str,
+        var_type: VarType,
+        causality: Causality,
+        start: Option<Value>,
+        unit: Option<&'static str>,
+        description: &str,
+        binding: Binding,
+    ) {
+        let variability = match (causality, var_type) {
+            (Causality::Parameter, _) => Variability::Fixed,
+            (_, VarType::Real) => Variability::Continuous,
+            _ => Variability::Discrete,
+        };
+        self.0.push(Variable {
+            name: name.to_string(),
+            value_reference: self.0.len() as u32,
+            var_type,
+            causality,
+            variability,
+            start,
+            unit,
+            description: description.to_string(),
+            binding,
+        });
+    }
+
+    fn input(
+        &mut self,
+        name: &str,
+        start: f64,
+        unit: &'static str,
+        description: &str,
+        binding: Binding,
+    ) {
+        self.push(
+            name,
+            VarType::Real,
+            Causality::Input,
+            Some(Value::Real(start)),
+            Some(unit),
+            description,
+            binding,
+        );
+    }
+
+    fn parameter(
+        &mut self,
+        name: &str,
+        start: Value,
+        unit: Option<&'static str>,
+        description: &str,
+        binding: Binding,
+    ) {
+        self.push(
+            name,
+            start.var_type(),
+            Causality::Parameter,
+            Some(start),
+            unit,
+            description,
+            binding,
+        );
+    }
+
+    fn output(&mut self, name: &str, unit: &'static str, description: &str, binding: Binding) {
+        self.push(
+            name,
+            VarType::Real,
+            Causality::Output,
+            None,
+            Some(unit),
+            description,
+            binding,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mech::ParallelArch;
+    use std::collections::HashSet;
+
+    fn specimen_table() -> (Model, Vec<Variable>) {
+        let model = ParallelArch::with_height(0.3).model().unwrap();
+        let table = variables(&model, Kind::ParallelArch { arch_height: 0.3 });
+        (model, table)
+    }
+
+    #[test]
+    fn names_unique_and_value_references_are_positions() {
+        let (_, table) = specimen_table();
+        let names: HashSet<&str> = table.iter().map(|v| v.name.as_str()).collect();
+        assert_eq!(names.len(), table.len());
+        for (i, v) in table.iter().enumerate() {
+            assert_eq!(v.value_reference as usize, i);
+            assert_eq!(
+                v.start.is_some(),
+                matches!(v.causality, Causality::Parameter | Causality::Input),
+                "{}",
+                v.name
+            );
+            if let Some(s) = v.start {
+                assert_eq!(s.var_type(), v.var_type, "{}", v.name);
+            }
+            if v.var_type != VarType::Real {
+                assert_ne!(v.variability, Variability::Continuous, "{}", v.name);
+            }
+            if let Some(u) = v.unit {
+                assert!(
+                    UNITS.iter().any(|(n, _)| *n == u),
+                    "unit {u} of {} is declared",
+                    v.name
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn specimen_table_has_the_documented_variables() {
+        let (model, table) = specimen_table();
+        let find = |n: &str| {
+            table
+                .iter()
+                .find(|v| v.name == n)
+                .unwrap_or_else(|| panic!("{n} missing"))
+        };
+        assert_eq!(find("time").causality, Causality::Independent);
+        assert_eq!(find("frame.dz").causality, Causality::Input);
+        assert_eq!(find("archHeight").start, Some(Value::Real(0.3)));
+        assert_eq!(
+            find("G9.kn").start,
+            Some(Value::Real(model.gaps[8].normal_stiffness))
+        );
+        assert_eq!(find("G1.status").var_type, VarType::Integer);
+        assert_eq!(
+            find("solver.incrementsPerStep").start,
+            Some(Value::Integer(DEFAULT_INCREMENTS_PER_STEP))
+        );
+        assert_eq!(
+            find("solver.useJuRowlands").start,
+            Some(Value::Boolean(false))
+        );
+        assert_eq!(find("mu").start, Some(Value::Real(0.2)));
+        let outputs = table
+            .iter()
+            .filter(|v| v.causality == Causality::Output)
+            .count();
+        assert_eq!(outputs, 9 * 5 + 3 + 4);
+        // A user model has no archHeight.
+        assert!(
+            variables(&model, Kind::Model)
+                .iter()
+                .all(|v| v.name != "archHeight")
+        );
+    }
+
+    #[test]
+    fn reals_round_trip_through_their_xml_form() {
+        for v in [0.3, 1e-8, 2.5e8, 0.1 + 0.2, -0.0, 1.0, 123456789.123] {
+            assert_eq!(
+                Value::Real(v).to_xml().parse::<f64>().unwrap().to_bits(),
+                v.to_bits()
+            );
+        }
+    }
+
+    #[test]
+    fn reserved_names_are_refused() {
+        let mut model = ParallelArch::default().model().unwrap();
+        assert!(check_names(&model).is_ok());
+        model.gaps[0].name = "solver".into();
+        let err = check_names(&model).unwrap_err();
+        assert!(err.contains("gap 'solver'"), "{err}");
+    }
+}
