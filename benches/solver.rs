@@ -92,28 +92,29 @@ fn whole_specimen() {
     println!();
 }
 
+/// One Newton iteration on the refined specimen, measured in a fresh process (clean RSS).
 fn iteration_at(refinement: usize, matrix: IterationMatrix) {
     let spec = ParallelArch {
         refinement,
         ..ParallelArch::with_height(0.3)
     };
     let model = spec.model().unwrap();
-    let (rss_before, _) = rss();
     let system = System::new(&model, matrix == IterationMatrix::JuRowlands).unwrap();
     let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
     // A deformed state: the frame lowered by 2 cm and the film sagging with it, gaps pressed.
-    let target = -0.02;
     let mut u = vec![0.0; model.dof_count()];
     for (i, p) in model.nodes.iter().enumerate() {
         let r = (p[0].powi(2) + p[1].powi(2)).sqrt().min(1.0);
-        u[3 * i + 2] = target * r * r;
+        u[3 * i + 2] = -0.02 * r * r;
         u[3 * i] = 1e-4 * p[0];
     }
     let history = vec![Vector2::zeros(); laws.len()];
     let mut internal = vec![0.0; model.dof_count()];
     let mut values = vec![0.0; system.nonzeros()];
     let mut rhs = vec![0.0; system.free_count];
-    let ours = rss().0.saturating_sub(rss_before);
+    // Ours: pattern, slots, elements, the value array and the vectors an iteration uses.
+    let ours =
+        system.memory_bytes() + 8 * (values.len() + internal.len() + rhs.len() + 2 * u.len());
     let mut linear = LinearSolver::new(&system).unwrap();
     let assemble = |internal: &mut Vec<f64>, values: &mut Vec<f64>| {
         system.assemble(&u, internal, Some(values), |g, d| {
@@ -127,9 +128,9 @@ fn iteration_at(refinement: usize, matrix: IterationMatrix) {
     };
     // A small diagonal shift keeps the synthetic state's matrix safely nonsingular.
     let shift = 1e-3 * model.material.membrane_stiffness();
+    let p = system.pattern();
     let diagonal: Vec<usize> = (0..system.free_count)
         .map(|j| {
-            let p = system.pattern();
             let rows = &p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]];
             p.col_ptr()[j] + rows.binary_search(&j).unwrap()
         })
@@ -142,7 +143,6 @@ fn iteration_at(refinement: usize, matrix: IterationMatrix) {
         30
     };
     let (mut t_assembly, mut t_factor, mut t_bare) = (vec![], vec![], vec![]);
-    let (rss_pre_factor, _) = rss();
     let mut factor_bytes = 0;
     for run in 0..runs {
         let start = Instant::now();
@@ -152,21 +152,21 @@ fn iteration_at(refinement: usize, matrix: IterationMatrix) {
             values[d] += shift;
         }
         rhs.fill(1.0);
+        let before = rss().0;
         let start = Instant::now();
         linear
             .factorize_and_solve(system.matrix(&values), &mut rhs)
             .unwrap();
         t_factor.push(start.elapsed());
         if run == 0 {
-            factor_bytes = rss()
-                .0
-                .saturating_sub(rss_pre_factor)
-                .max(8 * linear.factor_len());
+            // The factor's memory: what the first numeric factorization added (its buffers are
+            // allocated then and reused), at least the LDLᵀ value count.
+            factor_bytes = rss().0.saturating_sub(before).max(8 * linear.factor_len());
         }
-        // Bare factorization of the same matrix: a fresh solver each time (symbolic excluded).
-        let mut bare = LinearSolver::new(&system).unwrap();
+        // Bare: the same factorization again, with nothing else around it.
         let start = Instant::now();
-        bare.factorize_and_solve(system.matrix(&values), &mut rhs)
+        linear
+            .factorize_and_solve(system.matrix(&values), &mut rhs)
             .unwrap();
         t_bare.push(start.elapsed());
     }
@@ -188,32 +188,63 @@ fn iteration_at(refinement: usize, matrix: IterationMatrix) {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let max_dof: usize = args
-        .iter()
-        .position(|a| a == "--max-dof")
-        .and_then(|i| args.get(i + 1))
+    let option = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+    };
+    if let Some(one) = option("--one") {
+        // Child process: one (refinement, matrix) case.
+        let (r, m) = one.split_once(',').unwrap();
+        let matrix = if m == "lu" {
+            IterationMatrix::Consistent
+        } else {
+            IterationMatrix::JuRowlands
+        };
+        iteration_at(r.parse().unwrap(), matrix);
+        return;
+    }
+    let max_dof: usize = option("--max-dof")
         .and_then(|v| v.parse().ok())
         .unwrap_or(1_100_000);
+    // LU fill on the largest mesh would exceed this machine's 24 GiB; its size is capped apart.
+    let max_lu_dof: usize = option("--max-lu-dof")
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(400_000);
     whole_specimen();
     println!("## one Newton iteration on refined specimens\n");
     println!(
         "element + assembly + contact work (`assembly`) vs the factorization + solve of the same"
     );
     println!(
-        "matrix inside the iteration and a bare one; memory: our pattern/slots/values/vectors vs the factor.\n"
+        "matrix inside the iteration and a bare repeat of it; memory: our pattern, slots, values and"
     );
+    println!("vectors vs the factor (each case in a fresh process).\n");
     println!(
         "| refinement | matrix | free DOF | nonzeros | assembly | factor+solve | bare factor | assembly/bare | our memory | factor memory | ours/factor |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let exe = std::env::current_exe().unwrap();
     for refinement in [1, 4, 16, 33, 58] {
         let dof = 3 * (10 * refinement + 1usize).pow(2);
-        if dof > max_dof {
-            break;
-        }
-        for matrix in [IterationMatrix::Consistent, IterationMatrix::JuRowlands] {
-            iteration_at(refinement, matrix);
+        for (name, cap) in [("lu", max_lu_dof), ("ldlt", max_dof)] {
+            if dof > cap {
+                continue;
+            }
+            let out = std::process::Command::new(&exe)
+                .args(["--one", &format!("{refinement},{name}")])
+                .output()
+                .unwrap();
+            print!("{}", String::from_utf8_lossy(&out.stdout));
+            if !out.status.success() {
+                println!(
+                    "| {refinement} | {name} | failed: {} |",
+                    String::from_utf8_lossy(&out.stderr)
+                        .lines()
+                        .last()
+                        .unwrap_or("")
+                );
+            }
         }
     }
-    println!("\npeak RSS {:.0} MiB", mib(rss().1));
 }

@@ -190,6 +190,18 @@ impl System {
         self.symbolic.row_idx().len()
     }
 
+    /// Bytes held by the pattern, the slot table and the element data (not the values).
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let pattern =
+            (self.symbolic.col_ptr().len() + self.symbolic.row_idx().len()) * size_of::<usize>();
+        pattern
+            + self.slots.len() * size_of::<u32>()
+            + self.dofs.len() * size_of::<Dof>()
+            + self.triangles.len() * size_of::<([usize; 3], MembraneTriangle)>()
+            + self.gaps.len() * size_of::<GapGeometry>()
+    }
+
     /// Whether only the lower triangle is stored (symmetric iteration matrix).
     pub fn is_lower_only(&self) -> bool {
         self.lower_only
