@@ -615,6 +615,11 @@ impl Instance {
                 Binding::SlipY(g) => Value::Real(results.gaps[g].slip_y),
                 Binding::NormalForce(g) => Value::Real(results.gaps[g].normal_force),
                 Binding::FrictionForce(g) => Value::Real(results.gaps[g].friction_force),
+                // `GapResult::friction` is the force the film exerts on the support (the
+                // equilibrium of the film's Z forces shows it): the film feels the opposite.
+                Binding::GapFriction { gap, axis } => {
+                    Value::Real(-results.gaps[gap].friction[axis])
+                }
                 Binding::GapStatus(g) => Value::Integer(match results.gaps[g].status {
                     GapStatus::Open => 0,
                     GapStatus::Stick => 1,

@@ -17,6 +17,7 @@
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
+//! | `<gap>.frictionX/.frictionY` | Real | output | N | friction force on the film, local x, y (signed) |
 //! | `<gap>.status` | Integer | output | | 0 open, 1 stick, 2 slip |
 //! | `<group>.Rx/.Ry/.Rz` | Real | output | N | total reaction of the group |
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
@@ -152,6 +153,11 @@ pub enum Binding {
     SlipY(usize),
     NormalForce(usize),
     FrictionForce(usize),
+    /// Friction force on the film along the gap's local axis 0 (x) or 1 (y).
+    GapFriction {
+        gap: usize,
+        axis: usize,
+    },
     GapStatus(usize),
     /// Total reaction of a group along axis 0, 1, 2.
     Reaction {
@@ -419,6 +425,17 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             &format!("friction force magnitude of gap '{n}'"),
             Binding::FrictionForce(i),
         );
+        for (axis, a) in ["X", "Y"].iter().enumerate() {
+            table.output(
+                &format!("{n}.friction{a}"),
+                "N",
+                &format!(
+                    "friction force on the film at gap '{n}' along the gap's local {}",
+                    a.to_lowercase()
+                ),
+                Binding::GapFriction { gap: i, axis },
+            );
+        }
         table.push(
             &format!("{n}.status"),
             VarType::Integer,
@@ -639,7 +656,7 @@ mod tests {
             .iter()
             .filter(|v| v.causality == Causality::Output)
             .count();
-        assert_eq!(outputs, 9 * 5 + 3 + 4);
+        assert_eq!(outputs, 9 * 7 + 3 + 4);
         // A user model has no archHeight.
         assert!(
             variables(&model, Kind::Model)
