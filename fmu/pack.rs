@@ -78,8 +78,9 @@ fn parse(args: &[String]) -> Result<Options, String> {
 }
 
 /// The source as the FMU will read it back from its resources (so that the XML written here
-/// and the one `fmi2Instantiate` renders come from identical input).
-fn source(o: &Options) -> Result<Source, String> {
+/// and the one `fmi2Instantiate` renders come from identical input), and its description.
+/// Errors name the model file.
+fn source(o: &Options) -> Result<(Source, Description), String> {
     let given = match &o.model {
         None => Source::ParallelArch(ParallelArch::default()),
         Some(path) => {
@@ -88,12 +89,19 @@ fn source(o: &Options) -> Result<Source, String> {
             Source::Model(Model::from_json(&text).map_err(|e| format!("{}: {e}", path.display()))?)
         }
     };
+    let in_file = |e: String| match &o.model {
+        Some(path) => format!("{}: {e}", path.display()),
+        None => e,
+    };
     let (name, text) = given.resource_file();
-    let stored = Source::from_resource(name, &text)?;
+    let stored = Source::from_resource(name, &text).map_err(in_file)?;
     if stored != given {
-        return Err("the model does not survive its JSON round trip unchanged".into());
+        return Err(in_file(
+            "the model does not survive its JSON round trip unchanged".into(),
+        ));
     }
-    Ok(stored)
+    let description = describe(&stored).map_err(in_file)?;
+    Ok((stored, description))
 }
 
 /// Directory of this program (target/release).
@@ -159,8 +167,7 @@ fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> R
 }
 
 fn run(o: &Options) -> Result<(), String> {
-    let source = source(o)?;
-    let description = describe(&source)?;
+    let (source, description) = source(o)?;
     let dir = program_dir()?;
     let library_path = match &o.library {
         Some(p) => p.clone(),
