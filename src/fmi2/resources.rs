@@ -96,6 +96,20 @@ impl Source {
     }
 }
 
+/// The `file:///…` URI of a local absolute path, percent-encoded as fmpy sends it (RFC 3986:
+/// everything but unreserved characters and `/`). For in-process hosts such as benchmarks.
+pub fn file_uri(path: &Path) -> String {
+    let mut uri = String::from("file://");
+    for &b in path.as_os_str().as_encoded_bytes() {
+        if b.is_ascii_alphanumeric() || b"-._~/".contains(&b) {
+            uri.push(b as char);
+        } else {
+            uri.push_str(&format!("%{b:02X}"));
+        }
+    }
+    uri
+}
+
 /// The local directory named by an `fmuResourceLocation` URI.
 pub fn resource_dir(uri: &str) -> Result<PathBuf, String> {
     let (raw, decoded) = uri_paths(uri)?;
@@ -221,6 +235,14 @@ mod tests {
             let err = uri_paths(uri).unwrap_err();
             assert!(err.contains(why), "{uri}: {err}");
         }
+    }
+
+    #[test]
+    fn file_uri_round_trips() {
+        let path = Path::new("/tmp/a b/é%#/resources");
+        let uri = file_uri(path);
+        assert_eq!(uri, "file:///tmp/a%20b/%C3%A9%25%23/resources");
+        assert_eq!(uri_paths(&uri).unwrap().1, path);
     }
 
     #[test]

@@ -17,7 +17,7 @@ use std::sync::Mutex;
 use super::description::describe;
 use super::exports::*;
 use super::instance::allowed;
-use super::resources::Source;
+use super::resources::{Source, file_uri};
 use super::types::*;
 use super::variables::Variable;
 use crate::mech::ParallelArch;
@@ -125,8 +125,8 @@ impl Unpacked {
         std::fs::create_dir_all(&dir).unwrap();
         source.save(&dir).unwrap();
         let d = describe(&source).unwrap();
-        // Percent-encode the spaces, as fmpy does.
-        let uri = format!("file://{}", dir.display()).replace(' ', "%20");
+        // Percent-encoded (the directory name has spaces), as fmpy sends it.
+        let uri = file_uri(&dir);
         Self {
             dir,
             guid: CString::new(d.guid).unwrap(),
