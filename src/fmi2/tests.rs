@@ -9,6 +9,11 @@
 //! boundary group `frame`), written to a temporary `resources/` directory.
 //!
 //! BOUNDARY CONDITIONS: `frame.dz` ramped towards the specimen target −H/2 = −0.15 m.
+//!
+//! SAFETY of the `unsafe` blocks below: each calls an exported function the way an importer
+//! does, with an instance from [`Fmu`] (freed only in its `Drop`), and pointers to live locals
+//! or NUL-terminated literals holding the announced number of elements; the deliberately bad
+//! arguments are NULL pointers, which the functions must reject without dereferencing.
 
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::path::PathBuf;
