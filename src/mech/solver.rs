@@ -200,7 +200,8 @@ pub struct GapResult {
     pub normal_force: f64,
     /// Friction force magnitude `|t| ≤ μN` (N).
     pub friction_force: f64,
-    /// Friction force components (local x, y) on the film node (N).
+    /// Friction force components (local x, y) of the gap's internal force on node A (eq. 2.8):
+    /// the force the film exerts on the support; the support acts on the film with the opposite (N).
     pub friction: [f64; 2],
     /// Status at convergence.
     pub status: GapStatus,
