@@ -167,11 +167,11 @@ fn run(o: &Options) -> Result<(), String> {
         cutbacks += report.cutbacks;
         increments += report.iterations.len();
         iterations.push(report.total_iterations());
-        if let Some(dir) = &o.vtk {
-            let results = analysis.results();
+        let results = (o.csv.is_some() || o.vtk.is_some()).then(|| analysis.results());
+        if let (Some(dir), Some(results)) = (&o.vtk, &results) {
             let model = analysis.model();
             let file = format!("{}_{step:04}.vtu", model.name);
-            let text = vtk::unstructured_grid(model, &analysis.state().displacement, &results);
+            let text = vtk::unstructured_grid(model, &analysis.state().displacement, results);
             std::fs::write(std::path::Path::new(dir).join(&file), text)
                 .map_err(|e| format!("{dir}/{file}: {e}"))?;
             vtk_files.push((fraction, file));
@@ -182,8 +182,7 @@ fn run(o: &Options) -> Result<(), String> {
         if progress {
             eprint!("\rstep {step}/{} ({:.0}%)", o.steps, 100.0 * fraction);
         }
-        if let Some((f, path)) = csv.as_mut() {
-            let results = analysis.results();
+        if let (Some((f, path)), Some(results)) = (csv.as_mut(), &results) {
             for (g, r) in analysis.model().gaps.iter().zip(&results.gaps) {
                 writeln!(
                     f,
