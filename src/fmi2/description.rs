@@ -7,7 +7,8 @@
 //! * `<ModelVariables>`: one ScalarVariable per table row, in value-reference order;
 //! * `<ModelStructure>`: `<Outputs>` = every output, depending on the inputs (a step moves the
 //!   model to the inputs' values); `<InitialUnknowns>` = the same outputs (all `calculated`),
-//!   depending on the parameters (the initial state is the undeformed, prestressed film).
+//!   depending on the parameters (the initial state is the undeformed, prestressed film; not on
+//!   `results.directory`, which only says where the VTK files go).
 //!
 //! The GUID is the UUID v5 (OID namespace) of the rendered text with the GUID field left as it
 //! is in the template, formatted `{…}`. `fmu-pack` writes the XML; `fmi2Instantiate` renders it
@@ -23,7 +24,7 @@ use uuid::Uuid;
 
 use super::logger::CATEGORIES;
 use super::resources::Source;
-use super::variables::{Causality, Kind, UNITS, Variable, check_names, variables};
+use super::variables::{Causality, Kind, UNITS, Value, Variable, check_names, variables};
 use crate::mech::Model;
 
 /// The template (top-level `modelDescription.xml.in`).
@@ -193,7 +194,7 @@ fn write_variables(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()
                     e = e.with_attribute(("initial", initial));
                 }
                 e.write_inner_content(|w| {
-                    let start = v.start.map(|s| s.to_xml());
+                    let start = v.start.as_ref().map(Value::to_xml);
                     let mut t = w.create_element(v.var_type.name());
                     if let Some(unit) = v.unit {
                         t = t.with_attribute(("unit", unit));
@@ -211,15 +212,17 @@ fn write_variables(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()
 }
 
 fn write_structure(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
-    let indices = |c: Causality| {
+    let indices = |keep: fn(&Variable) -> bool| {
         table
             .iter()
-            .filter(|v| v.causality == c)
+            .filter(|v| keep(v))
             .map(|v| v.index().to_string())
             .collect::<Vec<_>>()
             .join(" ")
     };
-    let (inputs, parameters) = (indices(Causality::Input), indices(Causality::Parameter));
+    let inputs = indices(|v| v.causality == Causality::Input);
+    // `results.directory` only says where files go: no output depends on it.
+    let parameters = indices(Variable::is_model_parameter);
     let outputs: Vec<String> = table
         .iter()
         .filter(|v| v.causality == Causality::Output)
@@ -258,7 +261,7 @@ pub fn documentation_html(d: &Description) -> String {
             v.var_type.name(),
             v.causality.name(),
             v.unit.unwrap_or(""),
-            v.start.map(|s| s.to_xml()).unwrap_or_default(),
+            v.start.as_ref().map(Value::to_xml).unwrap_or_default(),
             e(&v.description)
         ));
     }
@@ -299,6 +302,9 @@ set a smaller change and call <code>fmi2DoStep</code> again from the same time.<
 <li>Parameters are fixed: set them before <code>fmi2ExitInitializationMode</code>, which builds the analysis
 (and reports an invalid value with <code>fmi2Error</code>).</li>
 <li>FMU states can be saved, restored and serialized (<code>canGetAndSetFMUstate</code>, <code>canSerializeFMUstate</code>).</li>
+<li><code>results.directory</code> (set with <code>fmi2SetString</code> before <code>fmi2ExitInitializationMode</code>):
+the instance writes <code>&lt;dir&gt;/{id}_NNNN.vtu</code> for the initial state (0000) and after every step, and
+rewrites <code>&lt;dir&gt;/{id}.pvd</code> (open it in ParaView). A failed write returns <code>fmi2Warning</code>; the step is kept.</li>
 </ul>
 <h2>Variables</h2>
 <table>

@@ -190,8 +190,7 @@ pub unsafe extern "C" fn fmi2_get_string(
     // SAFETY: FMI 2.0 caller contract; `vr` and `value` hold `nvr` elements.
     unsafe {
         with_instance(c, "fmi2GetString", allowed::GET, |i| {
-            output(value, nvr, "value")?;
-            i.get_string(input(vr, nvr, "vr")?)
+            i.get_string(input(vr, nvr, "vr")?, output(value, nvr, "value")?)
         })
     }
 }
@@ -248,11 +247,12 @@ pub unsafe extern "C" fn fmi2_set_string(
     nvr: usize,
     value: *const Fmi2String,
 ) -> Fmi2Status {
-    // SAFETY: FMI 2.0 caller contract; `vr` and `value` hold `nvr` elements.
+    // SAFETY: FMI 2.0 caller contract; `vr` and `value` hold `nvr` elements, each a
+    // NUL-terminated string valid during the call (the instance copies them).
     unsafe {
         with_instance(c, "fmi2SetString", allowed::SET, |i| {
-            input(value, nvr, "value")?;
-            i.set_string(input(vr, nvr, "vr")?)
+            let values = strings(value, nvr, "value")?;
+            i.set_string(input(vr, nvr, "vr")?, &values)
         })
     }
 }

@@ -27,8 +27,25 @@
 //! * `fmi2DoStep(t, h)` moves every group to its inputs in `solver.incrementsPerStep` increments
 //!   (`Analysis::step_to`). Time is a pseudo-time: only `t` = current time (to 1e-9 relative) and
 //!   `h > 0` are required, and time becomes `t + h`.
+//! * `results.directory` (String parameter, "" = off): after `fmi2ExitInitializationMode` and
+//!   after every successful `fmi2DoStep` the instance writes `<dir>/<id>_NNNN.vtu` (NNNN = 0000
+//!   for the initial state, then the number of steps since initialization) and rewrites
+//!   `<dir>/<id>.pvd` listing every file written so far with its time (`<id>` =
+//!   `modelIdentifier`; the directory is created if missing, a relative one is relative to the
+//!   importer's working directory). A failed write is logged and returns `fmi2Warning`: the step
+//!   (or initialization) itself stands. FMU states hold the step count and the file list, so after
+//!   `fmi2SetFMUstate` the next step writes the file that follows the restored state (overwriting
+//!   the one of the abandoned branch) and the `.pvd` lists that branch only; until that step the
+//!   `.pvd` on disk is the old one, and files of the abandoned branch beyond it stay on disk.
+//!   `fmi2Reset` empties the list. Instances of one FMU writing to one directory overwrite each
+//!   other's files: give each its own directory.
+//! * `fmi2GetString` returns pointers into buffers of the instance that stay valid until the next
+//!   `fmi2GetString` on the instance or `fmi2FreeInstance` (FMI 2.0 only promises "until the next
+//!   call"); `fmi2SetString` copies the strings.
 
 use std::collections::HashMap;
+use std::ffi::{CString, c_char};
+use std::path::{Path, PathBuf};
 
 use super::description::{Description, describe};
 use super::logger::Logger;
@@ -39,7 +56,7 @@ use super::types::{
 };
 use super::variables::{Binding, Causality, Value, VarType, Variable};
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, ParallelArch, SolverSettings, StepError, StepReport,
+    Analysis, GapStatus, IterationMatrix, ParallelArch, SolverSettings, StepError, StepReport, vtk,
 };
 use serde::{Deserialize, Serialize};
 
@@ -61,6 +78,15 @@ impl Failure {
     pub fn discard(message: impl Into<String>) -> Self {
         Self {
             status: Status::Discard,
+            message: message.into(),
+        }
+    }
+
+    /// The call did its work, but something on the side failed (the VTK output): logged under
+    /// `logStatusWarning`, `fmi2Warning` returned, the instance's new state stands.
+    pub fn warning(message: impl Into<String>) -> Self {
+        Self {
+            status: Status::Warning,
             message: message.into(),
         }
     }
@@ -162,7 +188,7 @@ pub mod allowed {
 /// The analysis and what it was built from.
 struct Built {
     analysis: Analysis,
-    /// The parameter values it was built with (table order, parameters only).
+    /// The parameter values it was built with (table order, model parameters only).
     parameters: Vec<Value>,
     increments: usize,
 }
@@ -180,6 +206,13 @@ pub struct Instance {
     stop_time: Option<f64>,
     analysis: Option<Built>,
     outputs_fresh: bool,
+    /// Successful steps since initialization: the number of the next VTK file.
+    steps: usize,
+    /// The VTK files written since initialization, with their times (what the `.pvd` lists).
+    vtk_files: Vec<(f64, String)>,
+    /// The strings handed out by the last `fmi2GetString`; the pointers stay valid until the
+    /// next `fmi2GetString` replaces them (or the instance is freed).
+    strings_out: Vec<CString>,
     /// Saved FMU states; the key is the address of the boxed snapshot, handed out as the opaque
     /// `fmi2FMUstate`. It is only ever used as a key, never dereferenced.
     states: HashMap<usize, Box<Snapshot>>,
@@ -243,6 +276,9 @@ impl Instance {
             stop_time: None,
             analysis: None,
             outputs_fresh: false,
+            steps: 0,
+            vtk_files: Vec::new(),
+            strings_out: Vec::new(),
             states: HashMap::new(),
         };
         instance.event(|| {
@@ -303,15 +339,21 @@ impl Instance {
     pub fn exit_initialization_mode(&mut self) -> Outcome {
         self.initial_outputs()?;
         self.phase = Phase::StepComplete;
+        self.steps = 0;
+        self.vtk_files.clear();
         self.event(|| {
             let m = self.analysis.as_ref().map(|b| b.analysis.model());
             let (nodes, gaps) = m.map_or((0, 0), |m| (m.nodes.len(), m.gaps.len()));
+            let vtk = match self.results_directory() {
+                None => String::new(),
+                Some(dir) => format!(", VTK output to {}", dir.display()),
+            };
             format!(
-                "initialized: {nodes} nodes, {gaps} gaps, start time {}",
+                "initialized: {nodes} nodes, {gaps} gaps, start time {}{vtk}",
                 self.time
             )
         });
-        Ok(())
+        self.write_results()
     }
 
     pub fn terminate(&mut self) -> Outcome {
@@ -330,6 +372,8 @@ impl Instance {
         self.stop_time = None;
         self.analysis = None;
         self.outputs_fresh = false;
+        self.steps = 0;
+        self.vtk_files.clear();
         Ok(())
     }
 
@@ -378,9 +422,9 @@ impl Instance {
 
     pub fn get_real(&mut self, vrs: &[u32], out: &mut [f64]) -> Outcome {
         for (i, o) in self.readable(vrs, VarType::Real)?.into_iter().zip(out) {
-            *o = match (self.description.variables[i].binding, self.values[i]) {
+            *o = match (self.description.variables[i].binding, &self.values[i]) {
                 (Binding::Time, _) => self.time,
-                (_, Value::Real(v)) => v,
+                (_, Value::Real(v)) => *v,
                 _ => unreachable!("values follow the table's types"),
             };
         }
@@ -408,18 +452,37 @@ impl Instance {
         Ok(())
     }
 
-    /// The FMU has no String variables: only an empty request succeeds.
-    pub fn get_string(&mut self, vrs: &[u32]) -> Outcome {
-        match vrs.first() {
-            None => Ok(()),
-            Some(vr) => Err(Failure::error(format!(
-                "value reference {vr}: this FMU has no String variables"
-            ))),
+    /// Writes pointers to NUL-terminated copies held by the instance: they stay valid until the
+    /// next `get_string` (which replaces them) or until the instance is dropped.
+    pub fn get_string(&mut self, vrs: &[u32], out: &mut [*const c_char]) -> Outcome {
+        let positions = self.readable(vrs, VarType::String)?;
+        let mut copies = Vec::with_capacity(positions.len());
+        for i in positions {
+            let Value::String(s) = &self.values[i] else {
+                unreachable!("values follow the table's types")
+            };
+            copies.push(CString::new(s.as_str()).map_err(|_| {
+                Failure::error(format!(
+                    "{} holds a NUL character",
+                    self.description.variables[i].name
+                ))
+            })?);
         }
+        // The pointers of the previous call end here, as FMI 2.0 allows.
+        self.strings_out = copies;
+        for (o, s) in out.iter_mut().zip(&self.strings_out) {
+            *o = s.as_ptr();
+        }
+        Ok(())
     }
 
-    pub fn set_string(&mut self, vrs: &[u32]) -> Outcome {
-        self.get_string(vrs)
+    /// Copies the strings (the caller's may go away after the call).
+    pub fn set_string(&mut self, vrs: &[u32], values: &[&str]) -> Outcome {
+        for &vr in vrs {
+            self.settable(vr, VarType::String)?;
+        }
+        self.assign(vrs, values.iter().map(|&x| Value::String(x.to_owned())));
+        Ok(())
     }
 
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Outcome {
@@ -479,16 +542,14 @@ impl Instance {
         }
     }
 
-    /// Stores checked values; a changed parameter drops the analysis built from the old ones.
+    /// Stores checked values; a changed model parameter drops the analysis built from the old
+    /// ones (`results.directory` does not: the analysis does not depend on it).
     fn assign(&mut self, vrs: &[u32], values: impl Iterator<Item = Value>) {
         for (&vr, value) in vrs.iter().zip(values) {
             let i = vr as usize;
-            match self.description.variables[i].causality {
-                Causality::Parameter if self.values[i] != value => {
-                    self.analysis = None;
-                    self.outputs_fresh = false;
-                }
-                _ => {}
+            if self.description.variables[i].is_model_parameter() && self.values[i] != value {
+                self.analysis = None;
+                self.outputs_fresh = false;
             }
             if self.description.variables[i].binding == Binding::Friction {
                 self.mu_set = true;
@@ -536,7 +597,7 @@ impl Instance {
         let mut settings = SolverSettings::default();
         let mut increments = 1;
         for (v, x) in table.iter().zip(values) {
-            if v.causality != Causality::Parameter {
+            if !v.is_model_parameter() {
                 continue;
             }
             let count = |x: i32, min: i32| {
@@ -545,7 +606,7 @@ impl Instance {
                     .filter(|_| x >= min)
                     .ok_or_else(|| format!("{} = {x} must be ≥ {min}", v.name))
             };
-            match (v.binding, *x) {
+            match (v.binding, x.clone()) {
                 (Binding::ArchHeight, _) => {}
                 (Binding::YoungsModulus, Value::Real(x)) => model.material.youngs_modulus = x,
                 (Binding::PoissonRatio, Value::Real(x)) => model.material.poisson_ratio = x,
@@ -667,11 +728,11 @@ impl Instance {
         let mut targets = vec![[0.0; 3]; self.description.model.groups.len()];
         let mut mu = None;
         for (v, x) in table.iter().zip(&self.values) {
-            match (v.binding, *x) {
-                (Binding::GroupDisplacement { group, axis }, Value::Real(x)) => {
+            match (v.binding, x) {
+                (Binding::GroupDisplacement { group, axis }, &Value::Real(x)) => {
                     targets[group][axis] = x
                 }
-                (Binding::Friction, Value::Real(x)) if self.mu_set => mu = Some(x),
+                (Binding::Friction, &Value::Real(x)) if self.mu_set => mu = Some(x),
                 _ => {}
             }
         }
@@ -703,7 +764,8 @@ impl Instance {
                         report.residual
                     )
                 });
-                Ok(())
+                self.steps += 1;
+                self.write_results()
             }
             Err(e) => {
                 if let Some(before) = before {
@@ -719,6 +781,54 @@ impl Instance {
                 })
             }
         }
+    }
+
+    // ---------------------------------------------------------------- VTK output
+
+    /// The value of `results.directory`, `None` when it is empty (no output).
+    fn results_directory(&self) -> Option<PathBuf> {
+        self.description
+            .variables
+            .iter()
+            .zip(&self.values)
+            .find_map(|(v, x)| match (v.binding, x) {
+                (Binding::ResultsDirectory, Value::String(dir)) if !dir.is_empty() => {
+                    Some(PathBuf::from(dir))
+                }
+                _ => None,
+            })
+    }
+
+    /// Writes the converged state as `<dir>/<id>_NNNN.vtu` (NNNN = steps since initialization)
+    /// and rewrites `<dir>/<id>.pvd`, if `results.directory` is set. A failure is a warning:
+    /// the analysis, time and outputs stand; a `.vtu` that could not be written is not listed.
+    fn write_results(&mut self) -> Outcome {
+        let (Some(dir), Some(built)) = (self.results_directory(), self.analysis.as_mut()) else {
+            return Ok(());
+        };
+        let id = &self.description.model_identifier;
+        let file = format!("{id}_{:04}.vtu", self.steps);
+        let a = &mut built.analysis;
+        let results = a.results();
+        let vtu = dir.join(&file);
+        let written = std::fs::create_dir_all(&dir)
+            .map_err(|e| format!("cannot create {}: {e}", dir.display()))
+            .and_then(|()| {
+                let text = vtk::unstructured_grid(a.model(), &a.state().displacement, &results);
+                std::fs::write(&vtu, text).map_err(|e| format!("{}: {e}", vtu.display()))
+            });
+        let pvd = dir.join(format!("{id}.pvd"));
+        let outcome = written.and_then(|()| {
+            self.vtk_files.push((self.time, file));
+            replace_file(&pvd, &vtk::collection(&self.vtk_files))
+                .map_err(|e| format!("{}: {e}", pvd.display()))
+        });
+        outcome.map_err(|e| {
+            Failure::warning(format!(
+                "VTK output at t = {} failed, the results are kept: {e}",
+                self.time
+            ))
+        })
     }
 
     // ---------------------------------------------------------------- status
@@ -769,6 +879,8 @@ impl Instance {
             stop_time: self.stop_time,
             outputs_fresh: self.outputs_fresh,
             analysis: self.analysis.as_ref().map(|b| b.analysis.state().clone()),
+            steps: self.steps,
+            vtk_files: self.vtk_files.clone(),
         }
     }
 
@@ -783,12 +895,18 @@ impl Instance {
             ));
         }
         for (v, x) in table.iter().zip(&s.values) {
-            if x.var_type() != v.var_type || matches!(x, Value::Real(r) if !r.is_finite()) {
+            let bad = match x {
+                Value::Real(r) => !r.is_finite(),
+                Value::String(text) => text.contains('\0'),
+                _ => false,
+            };
+            if x.var_type() != v.var_type || bad {
                 return Err(format!("the state's value of {} is {x:?}", v.name));
             }
         }
         let times = [s.time, s.start_time, s.stop_time.unwrap_or(0.0)];
-        if times.iter().any(|t| !t.is_finite()) {
+        let file_times = s.vtk_files.iter().map(|(t, _)| *t);
+        if times.into_iter().chain(file_times).any(|t| !t.is_finite()) {
             return Err("the state's times are not finite".into());
         }
         let needs_analysis = matches!(
@@ -838,6 +956,8 @@ impl Instance {
         self.start_time = s.start_time;
         self.stop_time = s.stop_time;
         self.outputs_fresh = s.outputs_fresh && self.analysis.is_some();
+        self.steps = s.steps;
+        self.vtk_files = s.vtk_files.clone();
         Ok(())
     }
 
@@ -922,10 +1042,11 @@ fn start_values(table: &[Variable]) -> Vec<Value> {
     table
         .iter()
         .map(|v| {
-            v.start.unwrap_or(match v.var_type {
+            v.start.clone().unwrap_or(match v.var_type {
                 VarType::Real => Value::Real(0.0),
                 VarType::Integer => Value::Integer(0),
                 VarType::Boolean => Value::Boolean(false),
+                VarType::String => Value::String(String::new()),
             })
         })
         .collect()
@@ -935,9 +1056,18 @@ fn parameters_of(table: &[Variable], values: &[Value]) -> Vec<Value> {
     table
         .iter()
         .zip(values)
-        .filter(|(v, _)| v.causality == Causality::Parameter)
-        .map(|(_, x)| *x)
+        .filter(|(v, _)| v.is_model_parameter())
+        .map(|(_, x)| x.clone())
         .collect()
+}
+
+/// Replaces `path` by `text` through a temporary file and a rename, so that a reader (ParaView
+/// reloading the `.pvd`) never sees a half-written file.
+fn replace_file(path: &Path, text: &str) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
 }
 
 fn article(t: VarType) -> &'static str {

@@ -2,9 +2,11 @@
 //!
 //! A [`Snapshot`] holds everything a restored instance needs to continue exactly as the original
 //! would: the phase, every variable value (parameters, inputs, the last outputs and solver
-//! statistics), the time, the experiment setup and the converged [`AnalysisState`].
+//! statistics), the time, the experiment setup, the converged [`AnalysisState`], and the VTK
+//! output written so far (step count and file list, so the `.pvd` continues from the state).
 //!
-//! Serialized form (little endian), version 1:
+//! Serialized form (little endian), version 2 (version 1 had no String values and no VTK
+//! output; its states are refused, as they came from an FMU with another GUID anyway):
 //!
 //! | bytes | content |
 //! |---|---|
@@ -36,10 +38,14 @@ pub struct Snapshot {
     pub outputs_fresh: bool,
     /// The converged state, when an analysis exists.
     pub analysis: Option<AnalysisState>,
+    /// Successful steps since initialization (the number of the next VTK file).
+    pub steps: usize,
+    /// The VTK files written since initialization and their times (the `.pvd` entries).
+    pub vtk_files: Vec<(f64, String)>,
 }
 
 const MAGIC: &[u8; 8] = b"MCFMI2ST";
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// The serialized bytes of `snapshot` for the FMU with `guid`.
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
@@ -147,6 +153,7 @@ mod tests {
                 Value::Integer(-3),
                 Value::Boolean(true),
                 Value::Real(1e-300),
+                Value::String("out dir/ä \"x\"".into()),
             ],
             mu_set: true,
             time: 0.35000000000000003,
@@ -154,6 +161,8 @@ mod tests {
             stop_time: Some(1.0),
             outputs_fresh: true,
             analysis: Some(converged_state()),
+            steps: 7,
+            vtk_files: vec![(0.0, "M_0000.vtu".into()), (0.1 + 0.2, "M_0007.vtu".into())],
         }
     }
 

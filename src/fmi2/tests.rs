@@ -3,7 +3,8 @@
 //! TEST GOAL: the C boundary behaves as FMI 2.0 says (and as `instance.rs` documents where it
 //! deviates): lifecycle, value references, bad pointers and values, wrong call order, GUID check,
 //! Discard and retry, FMU state save/restore and (de)serialization, independent instances on
-//! several threads, a panic turned into fmi2Fatal.
+//! several threads, a panic turned into fmi2Fatal, the String parameter `results.directory` and
+//! the VTK files it asks for (per step, after a restored state, after Reset, a failed write).
 //!
 //! MODEL: the default ParallelArch specimen (1/4 model, 121 nodes, 200 triangles, gaps G1..G9,
 //! boundary group `frame`), written to a temporary `resources/` directory.
@@ -220,6 +221,36 @@ impl<'a> Fmu<'a> {
         unsafe { fmi2_set_integer(self.c, &self.u.vr(name), 1, &v) }
     }
 
+    fn set_string(&self, name: &str, v: &str) -> c_int {
+        let v = CString::new(v).unwrap();
+        unsafe { fmi2_set_string(self.c, &self.u.vr(name), 1, &v.as_ptr()) }
+    }
+
+    /// The value of a String variable, copied before any other call (FMI 2.0 §2.1.7).
+    fn string(&self, name: &str) -> String {
+        let mut p: Fmi2String = std::ptr::null();
+        assert_eq!(
+            unsafe { fmi2_get_string(self.c, &self.u.vr(name), 1, &mut p) },
+            0,
+            "{name}"
+        );
+        unsafe { CStr::from_ptr(p) }.to_str().unwrap().to_owned()
+    }
+
+    /// Setup, initialization mode, `results.directory` = `dir`, exit: returns the exit status.
+    fn initialized_with_output(&self, dir: &std::path::Path) -> c_int {
+        unsafe {
+            assert_eq!(fmi2_setup_experiment(self.c, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi2_enter_initialization_mode(self.c), 0);
+        }
+        assert_eq!(
+            self.set_string("results.directory", dir.to_str().unwrap()),
+            0
+        );
+        assert_eq!(self.set_integer("solver.incrementsPerStep", 2), 0);
+        unsafe { fmi2_exit_initialization_mode(self.c) }
+    }
+
     fn real(&self, name: &str) -> f64 {
         let mut v = f64::NAN;
         assert_eq!(
@@ -251,7 +282,7 @@ impl<'a> Fmu<'a> {
             match v.var_type {
                 super::variables::VarType::Real => reals.push(self.real(&v.name)),
                 super::variables::VarType::Integer => ints.push(self.integer(&v.name)),
-                super::variables::VarType::Boolean => {}
+                super::variables::VarType::Boolean | super::variables::VarType::String => {}
             }
         }
         (reals, ints)
@@ -732,4 +763,205 @@ fn a_panic_becomes_fatal_and_the_instance_is_closed() {
         Status::Error.raw()
     );
     assert!(log.contains(Status::Error, "an earlier call failed fatally"));
+}
+
+/// The `(timestep, file)` entries of a `.pvd` (the format `vtk::collection` writes).
+fn pvd_entries(path: &std::path::Path) -> Vec<(f64, String)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.starts_with("<?xml") && text.trim_end().ends_with("</VTKFile>"));
+    let attribute = |line: &str, name: &str| -> String {
+        let start = line.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+        line[start..][..line[start..].find('"').unwrap()].to_string()
+    };
+    text.lines()
+        .filter(|l| l.starts_with("<DataSet "))
+        .map(|l| {
+            (
+                attribute(l, "timestep").parse().unwrap(),
+                attribute(l, "file"),
+            )
+        })
+        .collect()
+}
+
+/// Checks that `dir` holds the listed `.vtu` files, each a complete VTK file.
+fn assert_vtu_files(dir: &std::path::Path, entries: &[(f64, String)]) {
+    for (_, file) in entries {
+        let text =
+            std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(text.contains("<UnstructuredGrid"), "{file}");
+        assert!(
+            text.trim_end().ends_with("</VTKFile>"),
+            "{file} is complete"
+        );
+    }
+}
+
+#[test]
+fn results_directory_writes_every_step_as_vtk() {
+    let (u, log) = (Unpacked::specimen("vtk"), Log::default());
+    // Missing (two levels) and with a space: created at initialization.
+    let dir = u.dir.parent().unwrap().join("vtk out/run 1");
+    let fmu = Fmu::new(&u, &log);
+    assert_eq!(fmu.initialized_with_output(&dir), 0, "{:?}", log.take());
+    assert_eq!(fmu.string("results.directory"), dir.to_str().unwrap());
+    fmu.ramp(0, 3, 10);
+    let pvd = dir.join("ParallelArch.pvd");
+    let entries = pvd_entries(&pvd);
+    let files: Vec<&str> = entries.iter().map(|(_, f)| f.as_str()).collect();
+    assert_eq!(
+        files,
+        [
+            "ParallelArch_0000.vtu",
+            "ParallelArch_0001.vtu",
+            "ParallelArch_0002.vtu",
+            "ParallelArch_0003.vtu"
+        ]
+    );
+    for (k, (t, _)) in entries.iter().enumerate() {
+        assert!((t - k as f64 / 10.0).abs() < 1e-12, "entry {k}: t = {t}");
+    }
+    assert_eq!(entries[3].0, fmu.real("time"));
+    assert_vtu_files(&dir, &entries);
+    assert!(!dir.join("ParallelArch.pvd.tmp").exists());
+    // The parameter is fixed once initialized.
+    assert_eq!(
+        fmu.set_string("results.directory", "elsewhere"),
+        Status::Error.raw()
+    );
+    assert!(log.contains(Status::Error, "results.directory is a fixed parameter"));
+}
+
+#[test]
+fn strings_are_copied_on_set_and_stay_valid_until_the_next_get() {
+    let (u, log) = (Unpacked::specimen("strings"), Log::default());
+    let fmu = Fmu::new(&u, &log);
+    let vr = u.vr("results.directory");
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(
+        fmu.string("results.directory"),
+        "",
+        "start value: no output"
+    );
+    {
+        let value = CString::new("out/a").unwrap();
+        assert_eq!(
+            unsafe { fmi2_set_string(fmu.c, &vr, 1, &value.as_ptr()) },
+            0
+        );
+    } // the caller's string is gone: the instance holds a copy
+    let (mut first, mut second): (Fmi2String, Fmi2String) = (std::ptr::null(), std::ptr::null());
+    let vrs = [vr, vr];
+    let mut both = [std::ptr::null(); 2];
+    assert_eq!(
+        unsafe { fmi2_get_string(fmu.c, vrs.as_ptr(), 2, both.as_mut_ptr()) },
+        0
+    );
+    assert_eq!(unsafe { fmi2_get_string(fmu.c, &vr, 1, &mut first) }, 0);
+    // Other calls (a set, a get of another type) leave the returned pointer valid.
+    assert_eq!(fmu.set_string("results.directory", "out/b"), 0);
+    assert_eq!(fmu.real("film.E"), 1e9);
+    assert_eq!(unsafe { CStr::from_ptr(first) }.to_str().unwrap(), "out/a");
+    assert_eq!(unsafe { fmi2_get_string(fmu.c, &vr, 1, &mut second) }, 0);
+    assert_eq!(unsafe { CStr::from_ptr(second) }.to_str().unwrap(), "out/b");
+    // NULL strings, wrong types, outputs are refused and change nothing.
+    let null: Fmi2String = std::ptr::null();
+    let err = Status::Error.raw();
+    assert_eq!(unsafe { fmi2_set_string(fmu.c, &vr, 1, &null) }, err);
+    assert!(log.contains(Status::Error, "value[0] is NULL"));
+    let text = c"x".as_ptr();
+    assert_eq!(
+        unsafe { fmi2_set_string(fmu.c, &u.vr("film.E"), 1, &text) },
+        err
+    );
+    assert!(log.contains(Status::Error, "(film.E) is a Real, not a String"));
+    assert_eq!(fmu.string("results.directory"), "out/b");
+    let mut p: Fmi2String = std::ptr::null();
+    assert_eq!(unsafe { fmi2_get_string(fmu.c, &0, 1, &mut p) }, err);
+    assert!(log.contains(Status::Error, "(time) is a Real, not a String"));
+}
+
+#[test]
+fn a_restored_state_continues_the_pvd_and_reset_starts_it_again() {
+    let (u, log) = (Unpacked::specimen("vtk state"), Log::default());
+    let dir = u.dir.parent().unwrap().join("vtk");
+    let fmu = Fmu::new(&u, &log);
+    assert_eq!(fmu.initialized_with_output(&dir), 0);
+    fmu.ramp(0, 1, 10);
+    let mut state: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+    fmu.ramp(1, 4, 10);
+    let pvd = dir.join("ParallelArch.pvd");
+    assert_eq!(pvd_entries(&pvd).len(), 5);
+    let long_branch = std::fs::read_to_string(dir.join("ParallelArch_0002.vtu")).unwrap();
+
+    // Back to t = 0.1 (step 1) and another input: step 2 again, file 0002 rewritten.
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, state) }, 0);
+    assert_eq!(fmu.set_real("frame.dz", -0.001), 0);
+    assert_eq!(fmu.step(0.1, 0.1), 0);
+    let entries = pvd_entries(&pvd);
+    let files: Vec<&str> = entries.iter().map(|(_, f)| f.as_str()).collect();
+    assert_eq!(
+        files,
+        [
+            "ParallelArch_0000.vtu",
+            "ParallelArch_0001.vtu",
+            "ParallelArch_0002.vtu"
+        ]
+    );
+    assert!((entries[2].0 - 0.2).abs() < 1e-12);
+    assert_ne!(
+        std::fs::read_to_string(dir.join("ParallelArch_0002.vtu")).unwrap(),
+        long_branch
+    );
+    assert_vtu_files(&dir, &entries);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
+
+    // Reset: the parameter is back to "" (no output) and the list starts again.
+    assert_eq!(unsafe { fmi2_reset(fmu.c) }, 0);
+    assert_eq!(fmu.initialized_with_output(&dir), 0);
+    assert_eq!(
+        pvd_entries(&pvd),
+        [(0.0, "ParallelArch_0000.vtu".to_string())]
+    );
+    assert_eq!(unsafe { fmi2_reset(fmu.c) }, 0);
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(fmu.string("results.directory"), "");
+}
+
+#[test]
+fn a_failed_write_is_a_warning_and_the_step_stands() {
+    let (u, log) = (Unpacked::specimen("vtk fail"), Log::default());
+    // A directory below a regular file cannot be created.
+    let blocker = u.dir.parent().unwrap().join("not a directory");
+    std::fs::write(&blocker, "x").unwrap();
+    let fmu = Fmu::new(&u, &log);
+    let warning = Status::Warning.raw();
+    assert_eq!(fmu.initialized_with_output(&blocker.join("vtk")), warning);
+    let messages = log.take();
+    assert!(
+        messages.iter().any(|(s, c, m)| *s == warning
+            && c == "logStatusWarning"
+            && m.starts_with("fmi2ExitInitializationMode: VTK output at t = 0 failed")
+            && m.contains("not a directory")),
+        "{messages:?}"
+    );
+    assert_eq!(fmu.set_real("frame.dz", -0.01), 0);
+    assert_eq!(fmu.step(0.0, 0.1), warning);
+    assert!(log.contains(Status::Warning, "VTK output at t = 0.1 failed"));
+    assert_eq!(fmu.real("time"), 0.1, "the step is kept");
+    assert!(fmu.real("G9.slip") != 0.0);
+    let mut status = -1;
+    assert_eq!(
+        unsafe { fmi2_get_status(fmu.c, FMI2_DO_STEP_STATUS, &mut status) },
+        0
+    );
+    assert_eq!(status, 0);
+    assert_eq!(fmu.step(0.1, 0.1), warning, "and the next step is taken");
 }

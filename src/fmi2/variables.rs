@@ -16,6 +16,7 @@
 //! | `film.E`, `film.nu`, `film.thickness`, `film.prestressX/Y/XY` | Real | parameter | Pa, 1, m, Pa | film |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
+//! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
 //! | `<gap>.frictionX/.frictionY` | Real | output | N | friction force on the film, local x, y (signed) |
 //! | `<gap>.status` | Integer | output | | 0 open, 1 stick, 2 slip |
@@ -42,6 +43,7 @@ pub enum VarType {
     Real,
     Integer,
     Boolean,
+    String,
 }
 
 impl VarType {
@@ -50,6 +52,7 @@ impl VarType {
             Self::Real => "Real",
             Self::Integer => "Integer",
             Self::Boolean => "Boolean",
+            Self::String => "String",
         }
     }
 }
@@ -92,29 +95,33 @@ impl Variability {
     }
 }
 
-/// A value of any of the types.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// A value of any of the types (not `Copy`: a String owns its text).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Value {
     Real(f64),
     Integer(i32),
     Boolean(bool),
+    String(String),
 }
 
 impl Value {
-    pub fn var_type(self) -> VarType {
+    pub fn var_type(&self) -> VarType {
         match self {
             Self::Real(_) => VarType::Real,
             Self::Integer(_) => VarType::Integer,
             Self::Boolean(_) => VarType::Boolean,
+            Self::String(_) => VarType::String,
         }
     }
 
-    /// The value as written in a `start` attribute (shortest round-trip form for reals).
-    pub fn to_xml(self) -> String {
+    /// The value as written in a `start` attribute (shortest round-trip form for reals;
+    /// strings as they are, the XML writer escapes them).
+    pub fn to_xml(&self) -> String {
         match self {
-            Self::Real(v) => format_real(v),
+            Self::Real(v) => format_real(*v),
             Self::Integer(v) => v.to_string(),
             Self::Boolean(v) => v.to_string(),
+            Self::String(v) => v.clone(),
         }
     }
 }
@@ -149,6 +156,9 @@ pub enum Binding {
     MaxCutbacks,
     IncrementsPerStep,
     UseJuRowlands,
+    /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
+    /// it does not change the analysis, and no output depends on it.
+    ResultsDirectory,
     SlipX(usize),
     SlipY(usize),
     NormalForce(usize),
@@ -186,6 +196,12 @@ pub struct Variable {
 }
 
 impl Variable {
+    /// Whether the variable is a parameter of the analysis (everything but `results.directory`):
+    /// changing one rebuilds the analysis, and the outputs' initial values depend on them.
+    pub fn is_model_parameter(&self) -> bool {
+        self.causality == Causality::Parameter && self.binding != Binding::ResultsDirectory
+    }
+
     /// `initial` as written in the XML (`None`: omitted, the default applies).
     pub fn initial(&self) -> Option<&'static str> {
         match self.causality {
@@ -211,7 +227,7 @@ pub const UNITS: [(&str, [i32; 3]); 5] = [
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
-pub const RESERVED_NAMES: [&str; 5] = ["time", "mu", "archHeight", "film", "solver"];
+pub const RESERVED_NAMES: [&str; 6] = ["time", "mu", "archHeight", "film", "solver", "results"];
 
 /// Default of `solver.incrementsPerStep`.
 pub const DEFAULT_INCREMENTS_PER_STEP: i32 = 10;
@@ -398,6 +414,13 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     for (name, start, unit, description, binding) in solver_parameters {
         table.parameter(&format!("solver.{name}"), start, unit, description, binding);
     }
+    table.parameter(
+        "results.directory",
+        Value::String(String::new()),
+        None,
+        "directory for VTK output of every communication step (ParaView .vtu + .pvd); empty: none",
+        Binding::ResultsDirectory,
+    );
 
     for (i, g) in model.gaps.iter().enumerate() {
         let n = &g.name;
@@ -610,7 +633,7 @@ mod tests {
                 "{}",
                 v.name
             );
-            if let Some(s) = v.start {
+            if let Some(s) = &v.start {
                 assert_eq!(s.var_type(), v.var_type, "{}", v.name);
             }
             if v.var_type != VarType::Real {
@@ -652,17 +675,22 @@ mod tests {
             Some(Value::Boolean(false))
         );
         assert_eq!(find("mu").start, Some(Value::Real(0.2)));
+        let dir = find("results.directory");
+        assert_eq!(
+            (dir.var_type, dir.causality, dir.variability),
+            (VarType::String, Causality::Parameter, Variability::Fixed)
+        );
+        assert_eq!(dir.start, Some(Value::String(String::new())));
+        assert!(!dir.is_model_parameter() && find("film.E").is_model_parameter());
         let outputs = table
             .iter()
             .filter(|v| v.causality == Causality::Output)
             .count();
         assert_eq!(outputs, 9 * 7 + 3 + 4);
-        // A user model has no archHeight.
-        assert!(
-            variables(&model, Kind::Model)
-                .iter()
-                .all(|v| v.name != "archHeight")
-        );
+        // A user model has no archHeight, but the same results.directory.
+        let user = variables(&model, Kind::Model);
+        assert!(user.iter().all(|v| v.name != "archHeight"));
+        assert!(user.iter().any(|v| v.binding == Binding::ResultsDirectory));
     }
 
     #[test]
