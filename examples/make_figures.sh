@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Regenerates every example figure and its CSV into docs/figures/ (or the directory given as
+# the first argument): builds the core and packs the FMU, creates .venv if needed, then runs
+# the four examples with their default number of steps.
+#
+#   bash examples/make_figures.sh [OUT_DIR]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-docs/figures}"
+
+echo "== build the core and pack the FMU =="
+cargo build --release --locked
+cargo run --release --locked --bin fmu-pack
+
+echo "== python environment (.venv) =="
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+.venv/bin/pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
+
+mkdir -p "$out"
+for example in fig7_mu_sweep fig8_vs_experiment fig6_stress erection_sequence; do
+  echo "== $example =="
+  .venv/bin/python "examples/$example.py" --out "$out"
+done
+echo "figures and CSV files in $out/"
