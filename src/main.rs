@@ -23,7 +23,9 @@ options:
   --refine N         mesh refinement factor of the specimen (default 1: 200 triangles)
   --mu X             friction coefficient of every gap (default: the model's, 0.2 for specimens)
   --steps N          load steps to the target (default 20)
-  --matrix M         consistent (default) or ju-rowlands
+  --matrix M         consistent (default) or ju-rowlands (the paper's; converges linearly:
+                     give it --max-iterations 3000)
+  --max-iterations N Newton iterations per increment before it is halved (default 15)
   --csv FILE         write the gap results of every step as CSV
   --vtk DIR          write the deformed film of every step as VTK (DIR/<model>_NNNN.vtu + .pvd)
   --quiet            no progress indicator
@@ -37,6 +39,7 @@ struct Options {
     mu: Option<f64>,
     steps: usize,
     matrix: IterationMatrix,
+    max_iterations: Option<usize>,
     csv: Option<String>,
     vtk: Option<String>,
     quiet: bool,
@@ -51,6 +54,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         mu: None,
         steps: 20,
         matrix: IterationMatrix::Consistent,
+        max_iterations: None,
         csv: None,
         vtk: None,
         quiet: false,
@@ -94,6 +98,12 @@ fn parse(args: &[String]) -> Result<Options, String> {
                     }
                 }
             }
+            "--max-iterations" => {
+                let n = value("--max-iterations")?
+                    .parse()
+                    .map_err(|_| "--max-iterations needs a positive integer".to_string())?;
+                o.max_iterations = Some(n);
+            }
             "--csv" => o.csv = Some(value("--csv")?),
             "--vtk" => o.vtk = Some(value("--vtk")?),
             "--quiet" => o.quiet = true,
@@ -130,9 +140,11 @@ fn run(o: &Options) -> Result<(), String> {
         "" => return Err(String::new()),
         other => return Err(format!("unknown command '{other}'")),
     };
+    let defaults = SolverSettings::default();
     let settings = SolverSettings {
         iteration_matrix: o.matrix,
-        ..SolverSettings::default()
+        max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
+        ..defaults
     };
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
     if let Some(mu) = o.mu {
