@@ -121,8 +121,9 @@ impl System {
             Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
         let mut entry_rows: Vec<Option<(usize, usize)>> = Vec::with_capacity(pairs.capacity());
         let mut push_block = |global: &[usize]| {
-            for &gi in global {
-                for &gj in global {
+            // Column-major, like nalgebra's storage of the element matrix.
+            for &gj in global {
+                for &gi in global {
                     let entry = match (dofs[gi], dofs[gj]) {
                         (Dof::Free(i), Dof::Free(j)) if !lower_only || i >= j => Some((i, j)),
                         _ => None,
@@ -246,7 +247,7 @@ impl System {
             }
             if let Some(v) = values.as_deref_mut() {
                 let slots = &self.slots[81 * e..81 * (e + 1)];
-                for (s, kij) in slots.iter().zip(k.transpose().iter()) {
+                for (s, kij) in slots.iter().zip(k.iter()) {
                     if *s != NO_SLOT {
                         v[*s as usize] += kij;
                     }
@@ -270,7 +271,7 @@ impl System {
                 let slots = &self.slots[self.gap_offsets[g]..self.gap_offsets[g] + m * m];
                 for a in 0..m {
                     for b in 0..m {
-                        let s = slots[a * m + b];
+                        let s = slots[b * m + a];
                         if s != NO_SLOT {
                             let sign = if (a < 3) == (b < 3) { 1.0 } else { -1.0 };
                             v[s as usize] += sign * ka[(a % 3, b % 3)];
@@ -287,13 +288,33 @@ pub fn node_dofs(nodes: &[usize; 3]) -> [usize; 9] {
     std::array::from_fn(|i| 3 * nodes[i / 3] + i % 3)
 }
 
-/// The global DOFs of a gap: A's three, then B's three when B is a node.
-fn gap_dofs(g: &GapGeometry) -> Vec<usize> {
-    let mut d = vec![3 * g.film_node, 3 * g.film_node + 1, 3 * g.film_node + 2];
-    if let Some(b) = g.support_node {
-        d.extend([3 * b, 3 * b + 1, 3 * b + 2]);
+/// The global DOFs of a gap: A's three, then B's three when B is a node (no allocation: it
+/// runs for every gap in every assembly).
+fn gap_dofs(g: &GapGeometry) -> GapDofs {
+    let a = 3 * g.film_node;
+    match g.support_node {
+        Some(b) => GapDofs {
+            dofs: [a, a + 1, a + 2, 3 * b, 3 * b + 1, 3 * b + 2],
+            len: 6,
+        },
+        None => GapDofs {
+            dofs: [a, a + 1, a + 2, 0, 0, 0],
+            len: 3,
+        },
     }
-    d
+}
+
+/// The 3 or 6 global DOFs of a gap.
+struct GapDofs {
+    dofs: [usize; 6],
+    len: usize,
+}
+
+impl std::ops::Deref for GapDofs {
+    type Target = [usize];
+    fn deref(&self) -> &[usize] {
+        &self.dofs[..self.len]
+    }
 }
 
 /// Displacement of node `v` from the global vector.

@@ -205,12 +205,17 @@ impl MembraneTriangle {
             let D = material.elasticity();
             let B = [0, 1, 2].map(|k| self.strain_operator(&f, k));
             let DB = B.map(|b| D * b);
+            // The tangent is symmetric: compute the blocks l ≥ k and mirror them.
             for k in 0..3 {
-                for l in 0..3 {
+                for l in k..3 {
                     let geometric = (self.gradients[k].transpose() * S * self.gradients[l])[0];
                     let block =
                         (B[k].transpose() * DB[l] + Matrix3::identity() * geometric) * volume;
                     kt.fixed_view_mut::<3, 3>(3 * k, 3 * l).copy_from(&block);
+                    if l != k {
+                        kt.fixed_view_mut::<3, 3>(3 * l, 3 * k)
+                            .copy_from(&block.transpose());
+                    }
                 }
             }
         }
