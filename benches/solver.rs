@@ -226,10 +226,10 @@ fn main() {
     let max_dof: usize = option("--max-dof")
         .and_then(|v| v.parse().ok())
         .unwrap_or(1_100_000);
-    // LU fill on the largest mesh would exceed this machine's 24 GiB; its size is capped apart.
+    // LU at 1 M DOF needs ≈ 10 GiB and a few minutes; `--max-lu-dof` caps it apart.
     let max_lu_dof: usize = option("--max-lu-dof")
         .and_then(|v| v.parse().ok())
-        .unwrap_or(400_000);
+        .unwrap_or(1_100_000);
     whole_specimen();
     println!("## one Newton iteration on refined specimens\n");
     println!(
