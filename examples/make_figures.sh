@@ -8,15 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-docs/figures}"
 
-echo "== build the core and pack the FMU =="
-cargo build --release --locked
-cargo run --release --locked --bin fmu-pack
-
-echo "== python environment (.venv) =="
-if [ ! -x .venv/bin/python ]; then
-  python3 -m venv .venv
-fi
-.venv/bin/pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
+bash fmu/prepare.sh
 
 mkdir -p "$out"
 for example in fig7_mu_sweep fig8_vs_experiment fig6_stress erection_sequence; do

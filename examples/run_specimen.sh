@@ -4,10 +4,5 @@
 # Extra arguments go to examples/run_specimen.py (e.g. --height 400 --mu 0.3).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --locked
-cargo run --release --locked --quiet --bin fmu-pack
-if [ ! -x .venv/bin/python ]; then
-  python3 -m venv .venv
-fi
-.venv/bin/pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
+bash fmu/prepare.sh >/dev/null
 .venv/bin/python examples/run_specimen.py "$@"

@@ -7,15 +7,7 @@ cd "$(dirname "$0")/.."
 echo "== cargo test (release) =="
 cargo test --release --locked
 
-echo "== package the FMU =="
-cargo build --release --locked
-cargo run --release --locked --bin fmu-pack
-
-echo "== python environment =="
-if [ ! -x .venv/bin/python ]; then
-  python3 -m venv .venv
-fi
-.venv/bin/pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
+bash fmu/prepare.sh
 
 echo "== pytest (fmpy, libcosim) =="
 .venv/bin/python -m pytest tests/python -q -p no:cacheprovider

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Shared by the test runner and the example scripts: builds the crate, packs
+# target/fmu/ParallelArch.fmu, and creates/updates the Python environment .venv/ (fmpy,
+# libcosimpy, numpy, pytest, matplotlib). Idempotent; run from anywhere.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+echo "== build the crate and pack the FMU ==" >&2
+cargo build --release --locked
+cargo run --release --locked --quiet --bin fmu-pack
+
+echo "== python environment (.venv) ==" >&2
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+.venv/bin/pip install --quiet --disable-pip-version-check -r tests/python/requirements.txt
