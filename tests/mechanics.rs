@@ -670,3 +670,106 @@ fn vtk_output_is_well_formed_and_complete() {
     }
     assert!(vtk::collection(&[(0.5, "a.vtu".into())]).contains("timestep=\"0.5\""));
 }
+
+/// A small deterministic generator (xorshift) so the randomized checks are reproducible.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+#[test]
+fn tangent_matches_finite_difference_on_random_triangles_and_states() {
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let mut checked = 0;
+    while checked < 60 {
+        let x = [0, 1, 2].map(|_| Vector3::new(rng.next(), rng.next(), 0.3 * rng.next()));
+        let Ok(tri) = MembraneTriangle::new(x) else {
+            continue;
+        };
+        if tri.area() < 0.05 {
+            continue; // keep the finite difference well conditioned
+        }
+        let mat = Material {
+            prestress: [
+                1e6 * rng.next().abs(),
+                1e6 * rng.next().abs(),
+                3e5 * rng.next(),
+            ],
+            ..etfe()
+        };
+        let u = ElementVector::from_fn(|_, _| 0.1 * rng.next());
+        let k = tri.tangent_stiffness(&mat, &u);
+        let h = 1e-7;
+        for j in 0..9 {
+            let (mut up, mut um) = (u, u);
+            up[j] += h;
+            um[j] -= h;
+            let column =
+                (tri.internal_force(&mat, &up) - tri.internal_force(&mat, &um)) / (2.0 * h);
+            let err = (column - k.column(j)).amax();
+            assert!(
+                err < 1e-5 * k.amax(),
+                "triangle {x:?}, dof {j}: {err:e} vs {:e}",
+                k.amax()
+            );
+        }
+        checked += 1;
+    }
+}
+
+#[test]
+fn gap_tangent_matches_finite_difference_on_random_states() {
+    let mut rng = Rng(0x2545_F491_4F6C_DD1D);
+    let mut seen = std::collections::HashSet::new();
+    let mut checked = 0;
+    while checked < 300 {
+        let kn = 1e8 * (1.0 + rng.next().abs());
+        let law = GapLaw {
+            normal_stiffness: kn,
+            tangential_stiffness: kn * (0.05 + 0.2 * rng.next().abs()),
+            friction: 0.5 * rng.next().abs(),
+            initial_gap: 1e-4 * rng.next().abs(),
+        };
+        // Tangential scale spread over two decades so that both stick and slip occur.
+        let t = 10f64.powf(-6.0 + 2.0 * rng.next().abs());
+        let d = Vector3::new(t * rng.next(), t * rng.next(), 3e-4 * rng.next());
+        let history = Vector2::new(0.1 * t * rng.next(), 0.1 * t * rng.next());
+        let r = law.evaluate(d, history);
+        // Skip points next to the non-smooth surfaces (gap closing, cone edge).
+        let gap = law.initial_gap + d.z;
+        if gap.abs() < 1e-6
+            || (r.trial_magnitude - law.friction * r.normal_force).abs()
+                < 1e-3 * law.friction * r.normal_force
+        {
+            continue;
+        }
+        let k = law.consistent_tangent(&r);
+        let h = 1e-11;
+        for j in 0..3 {
+            let (mut dp, mut dm) = (d, d);
+            dp[j] += h;
+            dm[j] -= h;
+            let column =
+                (law.evaluate(dp, history).force - law.evaluate(dm, history).force) / (2.0 * h);
+            let err = (column - k.column(j)).amax();
+            assert!(
+                err < 1e-5 * kn,
+                "{:?} d {d:?}: column {j} off by {err:e}",
+                r.status
+            );
+        }
+        seen.insert(r.status as u8);
+        checked += 1;
+    }
+    assert_eq!(
+        seen.len(),
+        3,
+        "open, stick and slip states were all checked"
+    );
+}
