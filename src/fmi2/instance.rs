@@ -216,6 +216,18 @@ pub struct Instance {
     /// Saved FMU states; the key is the address of the boxed snapshot, handed out as the opaque
     /// `fmi2FMUstate`. It is only ever used as a key, never dereferenced.
     states: HashMap<usize, Box<Snapshot>>,
+    /// The last step refused with `fmi2Discard`, while no step has succeeded since.
+    discarded: Option<RefusedStep>,
+}
+
+/// A step refused with `fmi2Discard`: where it started and the inputs it was asked to reach.
+#[derive(Clone, Debug, PartialEq)]
+struct RefusedStep {
+    time: f64,
+    inputs: Vec<Value>,
+    /// Whether the identical step (same start time and inputs) was asked again and refused
+    /// again: then `fmi2GetBooleanStatus(fmi2Terminated)` is true.
+    repeated: bool,
 }
 
 impl std::fmt::Debug for Instance {
@@ -280,6 +292,7 @@ impl Instance {
             vtk_files: Vec::new(),
             strings_out: Vec::new(),
             states: HashMap::new(),
+            discarded: None,
         };
         instance.event(|| {
             format!(
@@ -374,6 +387,7 @@ impl Instance {
         self.outputs_fresh = false;
         self.steps = 0;
         self.vtk_files.clear();
+        self.discarded = None;
         Ok(())
     }
 
@@ -711,8 +725,18 @@ impl Instance {
         }
         let tolerance = 1e-9 * t.abs().max(self.time.abs()).max(1.0);
         if (t - self.time).abs() > tolerance {
+            let stale = if self.discarded.is_some() {
+                format!(
+                    ". The step from t = {0} was refused (fmi2Discard) and the FMU stayed there: its outputs are \
+                     those of t = {0}, not of later times. Retry from t = {0} with a smaller change of the inputs, \
+                     or stop the simulation",
+                    self.time
+                )
+            } else {
+                String::new()
+            };
             return Err(Failure::error(format!(
-                "currentCommunicationPoint = {t} differs from the FMU's time {} (the last converged communication point)",
+                "currentCommunicationPoint = {t} differs from the FMU's time {} (the last converged communication point){stale}",
                 self.time
             )));
         }
@@ -753,6 +777,7 @@ impl Instance {
             Ok(report) => {
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
+                self.discarded = None;
                 self.refresh_outputs(Some(&report));
                 self.event(|| {
                     format!(
@@ -774,13 +799,44 @@ impl Instance {
                 self.phase = Phase::StepFailed;
                 let message = format!("step from t = {t} to {}: {e}", t + h);
                 Err(match e {
-                    StepError::NotConverged { .. } => Failure::discard(format!(
-                        "{message}. Time stays {t}: set a smaller change of the inputs and call fmi2DoStep again"
-                    )),
+                    StepError::NotConverged { .. } => {
+                        let inputs = self.input_values();
+                        let repeated = self
+                            .discarded
+                            .as_ref()
+                            .is_some_and(|d| d.time == self.time && d.inputs == inputs);
+                        self.discarded = Some(RefusedStep {
+                            time: self.time,
+                            inputs,
+                            repeated,
+                        });
+                        Failure::discard(if repeated {
+                            format!(
+                                "{message}. The identical step was refused before: fmi2GetBooleanStatus(fmi2Terminated) \
+                                 is now true. Time stays {t}; only a smaller change of the inputs can succeed"
+                            )
+                        } else {
+                            format!(
+                                "{message}. Time stays {t}: set a smaller change of the inputs and call fmi2DoStep again \
+                                 (asking the identical step again makes fmi2GetBooleanStatus(fmi2Terminated) true)"
+                            )
+                        })
+                    }
                     StepError::InvalidInput { .. } => Failure::error(message),
                 })
             }
         }
+    }
+
+    /// The current values of the inputs (table order).
+    fn input_values(&self) -> Vec<Value> {
+        self.description
+            .variables
+            .iter()
+            .zip(&self.values)
+            .filter(|(v, _)| v.causality == Causality::Input)
+            .map(|(_, x)| x.clone())
+            .collect()
     }
 
     // ---------------------------------------------------------------- VTK output
@@ -855,10 +911,14 @@ impl Instance {
         Err(unavailable_status(kind, "fmi2GetIntegerStatus"))
     }
 
-    /// `fmi2Terminated`: the FMU never asks the master to stop.
+    /// `fmi2Terminated`: true while the last step was refused (`fmi2Discard`) for the second
+    /// time with the same start time and inputs. Retrying the identical step cannot succeed (the
+    /// FMU already cut it down to its smallest increment), so a master that repeats it, as
+    /// `fmpy.simulate_fmu` does, is told to stop; any other retry is still allowed.
     pub fn get_boolean_status(&self, kind: i32) -> Outcome<bool> {
         match kind {
-            FMI2_TERMINATED => Ok(false),
+            FMI2_TERMINATED => Ok(self.phase == Phase::StepFailed
+                && self.discarded.as_ref().is_some_and(|d| d.repeated)),
             _ => Err(unavailable_status(kind, "fmi2GetBooleanStatus")),
         }
     }
@@ -955,6 +1015,8 @@ impl Instance {
         self.time = s.time;
         self.start_time = s.start_time;
         self.stop_time = s.stop_time;
+        // A restored state starts a new branch: no refused step on it yet.
+        self.discarded = None;
         self.outputs_fresh = s.outputs_fresh && self.analysis.is_some();
         self.steps = s.steps;
         self.vtk_files = s.vtk_files.clone();

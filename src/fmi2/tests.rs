@@ -633,6 +633,46 @@ fn a_step_that_cannot_converge_is_discarded_and_can_be_retried() {
 }
 
 #[test]
+fn repeating_a_refused_step_identically_reports_terminated() {
+    let (u, log) = (Unpacked::specimen("terminated"), Log::default());
+    let settings = [
+        ("solver.maxCutbacks", 0),
+        ("solver.maxIterations", 6),
+        ("solver.incrementsPerStep", 1),
+    ];
+    let fmu = Fmu::initialized(&u, &log, &[], &settings);
+    let terminated = || {
+        let mut value = -1;
+        assert_eq!(
+            unsafe { fmi2_get_boolean_status(fmu.c, FMI2_TERMINATED, &mut value) },
+            0
+        );
+        value
+    };
+    assert_eq!(terminated(), 0);
+    assert_eq!(fmu.set_real("frame.dz", -0.15), 0);
+    assert_eq!(fmu.step(0.0, 1.0), Status::Discard.raw());
+    // A first refusal leaves the retry open: what fmpy.simulate_fmu asks before repeating.
+    assert_eq!(terminated(), 0);
+    assert!(log.contains(Status::Discard, "asking the identical step again"));
+    // The identical step again (the step size does not matter for a pseudo-time): refused, and
+    // now the FMU asks the master to stop.
+    assert_eq!(fmu.step(0.0, 0.5), Status::Discard.raw());
+    assert_eq!(terminated(), 1);
+    assert!(log.contains(Status::Discard, "fmi2Terminated) is now true"));
+    // A master that ignores the Discard and goes on is refused with a message that the outputs
+    // are stale, at every call.
+    for _ in 0..2 {
+        assert_eq!(fmu.step(1.0, 1.0), Status::Error.raw());
+        assert!(log.contains(Status::Error, "its outputs are those of t = 0"));
+    }
+    // A smaller change still works and clears the flag.
+    assert_eq!(fmu.set_real("frame.dz", -0.001), 0);
+    assert_eq!(fmu.step(0.0, 0.1), 0);
+    assert_eq!(terminated(), 0);
+}
+
+#[test]
 fn saved_states_restore_and_continue_identically() {
     let (u, log) = (Unpacked::specimen("state"), Log::default());
     let fmu = Fmu::initialized(&u, &log, &[("mu", 0.3)], &[("solver.incrementsPerStep", 2)]);

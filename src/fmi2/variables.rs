@@ -372,14 +372,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
             Some("1"),
-            "Newton converges when the correction is below this fraction of the increment's displacement",
+            "Newton converges when the last correction is below this fraction of the largest displacement (increment or total)",
             Binding::DisplacementTolerance,
         ),
         (
             "residualTolerance",
             Value::Real(solver.residual_tolerance),
             Some("1"),
-            "... and the free residual is below this fraction of the largest nodal force",
+            "... and the out-of-balance force is below this fraction of the largest nodal force of the model",
             Binding::ResidualTolerance,
         ),
         (

@@ -218,3 +218,32 @@ def test_states_are_opaque_handles(fmu_path):
         assert s.logged(ERROR, "was not created by this instance")
         s.ramp(RAMP, 20, last=1)
 
+
+
+def test_simulate_fmu_ends_on_a_refused_step(fmu_path, tmp_path):
+    """fmpy.simulate_fmu repeats a Discarded step until fmi2GetBooleanStatus(fmi2Terminated) is
+    true. The FMU says so when the identical step is refused a second time, so the run ends at the
+    last successful time instead of hanging. Run in a child process with a timeout: a hang must
+    fail the test, not the CI job."""
+    import subprocess
+    import sys
+    import textwrap
+
+    script = textwrap.dedent(f"""
+        import numpy as np
+        from fmpy import simulate_fmu
+        signals = np.array([(0.0, 0.0), (0.1, -0.15), (1.0, -0.15)],
+                           dtype=[("time", np.float64), ("frame.dz", np.float64)])
+        # One increment, no cut-back, few iterations: the jump to -H/2 cannot converge.
+        result = simulate_fmu({str(fmu_path)!r}, stop_time=1.0, step_size=0.1, input=signals,
+                              start_values={{"solver.incrementsPerStep": 1, "solver.maxCutbacks": 0,
+                                             "solver.maxIterations": 3}},
+                              output=["frame.Rz"])
+        print("ROWS", len(result), "LAST", float(result["time"][-1]))
+    """)
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    line = [l for l in done.stdout.splitlines() if l.startswith("ROWS")][-1]
+    last = float(line.split()[-1])
+    # The run stopped early, at a time before the refused jump, instead of looping for ever.
+    assert last < 1.0, line
