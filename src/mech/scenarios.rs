@@ -545,6 +545,9 @@ pub struct ArchPanel {
     pub material: Material,
     /// `μ` of every gap.
     pub friction: f64,
+    /// Drop of the far corner of the jacked edge at the end of the standard run (m): the model's
+    /// group targets (what `membrane-contact model` ramps to) and [`ArchPanel::jacked`]'s.
+    pub corner_drop: f64,
 }
 
 impl Default for ArchPanel {
@@ -558,6 +561,7 @@ impl Default for ArchPanel {
             arch_x: [1.0, 2.0],
             material: ParallelArch::default().material,
             friction: 0.2,
+            corner_drop: 0.2,
         }
     }
 }
@@ -617,11 +621,14 @@ impl ArchPanel {
                 fixed: vec![Axis::X, Axis::Y, Axis::Z],
             })
             .collect();
-        let groups = (0..=ny)
-            .map(|j| BoundaryGroup {
+        let groups = self
+            .jack_targets(self.angle_for_drop(self.corner_drop))
+            .into_iter()
+            .enumerate()
+            .map(|(j, target)| BoundaryGroup {
                 name: format!("J{j}"),
                 nodes: vec![id(nx, j)],
-                target: [0.0; 3],
+                target,
             })
             .collect();
         validated(Model {
@@ -658,11 +665,12 @@ impl ArchPanel {
         (drop / self.width).clamp(-1.0, 1.0).asin()
     }
 
-    /// Jacked down by `angle` in `stages` equal stages of `steps` steps each, `μ` set at the first
-    /// stage to `mu` (`None`: the model's); every stage ends on the exact rotation.
+    /// Jacked down until the far corner has dropped by `corner_drop`, in `stages` equal stages
+    /// (of the angle) of `steps` steps each, `μ` set at the first stage to `mu` (`None`: the
+    /// model's); every stage ends on the exact rotation. `jacked(1, n, None, 1)` is what
+    /// `membrane-contact model panel.json --steps n` does.
     pub fn jacked(
         &self,
-        angle: f64,
         stages: usize,
         steps: usize,
         mu: Option<f64>,
@@ -672,6 +680,7 @@ impl ArchPanel {
             return Err("panel path: stages and steps must be ≥ 1".into());
         }
         let model = self.model()?;
+        let angle = self.angle_for_drop(self.corner_drop);
         let stages_list = (1..=stages)
             .map(|k| Stage {
                 targets: self.jack_targets(angle * k as f64 / stages as f64),
@@ -682,10 +691,10 @@ impl ArchPanel {
         Ok(Scenario {
             family: Family::Panel,
             name: format!(
-                "panel H={} mu={} angle={:.2}deg stages={stages}x{steps} incr={increments_per_step}",
+                "panel H={} mu={} drop={}m stages={stages}x{steps} incr={increments_per_step}",
                 self.arch_rise,
                 mu.unwrap_or(self.friction),
-                angle.to_degrees()
+                self.corner_drop
             ),
             model,
             path: LoadPath {
@@ -713,6 +722,10 @@ pub struct CylinderStrip {
     pub material: Material,
     /// `μ` of every gap.
     pub friction: f64,
+    /// Downward pull of both leg ends at the end of the standard run (m).
+    pub down: f64,
+    /// Outward pull of both leg ends (m).
+    pub out: f64,
 }
 
 impl Default for CylinderStrip {
@@ -727,6 +740,8 @@ impl Default for CylinderStrip {
                 ..ParallelArch::default().material
             },
             friction: 0.2,
+            down: 0.005,
+            out: 0.0,
         }
     }
 }
@@ -776,10 +791,10 @@ impl CylinderStrip {
         };
         let constants = GapConstants::for_film(&self.material, self.friction);
         let gaps = gaps_on_arc(&nodes, &film, &support, constants, "C")?;
-        let group = |name: &str, s| BoundaryGroup {
+        let group = |name: &str, s, sign: f64| BoundaryGroup {
             name: name.into(),
             nodes: vec![id(s, 0), id(s, 1)],
-            target: [0.0; 3],
+            target: [sign * self.out, 0.0, -self.down],
         };
         validated(Model {
             name: "CylinderStrip".into(),
@@ -790,39 +805,34 @@ impl CylinderStrip {
             supports: vec![],
             symmetry: vec![],
             gaps,
-            groups: vec![group("left", 0), group("right", n + 1)],
+            groups: vec![group("left", 0, -1.0), group("right", n + 1, 1.0)],
         })
     }
 
-    /// Both ends pulled down by `down` and out by `out` (m) in `steps` steps.
-    pub fn pulled(
-        &self,
-        down: f64,
-        out: f64,
-        steps: usize,
-        increments_per_step: usize,
-    ) -> Result<Scenario, String> {
+    /// Both ends pulled down by `down` and out by `out` in `steps` steps.
+    pub fn pulled(&self, steps: usize, increments_per_step: usize) -> Result<Scenario, String> {
         if steps == 0 {
             return Err("strip path: steps must be ≥ 1".into());
         }
+        let model = self.model()?;
         Ok(Scenario {
             family: Family::Strip,
             name: format!(
                 "strip R={} mu={} down={:.0}mm out={:.0}mm steps={steps}",
                 self.radius,
                 self.friction,
-                down * 1e3,
-                out * 1e3
+                self.down * 1e3,
+                self.out * 1e3
             ),
-            model: self.model()?,
             path: LoadPath {
                 stages: vec![Stage {
-                    targets: vec![[-out, 0.0, -down], [out, 0.0, -down]],
+                    targets: model.groups.iter().map(|g| g.target).collect(),
                     steps,
                     friction: None,
                 }],
                 increments_per_step,
             },
+            model,
         })
     }
 }
@@ -1020,29 +1030,31 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
     }
     for rise in [0.15, 0.3] {
         for mu in [0.0, 0.2, 0.5] {
-            let panel = ArchPanel {
-                arch_rise: rise,
-                friction: mu,
-                ..ArchPanel::default()
-            };
-            for drop in [0.5 * rise, rise] {
-                let angle = panel.angle_for_drop(drop);
-                out.push(panel.jacked(angle, 1, 20, None, 1)?);
-                out.push(panel.jacked(angle, 1, 5, None, ips)?);
-                out.push(panel.jacked(angle, 3, 5, None, ips)?);
+            for corner_drop in [0.5 * rise, rise] {
+                let panel = ArchPanel {
+                    arch_rise: rise,
+                    friction: mu,
+                    corner_drop,
+                    ..ArchPanel::default()
+                };
+                out.push(panel.jacked(1, 20, None, 1)?);
+                out.push(panel.jacked(1, 5, None, ips)?);
+                out.push(panel.jacked(3, 5, None, ips)?);
             }
         }
     }
     for radius in [0.2, 0.3, 0.5] {
         for mu in [0.0, 0.2, 0.5] {
-            let strip = CylinderStrip {
-                radius,
-                friction: mu,
-                ..CylinderStrip::default()
-            };
-            for (down, out_mm) in [(0.005, 0.0), (0.01, 0.0), (0.01, 0.005)] {
+            for (down, pull_out) in [(0.005, 0.0), (0.01, 0.0), (0.01, 0.005)] {
+                let strip = CylinderStrip {
+                    radius,
+                    friction: mu,
+                    down,
+                    out: pull_out,
+                    ..CylinderStrip::default()
+                };
                 for steps in [1, 10] {
-                    out.push(strip.pulled(down, out_mm, steps, ips)?);
+                    out.push(strip.pulled(steps, ips)?);
                 }
             }
         }
