@@ -10,6 +10,7 @@
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
 //! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
 //! | [`specimen`] | the parallel-arch specimens of §4 and every assumption about them |
+//! | [`scenarios`] | load-path generators (specimen family, arch panel, cylinder strip, arch edge) |
 //! | [`vtk`] | VTK text of the deformed film and its stresses (Fig. 6) |
 
 pub mod assembly;
@@ -17,6 +18,7 @@ pub mod contact;
 pub mod element;
 pub mod linear;
 pub mod model;
+pub mod scenarios;
 pub mod solver;
 pub mod specimen;
 pub mod vtk;

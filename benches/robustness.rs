@@ -1,0 +1,171 @@
+//! Robustness benchmark (`cargo bench --bench robustness`): every load path of
+//! [`scenarios::robustness_grid`] (≥ 500: the specimen family, panels over two arches with an
+//! edge jacked about a hinge, strips over cylinders, a film edge on an arch) run with the
+//! default solver settings and the FMU's default increments per step. Prints, per family, how
+//! many paths converge, Newton iterations per increment (mean over all converged increments,
+//! and the largest per-step mean), cut-backs, and the first failure; then the total.
+//!
+//! Options (after `--`): `--family NAME` (specimen, panel, strip, arch-edge; repeatable),
+//! `--quick` (every 10th path of each family), `--failures` (print every failed path),
+//! `--threads N` (paths run in parallel, default: available cores).
+//!
+//! This measures convergence, not speed; the wall time is printed only so that the run can be
+//! planned.
+
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
+use membrane_contact::mech::SolverSettings;
+use membrane_contact::mech::scenarios::{Family, RunOutcome, Scenario, robustness_grid};
+
+struct Options {
+    families: Vec<Family>,
+    quick: bool,
+    failures: bool,
+    threads: usize,
+}
+
+fn parse() -> Result<Options, String> {
+    let mut o = Options {
+        families: vec![],
+        quick: false,
+        failures: false,
+        threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--bench" => {}
+            "--quick" => o.quick = true,
+            "--failures" => o.failures = true,
+            "--family" => {
+                let name = args.next().ok_or("--family needs a name")?;
+                let f = Family::ALL
+                    .into_iter()
+                    .find(|f| f.name() == name)
+                    .ok_or_else(|| format!("--family: unknown '{name}'"))?;
+                o.families.push(f);
+            }
+            "--threads" => {
+                o.threads = args
+                    .next()
+                    .and_then(|v| v.parse().ok())
+                    .filter(|&n| n > 0)
+                    .ok_or("--threads needs a positive integer")?
+            }
+            other => return Err(format!("unknown option {other}")),
+        }
+    }
+    if o.families.is_empty() {
+        o.families = Family::ALL.to_vec();
+    }
+    Ok(o)
+}
+
+/// Runs `paths` on `threads` worker threads; results in the order of `paths`.
+fn run_all(paths: &[Scenario], threads: usize) -> Vec<(RunOutcome, f64)> {
+    let next = AtomicUsize::new(0);
+    let results = Mutex::new(vec![None; paths.len()]);
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(p) = paths.get(i) else { break };
+                    let start = Instant::now();
+                    let outcome = p.run(SolverSettings::default());
+                    let seconds = start.elapsed().as_secs_f64();
+                    results.lock().unwrap()[i] = Some((outcome, seconds));
+                }
+            });
+        }
+    });
+    results.into_inner().unwrap().into_iter().map(|r| r.unwrap()).collect()
+}
+
+fn main() {
+    let o = match parse() {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("{e}");
+            std::process::exit(2);
+        }
+    };
+    let increments = usize::try_from(DEFAULT_INCREMENTS_PER_STEP).unwrap();
+    let grid = robustness_grid(increments).expect("the benchmark grid builds");
+    let mut paths: Vec<Scenario> = vec![];
+    for family in &o.families {
+        let of: Vec<Scenario> = grid.iter().filter(|s| s.family == *family).cloned().collect();
+        let stride = if o.quick { 10 } else { 1 };
+        paths.extend(of.into_iter().step_by(stride));
+    }
+    println!(
+        "## robustness: {} load paths, default solver settings, {increments} increments per step \
+         (1 for the CLI-style panel ramps), {} threads\n",
+        paths.len(),
+        o.threads
+    );
+    let start = Instant::now();
+    let results = run_all(&paths, o.threads);
+    let wall = start.elapsed().as_secs_f64();
+
+    println!(
+        "| family | paths | converged | % | iterations / increment (mean) | max per-step mean | cut-backs | steps converged | CPU s | first failure |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let mut total = (0, 0, 0, 0, 0, 0.0);
+    let row = |name: &str, sel: &[(&Scenario, &(RunOutcome, f64))]| {
+        let n = sel.len();
+        let ok = sel.iter().filter(|(_, (r, _))| r.converged()).count();
+        let iterations: usize = sel.iter().map(|(_, (r, _))| r.iterations()).sum();
+        let incs: usize = sel.iter().map(|(_, (r, _))| r.increments()).sum();
+        let cut: usize = sel.iter().map(|(_, (r, _))| r.cutbacks()).sum();
+        let steps_ok: usize = sel
+            .iter()
+            .map(|(_, (r, _))| r.steps.iter().filter(|s| s.error.is_none()).count())
+            .sum();
+        let steps_all: usize = sel.iter().map(|(s, _)| s.path.steps()).sum();
+        let max = sel
+            .iter()
+            .map(|(_, (r, _))| r.max_step_iterations_per_increment())
+            .fold(0.0, f64::max);
+        let cpu: f64 = sel.iter().map(|(_, (_, t))| t).sum();
+        let first = sel
+            .iter()
+            .find_map(|(s, (r, _))| r.failure_message().map(|m| format!("{}: {m}", s.name)))
+            .unwrap_or_else(|| "–".into());
+        println!(
+            "| {name} | {n} | {ok} | {:.1} | {:.2} | {max:.1} | {cut} | {steps_ok}/{steps_all} | {cpu:.1} | {} |",
+            100.0 * ok as f64 / n.max(1) as f64,
+            iterations as f64 / incs.max(1) as f64,
+            first.replace('|', "/")
+        );
+        (n, ok, iterations, incs, cut, cpu)
+    };
+    let pairs: Vec<(&Scenario, &(RunOutcome, f64))> = paths.iter().zip(&results).collect();
+    for family in &o.families {
+        let sel: Vec<_> = pairs.iter().copied().filter(|(s, _)| s.family == *family).collect();
+        let r = row(family.name(), &sel);
+        total = (total.0 + r.0, total.1 + r.1, total.2 + r.2, total.3 + r.3, total.4 + r.4, total.5 + r.5);
+    }
+    println!(
+        "| **total** | {} | {} | {:.1} | {:.2} | | {} | | {:.1} | |",
+        total.0,
+        total.1,
+        100.0 * total.1 as f64 / total.0.max(1) as f64,
+        total.2 as f64 / total.3.max(1) as f64,
+        total.4,
+        total.5
+    );
+    println!("\nwall time {wall:.1} s");
+    if o.failures {
+        println!("\n### failed paths\n");
+        for (s, (r, _)) in &pairs {
+            if let Some(m) = r.failure_message() {
+                println!("- {}: {m}", s.name);
+            }
+        }
+    }
+}
