@@ -5,8 +5,12 @@
 //! `x` the sliding direction, `y = z × x`. With `d = R (u_A − u_B)` the relative displacement
 //! in that frame and `g = g0 + d_z` the gap:
 //!
-//! * **open** (`g ≥ 0`, the normal force would pull): no force, no stiffness; the tangential
-//!   reference follows node A, so sliding is counted from closure;
+//! * **open** (`g > 0`, the normal force would pull): no force, no stiffness; the tangential
+//!   reference follows node A, so sliding is counted from closure. A touching gap (`g = 0`
+//!   exactly, e.g. `g0 = 0` at the start) is closed with `N = 0`: it carries nothing, but its
+//!   tangent holds the node against penetration, where the open tangent would leave an
+//!   unstressed film a mechanism pushing straight into the support (measured: the strip over a
+//!   cylinder of issue 7, whose Newton direction then raised the residual at every step size);
 //! * **closed**: normal force `N = −k_n g ≥ 0`; trial friction `t* = k_s (d_t − s_p)` with `s_p`
 //!   the slip history; **stick** while `|t*| − μN ≤ 0` (eq. 2.13), else **slip** with the
 //!   return mapping `t = μN t*/|t*|` onto the Coulomb limit, the direction (and so its sign) taken
@@ -132,7 +136,7 @@ impl GapLaw {
     pub fn evaluate(&self, d: Vector3<f64>, plastic_slip: Vector2<f64>) -> GapResponse {
         let tangential = Vector2::new(d.x, d.y);
         let gap = self.initial_gap + d.z;
-        if gap >= 0.0 {
+        if gap > 0.0 {
             return GapResponse {
                 status: GapStatus::Open,
                 relative: d,

@@ -51,7 +51,7 @@ impl Default for SolverSettings {
     fn default() -> Self {
         Self {
             iteration_matrix: IterationMatrix::default(),
-            displacement_tolerance: 1e-6,
+            displacement_tolerance: 1e-5,
             residual_tolerance: 1e-5,
             max_iterations: 50,
             max_cutbacks: 12,
@@ -369,6 +369,8 @@ struct Workspace {
     latched: Vec<Option<Vector2<f64>>>,
     /// Gaps found closed at some iteration of the current Newton loop.
     closed: Vec<bool>,
+    /// Slot of each free DOF's diagonal entry in `values` (for the Levenberg–Marquardt shift).
+    diagonal: Vec<usize>,
 }
 
 impl Analysis {
@@ -404,6 +406,7 @@ impl Analysis {
             responses: idle.map_or_else(Vec::new, |r| vec![r; laws.len()]),
             latched: vec![None; laws.len()],
             closed: vec![false; laws.len()],
+            diagonal: diagonal_slots(&system),
         };
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * model.material.membrane_stiffness() * length_scale;
@@ -635,7 +638,9 @@ impl Analysis {
         // Status of every gap at the previous iteration and the last iteration it changed.
         let mut previous: Vec<GapStatus> = start.status.clone();
         let mut changed_at: Vec<Option<usize>> = vec![None; previous.len()];
-        let (mut best, mut best_at) = (f64::INFINITY, 0);
+        let (mut best, mut best_correction, mut best_at) = (f64::INFINITY, f64::INFINITY, 0);
+        // Levenberg–Marquardt shift of the free diagonal, relative to its mean.
+        let mut damping = 0.0_f64;
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
             let residual = if assembled {
@@ -702,11 +707,14 @@ impl Analysis {
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            // A new best must improve on the old one by a margin: a cycle between two states
-            // repeats its residuals to round-off and never does. The Ju–Rowlands matrix converges
+            // Progress is a residual or a correction 10 % below the best so far: a cycle between
+            // two states repeats both to round-off and never makes it, while the slow approach
+            // along a soft direction of the film (small residual, shrinking corrections) does. The Ju–Rowlands matrix converges
             // linearly and slowly by design (docs/mechanics.md): it is judged by the limit only.
-            if residual < Self::PROGRESS * best {
-                (best, best_at) = (residual, iteration);
+            if residual < Self::PROGRESS * best || correction_norm < Self::PROGRESS * best_correction {
+                best = best.min(residual);
+                best_correction = best_correction.min(correction_norm);
+                best_at = iteration;
             } else if s.iteration_matrix == IterationMatrix::Consistent
                 && iteration >= best_at + Self::STALL_PATIENCE
             {
@@ -722,6 +730,14 @@ impl Analysis {
                     self.work.rhs[*eq] = -self.work.internal[i];
                 }
             }
+            if damping > 0.0 {
+                let values = &mut self.work.values;
+                let mean = self.work.diagonal.iter().map(|&d| values[d].abs()).sum::<f64>()
+                    / self.work.diagonal.len() as f64;
+                for &d in &self.work.diagonal {
+                    values[d] += damping * mean;
+                }
+            }
             let matrix = self.system.matrix(&self.work.values);
             self.linear
                 .factorize_and_solve(matrix, &mut self.work.rhs)
@@ -730,13 +746,31 @@ impl Analysis {
             if !correction_norm.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            let (step, with_tangent) = self.line_search(&mut u, &laws, &history, iteration + 1);
+            let (step, with_tangent, decreased) =
+                self.line_search(&mut u, &laws, &history, iteration + 1);
             assembled = with_tangent;
             correction_norm *= step;
+            // Levenberg–Marquardt: a direction that cannot lower the residual (a mechanism of an
+            // unstressed film, an indefinite compressed one) gets a diagonal shift, raised until
+            // steps succeed and lowered again after full ones. Only the iteration matrix changes,
+            // never the residual: the converged state is the same, and with the shift gone the
+            // last iterations are Newton's again.
+            if s.iteration_matrix == IterationMatrix::Consistent {
+                damping = if !decreased {
+                    (4.0 * damping).max(Self::DAMPING_START)
+                } else if step == 1.0 && damping > 0.0 {
+                    let lower = damping / 4.0;
+                    if lower < Self::DAMPING_START / 64.0 { 0.0 } else { lower }
+                } else {
+                    damping
+                };
+            }
         }
         unreachable!("the loop returns at max_iterations")
     }
 
+    /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).
+    const DAMPING_START: f64 = 1e-4;
     /// A residual below this fraction of the best so far counts as progress.
     const PROGRESS: f64 = 0.9;
     /// Iterations without progress before an increment is declared stalled and cut back.
@@ -744,8 +778,8 @@ impl Analysis {
 
     /// Applies the Newton correction held in `work.rhs` to `u`, scaled by a backtracking line
     /// search on `φ(α) = ½‖R_free(u + αΔ)‖₂²` (the full step when line search is off). Returns
-    /// the scale used and whether the workspace now holds the residual and Newton matrix at the
-    /// new `u` (assembled for `next_iteration`).
+    /// the scale used, whether the workspace now holds the residual and Newton matrix at the
+    /// new `u` (assembled for `next_iteration`), and whether the step decreased `φ` enough.
     ///
     /// Backtracking (Dennis & Schnabel, *Numerical Methods for Unconstrained Optimization*,
     /// §6.3.2): accept the first `α` with `φ(α) ≤ (1 − 2·10⁻⁴ α) φ(0)` (Armijo, with
@@ -754,15 +788,15 @@ impl Analysis {
     /// closes makes `R` only piecewise smooth: a closing penalty gap can raise `φ(1)` by orders of
     /// magnitude while the equilibrium lies at `α ≈ 10⁻³`, which the interpolation reaches in a
     /// few trials where plain halving would need ten. When no trial decreases `φ`, the best one
-    /// with `α ≥ 1/8` is taken (Newton then continues from there; a cycle is caught by the stall
-    /// test).
+    /// is taken (with `α ≥ 1/8` for the Ju–Rowlands matrix); Newton continues from there and a
+    /// cycle is caught by the stall test.
     fn line_search(
         &mut self,
         u: &mut [f64],
         laws: &[GapLaw],
         history: &[Vector2<f64>],
         next_iteration: usize,
-    ) -> (f64, bool) {
+    ) -> (f64, bool, bool) {
         let apply = |u: &mut [f64], dofs: &[Dof], delta: &[f64], scale: f64| {
             for (i, d) in dofs.iter().enumerate() {
                 if let Dof::Free(eq) = d {
@@ -774,9 +808,10 @@ impl Analysis {
         if !self.settings.line_search {
             apply(u, &self.system.dofs, &delta, 1.0);
             self.work.rhs = delta;
-            return (1.0, false);
+            return (1.0, false, true);
         }
         let phi0 = 0.5 * self.free_norm2().powi(2);
+        let consistent = self.settings.iteration_matrix == IterationMatrix::Consistent;
         let (mut best, mut best_phi, mut applied) = (1.0, f64::INFINITY, 0.0);
         let mut scale: f64 = 1.0;
         for trial in 0..Self::LINE_SEARCH_TRIALS {
@@ -788,9 +823,9 @@ impl Analysis {
             let phi = 0.5 * self.free_norm2().powi(2);
             if phi <= (1.0 - 2e-4 * scale) * phi0 {
                 self.work.rhs = delta;
-                return (scale, trial == 0);
+                return (scale, trial == 0, true);
             }
-            if phi < best_phi && scale >= Self::SMALLEST_FALLBACK {
+            if phi < best_phi && (scale >= Self::SMALLEST_FALLBACK || consistent) {
                 (best, best_phi) = (scale, phi);
             }
             // Minimum of q(α) = φ0 − 2φ0 α + (φ − φ0 + 2φ0 α0) α²/α0², clamped.
@@ -804,13 +839,16 @@ impl Analysis {
         }
         apply(u, &self.system.dofs, &delta, best - applied);
         self.work.rhs = delta;
-        (best, false)
+        (best, false, false)
     }
 
     /// Trials of the line search before it takes the best one.
     const LINE_SEARCH_TRIALS: usize = 8;
-    /// Smallest scale taken when no trial decreases `φ`: a tiny step would freeze the iteration
-    /// (the Ju–Rowlands matrix, whose direction is not Newton's, relies on moving on).
+    /// Smallest scale the Ju–Rowlands iteration takes when no trial decreases `φ`: a tiny step
+    /// would freeze it (its direction is not Newton's, it relies on moving on). With the
+    /// consistent tangent the best trial is taken whatever its size: a full step that raised the
+    /// residual by eight orders of magnitude was measured to wreck an increment that was one
+    /// iteration from convergence.
     const SMALLEST_FALLBACK: f64 = 0.125;
 
     /// `‖R_free‖∞` of the last assembly.
@@ -979,6 +1017,18 @@ fn nan_max(m: f64, v: f64) -> f64 {
 /// `max |a − b|` over two equally long vectors, NaN-aware like [`max_abs`].
 fn max_abs_difference(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).fold(0.0, |m, (x, y)| nan_max(m, (x - y).abs()))
+}
+
+/// Slot of each equation's diagonal entry in the value array (the pattern keeps them all).
+fn diagonal_slots(system: &System) -> Vec<usize> {
+    let pattern = system.pattern();
+    let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+    (0..system.free_count)
+        .map(|j| {
+            let rows = &row_idx[col_ptr[j]..col_ptr[j + 1]];
+            col_ptr[j] + rows.binary_search(&j).expect("the pattern keeps every diagonal")
+        })
+        .collect()
 }
 
 /// Diagonal of the axis-aligned bounding box of `nodes` (m).
