@@ -704,6 +704,23 @@ mod tests {
             (VarType::String, Some(Value::String("isotropic".into())))
         );
         assert!(law.is_model_parameter());
+        // Gaps with different laws: the parameter starts empty (each keeps its own).
+        let mut mixed = model.clone();
+        mixed.gaps[0].friction_law = crate::mech::FrictionLaw::SlidingDirection;
+        let start = |m: &Model| {
+            let table = variables(m, Kind::Model);
+            table
+                .into_iter()
+                .find(|v| v.name == "frictionLaw")
+                .unwrap()
+                .start
+        };
+        assert_eq!(start(&mixed), Some(Value::String(String::new())));
+        mixed.set_friction_law(crate::mech::FrictionLaw::SlidingDirection);
+        assert_eq!(
+            start(&mixed),
+            Some(Value::String("sliding-direction".into()))
+        );
         let dir = find("results.directory");
         assert_eq!(
             (dir.var_type, dir.causality, dir.variability),
