@@ -580,6 +580,79 @@ fn both_iteration_matrices_converge_to_the_same_answer_with_the_sliding_directio
     }
 }
 
+/// A film edge lying on an arch (issue 7, case 5).
+///
+/// ```text
+///   z ↑  film: a cylinder segment x ∈ [0, 0.6], y ∈ [0, 0.6] on the arch radius R = 1 m
+///      |  (axis along X, crown at y = 0, z = 0); 6 × 6 cells
+///   y=0.6  E E E E E E E    E: group "edge" (outer edges), lowered by dz
+///          G · · · · · E    G0..G5: gaps on the edge x = 0, on the arch (g0 = 0), frame x =
+///          G · · · · · E    arch tangent, z = radial, y = z × x = global ±X (across the arch)
+///   y=0    G s s s s s E    s: symmetry plane y = 0
+///         x=0         x=0.6
+/// ```
+/// Prestress 0.5 MPa around the arch, `prestress_across` across it (σx).
+fn film_edge_on_arch(law: FrictionLaw, prestress_across: f64) -> Model {
+    let (nx, ny, r) = (6, 6, 1.0);
+    let mut m = patch(nx, ny, 0.6, 0.6);
+    for p in &mut m.nodes {
+        p[2] = -r + (r * r - p[1] * p[1]).sqrt();
+    }
+    m.material.prestress = [prestress_across, 0.5e6, 0.0];
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    let centre = Vector3::new(0.0, 0.0, -r);
+    for j in 0..ny {
+        let node = id(0, j);
+        let n = (Vector3::from(m.nodes[node]) - centre).normalize();
+        let mut gap = gap_below(&format!("G{j}"), node, m.nodes[node], 0.0, 0.2);
+        gap.support = GapSupport::Point((centre + n * r).into());
+        gap.frame = GapFrame::from_x_and_z(Vector3::new(0.0, n.z, -n.y), n);
+        gap.friction_law = law;
+        m.gaps.push(gap);
+    }
+    m.symmetry.push(Symmetry {
+        name: "y0".into(),
+        normal: Axis::Y,
+        nodes: (0..nx).map(|i| id(i, 0)).collect(),
+    });
+    let mut edge: Vec<usize> = (0..=ny).map(|j| id(nx, j)).collect();
+    edge.extend((0..nx).map(|i| id(i, ny)));
+    m.groups.push(BoundaryGroup {
+        name: "edge".into(),
+        nodes: edge,
+        target: [0.0, 0.0, -0.1],
+    });
+    m
+}
+
+#[test]
+fn papers_law_holds_a_film_edge_on_an_arch_that_the_cone_lets_slide_across() {
+    // Issue 7, case 5: with no prestress across the arch, the cone lets the edge slide
+    // sideways and Newton stalls; the paper's law converges with default settings and keeps
+    // the edge on the arch line, sliding along it only.
+    let run = |law, across| {
+        let mut a =
+            Analysis::new(film_edge_on_arch(law, across), SolverSettings::default()).unwrap();
+        for k in 1..=20 {
+            a.step_to(&[[0.0, 0.0, -0.1 * k as f64 / 20.0]], 1)
+                .map_err(|e| format!("{law}, step {k}: {e}"))?;
+        }
+        Ok::<_, String>(a.results().gaps)
+    };
+    for across in [0.0, 0.5e6] {
+        let gaps = run(FrictionLaw::SlidingDirection, across).unwrap();
+        assert!(gaps.iter().all(|g| g.slip_y.abs() < 2e-4), "{gaps:?}");
+        assert!(
+            gaps[5].slip_x > 0.05,
+            "the edge slides along the arch: {gaps:?}"
+        );
+    }
+    // With prestress across the arch the cone converges, having slid the edge off the arch line.
+    if let Ok(cone) = run(FrictionLaw::Isotropic, 0.5e6) {
+        assert!(cone.iter().any(|g| g.slip_y.abs() > 0.01), "{cone:?}");
+    }
+}
+
 #[test]
 fn model_files_name_the_friction_law_and_default_to_isotropic() {
     let mut m = pressed_node_model(0.0, 0.2);
