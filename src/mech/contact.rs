@@ -267,7 +267,7 @@ pub struct GapResponse {
     pub plastic_slip: Vector2<f64>,
     /// Unit direction of the trial friction force `t*/|t*|` (zero when open or `t* = 0`); in
     /// slip it is the slip direction, its sign included: `(±1, 0)` for the sliding-direction
-    /// law, zero when y alone holds its limit (x free, no direction).
+    /// law, the sign of `t*_x` (`+1` when `t*_x = 0`).
     pub direction: Vector2<f64>,
     /// `|t*|`, the trial friction force magnitude.
     pub trial_magnitude: f64,
