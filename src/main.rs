@@ -8,13 +8,13 @@ use std::process::ExitCode;
 use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
 use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
-    Analysis, IterationMatrix, Model, ParallelArch, Results, SolverSettings,
+    Analysis, FrictionLaw, IterationMatrix, Model, ParallelArch, Results, SolverSettings,
 };
 
 const USAGE: &str = "\
 usage: membrane-contact specimen [--height MM] [options]
        membrane-contact model FILE.json [options]
-       membrane-contact export-specimen [--height MM] [--refine N]   (prints the model JSON)
+       membrane-contact export-specimen [--height MM] [--refine N] [--friction-law L]   (prints the model JSON)
 
 Runs the analysis: every boundary group is moved to its target displacement in --steps steps.
 
@@ -22,6 +22,9 @@ options:
   --height MM        arch height of the specimen in mm (200, 300, 400; default 300)
   --refine N         mesh refinement factor of the specimen (default 1: 200 triangles)
   --mu X             friction coefficient of every gap (default: the model's, 0.2 for specimens)
+  --friction-law L   isotropic (Coulomb cone) or sliding-direction (the paper's §2.2: slides
+                     along the gap's local x only) for every gap (default: the model's,
+                     isotropic for specimens)
   --steps N          load steps to the target (default 20)
   --matrix M         consistent (default) or ju-rowlands (the paper's; converges linearly:
                      give it --max-iterations 3000)
@@ -37,6 +40,7 @@ struct Options {
     height_mm: f64,
     refine: usize,
     mu: Option<f64>,
+    friction_law: Option<FrictionLaw>,
     steps: usize,
     matrix: IterationMatrix,
     max_iterations: Option<usize>,
@@ -52,6 +56,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         height_mm: 300.0,
         refine: 1,
         mu: None,
+        friction_law: None,
         steps: 20,
         matrix: IterationMatrix::Consistent,
         max_iterations: None,
@@ -79,6 +84,10 @@ fn parse(args: &[String]) -> Result<Options, String> {
                     .map_err(|_| "--refine needs a positive integer".to_string())?
             }
             "--mu" => o.mu = Some(number("--mu", value("--mu")?)?),
+            "--friction-law" => {
+                let law = value("--friction-law")?;
+                o.friction_law = Some(law.parse().map_err(|e| format!("--friction-law: {e}"))?);
+            }
             "--steps" => {
                 o.steps = value("--steps")?
                     .parse()
@@ -119,6 +128,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
 fn specimen(o: &Options) -> Result<ParallelArch, String> {
     let spec = ParallelArch {
         refinement: o.refine,
+        friction_law: o.friction_law.unwrap_or_default(),
         ..ParallelArch::with_height(o.height_mm / 1000.0)
     };
     spec.check()?;
@@ -126,7 +136,7 @@ fn specimen(o: &Options) -> Result<ParallelArch, String> {
 }
 
 fn run(o: &Options) -> Result<(), String> {
-    let model = match o.command.as_str() {
+    let mut model = match o.command.as_str() {
         "specimen" => specimen(o)?.model()?,
         "export-specimen" => {
             println!("{}", specimen(o)?.model()?.to_json());
@@ -140,6 +150,9 @@ fn run(o: &Options) -> Result<(), String> {
         "" => return Err(String::new()),
         other => return Err(format!("unknown command '{other}'")),
     };
+    if let Some(law) = o.friction_law {
+        model.set_friction_law(law);
+    }
     let defaults = SolverSettings::default();
     let settings = SolverSettings {
         iteration_matrix: o.matrix,

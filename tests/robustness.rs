@@ -208,6 +208,7 @@ fn gaps_on_arc_refuses_a_node_inside_the_support_and_names_it() {
         normal_stiffness: 1.0,
         tangential_stiffness: 1.0,
         friction: 0.2,
+        friction_law: Default::default(),
     };
     let err = gaps_on_arc(&nodes, &[0, 1], &support, constants, "G").unwrap_err();
     assert!(err.contains("G2") && err.contains("node 1") && err.contains("inside"), "{err}");

@@ -299,6 +299,8 @@ applied in <code>solver.incrementsPerStep</code> equal increments. Any step size
 <li>A step that cannot converge returns <code>fmi2Discard</code> and keeps the last converged state and time:
 set a smaller change and call <code>fmi2DoStep</code> again from the same time.</li>
 <li><code>mu</code> sets the friction coefficient of every gap from the next step on (the model's own values apply until it is set).</li>
+<li><code>frictionLaw</code> (a String parameter, <code>fmi2SetString</code>): <code>isotropic</code> (Coulomb cone) or
+<code>sliding-direction</code> (the paper's law: each gap slides along its local x only, y stays elastic) for every gap.</li>
 <li>Parameters are fixed: set them before <code>fmi2ExitInitializationMode</code>, which builds the analysis
 (and reports an invalid value with <code>fmi2Error</code>).</li>
 <li>FMU states can be saved, restored and serialized (<code>canGetAndSetFMUstate</code>, <code>canSerializeFMUstate</code>).</li>

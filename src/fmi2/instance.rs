@@ -492,8 +492,12 @@ impl Instance {
 
     /// Copies the strings (the caller's may go away after the call).
     pub fn set_string(&mut self, vrs: &[u32], values: &[&str]) -> Outcome {
-        for &vr in vrs {
-            self.settable(vr, VarType::String)?;
+        for (&vr, &x) in vrs.iter().zip(values) {
+            let v = self.settable(vr, VarType::String)?;
+            if v.binding == Binding::FrictionLaw && !x.is_empty() {
+                x.parse::<crate::mech::FrictionLaw>()
+                    .map_err(|e| Failure::error(format!("{}: {e}", v.name)))?;
+            }
         }
         self.assign(vrs, values.iter().map(|&x| Value::String(x.to_owned())));
         Ok(())
@@ -639,6 +643,10 @@ impl Instance {
                 }
                 (Binding::MaxCutbacks, Value::Integer(x)) => settings.max_cutbacks = count(x, 0)?,
                 (Binding::IncrementsPerStep, Value::Integer(x)) => increments = count(x, 1)?,
+                (Binding::FrictionLaw, Value::String(name)) if name.is_empty() => {}
+                (Binding::FrictionLaw, Value::String(name)) => {
+                    model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
+                }
                 (Binding::UseJuRowlands, Value::Boolean(b)) => {
                     settings.iteration_matrix = if b {
                         IterationMatrix::JuRowlands

@@ -1005,3 +1005,53 @@ fn a_failed_write_is_a_warning_and_the_step_stands() {
     assert_eq!(status, 0);
     assert_eq!(fmu.step(0.1, 0.1), warning, "and the next step is taken");
 }
+
+#[test]
+fn friction_law_parameter_gives_every_gap_the_papers_law() {
+    let (u, log) = (Unpacked::specimen("law"), Log::default());
+    let fmu = Fmu::new(&u, &log);
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(fmu.string("frictionLaw"), "isotropic");
+    assert_eq!(fmu.set_string("frictionLaw", "x-only"), Status::Error.raw());
+    assert!(log.contains(Status::Error, "frictionLaw: unknown friction law 'x-only'"));
+    assert_eq!(
+        fmu.string("frictionLaw"),
+        "isotropic",
+        "a refused value changes nothing"
+    );
+    assert_eq!(fmu.set_string("frictionLaw", "sliding-direction"), 0);
+    assert_eq!(
+        unsafe { fmi2_exit_initialization_mode(fmu.c) },
+        0,
+        "{:?}",
+        log.take()
+    );
+    fmu.ramp(0, 2, 20);
+
+    // The same path through the core, with the law set in the specimen and with the cone.
+    let run = |friction_law| {
+        let spec = ParallelArch {
+            friction_law,
+            ..ParallelArch::default()
+        };
+        let mut a = crate::mech::Analysis::new(spec.model().unwrap(), Default::default()).unwrap();
+        for k in 1..=2 {
+            a.step_to(&[[0.0, 0.0, spec.target()[2] * (k as f64 / 20.0)]], 10)
+                .unwrap();
+        }
+        a.results().gaps[0]
+    };
+    let paper = run(crate::mech::FrictionLaw::SlidingDirection);
+    // The FMU reports the force on the film, the opposite of the gap's internal force.
+    assert_eq!(fmu.real("G1.frictionX"), -paper.friction[0]);
+    assert_eq!(fmu.real("G1.frictionY"), -paper.friction[1]);
+    assert_eq!(fmu.real("G1.slipY"), paper.slip_y);
+    let cone = run(crate::mech::FrictionLaw::Isotropic);
+    assert!(
+        (cone.friction[1] - paper.friction[1]).abs() > 1.0,
+        "{cone:?} {paper:?}"
+    );
+}

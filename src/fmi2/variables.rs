@@ -15,6 +15,7 @@
 //! | `archHeight` | Real | parameter | m | ParallelArch only: the model is regenerated from it |
 //! | `film.E`, `film.nu`, `film.thickness`, `film.prestressX/Y/XY` | Real | parameter | Pa, 1, m, Pa | film |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
+//! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap; start: the model's when uniform, else "" (each gap keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
@@ -150,6 +151,8 @@ pub enum Binding {
     Prestress(usize),
     NormalStiffness(usize),
     TangentialStiffness(usize),
+    /// Friction law of every gap (a String parameter; "" keeps each gap's own).
+    FrictionLaw,
     DisplacementTolerance,
     ResidualTolerance,
     MaxIterations,
@@ -227,7 +230,15 @@ pub const UNITS: [(&str, [i32; 3]); 5] = [
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
-pub const RESERVED_NAMES: [&str; 6] = ["time", "mu", "archHeight", "film", "solver", "results"];
+pub const RESERVED_NAMES: [&str; 7] = [
+    "time",
+    "mu",
+    "frictionLaw",
+    "archHeight",
+    "film",
+    "solver",
+    "results",
+];
 
 /// Default of `solver.incrementsPerStep`.
 pub const DEFAULT_INCREMENTS_PER_STEP: i32 = 10;
@@ -367,6 +378,18 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::TangentialStiffness(i),
         );
     }
+    table.parameter(
+        "frictionLaw",
+        Value::String(
+            model
+                .uniform_friction_law()
+                .map_or(String::new(), |l| l.name().to_string()),
+        ),
+        None,
+        "friction law of every gap: isotropic (Coulomb cone) or sliding-direction (the paper's: \
+         slides along the gap's local x only); empty: each gap keeps the model file's",
+        Binding::FrictionLaw,
+    );
     let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 6] = [
         (
             "displacementTolerance",
@@ -675,6 +698,29 @@ mod tests {
             Some(Value::Boolean(false))
         );
         assert_eq!(find("mu").start, Some(Value::Real(0.2)));
+        let law = find("frictionLaw");
+        assert_eq!(
+            (law.var_type, law.start.clone()),
+            (VarType::String, Some(Value::String("isotropic".into())))
+        );
+        assert!(law.is_model_parameter());
+        // Gaps with different laws: the parameter starts empty (each keeps its own).
+        let mut mixed = model.clone();
+        mixed.gaps[0].friction_law = crate::mech::FrictionLaw::SlidingDirection;
+        let start = |m: &Model| {
+            let table = variables(m, Kind::Model);
+            table
+                .into_iter()
+                .find(|v| v.name == "frictionLaw")
+                .unwrap()
+                .start
+        };
+        assert_eq!(start(&mixed), Some(Value::String(String::new())));
+        mixed.set_friction_law(crate::mech::FrictionLaw::SlidingDirection);
+        assert_eq!(
+            start(&mixed),
+            Some(Value::String("sliding-direction".into()))
+        );
         let dir = find("results.directory");
         assert_eq!(
             (dir.var_type, dir.causality, dir.variability),

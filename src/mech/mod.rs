@@ -23,7 +23,7 @@ pub mod solver;
 pub mod specimen;
 pub mod vtk;
 
-pub use contact::{GapStatus, IterationMatrix};
+pub use contact::{FrictionLaw, GapStatus, IterationMatrix};
 pub use element::Material;
 pub use model::{Model, ModelError};
 pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};

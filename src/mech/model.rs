@@ -11,7 +11,7 @@ use std::fmt;
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::contact::{GapFrame, GapLaw};
+use super::contact::{FrictionLaw, GapFrame, GapLaw};
 use super::element::{Material, MembraneTriangle};
 
 /// A global axis, used for supports and symmetry planes.
@@ -86,6 +86,9 @@ pub struct GapSpec {
     pub tangential_stiffness: f64,
     /// Friction coefficient `μ ≥ 0`.
     pub friction: f64,
+    /// How the gap slides: `"isotropic"` (default) or `"sliding-direction"` (the paper's §2.2).
+    #[serde(default)]
+    pub friction_law: FrictionLaw,
 }
 
 impl GapSpec {
@@ -96,6 +99,7 @@ impl GapSpec {
             tangential_stiffness: self.tangential_stiffness,
             friction: self.friction,
             initial_gap: self.initial_gap,
+            friction_law: self.friction_law,
         }
     }
 }
@@ -417,6 +421,22 @@ impl Model {
     /// Index of the gap named `name`.
     pub fn gap_index(&self, name: &str) -> Option<usize> {
         self.gaps.iter().position(|g| g.name == name)
+    }
+
+    /// The friction law of every gap when they all have the same one (`None`: mixed, or no gaps).
+    pub fn uniform_friction_law(&self) -> Option<FrictionLaw> {
+        let first = self.gaps.first()?.friction_law;
+        self.gaps
+            .iter()
+            .all(|g| g.friction_law == first)
+            .then_some(first)
+    }
+
+    /// Gives every gap the friction law `law`.
+    pub fn set_friction_law(&mut self, law: FrictionLaw) {
+        for g in &mut self.gaps {
+            g.friction_law = law;
+        }
     }
 
     /// Number of DOFs (three per node).

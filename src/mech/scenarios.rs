@@ -63,7 +63,7 @@ use std::fmt;
 
 use nalgebra::Vector3;
 
-use super::contact::GapFrame;
+use super::contact::{FrictionLaw, GapFrame};
 use super::element::Material;
 use super::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Support, Symmetry};
 use super::solver::{Analysis, SolverSettings, StepError};
@@ -306,6 +306,8 @@ pub struct GapConstants {
     pub tangential_stiffness: f64,
     /// `μ`.
     pub friction: f64,
+    /// Friction law of every generated gap.
+    pub friction_law: FrictionLaw,
 }
 
 impl GapConstants {
@@ -317,6 +319,7 @@ impl GapConstants {
             normal_stiffness: kn,
             tangential_stiffness: spec.tangential_penalty_ratio * kn,
             friction,
+            friction_law: FrictionLaw::default(),
         }
     }
 }
@@ -376,6 +379,7 @@ pub fn gaps_on_arc(
                 normal_stiffness: constants.normal_stiffness,
                 tangential_stiffness: constants.tangential_stiffness,
                 friction: constants.friction,
+                friction_law: constants.friction_law,
             })
         })
         .collect()

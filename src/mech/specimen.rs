@@ -14,6 +14,7 @@
 //! | `k_n` | `1000 · E · t` (N/m) | §4.4 "three orders higher than the ETFE film", read as the film's membrane stiffness `E·t` |
 //! | `k_s` | `0.1 · k_n` | §4.4 (S.H. Lee's recommendation; Nastran PGAP `KT ≥ 0.1 KA`) |
 //! | `μ` | 0.2 | §4.4, Asahi Glass technical report [8] |
+//! | friction law | isotropic Coulomb cone (default); `friction_law: sliding-direction` gives the paper's own law | §2.2, §4.3–4.4 slide along the arch (local x) only; the default stays the cone so that earlier results and figures are unchanged — ask for the paper's law to reproduce the paper |
 //! | arch span | 1.6 m (half span 0.8 m) | assumed; rises 200/300/400 mm give span/rise 8, 5.3, 4 |
 //! | arch spacing | 0.8 m (arches at `x = ±0.4 m`) | assumed |
 //! | outside frame | 2.0 m × 2.0 m (1/4 model 1.0 m × 1.0 m) | assumed; the frame is 0.2 m beyond the arch feet |
@@ -29,7 +30,7 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::contact::GapFrame;
+use super::contact::{FrictionLaw, GapFrame};
 use super::element::Material;
 use super::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Symmetry};
 
@@ -61,6 +62,8 @@ pub struct ParallelArch {
     pub tangential_penalty_ratio: f64,
     /// Friction coefficient `μ`.
     pub friction: f64,
+    /// Friction law of every gap (the paper's is [`FrictionLaw::SlidingDirection`]).
+    pub friction_law: FrictionLaw,
     /// Target frame displacement in Z as a multiple of `H` (negative: lowered).
     pub target_dz_per_height: f64,
     /// Mesh refinement factor (1 gives the paper's 200 triangles).
@@ -84,6 +87,7 @@ impl Default for ParallelArch {
             normal_penalty_factor: 1000.0,
             tangential_penalty_ratio: 0.1,
             friction: 0.2,
+            friction_law: FrictionLaw::Isotropic,
             target_dz_per_height: -0.5,
             refinement: 1,
         }
@@ -209,6 +213,7 @@ impl ParallelArch {
                     normal_stiffness: kn,
                     tangential_stiffness: self.tangential_penalty_ratio * kn,
                     friction: self.friction,
+                    friction_law: self.friction_law,
                 }
             })
             .collect();

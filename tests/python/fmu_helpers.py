@@ -89,6 +89,8 @@ class Slave:
                 self.fmu.setInteger([v.valueReference], [int(value)])
             elif v.type == "Boolean":
                 self.fmu.setBoolean([v.valueReference], [bool(value)])
+            elif v.type == "String":
+                self.fmu.setString([v.valueReference], [str(value)])
             else:
                 raise TypeError(f"{name}: {v.type}")
 

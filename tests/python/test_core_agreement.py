@@ -9,6 +9,8 @@ TEST GOAL:
 * slips (local x and y), normal forces and gap statuses of every step agree with the CLI for the
   200, 300 and 400 mm specimens and for a user model file;
 * a friction sweep gives less slip for more friction;
+* the String parameter ``frictionLaw = sliding-direction`` (set through fmpy) gives what the
+  CLI's ``--friction-law sliding-direction`` gives;
 * the film's Z equilibrium: the frame group's reaction balances the gap forces projected on Z
   (the symmetry planes x = 0, y = 0 carry no Z force).
 
@@ -97,6 +99,16 @@ def test_more_friction_less_slip(fmu_path, cli):
     # mu input = the CLI's --mu.
     reference = cli.final_slips_mm("specimen", "--height", 300, "--steps", 10, "--mu", 0.4)
     assert [slips[-1][i] for i in range(9)] == pytest.approx([reference[g] for g in GAPS], abs=1e-6)
+
+
+def test_papers_friction_law_matches_the_core(fmu_path, cli):
+    # 60 steps: with 20, Newton chatters open <-> closed where G2 closes under this law.
+    steps = 60
+    per_step = run_fmu(fmu_path, "frame", -0.15, steps, parameters={"frictionLaw": "sliding-direction"})
+    rows = cli.run("specimen", "--height", 300, "--steps", steps, "--friction-law", "sliding-direction")
+    compare(per_step, rows)
+    cone = cli.final_slips_mm("specimen", "--height", 300, "--steps", steps)
+    assert per_step[-1]["G2"][0] != pytest.approx(cone["G2"], abs=1e-3), "the law was not applied"
 
 
 def test_frame_reaction_balances_the_gap_forces(fmu_path, cli):

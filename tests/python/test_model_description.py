@@ -81,6 +81,8 @@ def test_specimen_variables(fmu_path):
     assert v["G5.status"].type == "Integer" and v["G5.status"].variability == "discrete"
     assert v["solver.useJuRowlands"].type == "Boolean" and v["solver.useJuRowlands"].start == "false"
     assert v["solver.incrementsPerStep"].start == "10"
+    law = v["frictionLaw"]
+    assert (law.type, law.causality, law.start) == ("String", "parameter", "isotropic")
     for gap in [f"G{i}" for i in range(1, 10)]:
         for suffix in ["slip", "slipY", "normalForce", "frictionForce", "frictionX", "frictionY", "status"]:
             assert v[f"{gap}.{suffix}"].causality == "output"
