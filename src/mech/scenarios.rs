@@ -861,6 +861,10 @@ pub struct ArchEdge {
     pub prestress_along: f64,
     /// `μ`.
     pub friction: f64,
+    /// Friction law of the edge gaps: the paper's (§2.2, sliding along the arch only) by
+    /// default, as in reproduction 5 of issue 7; the isotropic cone lets the unprestressed edge
+    /// slide across the arch.
+    pub friction_law: FrictionLaw,
 }
 
 impl Default for ArchEdge {
@@ -872,6 +876,7 @@ impl Default for ArchEdge {
             cells_along: 8,
             prestress_along: ParallelArch::default().material.prestress[1],
             friction: 0.2,
+            friction_law: FrictionLaw::SlidingDirection,
         }
     }
 }
@@ -916,7 +921,10 @@ impl ArchEdge {
             &nodes,
             &film,
             &support,
-            GapConstants::for_film(&material, self.friction),
+            GapConstants {
+                friction_law: self.friction_law,
+                ..GapConstants::for_film(&material, self.friction)
+            },
             "E",
         )?;
         let frame = (0..=ny)
