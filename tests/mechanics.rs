@@ -1026,12 +1026,7 @@ fn shear_panel(n: usize, material: Material) -> Model {
 }
 
 fn state_counts(results: &membrane_contact::mech::Results) -> [usize; 3] {
-    let mut n = [0; 3];
-    results
-        .elements
-        .iter()
-        .for_each(|e| n[e.state as usize] += 1);
-    n
+    membrane_contact::mech::element::state_counts(&results.elements)
 }
 
 #[test]

@@ -52,6 +52,13 @@ pub struct ElementStress {
     pub tension_direction: [f64; 3],
 }
 
+/// How many elements are taut, wrinkled and slack (indexed by [`WrinklingState`] as `usize`).
+pub fn state_counts(elements: &[ElementStress]) -> [usize; 3] {
+    let mut counts = [0; 3];
+    elements.iter().for_each(|e| counts[e.state as usize] += 1);
+    counts
+}
+
 /// Why a triangle cannot be built.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DegenerateTriangle {
