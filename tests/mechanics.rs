@@ -1195,3 +1195,165 @@ fn wrinkling_tangent_matches_finite_difference_in_every_state() {
         seen[state as usize] += 1;
     }
 }
+
+/// An annular film `a ≤ r ≤ b` (geometric radial spacing, `nr × nt` cells, alternating
+/// diagonals): hub nodes one group each ("h<node>"), outer rim clamped, z held elsewhere.
+fn annulus(a: f64, b: f64, nr: usize, nt: usize, material: Material) -> Model {
+    let mut m = patch(1, 1, 1.0, 1.0);
+    m.material = material;
+    m.nodes.clear();
+    m.triangles.clear();
+    let id = |i: usize, j: usize| i * nt + j % nt;
+    for i in 0..=nr {
+        let r = a * (b / a).powf(i as f64 / nr as f64);
+        for j in 0..nt {
+            let phi = std::f64::consts::TAU * j as f64 / nt as f64;
+            m.nodes.push([r * phi.cos(), r * phi.sin(), 0.0]);
+        }
+    }
+    for i in 0..nr {
+        for j in 0..nt {
+            let (p, q, r, s) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                m.triangles.extend([[p, q, r], [p, r, s]]);
+            } else {
+                m.triangles.extend([[p, q, s], [q, r, s]]);
+            }
+        }
+    }
+    for j in 0..nt {
+        m.groups.push(BoundaryGroup {
+            name: format!("h{j}"),
+            nodes: vec![id(0, j)],
+            target: [0.0; 3],
+        });
+        m.supports.push(Support {
+            node: id(nr, j),
+            fixed: vec![Axis::X, Axis::Y, Axis::Z],
+        });
+        for i in 1..nr {
+            m.supports.push(Support {
+                node: id(i, j),
+                fixed: vec![Axis::Z],
+            });
+        }
+    }
+    m
+}
+
+/// Hub targets for a rigid rotation by `phi` of the hub nodes (the first groups).
+fn hub_rotation(model: &Model, phi: f64) -> Vec<[f64; 3]> {
+    let (s, c) = phi.sin_cos();
+    model
+        .groups
+        .iter()
+        .map(|g| {
+            let [x, y, _] = model.nodes[g.nodes[0]];
+            [c * x - s * y - x, s * x + c * y - y, 0.0]
+        })
+        .collect()
+}
+
+#[test]
+fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
+    // In-plane torsion of an annulus (note §2.3; Mikulas 1964, Miller & Hedgepeth 1982): hub
+    // a = 0.1, rim b = 0.5, t = 1e-4, Y = 1 GPa, ν = 0.3, σ0 = 1 MPa isotropic. Taut (linear):
+    // M = 4π t G φ / (1/a² − 1/b²); τ(r) = M/(2π t r²) in every state; first wrinkles at the hub
+    // when τ(a) = σ0: M_cr = 2π a² t σ0 = 6.283 N·m at φ_cr = σ0 (1 − a²/b²)/(2G) = 1.248e-3.
+    let (a, b, t, y, nu, s0) = (0.1, 0.5, 1e-4, 1e9, 0.3, 1e6);
+    let film = Material {
+        youngs_modulus: y,
+        poisson_ratio: nu,
+        thickness: t,
+        prestress: [s0, s0, 0.0],
+        wrinkling: Wrinkling::TensionField,
+        wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+    };
+    let g = y / (2.0 * (1.0 + nu));
+    let (m_cr, phi_cr) = (
+        std::f64::consts::TAU * a * a * t * s0,
+        s0 * (1.0 - a * a / (b * b)) / (2.0 * g),
+    );
+    assert!((m_cr - 6.283).abs() < 1e-3 && (phi_cr - 1.248e-3).abs() < 1e-6);
+    let model = annulus(a, b, 12, 48, film);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    // Hub torque from the reactions (the force the hub applies to the film), deformed positions.
+    let torque = |analysis: &mut Analysis| {
+        let results = analysis.results();
+        let m: f64 = (0..model.groups.len())
+            .map(|k| {
+                let v = model.groups[k].nodes[0];
+                let p = Vector3::from(model.nodes[v]) + analysis.node_displacement(v);
+                let r = results.reactions[k];
+                p.x * r[1] - p.y * r[0]
+            })
+            .sum();
+        (m, results)
+    };
+    let centroid_radius = |tri: &[usize; 3]| {
+        tri.iter()
+            .fold(Vector3::zeros(), |s, &v| s + Vector3::from(model.nodes[v]))
+            .norm()
+            / 3.0
+    };
+    let mut done = 0.0;
+    for fraction in [0.5, 0.9, 1.1, 2.0] {
+        let increments = (4.0 * (fraction - done) / 0.5_f64).ceil() as usize;
+        done = fraction;
+        analysis
+            .step_to(&hub_rotation(&model, fraction * phi_cr), increments)
+            .unwrap();
+        let (m, results) = torque(&mut analysis);
+        let [_, wrinkled, slack] = state_counts(&results);
+        assert_eq!(slack, 0, "the prestress keeps the radial tension");
+        // Tangential equilibrium, ring by ring (96 triangles each), in every state:
+        // τ_rθ = −M/(2π t r²) (the hub turns the film counter-clockwise).
+        for ring in 0..12 {
+            let (mut tau, mut radius) = (0.0, 0.0);
+            for e in 96 * ring..96 * (ring + 1) {
+                let c = model.triangles[e]
+                    .iter()
+                    .fold(Vector3::zeros(), |s, &v| s + Vector3::from(model.nodes[v]));
+                let th = c.y.atan2(c.x);
+                let [sx, sy, sxy] = results.elements[e].stress;
+                tau += ((sy - sx) * th.sin() * th.cos() + sxy * (2.0 * th).cos()) / 96.0;
+                radius += centroid_radius(&model.triangles[e]) / 96.0;
+            }
+            let expected = -m / (std::f64::consts::TAU * t * radius * radius);
+            assert!(
+                (tau - expected).abs() < 0.015 * expected.abs(),
+                "φ = {fraction} φ_cr, ring {ring}: τ {tau:e} vs {expected:e}"
+            );
+        }
+        let zone = results
+            .elements
+            .iter()
+            .zip(&model.triangles)
+            .filter(|(e, _)| e.state == WrinklingState::Wrinkled)
+            .fold(0.0_f64, |r, (_, tri)| r.max(centroid_radius(tri)));
+        match fraction {
+            // Taut: the linear torque (CST within 2 %), no wrinkles below the onset.
+            f if f < 1.0 => {
+                assert_eq!(wrinkled, 0, "φ = {f} φ_cr");
+                assert!((m / (f * m_cr) - 1.0).abs() < 0.02, "M {m} vs {}", f * m_cr);
+            }
+            // Just past the onset: wrinkles only in the ring at the hub.
+            f if f < 1.5 => assert!(wrinkled > 0 && zone < (b / a).powf(1.0 / 12.0) * a),
+            // Well past it: the torque softens below the linear one, and the wrinkled zone
+            // reaches about R = √(M/(2π t σ0)) (exact at onset, first estimate beyond).
+            f => {
+                assert!(m < 0.9 * f * m_cr, "M {m} vs linear {}", f * m_cr);
+                let r_estimate = (m / (std::f64::consts::TAU * t * s0)).sqrt();
+                assert!(
+                    zone < r_estimate && zone > 0.8 * r_estimate,
+                    "{zone} vs {r_estimate}"
+                );
+                assert!(
+                    results.elements[..96]
+                        .iter()
+                        .all(|e| e.state == WrinklingState::Wrinkled)
+                );
+            }
+        }
+    }
+}
