@@ -924,9 +924,31 @@ fn over_contracted_stretch_is_uniaxial_tension() {
         let right = edge_reaction(a.model(), &results.reactions, |p| {
             (p[0] - 1.0).abs() < 1e-12
         });
-        (results, right)
+        let text = membrane_contact::mech::vtk::unstructured_grid(
+            a.model(),
+            &a.state().displacement,
+            &results,
+        );
+        (results, right, text)
     };
-    let (results, right) = run(Wrinkling::TensionField);
+    let (results, right, text) = run(Wrinkling::TensionField);
+    // The VTK cell data carry the state (1 = wrinkled) and the tension direction (global X).
+    let array = |name: &str| -> Vec<f64> {
+        let start = text.find(&format!("Name=\"{name}\"")).unwrap();
+        let body = &text[text[start..].find('>').unwrap() + start + 1..];
+        body[..body.find("</DataArray>").unwrap()]
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    assert!(array("wrinkling_state").iter().all(|&s| s == 1.0));
+    let directions = array("tension_direction");
+    assert_eq!(directions.len(), 3 * results.elements.len());
+    assert!(
+        directions
+            .chunks(3)
+            .all(|d| (d[0] - 1.0).abs() < 1e-12 && d[1].abs() < 1e-12)
+    );
     let exx = 0.5 * (1.02f64.powi(2) - 1.0);
     for e in &results.elements {
         assert_eq!(e.state, WrinklingState::Wrinkled);
@@ -947,7 +969,7 @@ fn over_contracted_stretch_is_uniaxial_tension() {
         (right[0] - 20.604).abs() < 1e-9 && right[1].abs() < 1e-9,
         "{right:?}"
     );
-    let (taut, _) = run(Wrinkling::None);
+    let (taut, _, _) = run(Wrinkling::None);
     assert!(
         taut.elements
             .iter()
