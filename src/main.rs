@@ -5,6 +5,7 @@
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
+use membrane_contact::mech::element::state_counts;
 use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
 use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
@@ -277,6 +278,10 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
         lo / 1e6,
         hi / 1e6
     );
+    if !model.material.wrinkling.is_none() {
+        let [taut, wrinkled, slack] = state_counts(&results.elements);
+        println!("tension-field film: {taut} taut, {wrinkled} wrinkled, {slack} slack elements");
+    }
     if o.command == "specimen" {
         let measured = table1()
             .into_iter()

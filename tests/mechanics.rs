@@ -15,6 +15,9 @@ use membrane_contact::mech::contact::{
     FrictionLaw, GapFrame, GapLaw, GapResponse, GapStatus, IterationMatrix,
 };
 use membrane_contact::mech::element::{ElementVector, Material, MembraneTriangle};
+use membrane_contact::mech::material::{
+    DEFAULT_WRINKLING_REGULARISATION, Wrinkling, WrinklingState,
+};
 use membrane_contact::mech::model::{
     Axis, BoundaryGroup, GapSpec, GapSupport, Model, Support, Symmetry,
 };
@@ -27,6 +30,8 @@ fn etfe() -> Material {
         poisson_ratio: 0.43,
         thickness: 250e-6,
         prestress: [0.5e6, 0.5e6, 0.0],
+        wrinkling: Wrinkling::None,
+        wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     }
 }
 
@@ -947,11 +952,13 @@ fn vtk_output_is_well_formed_and_complete() {
         "gap_slip_x",
         "gap_normal_force",
         "gap_status",
+        "wrinkling_state",
         "types",
         "offsets",
     ] {
         assert_eq!(arrays[name], cells, "{name}");
     }
+    assert_eq!(arrays["tension_direction"], 3 * cells);
     assert!(vtk::collection(&[(0.5, "a.vtu".into())]).contains("timestep=\"0.5\""));
 }
 
@@ -1079,5 +1086,616 @@ fn gap_tangent_matches_finite_difference_on_random_states_of_both_laws() {
             expected,
             "{friction_law}: states checked {seen:?}"
         );
+    }
+}
+
+// ------------------------------------------------------------------ wrinkling (tension field)
+//
+// Source: the implementation note /work/shared/notes/wrinkling-and-contact.md §1–2, summarised
+// in docs/mechanics.md § "Wrinkling". Film Y = 1000, ν = 0.3, t = 1 on a unit square unless said.
+//
+//   n × n unit patch (here n = 4)       boundary nodes: one group each, target = map(X) − X
+//   20 - 21 - 22 - 23 - 24              interior nodes: free in x, y; z held (a flat membrane has
+//   |  / |  / |  / |  / |               no out-of-plane stiffness across the wrinkles)
+//   ...
+//   0 -- 1 -- 2 -- 3 -- 4
+
+/// The benchmark film of the note with the tension-field option and regularisation `eta`.
+fn tension_field_film(eta: f64, prestress: f64) -> Material {
+    Material {
+        youngs_modulus: 1000.0,
+        poisson_ratio: 0.3,
+        thickness: 1.0,
+        prestress: [prestress, prestress, 0.0],
+        wrinkling: Wrinkling::TensionField,
+        wrinkling_regularisation: eta,
+    }
+}
+
+/// A unit `n × n` patch whose boundary nodes each follow `map` (every boundary node its own
+/// group "b<node>"); interior nodes are free in-plane with z held. Returns the model and targets.
+fn mapped_boundary_patch(
+    n: usize,
+    material: Material,
+    map: impl Fn(f64, f64) -> [f64; 2],
+) -> (Model, Vec<[f64; 3]>) {
+    let mut m = patch(n, n, 1.0, 1.0);
+    m.material = material;
+    let mut targets = vec![];
+    for (v, p) in m.nodes.clone().iter().enumerate() {
+        let on_boundary = [p[0], p[1]]
+            .iter()
+            .any(|c| c.abs() < 1e-12 || (c - 1.0).abs() < 1e-12);
+        if on_boundary {
+            let x = map(p[0], p[1]);
+            let target = [x[0] - p[0], x[1] - p[1], 0.0];
+            m.groups.push(BoundaryGroup {
+                name: format!("b{v}"),
+                nodes: vec![v],
+                target,
+            });
+            targets.push(target);
+        } else {
+            m.supports.push(Support {
+                node: v,
+                fixed: vec![Axis::Z],
+            });
+        }
+    }
+    (m, targets)
+}
+
+/// Total reaction (x, y) of the boundary groups whose node satisfies `on_edge`.
+fn edge_reaction(
+    model: &Model,
+    reactions: &[[f64; 3]],
+    on_edge: impl Fn([f64; 3]) -> bool,
+) -> [f64; 2] {
+    let mut f = [0.0; 2];
+    for (g, group) in model.groups.iter().enumerate() {
+        if on_edge(model.nodes[group.nodes[0]]) {
+            f[0] += reactions[g][0];
+            f[1] += reactions[g][1];
+        }
+    }
+    f
+}
+
+#[test]
+fn homogeneous_simple_shear_gives_the_tension_field_closed_form() {
+    // x = X + γY, y = Y on the whole boundary; every element is wrinkled with (note §2.1)
+    // ê1,2 = γ²/4 ± (γ/2)√(1 + γ²/4), θ = 45° + ½ atan(γ/2), S = Y ê1 [c², s², cs],
+    // top-edge force Fx = tL(Sxy + γ Syy), Fy = tL Syy; small γ: Sxy → Yγ/4 (Wagner's tension
+    // field), not the taut Gγ.
+    let (y, nu, gamma) = (1000.0, 0.3, 0.01);
+    let (model, targets) = mapped_boundary_patch(4, tension_field_film(1e-5, 0.0), |x, yy| {
+        [x + gamma * yy, yy]
+    });
+    let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+    a.step_to(&targets, 5).unwrap();
+    let results = a.results();
+    let root = (1.0 + gamma * gamma / 4.0).sqrt();
+    let e1 = gamma * gamma / 4.0 + 0.5 * gamma * root;
+    let theta = std::f64::consts::FRAC_PI_4 + 0.5 * (gamma / 2.0).atan();
+    let (s, c) = theta.sin_cos();
+    let exact = [c * c, s * s, c * s].map(|m| y * e1 * m);
+    for (i, e) in results.elements.iter().enumerate() {
+        assert_eq!(e.state, WrinklingState::Wrinkled, "element {i}");
+        for k in 0..3 {
+            assert!(
+                (e.stress[k] - exact[k]).abs() < 1e-9 * y * e1,
+                "element {i}: {:?} vs {exact:?}",
+                e.stress
+            );
+        }
+        // The tension rays are F n1 on the deformed film.
+        let ray = Vector3::new(c + gamma * s, s, 0.0).normalize();
+        assert!(
+            (Vector3::from(e.tension_direction) - ray).amax() < 1e-9,
+            "{:?}",
+            e.tension_direction
+        );
+        assert!(e.principal[1].abs() < 1e-9 * e.principal[0]);
+    }
+    let top = edge_reaction(a.model(), &results.reactions, |p| {
+        (p[1] - 1.0).abs() < 1e-12
+    });
+    let (fx, fy) = (exact[2] + gamma * exact[1], exact[1]);
+    assert!(
+        (top[0] - fx).abs() < 1e-9 * fx && (top[1] - fy).abs() < 1e-9 * fy,
+        "{top:?} vs {fx}, {fy}"
+    );
+    // The note's published figures for these numbers.
+    assert!((exact[0] - 2.499969).abs() < 1e-6 && (exact[1] - 2.525094).abs() < 1e-6);
+    assert!((exact[2] - 2.512500).abs() < 1e-6);
+    assert!((fx - 2.537751).abs() < 1e-6 && (fy - 2.525094).abs() < 1e-6);
+    // Wagner's linear tension field Yγ/4 within O(γ); far below the taut shear stress Gγ.
+    let g = y / (2.0 * (1.0 + nu));
+    assert!((exact[2] - y * gamma / 4.0).abs() < gamma * y * gamma / 4.0);
+    assert!(exact[2] < 0.7 * g * gamma);
+}
+
+#[test]
+fn over_contracted_stretch_is_uniaxial_tension() {
+    // x = 1.02 X, y = 0.99 Y: Eyy = −0.00995 < −ν Exx ⇒ wrinkled, Sxx = Y Exx = 20.2,
+    // Syy = Sxy = 0, right-edge force λ1 Sxx t L = 20.604 (note §2.2). Without wrinkling the
+    // same stretch gives Sxx = 18.918, Syy = −4.275 (compression).
+    let run = |wrinkling| {
+        let film = Material {
+            wrinkling,
+            ..tension_field_film(1e-5, 0.0)
+        };
+        let (model, targets) = mapped_boundary_patch(3, film, |x, y| [1.02 * x, 0.99 * y]);
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        a.step_to(&targets, 2).unwrap();
+        let results = a.results();
+        let right = edge_reaction(a.model(), &results.reactions, |p| {
+            (p[0] - 1.0).abs() < 1e-12
+        });
+        let text = membrane_contact::mech::vtk::unstructured_grid(
+            a.model(),
+            &a.state().displacement,
+            &results,
+        );
+        (results, right, text)
+    };
+    let (results, right, text) = run(Wrinkling::TensionField);
+    // The VTK cell data carry the state (1 = wrinkled) and the tension direction (global X).
+    let array = |name: &str| -> Vec<f64> {
+        let start = text.find(&format!("Name=\"{name}\"")).unwrap();
+        let body = &text[text[start..].find('>').unwrap() + start + 1..];
+        body[..body.find("</DataArray>").unwrap()]
+            .split_whitespace()
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    assert!(array("wrinkling_state").iter().all(|&s| s == 1.0));
+    let directions = array("tension_direction");
+    assert_eq!(directions.len(), 3 * results.elements.len());
+    assert!(
+        directions
+            .chunks(3)
+            .all(|d| (d[0] - 1.0).abs() < 1e-12 && d[1].abs() < 1e-12)
+    );
+    let exx = 0.5 * (1.02f64.powi(2) - 1.0);
+    for e in &results.elements {
+        assert_eq!(e.state, WrinklingState::Wrinkled);
+        assert!(
+            (e.stress[0] - 1000.0 * exx).abs() < 1e-9 * 20.0,
+            "{:?}",
+            e.stress
+        );
+        assert!(
+            e.stress[1].abs() < 1e-9 && e.stress[2].abs() < 1e-9,
+            "{:?}",
+            e.stress
+        );
+        assert!((Vector3::from(e.tension_direction) - Vector3::x()).amax() < 1e-12);
+    }
+    assert!((exx * 1000.0 - 20.2).abs() < 1e-9);
+    assert!(
+        (right[0] - 20.604).abs() < 1e-9 && right[1].abs() < 1e-9,
+        "{right:?}"
+    );
+    let (taut, _, _) = run(Wrinkling::None);
+    assert!(
+        taut.elements
+            .iter()
+            .all(|e| e.state == WrinklingState::Taut)
+    );
+    assert!((taut.elements[0].stress[0] - 18.918).abs() < 1e-3);
+    assert!((taut.elements[0].stress[1] + 4.275).abs() < 1e-3);
+}
+
+#[test]
+fn slack_film_gives_zero_reactions_without_a_singular_solve() {
+    // λ1 = 0.99, λ2 = 0.98: both principal strains negative ⇒ slack everywhere, no stress; the
+    // interior nodes keep only the η D tangent, which must keep the Newton matrix regular.
+    let (model, targets) = mapped_boundary_patch(3, tension_field_film(1e-5, 0.0), |x, y| {
+        [0.99 * x, 0.98 * y]
+    });
+    let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+    let report = a.step_to(&targets, 2).expect("a slack film solves");
+    let results = a.results();
+    // A slack film has no unique shape: any arrangement of the free nodes in which no element
+    // is stretched is in equilibrium. Newton stops at one within its tolerances, so an element
+    // may end a hair on the wrinkled side, with a stress of nano-pascals against the taut
+    // film's 20 MPa at this strain: the film carries nothing.
+    assert!(
+        results
+            .elements
+            .iter()
+            .filter(|e| e.state != WrinklingState::Slack)
+            .all(|e| e.von_mises < 1e-6 && e.state == WrinklingState::Wrinkled),
+        "{:?}",
+        results.elements
+    );
+    assert!(
+        results
+            .elements
+            .iter()
+            .filter(|e| e.state == WrinklingState::Slack)
+            .all(|e| e.von_mises == 0.0 && e.tension_direction == [0.0; 3])
+    );
+    assert!(
+        results.elements.iter().filter(|e| e.state == WrinklingState::Slack).count()
+            > results.elements.len() / 2
+    );
+    assert!(
+        results.reactions.iter().flatten().all(|r| r.abs() < 1e-8),
+        "{:?}",
+        results.reactions
+    );
+    assert!(report.residual < 1e-8, "{}", report.residual);
+    // A prestress s0 moves the threshold to Exx = −s0 (1 − ν)/Y: the same film with enough
+    // prestress stays taut under this compression.
+    let s0 = 20.0; // shift 0.014 > the 0.0199 / 2… strains: Exx = −0.00995, Eyy = −0.0198
+    let (model, targets) =
+        mapped_boundary_patch(3, tension_field_film(1e-5, s0), |x, y| [0.99 * x, 0.98 * y]);
+    let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+    a.step_to(&targets, 2).unwrap();
+    let results = a.results();
+    assert!(
+        results
+            .elements
+            .iter()
+            .all(|e| e.state != WrinklingState::Slack)
+    );
+}
+
+/// A unit square, bottom edge clamped, top edge moved by (γ, δ), free sides, z held: the
+/// realistic shear panel (Wong & Pellegrino 2006), wrinkled in the middle, taut elsewhere.
+fn shear_panel(n: usize, material: Material) -> Model {
+    let mut m = patch(n, n, 1.0, 1.0);
+    m.material = material;
+    let top: Vec<usize> = (0..=n).map(|i| n * (n + 1) + i).collect();
+    for v in 0..m.nodes.len() {
+        let fixed = if v <= n {
+            vec![Axis::X, Axis::Y, Axis::Z]
+        } else {
+            vec![Axis::Z]
+        };
+        if !top.contains(&v) {
+            m.supports.push(Support { node: v, fixed });
+        }
+    }
+    m.groups.push(BoundaryGroup {
+        name: "top".into(),
+        nodes: top,
+        target: [0.05, 0.005, 0.0],
+    });
+    m
+}
+
+fn state_counts(results: &membrane_contact::mech::Results) -> [usize; 3] {
+    membrane_contact::mech::element::state_counts(&results.elements)
+}
+
+#[test]
+fn wrinkled_element_carries_no_compression() {
+    let settings = SolverSettings {
+        max_iterations: 40,
+        ..Default::default()
+    };
+    let run = |wrinkling| {
+        let film = Material {
+            wrinkling,
+            ..tension_field_film(1e-5, 0.5)
+        };
+        let mut a = Analysis::new(shear_panel(8, film), settings).unwrap();
+        a.step_to(&[[0.05, 0.005, 0.0]], 10).unwrap();
+        a.results()
+    };
+    let results = run(Wrinkling::TensionField);
+    let [taut, wrinkled, _] = state_counts(&results);
+    assert!(wrinkled > 20 && taut > 0, "{:?}", state_counts(&results));
+    let largest = results
+        .elements
+        .iter()
+        .fold(0.0_f64, |m, e| m.max(e.principal[0]));
+    for e in &results.elements {
+        assert!(e.principal[1] >= -1e-12 * largest, "{e:?}");
+        if e.state == WrinklingState::Wrinkled {
+            assert!(e.principal[1].abs() <= 1e-12 * largest, "{e:?}");
+        }
+    }
+    // The same panel without wrinkling is in compression: the check above can fail.
+    let linear = run(Wrinkling::None);
+    let most_compressed = linear
+        .elements
+        .iter()
+        .fold(0.0_f64, |m, e| m.min(e.principal[1]));
+    assert!(
+        most_compressed < -0.1 * largest,
+        "{most_compressed} vs {largest}"
+    );
+}
+
+#[test]
+fn regularisation_does_not_change_the_converged_answer() {
+    // η enters the Newton matrix only: η and η/10 must converge to the same displacements (to
+    // the solver tolerance). A small prestress gives a taut start (without it the slack corners
+    // of this panel have no unique displacement, see docs/mechanics.md).
+    let settings = SolverSettings {
+        max_iterations: 60,
+        displacement_tolerance: 1e-10,
+        residual_tolerance: 1e-10,
+        ..Default::default()
+    };
+    let run = |eta| {
+        let mut a = Analysis::new(shear_panel(8, tension_field_film(eta, 0.5)), settings).unwrap();
+        a.step_to(&[[0.05, 0.005, 0.0]], 10).unwrap();
+        (a.state().displacement.clone(), a.results())
+    };
+    let (u1, r1) = run(1e-4);
+    let (u2, r2) = run(1e-5);
+    let scale = u1.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    let du = u1
+        .iter()
+        .zip(&u2)
+        .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+    assert!(
+        du < 1e-8 * scale,
+        "displacements differ by {du:e} (scale {scale:e})"
+    );
+    assert_eq!(state_counts(&r1), state_counts(&r2));
+    let reaction = |r: &membrane_contact::mech::Results| r.reactions[0];
+    for k in 0..2 {
+        let (a, b) = (reaction(&r1)[k], reaction(&r2)[k]);
+        assert!((a - b).abs() < 1e-7 * a.abs().max(b.abs()), "{a} vs {b}");
+    }
+}
+
+#[test]
+fn newton_converges_quadratically_with_wrinkled_and_taut_elements() {
+    // η = 0 and a prestress (taut start, note §1.5 option 3): the consistent tension-field tangent
+    // makes the last iterations quadratic once the states settle.
+    let settings = SolverSettings {
+        max_iterations: 40,
+        residual_tolerance: 1e-13,
+        displacement_tolerance: 1e-13,
+        ..Default::default()
+    };
+    let mut a = Analysis::new(shear_panel(6, tension_field_film(0.0, 0.5)), settings).unwrap();
+    a.step_to(&[[0.025, 0.02, 0.0]], 8).unwrap();
+    let report = a.step_to(&[[0.03, 0.02, 0.0]], 1).unwrap();
+    let [taut, wrinkled, _] = state_counts(&a.results());
+    assert!(taut > 0 && wrinkled > 0, "{taut} taut, {wrinkled} wrinkled");
+    let r = &report.residual_history;
+    let tail: Vec<f64> = r.iter().copied().filter(|v| *v > 1e-11).collect();
+    let n = tail.len();
+    assert!(n >= 3, "{r:?}");
+    let ratios: Vec<f64> = (n - 3..n - 1)
+        .map(|k| tail[k + 1] / tail[k].powi(2))
+        .collect();
+    assert!(
+        ratios.iter().all(|c| *c < 10.0),
+        "not quadratic: {r:?}, ratios {ratios:?}"
+    );
+    assert!(r.last().unwrap() / r[0] < 1e-10, "{r:?}");
+}
+
+#[test]
+fn wrinkling_tangent_matches_finite_difference_in_every_state() {
+    // Element level (note §1.7.3): random triangles and displacements, tension-field film with
+    // and without prestress, η = 0; points whose state changes under ±h are skipped.
+    let mut rng = Rng(0x51_7C_C1_B7_27_22_0A_95);
+    let mut seen = [0usize; 3];
+    while seen.iter().any(|&n| n < 15) {
+        let x = [0, 1, 2].map(|_| Vector3::new(rng.next(), rng.next(), 0.3 * rng.next()));
+        let Ok(tri) = MembraneTriangle::new(x) else {
+            continue;
+        };
+        if tri.area() < 0.05 {
+            continue;
+        }
+        let prestress = if rng.next() > 0.0 {
+            0.0
+        } else {
+            5.0 * rng.next().abs()
+        };
+        let mat = tension_field_film(0.0, prestress);
+        let u = ElementVector::from_fn(|_, _| 0.02 * rng.next());
+        let state = tri.stress_state(&mat, &u).state;
+        let k = tri.tangent_stiffness(&mat, &u);
+        let scale = tri.area() * mat.elasticity().amax();
+        let h = 1e-7;
+        let mut columns = vec![];
+        for j in 0..9 {
+            let (mut up, mut um) = (u, u);
+            up[j] += h;
+            um[j] -= h;
+            if tri.stress_state(&mat, &up).state != state
+                || tri.stress_state(&mat, &um).state != state
+            {
+                break;
+            }
+            columns
+                .push((tri.internal_force(&mat, &up) - tri.internal_force(&mat, &um)) / (2.0 * h));
+        }
+        if columns.len() < 9 {
+            continue;
+        }
+        for (j, column) in columns.iter().enumerate() {
+            let err = (column - k.column(j)).amax();
+            assert!(
+                err < 1e-6 * scale,
+                "{state:?} dof {j}: {err:e} vs {scale:e}"
+            );
+        }
+        // The regularisation reaches the tangent only, and only off the taut state.
+        let regular = Material {
+            wrinkling_regularisation: 1e-3,
+            ..mat
+        };
+        assert_eq!(
+            tri.internal_force(&regular, &u),
+            tri.internal_force(&mat, &u)
+        );
+        let added = (tri.tangent_stiffness(&regular, &u) - k).amax();
+        assert_eq!(added == 0.0, state == WrinklingState::Taut, "{state:?}");
+        seen[state as usize] += 1;
+    }
+}
+
+/// An annular film `a ≤ r ≤ b` (geometric radial spacing, `nr × nt` cells, alternating
+/// diagonals): hub nodes one group each ("h<node>"), outer rim clamped, z held elsewhere.
+fn annulus(a: f64, b: f64, nr: usize, nt: usize, material: Material) -> Model {
+    let mut m = patch(1, 1, 1.0, 1.0);
+    m.material = material;
+    m.nodes.clear();
+    m.triangles.clear();
+    let id = |i: usize, j: usize| i * nt + j % nt;
+    for i in 0..=nr {
+        let r = a * (b / a).powf(i as f64 / nr as f64);
+        for j in 0..nt {
+            let phi = std::f64::consts::TAU * j as f64 / nt as f64;
+            m.nodes.push([r * phi.cos(), r * phi.sin(), 0.0]);
+        }
+    }
+    for i in 0..nr {
+        for j in 0..nt {
+            let (p, q, r, s) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if (i + j) % 2 == 0 {
+                m.triangles.extend([[p, q, r], [p, r, s]]);
+            } else {
+                m.triangles.extend([[p, q, s], [q, r, s]]);
+            }
+        }
+    }
+    for j in 0..nt {
+        m.groups.push(BoundaryGroup {
+            name: format!("h{j}"),
+            nodes: vec![id(0, j)],
+            target: [0.0; 3],
+        });
+        m.supports.push(Support {
+            node: id(nr, j),
+            fixed: vec![Axis::X, Axis::Y, Axis::Z],
+        });
+        for i in 1..nr {
+            m.supports.push(Support {
+                node: id(i, j),
+                fixed: vec![Axis::Z],
+            });
+        }
+    }
+    m
+}
+
+/// Hub targets for a rigid rotation by `phi` of the hub nodes (the first groups).
+fn hub_rotation(model: &Model, phi: f64) -> Vec<[f64; 3]> {
+    let (s, c) = phi.sin_cos();
+    model
+        .groups
+        .iter()
+        .map(|g| {
+            let [x, y, _] = model.nodes[g.nodes[0]];
+            [c * x - s * y - x, s * x + c * y - y, 0.0]
+        })
+        .collect()
+}
+
+#[test]
+fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
+    // In-plane torsion of an annulus (note §2.3; Mikulas 1964, Miller & Hedgepeth 1982): hub
+    // a = 0.1, rim b = 0.5, t = 1e-4, Y = 1 GPa, ν = 0.3, σ0 = 1 MPa isotropic. Taut (linear):
+    // M = 4π t G φ / (1/a² − 1/b²); τ(r) = M/(2π t r²) in every state; first wrinkles at the hub
+    // when τ(a) = σ0: M_cr = 2π a² t σ0 = 6.283 N·m at φ_cr = σ0 (1 − a²/b²)/(2G) = 1.248e-3.
+    let (a, b, t, y, nu, s0) = (0.1, 0.5, 1e-4, 1e9, 0.3, 1e6);
+    let film = Material {
+        youngs_modulus: y,
+        poisson_ratio: nu,
+        thickness: t,
+        prestress: [s0, s0, 0.0],
+        wrinkling: Wrinkling::TensionField,
+        wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+    };
+    let g = y / (2.0 * (1.0 + nu));
+    let (m_cr, phi_cr) = (
+        std::f64::consts::TAU * a * a * t * s0,
+        s0 * (1.0 - a * a / (b * b)) / (2.0 * g),
+    );
+    assert!((m_cr - 6.283).abs() < 1e-3 && (phi_cr - 1.248e-3).abs() < 1e-6);
+    let model = annulus(a, b, 12, 48, film);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    // Hub torque from the reactions (the force the hub applies to the film), deformed positions.
+    let torque = |analysis: &mut Analysis| {
+        let results = analysis.results();
+        let m: f64 = (0..model.groups.len())
+            .map(|k| {
+                let v = model.groups[k].nodes[0];
+                let p = Vector3::from(model.nodes[v]) + analysis.node_displacement(v);
+                let r = results.reactions[k];
+                p.x * r[1] - p.y * r[0]
+            })
+            .sum();
+        (m, results)
+    };
+    let centroid_radius = |tri: &[usize; 3]| {
+        tri.iter()
+            .fold(Vector3::zeros(), |s, &v| s + Vector3::from(model.nodes[v]))
+            .norm()
+            / 3.0
+    };
+    let mut done = 0.0;
+    for fraction in [0.5, 0.9, 1.1, 2.0] {
+        let increments = (4.0 * (fraction - done) / 0.5_f64).ceil() as usize;
+        done = fraction;
+        analysis
+            .step_to(&hub_rotation(&model, fraction * phi_cr), increments)
+            .unwrap();
+        let (m, results) = torque(&mut analysis);
+        let [_, wrinkled, slack] = state_counts(&results);
+        assert_eq!(slack, 0, "the prestress keeps the radial tension");
+        // Tangential equilibrium, ring by ring (96 triangles each), in every state:
+        // τ_rθ = −M/(2π t r²) (the hub turns the film counter-clockwise).
+        for ring in 0..12 {
+            let (mut tau, mut radius) = (0.0, 0.0);
+            for e in 96 * ring..96 * (ring + 1) {
+                let c = model.triangles[e]
+                    .iter()
+                    .fold(Vector3::zeros(), |s, &v| s + Vector3::from(model.nodes[v]));
+                let th = c.y.atan2(c.x);
+                let [sx, sy, sxy] = results.elements[e].stress;
+                tau += ((sy - sx) * th.sin() * th.cos() + sxy * (2.0 * th).cos()) / 96.0;
+                radius += centroid_radius(&model.triangles[e]) / 96.0;
+            }
+            let expected = -m / (std::f64::consts::TAU * t * radius * radius);
+            assert!(
+                (tau - expected).abs() < 0.015 * expected.abs(),
+                "φ = {fraction} φ_cr, ring {ring}: τ {tau:e} vs {expected:e}"
+            );
+        }
+        let zone = results
+            .elements
+            .iter()
+            .zip(&model.triangles)
+            .filter(|(e, _)| e.state == WrinklingState::Wrinkled)
+            .fold(0.0_f64, |r, (_, tri)| r.max(centroid_radius(tri)));
+        match fraction {
+            // Taut: the linear torque (CST within 2 %), no wrinkles below the onset.
+            f if f < 1.0 => {
+                assert_eq!(wrinkled, 0, "φ = {f} φ_cr");
+                assert!((m / (f * m_cr) - 1.0).abs() < 0.02, "M {m} vs {}", f * m_cr);
+            }
+            // Just past the onset: wrinkles only in the ring at the hub.
+            f if f < 1.5 => assert!(wrinkled > 0 && zone < (b / a).powf(1.0 / 12.0) * a),
+            // Well past it: the torque softens below the linear one, and the wrinkled zone
+            // reaches about R = √(M/(2π t σ0)) (exact at onset, first estimate beyond).
+            f => {
+                assert!(m < 0.9 * f * m_cr, "M {m} vs linear {}", f * m_cr);
+                let r_estimate = (m / (std::f64::consts::TAU * t * s0)).sqrt();
+                assert!(
+                    zone < r_estimate && zone > 0.8 * r_estimate,
+                    "{zone} vs {r_estimate}"
+                );
+                assert!(
+                    results.elements[..96]
+                        .iter()
+                        .all(|e| e.state == WrinklingState::Wrinkled)
+                );
+            }
+        }
     }
 }

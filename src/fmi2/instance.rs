@@ -55,6 +55,8 @@ use super::types::{
     FMI2_CO_SIMULATION, FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status,
 };
 use super::variables::{Binding, Causality, Value, VarType, Variable};
+use crate::mech::element::state_counts;
+use crate::mech::material::Wrinkling;
 use crate::mech::{
     Analysis, GapStatus, IterationMatrix, ParallelArch, SolverSettings, StepError, StepReport, vtk,
 };
@@ -630,6 +632,13 @@ impl Instance {
                 (Binding::PoissonRatio, Value::Real(x)) => model.material.poisson_ratio = x,
                 (Binding::Thickness, Value::Real(x)) => model.material.thickness = x,
                 (Binding::Prestress(c), Value::Real(x)) => model.material.prestress[c] = x,
+                (Binding::Wrinkling, Value::Boolean(b)) => {
+                    model.material.wrinkling = if b {
+                        Wrinkling::TensionField
+                    } else {
+                        Wrinkling::None
+                    }
+                }
                 (Binding::NormalStiffness(g), Value::Real(x)) => model.gaps[g].normal_stiffness = x,
                 (Binding::TangentialStiffness(g), Value::Real(x)) => {
                     model.gaps[g].tangential_stiffness = x
@@ -686,6 +695,7 @@ impl Instance {
         };
         let results = built.analysis.results();
         let max_stress = results.von_mises_range().1;
+        let [_, wrinkled, slack] = state_counts(&results.elements);
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
             .description
@@ -713,6 +723,8 @@ impl Instance {
                 Binding::Cutbacks => count(report.map_or(0, |r| r.cutbacks)),
                 Binding::Residual => Value::Real(report.map_or(0.0, |r| r.residual)),
                 Binding::MaxEquivalentStress => Value::Real(max_stress),
+                Binding::WrinkledElements => count(wrinkled),
+                Binding::SlackElements => count(slack),
                 _ => continue,
             };
         }

@@ -1055,3 +1055,41 @@ fn friction_law_parameter_gives_every_gap_the_papers_law() {
         "{cone:?} {paper:?}"
     );
 }
+
+#[test]
+fn wrinkling_parameter_switches_the_film_and_counts_its_elements() {
+    // film.wrinkling starts from the model (false for the specimen). Initial outputs of the
+    // undeformed film (ε = 0, so ε̂ = D⁻¹σ0): the 0.5 MPa biaxial prestress is taut; no prestress
+    // is slack everywhere; σ0 = (0.5, −0.1) MPa is wrinkled everywhere (σ2 < 0 needs ê2 < −ν ê1).
+    let u = Unpacked::specimen("wrinkling");
+    let counts = |wrinkling: bool, prestress: [f64; 2]| {
+        let log = Log::default();
+        let fmu = Fmu::new(&u, &log);
+        unsafe {
+            assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+            assert_eq!(
+                fmi2_set_boolean(fmu.c, &u.vr("film.wrinkling"), 1, &c_int::from(wrinkling)),
+                0
+            );
+        }
+        assert_eq!(fmu.set_real("film.prestressX", prestress[0]), 0);
+        assert_eq!(fmu.set_real("film.prestressY", prestress[1]), 0);
+        assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+        [
+            fmu.integer("film.wrinkledElements"),
+            fmu.integer("film.slackElements"),
+        ]
+    };
+    let (log, mut start) = (Log::default(), 1);
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    assert_eq!(
+        unsafe { fmi2_get_boolean(fmu.c, &u.vr("film.wrinkling"), 1, &mut start) },
+        0
+    );
+    assert_eq!(start, 0);
+    assert_eq!(counts(true, [0.5e6, 0.5e6]), [0, 0]);
+    assert_eq!(counts(true, [0.0, 0.0]), [0, 200]);
+    assert_eq!(counts(true, [0.5e6, -0.1e6]), [200, 0]);
+    assert_eq!(counts(false, [0.5e6, -0.1e6]), [0, 0]);
+}

@@ -14,6 +14,7 @@
 //! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step |
 //! | `archHeight` | Real | parameter | m | ParallelArch only: the model is regenerated from it |
 //! | `film.E`, `film.nu`, `film.thickness`, `film.prestressX/Y/XY` | Real | parameter | Pa, 1, m, Pa | film |
+//! | `film.wrinkling` | Boolean | parameter | | tension-field film (start: the model's `wrinkling`) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap; start: the model's when uniform, else "" (each gap keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
@@ -24,6 +25,7 @@
 //! | `<group>.Rx/.Ry/.Rz` | Real | output | N | total reaction of the group |
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
 //! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
+//! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
 
 use serde::{Deserialize, Serialize};
 
@@ -149,6 +151,8 @@ pub enum Binding {
     Thickness,
     /// Prestress component 0 (x), 1 (y), 2 (xy).
     Prestress(usize),
+    /// Tension-field film on (true) or off.
+    Wrinkling,
     NormalStiffness(usize),
     TangentialStiffness(usize),
     /// Friction law of every gap (a String parameter; "" keeps each gap's own).
@@ -181,6 +185,8 @@ pub enum Binding {
     Cutbacks,
     Residual,
     MaxEquivalentStress,
+    WrinkledElements,
+    SlackElements,
 }
 
 /// One ScalarVariable.
@@ -362,6 +368,13 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             binding,
         );
     }
+    table.parameter(
+        "film.wrinkling",
+        Value::Boolean(!m.wrinkling.is_none()),
+        None,
+        "true: tension-field film (no compression; elements taut, wrinkled or slack); false: linear elastic, the paper's",
+        Binding::Wrinkling,
+    );
     for (i, g) in model.gaps.iter().enumerate() {
         table.parameter(
             &format!("{}.kn", g.name),
@@ -539,6 +552,18 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "Pa",
         "largest von Mises stress of the film elements",
         Binding::MaxEquivalentStress,
+    );
+    integer_output(
+        &mut table,
+        "film.wrinkledElements",
+        "number of wrinkled film elements (uniaxial tension; 0 without wrinkling)",
+        Binding::WrinkledElements,
+    );
+    integer_output(
+        &mut table,
+        "film.slackElements",
+        "number of slack film elements (no stress; 0 without wrinkling)",
+        Binding::SlackElements,
     );
     table.0
 }
@@ -732,7 +757,9 @@ mod tests {
             .iter()
             .filter(|v| v.causality == Causality::Output)
             .count();
-        assert_eq!(outputs, 9 * 7 + 3 + 4);
+        assert_eq!(outputs, 9 * 7 + 3 + 4 + 2);
+        assert_eq!(find("film.wrinkling").start, Some(Value::Boolean(false)));
+        assert_eq!(find("film.slackElements").var_type, VarType::Integer);
         // A user model has no archHeight, but the same results.directory.
         let user = variables(&model, Kind::Model);
         assert!(user.iter().all(|v| v.name != "archHeight"));

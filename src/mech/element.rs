@@ -17,70 +17,46 @@
 //! Writing `F` in global axes makes the rotation `T = diag(R, R, R)` of the paper unnecessary:
 //! `(B0 + AG)` expressed on global DOF is exactly `B_k` below, and `GᵀMG` is the isotropic
 //! `(∇N_kᵀ S ∇N_l) I3` block. `docs/mechanics.md` has the derivation.
+//!
+//! A wrinkling film ([`Material::response`]) replaces `σ` by the tension-field stress `S_mod` in
+//! the force and in the geometric term, and `D` by its consistent tangent (+ `η D`) in `B_kᵀ D B_l`.
 
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
+
+pub use super::material::{Material, Wrinkling, WrinklingState};
 
 /// Element vector on the nine nodal DOF.
 pub type ElementVector = SVector<f64, 9>;
 /// Element matrix on the nine nodal DOF.
 pub type ElementMatrix = SMatrix<f64, 9, 9>;
 
-/// Linear-elastic plane-stress film with an initial stress (eq. 2.3).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Material {
-    /// Young's modulus `E` (Pa).
-    pub youngs_modulus: f64,
-    /// Poisson's ratio `ν`, in `[0, 0.5)`.
-    pub poisson_ratio: f64,
-    /// Film thickness `t` (m).
-    pub thickness: f64,
-    /// Initial stress `σ0 = [σx, σy, τxy]` (Pa) in each element's local frame (e1 ∥ global X).
-    #[serde(default)]
-    pub prestress: [f64; 3],
-}
-
-impl Material {
-    /// Plane-stress elasticity matrix `D` of eq. (2.3).
-    pub fn elasticity(&self) -> Matrix3<f64> {
-        let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
-        let c = e / (1.0 - nu * nu);
-        Matrix3::new(
-            c,
-            c * nu,
-            0.0,
-            c * nu,
-            c,
-            0.0,
-            0.0,
-            0.0,
-            c * (1.0 - nu) / 2.0,
-        )
-    }
-
-    /// Stress `σ = D ε + σ0` (eq. 2.3) for a Voigt strain `[εx, εy, γxy]`.
-    pub fn stress(&self, strain: &Vector3<f64>) -> Vector3<f64> {
-        self.elasticity() * strain + Vector3::from(self.prestress)
-    }
-
-    /// Membrane stiffness `E·t` (N/m), the scale the gap penalties are set against.
-    pub fn membrane_stiffness(&self) -> f64 {
-        self.youngs_modulus * self.thickness
-    }
-}
-
 /// Strain and stress state of one element.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ElementStress {
     /// Green–Lagrange strain `[εx, εy, γxy]` in the element's local frame.
     pub strain: [f64; 3],
-    /// Stress `σ = Dε + σ0` `[σx, σy, τxy]` (Pa) in the element's local frame.
+    /// Stress `σ = Dε + σ0` `[σx, σy, τxy]` (Pa) in the element's local frame (the
+    /// tension-field stress when the material wrinkles).
     pub stress: [f64; 3],
     /// Principal stresses `σ1 ≥ σ2` (Pa).
     pub principal: [f64; 2],
     /// Plane-stress von Mises equivalent stress `√(σ1² − σ1σ2 + σ2²)` (Pa).
     pub von_mises: f64,
+    /// Taut, wrinkled or slack (always taut without wrinkling).
+    #[serde(default)]
+    pub state: WrinklingState,
+    /// Unit tension direction `F n1/|F n1|` in global axes on the deformed film when wrinkled
+    /// (the wrinkles run along it); zero otherwise.
+    #[serde(default)]
+    pub tension_direction: [f64; 3],
+}
+
+/// How many elements are taut, wrinkled and slack (indexed by [`WrinklingState`] as `usize`).
+pub fn state_counts(elements: &[ElementStress]) -> [usize; 3] {
+    let mut counts = [0; 3];
+    elements.iter().for_each(|e| counts[e.state as usize] += 1);
+    counts
 }
 
 /// Why a triangle cannot be built.
@@ -192,7 +168,9 @@ impl MembraneTriangle {
     ) -> (ElementVector, ElementMatrix) {
         let volume = self.area * material.thickness;
         let f = self.deformation_gradient(u);
-        let s = material.stress(&strain_from(&f));
+        // S_mod enters the force and the geometric term; the material term gets C_mod (+ η D).
+        let response = material.response(&strain_from(&f));
+        let s = response.stress;
         let S = Matrix2::new(s.x, s.z, s.z, s.y);
         let FS = f * S;
         let mut r = ElementVector::zeros();
@@ -202,15 +180,15 @@ impl MembraneTriangle {
         }
         let mut kt = ElementMatrix::zeros();
         if with_tangent {
-            let D = material.elasticity();
+            let C = material.iteration_tangent(&response);
             let B = [0, 1, 2].map(|k| self.strain_operator(&f, k));
-            let DB = B.map(|b| D * b);
+            let CB = B.map(|b| C * b);
             // The tangent is symmetric: compute the blocks l ≥ k and mirror them.
             for k in 0..3 {
                 for l in k..3 {
                     let geometric = (self.gradients[k].transpose() * S * self.gradients[l])[0];
                     let block =
-                        (B[k].transpose() * DB[l] + Matrix3::identity() * geometric) * volume;
+                        (B[k].transpose() * CB[l] + Matrix3::identity() * geometric) * volume;
                     kt.fixed_view_mut::<3, 3>(3 * k, 3 * l).copy_from(&block);
                     if l != k {
                         kt.fixed_view_mut::<3, 3>(3 * l, 3 * k)
@@ -224,8 +202,16 @@ impl MembraneTriangle {
 
     /// Strains, stresses, principal and von Mises stress at displacement `u`.
     pub fn stress_state(&self, material: &Material, u: &ElementVector) -> ElementStress {
-        let strain = self.green_strain(u);
-        let s = material.stress(&strain);
+        let f = self.deformation_gradient(u);
+        let strain = strain_from(&f);
+        let response = material.response(&strain);
+        let s = response.stress;
+        let tension = f * response.direction;
+        let tension_direction = if response.state == WrinklingState::Wrinkled {
+            (tension / tension.norm()).into()
+        } else {
+            [0.0; 3]
+        };
         let centre = 0.5 * (s.x + s.y);
         let radius = (0.25 * (s.x - s.y).powi(2) + s.z * s.z).sqrt();
         let (s1, s2) = (centre + radius, centre - radius);
@@ -234,6 +220,8 @@ impl MembraneTriangle {
             stress: s.into(),
             principal: [s1, s2],
             von_mises: (s1 * s1 - s1 * s2 + s2 * s2).sqrt(),
+            state: response.state,
+            tension_direction,
         }
     }
 }
@@ -254,6 +242,8 @@ mod tests {
             poisson_ratio: 0.43,
             thickness: 250e-6,
             prestress: [1.0e6, 0.5e6, 0.2e6],
+            wrinkling: Wrinkling::None,
+            wrinkling_regularisation: 1e-5,
         }
     }
 

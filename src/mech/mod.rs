@@ -4,6 +4,7 @@
 //! | module | what |
 //! |---|---|
 //! | [`element`] | CST membrane triangle, eqs. (2.2)–(2.7) |
+//! | [`material`] | film law, eq. (2.3), and its tension-field (wrinkling) option |
 //! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
 //! | [`model`] | model file format and validation |
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
@@ -17,6 +18,7 @@ pub mod assembly;
 pub mod contact;
 pub mod element;
 pub mod linear;
+pub mod material;
 pub mod model;
 pub mod scenarios;
 pub mod solver;
@@ -24,7 +26,7 @@ pub mod specimen;
 pub mod vtk;
 
 pub use contact::{FrictionLaw, GapStatus, IterationMatrix};
-pub use element::Material;
+pub use material::{Material, Wrinkling, WrinklingState};
 pub use model::{Model, ModelError};
 pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};
 pub use specimen::ParallelArch;

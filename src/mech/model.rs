@@ -2,7 +2,7 @@
 //! from a JSON model file (format in `docs/model-format.md`) and validated before any analysis.
 //!
 //! Validation names the offending item: an unknown node index, a degenerate triangle, `E ≤ 0`,
-//! `ν` outside `[0, 0.5)`, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node that
+//! `ν` outside `[0, 0.5)`, `η` outside `[0, 1)`, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node that
 //! is both constrained and prescribed. Nothing here panics on user input.
 
 use std::collections::HashSet;
@@ -286,6 +286,12 @@ impl Model {
         if m.prestress.iter().any(|v| !v.is_finite()) {
             return Err(ModelError::Material {
                 message: "prestress must be finite".into(),
+            });
+        }
+        let eta = m.wrinkling_regularisation;
+        if !(0.0..1.0).contains(&eta) {
+            return Err(ModelError::Material {
+                message: format!("wrinkling_regularisation = {eta} must lie in [0, 1)"),
             });
         }
         let mut connected = vec![false; n];

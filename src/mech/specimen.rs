@@ -31,7 +31,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::contact::{FrictionLaw, GapFrame};
-use super::element::Material;
+use super::material::{DEFAULT_WRINKLING_REGULARISATION, Material, Wrinkling};
 use super::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Symmetry};
 
 /// Measured sliding along the arch at the final step (mm), the paper's Table 1 (points 1–5).
@@ -83,6 +83,8 @@ impl Default for ParallelArch {
                 poisson_ratio: 0.43,
                 thickness: 250e-6,
                 prestress: [0.5e6, 0.5e6, 0.0],
+                wrinkling: Wrinkling::None,
+                wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
             },
             normal_penalty_factor: 1000.0,
             tangential_penalty_ratio: 0.1,

@@ -7,7 +7,9 @@
 //! support. Point data: `displacement`. Cell data (triangles | gaps): `von_mises`,
 //! `principal_1`, `principal_2`, `stress` (σx, σy, τxy in the element frame) | zero, and
 //! `gap_slip_x`, `gap_slip_y`, `gap_normal_force`, `gap_friction_force`, `gap_status`
-//! (0 open, 1 stick, 2 slip) | zero / −1 on triangles.
+//! (0 open, 1 stick, 2 slip) | zero / −1 on triangles; `wrinkling_state` (0 taut, 1 wrinkled,
+//! 2 slack) | −1, and `tension_direction` (unit vector along the tension rays of a wrinkled
+//! triangle, global axes, deformed film; zero when taut or slack) | zero.
 
 use std::fmt::Write;
 
@@ -101,16 +103,24 @@ pub fn unstructured_grid(model: &Model, displacement: &[f64], results: &Results)
     scalar("gap_normal_force", &|_| 0.0, &|k| gp[k].normal_force);
     scalar("gap_friction_force", &|_| 0.0, &|k| gp[k].friction_force);
     scalar("gap_status", &|_| -1.0, &|k| gp[k].status as i32 as f64);
-    s.push_str(
-        "<DataArray type=\"Float64\" Name=\"stress\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-    );
-    for e in el {
-        let _ = writeln!(s, "{:e} {:e} {:e}", e.stress[0], e.stress[1], e.stress[2]);
-    }
-    for _ in 0..gaps {
-        s.push_str("0 0 0\n");
-    }
-    s.push_str("</DataArray>\n</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
+    scalar("wrinkling_state", &|e| el[e].state as i32 as f64, &|_| -1.0);
+    let mut vector = |name: &str, tri: &dyn Fn(usize) -> [f64; 3]| {
+        let _ = writeln!(
+            s,
+            "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">"
+        );
+        for e in 0..tris {
+            let v = tri(e);
+            let _ = writeln!(s, "{:e} {:e} {:e}", v[0], v[1], v[2]);
+        }
+        for _ in 0..gaps {
+            s.push_str("0 0 0\n");
+        }
+        s.push_str("</DataArray>\n");
+    };
+    vector("stress", &|e| el[e].stress);
+    vector("tension_direction", &|e| el[e].tension_direction);
+    s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
     s
 }
 

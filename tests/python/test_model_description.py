@@ -83,6 +83,9 @@ def test_specimen_variables(fmu_path):
     assert v["solver.incrementsPerStep"].start == "10"
     law = v["frictionLaw"]
     assert (law.type, law.causality, law.start) == ("String", "parameter", "isotropic")
+    assert v["film.wrinkling"].type == "Boolean" and v["film.wrinkling"].start == "false"
+    for name in ["film.wrinkledElements", "film.slackElements"]:
+        assert v[name].type == "Integer" and v[name].causality == "output", name
     for gap in [f"G{i}" for i in range(1, 10)]:
         for suffix in ["slip", "slipY", "normalForce", "frictionForce", "frictionX", "frictionY", "status"]:
             assert v[f"{gap}.{suffix}"].causality == "output"
@@ -103,6 +106,16 @@ def test_custom_model_variables_come_from_the_file(custom_fmu, custom_model):
     assert md.description == model["description"]
 
 
+def test_model_wrinkling_setting_is_the_parameter_start(custom_model, tmp_path):
+    model = json.loads(custom_model.read_text())
+    model["material"]["wrinkling"] = "tension-field"
+    path = tmp_path / "wrinkling.json"
+    path.write_text(json.dumps(model))
+    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(path), "--out", str(tmp_path))
+    v = {x.name: x for x in read_model_description(str(tmp_path / "CustomArch.fmu")).modelVariables}
+    assert v["film.wrinkling"].start == "true"
+
+
 def test_packing_is_deterministic(fmu_path, tmp_path):
     cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", "--out", str(tmp_path))
     again = tmp_path / "ParallelArch.fmu"
@@ -120,6 +133,9 @@ def test_fmu_pack_refuses_a_bad_model_and_writes_nothing(custom_model, tmp_path)
     bad = json.loads(json.dumps(model))
     bad["gaps"][0]["name"] = "mu"
     cases.append((bad, "gap 'mu': the name is reserved"))
+    bad = json.loads(json.dumps(model))
+    bad["material"]["wrinkling"] = "sometimes"
+    cases.append((bad, "unknown variant `sometimes`, expected `none` or `tension-field`"))
     bad = json.loads(json.dumps(model))
     bad["name"] = "not an identifier"
     cases.append((bad, "must be an identifier"))
