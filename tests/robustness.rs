@@ -17,8 +17,8 @@
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::scenarios::{
-    ArchEdge, ArchPanel, CircularSupport, CylinderStrip, Family, GapConstants, PathShape,
-    Scenario, SpecimenPath, gaps_on_arc, robustness_grid,
+    ArchEdge, ArchPanel, CircularSupport, CylinderStrip, Family, GapConstants, PathShape, Scenario,
+    SpecimenPath, gaps_on_arc, robustness_grid,
 };
 use membrane_contact::mech::{Analysis, GapStatus, ParallelArch, SolverSettings};
 use nalgebra::Vector3;
@@ -150,7 +150,9 @@ fn assert_all_converge(paths: &[Scenario]) {
         .iter()
         .filter_map(|s| {
             let outcome = s.run(SolverSettings::default());
-            outcome.failure_message().map(|m| format!("{}: {m}", s.name))
+            outcome
+                .failure_message()
+                .map(|m| format!("{}: {m}", s.name))
         })
         .collect();
     assert!(failures.is_empty(), "{failures:#?}");
@@ -191,7 +193,11 @@ fn gaps_on_arc_reproduces_the_specimens_section_4_3_gaps() {
             _ => panic!("specimen gaps end on fixed points"),
         };
         assert!(close(&point(a), &point(b)), "{}", a.name);
-        assert!(close(&a.frame.x, &b.frame.x) && close(&a.frame.z, &b.frame.z), "{}", a.name);
+        assert!(
+            close(&a.frame.x, &b.frame.x) && close(&a.frame.z, &b.frame.z),
+            "{}",
+            a.name
+        );
         assert!((a.initial_gap - b.initial_gap).abs() < 1e-12, "{}", a.name);
         assert_eq!(
             (a.normal_stiffness, a.tangential_stiffness, a.friction),
@@ -214,7 +220,10 @@ fn gaps_on_arc_refuses_a_node_inside_the_support_and_names_it() {
         friction: 0.2,
     };
     let err = gaps_on_arc(&nodes, &[0, 1], &support, constants, "G").unwrap_err();
-    assert!(err.contains("G2") && err.contains("node 1") && err.contains("inside"), "{err}");
+    assert!(
+        err.contains("G2") && err.contains("node 1") && err.contains("inside"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -222,7 +231,11 @@ fn panel_has_about_1400_triangles_and_19_gaps_above_each_arch() {
     let model = ArchPanel::default().model().unwrap();
     assert!((1300..=1500).contains(&model.triangles.len()));
     for prefix in ["AL", "AR"] {
-        let on_arch = model.gaps.iter().filter(|g| g.name.starts_with(prefix)).count();
+        let on_arch = model
+            .gaps
+            .iter()
+            .filter(|g| g.name.starts_with(prefix))
+            .count();
         assert_eq!(on_arch, 19, "{prefix}");
     }
     // The crown nodes touch their arch; the rest are above it.
@@ -246,7 +259,10 @@ fn jack_targets_rotate_the_edge_rigidly_about_the_hinge() {
         .iter()
         .map(|g| Vector3::from(model.nodes[g.nodes[0]]))
         .collect();
-    assert!((moved[0] - start[0]).norm() == 0.0, "the hinge does not move");
+    assert!(
+        (moved[0] - start[0]).norm() == 0.0,
+        "the hinge does not move"
+    );
     for i in 0..moved.len() {
         for j in 0..moved.len() {
             let d0 = (start[i] - start[j]).norm();
@@ -269,7 +285,13 @@ fn strip_has_38_gaps_that_touch_the_cylinder_and_start_open() {
     assert!(model.gaps.iter().all(|g| g.initial_gap.abs() < 1e-12));
     assert!(model.material.prestress == [0.0; 3]);
     let analysis = Analysis::new(model, SolverSettings::default()).unwrap();
-    assert!(analysis.state().status.iter().all(|s| *s == GapStatus::Open));
+    assert!(
+        analysis
+            .state()
+            .status
+            .iter()
+            .all(|s| *s == GapStatus::Open)
+    );
 }
 
 #[test]
@@ -291,7 +313,11 @@ fn robustness_grid_holds_at_least_500_paths_across_every_family() {
     }
     // Deterministic: the same grid twice.
     let again = robustness_grid(fmu_increments()).unwrap();
-    assert!(grid.iter().zip(&again).all(|(a, b)| a.name == b.name && a.path == b.path));
+    assert!(
+        grid.iter()
+            .zip(&again)
+            .all(|(a, b)| a.name == b.name && a.path == b.path)
+    );
 }
 
 #[test]
@@ -304,14 +330,19 @@ fn specimen_path_shapes_end_where_they_say() {
     assert_eq!(end(PathShape::Monotone), [0.0, 0.0, -0.15]);
     assert_eq!(end(PathShape::Reversal), [0.0, 0.0, -0.15]);
     assert_eq!(end(PathShape::Unload), [0.0; 3]);
-    assert_eq!(end(PathShape::Pull { dx: 0.005, dy: 0.0 }), [0.005, 0.0, -0.15]);
+    assert_eq!(
+        end(PathShape::Pull { dx: 0.005, dy: 0.0 }),
+        [0.005, 0.0, -0.15]
+    );
 }
 
 /// `Scenario::run` stops at the first refused step and reports it (one Newton iteration and no
 /// cut-back cannot converge the first step of the specimen).
 #[test]
 fn run_stops_at_the_first_refused_step_and_reports_it() {
-    let s = SpecimenPath::monotone(0.3, 0.2, 0.5, 20).scenario().unwrap();
+    let s = SpecimenPath::monotone(0.3, 0.2, 0.5, 20)
+        .scenario()
+        .unwrap();
     let settings = SolverSettings {
         max_iterations: 1,
         max_cutbacks: 0,

@@ -155,6 +155,8 @@ pub struct StepOutcome {
     pub step: usize,
     /// Newton iterations of the converged increments.
     pub iterations: usize,
+    /// Most Newton iterations of one converged increment.
+    pub max_increment_iterations: usize,
     /// Converged increments.
     pub increments: usize,
     /// Halved increments.
@@ -213,14 +215,13 @@ impl RunOutcome {
         self.steps.iter().map(|s| s.cutbacks).sum()
     }
 
-    /// Largest Newton iteration count of one increment is not kept; this is the largest mean
-    /// over a step (`iterations / increments`), 0 when nothing converged.
-    pub fn max_step_iterations_per_increment(&self) -> f64 {
+    /// Most Newton iterations of one converged increment.
+    pub fn max_increment_iterations(&self) -> usize {
         self.steps
             .iter()
-            .filter(|s| s.increments > 0)
-            .map(|s| s.iterations as f64 / s.increments as f64)
-            .fold(0.0, f64::max)
+            .map(|s| s.max_increment_iterations)
+            .max()
+            .unwrap_or(0)
     }
 }
 
@@ -256,6 +257,7 @@ impl Scenario {
                     stage: s,
                     step: k,
                     iterations: 0,
+                    max_increment_iterations: 0,
                     increments: 0,
                     cutbacks: 0,
                     error: None,
@@ -263,6 +265,8 @@ impl Scenario {
                 match analysis.step_to(&target, self.path.increments_per_step) {
                     Ok(report) => {
                         record.iterations = report.total_iterations();
+                        record.max_increment_iterations =
+                            report.iterations.iter().copied().max().unwrap_or(0);
                         record.increments = report.iterations.len();
                         record.cutbacks = report.cutbacks;
                         outcome.steps.push(record);
@@ -357,7 +361,9 @@ pub fn gaps_on_arc(
             let radial = p - centre - axis * along;
             let distance = radial.norm();
             if distance < 1e-9 * support.radius {
-                return Err(format!("gap {name}: node {node} lies on the support's axis"));
+                return Err(format!(
+                    "gap {name}: node {node} lies on the support's axis"
+                ));
             }
             let z = radial / distance;
             let g0 = distance - support.radius;
@@ -495,7 +501,9 @@ impl SpecimenPath {
                 stage([0.0, 0.0, down[2] / 2.0], half),
                 stage(down, half),
             ],
-            PathShape::Pull { dx, dy } => vec![stage(down, self.steps), stage([dx, dy, down[2]], half)],
+            PathShape::Pull { dx, dy } => {
+                vec![stage(down, self.steps), stage([dx, dy, down[2]], half)]
+            }
             PathShape::PullWhileLowering { dx, dy } => vec![stage([dx, dy, down[2]], self.steps)],
             PathShape::Unload => vec![stage(down, self.steps), stage([0.0; 3], self.steps)],
         };
@@ -584,7 +592,9 @@ impl ArchPanel {
             return Err(format!("refinement {} must lie in 1..=20", self.refinement));
         }
         if self.arch_span > self.width || self.arch_rise > self.arch_span / 2.0 {
-            return Err("arch span must fit in the width and the rise must not exceed half the span".into());
+            return Err(
+                "arch span must fit in the width and the rise must not exceed half the span".into(),
+            );
         }
         let (nx, ny) = self.cells();
         let (dx, dy) = (self.length / nx as f64, self.width / ny as f64);
@@ -603,7 +613,9 @@ impl ArchPanel {
         for (x, prefix) in self.arch_x.iter().zip(["AL", "AR"]) {
             let i = grid_line(*x, dx, nx)
                 .filter(|&i| i > 0 && i < nx)
-                .ok_or_else(|| format!("arch at x = {x} must lie on an interior grid line (spacing {dx})"))?;
+                .ok_or_else(|| {
+                    format!("arch at x = {x} must lie on an interior grid line (spacing {dx})")
+                })?;
             let film: Vec<usize> = (0..=ny)
                 .filter(|&j| (j as f64 * dy - yc).abs() <= self.arch_span / 2.0 + 1e-9)
                 .map(|j| id(i, j))
@@ -881,7 +893,9 @@ impl ArchEdge {
             ("film length", self.length),
         ])?;
         if self.arch_height > self.arch_half_span || self.cells_along < 2 {
-            return Err("arch height larger than the half span, or fewer than 2 cells along it".into());
+            return Err(
+                "arch height larger than the half span, or fewer than 2 cells along it".into(),
+            );
         }
         let ny = self.cells_along;
         let dy = self.arch_half_span / ny as f64;
@@ -1013,7 +1027,14 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
                 (0.5, 20, PathShape::Unload),
                 (0.5, 20, PathShape::Pull { dx: 0.005, dy: 0.0 }),
                 (0.5, 20, PathShape::Pull { dx: 0.0, dy: 0.005 }),
-                (0.5, 20, PathShape::PullWhileLowering { dx: 0.005, dy: 0.005 }),
+                (
+                    0.5,
+                    20,
+                    PathShape::PullWhileLowering {
+                        dx: 0.005,
+                        dy: 0.005,
+                    },
+                ),
             ];
             for (depth, steps, shape) in paths {
                 out.push(
