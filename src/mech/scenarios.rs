@@ -992,7 +992,8 @@ impl ArchEdge {
 /// The robustness benchmark's fixed sampling grid (no randomness), in family order:
 ///
 /// * specimen: `H` ∈ {0.15, 0.2, …, 0.45} m × `μ` ∈ {0, 0.1, 0.2, 0.4, 0.8} × 12 paths: down to
-///   `−H/2` in 1, 20 and 200 steps, in steps of 1.5 mm (the issue's reproduction 1), to `−H`
+///   `−H/2` in 1, 20 and 200 steps, in steps of 1.5 mm until `−H/2` is passed (the issue's
+///   reproduction 1), to `−H`
 ///   in 5 and 80 steps, down–up–down (to `−H/2` in 20 and to `−0.75 H` in 40), down and unload
 ///   (20 + 20), down then pulled 5 mm in `x` or `y`, lowered while pulled 5 mm in `x` and `y`
 ///   (420 paths);
@@ -1014,12 +1015,14 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
                 increments_per_step: ips,
                 ..SpecimenPath::monotone(h, mu, 0.5, 20)
             };
-            let fine = ((0.5 * h) / 0.0015).round() as usize;
+            // 1.5 mm per step until −H/2 is reached (reproduction 1 of issue 7).
+            let fine = ((0.5 * h) / 0.0015).ceil() as usize;
+            let fine_depth = fine as f64 * 0.0015 / h;
             let paths = [
                 (0.5, 1, PathShape::Monotone),
                 (0.5, 20, PathShape::Monotone),
                 (0.5, 200, PathShape::Monotone),
-                (0.5, fine, PathShape::Monotone),
+                (fine_depth, fine, PathShape::Monotone),
                 (1.0, 5, PathShape::Monotone),
                 (1.0, 80, PathShape::Monotone),
                 (0.5, 20, PathShape::Reversal),
