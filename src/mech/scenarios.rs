@@ -21,12 +21,12 @@
 //! ```text
 //!   y (m)                                         z
 //!   2.0  +----+---------+---------+----+ J24       ^   jacked edge, seen along x:
-//!        |    |    .    |    .    |    |           |   J0 ---- J12 ---- J24   (θ = 0, z = H)
-//!   1.75 |    o G19     o A19     |    |           |   J0 ·.
+//!        |    |         |         |    |           |   J0 ---- J12 ---- J24   (θ = 0, z = H)
+//!   1.75 |    o AL19    o AR19    |    |           |   J0 ·.
 //!        |    o         o         |    |           |         ·. J12
 //!  clamp |    o  arch   o  arch   |    | jack      |               ·. J24    (rotated by θ about
-//!  (xyz) |    o  AL     o  AR     |    | groups    |                        the x axis through J0)
-//!   0.25 |    o G1      o A1      |    | J0..J24   +---------------------> y
+//!  (xyz) |    o         o         |    | groups    |                        the x axis through J0)
+//!   0.25 |    o AL1     o AR1     |    | J0..J24   +---------------------> y
 //!        |    |         |         |    |
 //!   0.0  +----+---------+---------+----+ J0 = hinge      arch (in the plane x = 1 or 2):
 //!       x=0  x=1       x=2       x=3                     crown z = H at y = 1, feet z = 0 at
