@@ -380,3 +380,18 @@ fn specimen_standard_path_converges() {
             .unwrap(),
     );
 }
+
+/// The generated models are ordinary model files: they survive a JSON round trip, so the panel
+/// can be exported and run as `membrane-contact model panel.json --steps 20`.
+#[test]
+fn generated_models_round_trip_through_the_model_file_format() {
+    let models = [
+        ArchPanel::default().model().unwrap(),
+        CylinderStrip::default().model().unwrap(),
+        ArchEdge::default().model().unwrap(),
+    ];
+    for model in models {
+        let back = membrane_contact::mech::Model::from_json(&model.to_json()).unwrap();
+        assert_eq!(back, model, "{}", model.name);
+    }
+}
