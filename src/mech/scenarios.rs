@@ -342,7 +342,8 @@ pub fn gaps_on_arc(
     prefix: &str,
 ) -> Result<Vec<GapSpec>, String> {
     let axis = Vector3::from(support.axis);
-    if !(axis.norm() > 0.0) || !(support.radius > 0.0 && support.radius.is_finite()) {
+    let (length, radius) = (axis.norm(), support.radius);
+    if length == 0.0 || !length.is_finite() || radius <= 0.0 || !radius.is_finite() {
         return Err("circular support: axis must be non-zero and radius > 0".into());
     }
     let axis = axis.normalize();
