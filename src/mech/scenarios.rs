@@ -21,12 +21,12 @@
 //! ```text
 //!   y (m)                                         z
 //!   2.0  +----+---------+---------+----+ J24       ^   jacked edge, seen along x:
-//!        |    |    .    |    .    |    |           |   J0 ---- J12 ---- J24   (θ = 0, z = H)
-//!   1.75 |    o G19     o A19     |    |           |   J0 ·.
+//!        |    |         |         |    |           |   J0 ---- J12 ---- J24   (θ = 0, z = H)
+//!   1.75 |    o AL19    o AR19    |    |           |   J0 ·.
 //!        |    o         o         |    |           |         ·. J12
 //!  clamp |    o  arch   o  arch   |    | jack      |               ·. J24    (rotated by θ about
-//!  (xyz) |    o  AL     o  AR     |    | groups    |                        the x axis through J0)
-//!   0.25 |    o G1      o A1      |    | J0..J24   +---------------------> y
+//!  (xyz) |    o         o         |    | groups    |                        the x axis through J0)
+//!   0.25 |    o AL1     o AR1     |    | J0..J24   +---------------------> y
 //!        |    |         |         |    |
 //!   0.0  +----+---------+---------+----+ J0 = hinge      arch (in the plane x = 1 or 2):
 //!       x=0  x=1       x=2       x=3                     crown z = H at y = 1, feet z = 0 at
@@ -155,6 +155,8 @@ pub struct StepOutcome {
     pub step: usize,
     /// Newton iterations of the converged increments.
     pub iterations: usize,
+    /// Most Newton iterations of one converged increment.
+    pub max_increment_iterations: usize,
     /// Converged increments.
     pub increments: usize,
     /// Halved increments.
@@ -213,14 +215,13 @@ impl RunOutcome {
         self.steps.iter().map(|s| s.cutbacks).sum()
     }
 
-    /// Largest Newton iteration count of one increment is not kept; this is the largest mean
-    /// over a step (`iterations / increments`), 0 when nothing converged.
-    pub fn max_step_iterations_per_increment(&self) -> f64 {
+    /// Most Newton iterations of one converged increment.
+    pub fn max_increment_iterations(&self) -> usize {
         self.steps
             .iter()
-            .filter(|s| s.increments > 0)
-            .map(|s| s.iterations as f64 / s.increments as f64)
-            .fold(0.0, f64::max)
+            .map(|s| s.max_increment_iterations)
+            .max()
+            .unwrap_or(0)
     }
 }
 
@@ -256,6 +257,7 @@ impl Scenario {
                     stage: s,
                     step: k,
                     iterations: 0,
+                    max_increment_iterations: 0,
                     increments: 0,
                     cutbacks: 0,
                     error: None,
@@ -263,6 +265,8 @@ impl Scenario {
                 match analysis.step_to(&target, self.path.increments_per_step) {
                     Ok(report) => {
                         record.iterations = report.total_iterations();
+                        record.max_increment_iterations =
+                            report.iterations.iter().copied().max().unwrap_or(0);
                         record.increments = report.iterations.len();
                         record.cutbacks = report.cutbacks;
                         outcome.steps.push(record);
@@ -341,7 +345,8 @@ pub fn gaps_on_arc(
     prefix: &str,
 ) -> Result<Vec<GapSpec>, String> {
     let axis = Vector3::from(support.axis);
-    if !(axis.norm() > 0.0) || !(support.radius > 0.0 && support.radius.is_finite()) {
+    let (length, radius) = (axis.norm(), support.radius);
+    if length == 0.0 || !length.is_finite() || radius <= 0.0 || !radius.is_finite() {
         return Err("circular support: axis must be non-zero and radius > 0".into());
     }
     let axis = axis.normalize();
@@ -360,7 +365,9 @@ pub fn gaps_on_arc(
             let radial = p - centre - axis * along;
             let distance = radial.norm();
             if distance < 1e-9 * support.radius {
-                return Err(format!("gap {name}: node {node} lies on the support's axis"));
+                return Err(format!(
+                    "gap {name}: node {node} lies on the support's axis"
+                ));
             }
             let z = radial / distance;
             let g0 = distance - support.radius;
@@ -499,7 +506,9 @@ impl SpecimenPath {
                 stage([0.0, 0.0, down[2] / 2.0], half),
                 stage(down, half),
             ],
-            PathShape::Pull { dx, dy } => vec![stage(down, self.steps), stage([dx, dy, down[2]], half)],
+            PathShape::Pull { dx, dy } => {
+                vec![stage(down, self.steps), stage([dx, dy, down[2]], half)]
+            }
             PathShape::PullWhileLowering { dx, dy } => vec![stage([dx, dy, down[2]], self.steps)],
             PathShape::Unload => vec![stage(down, self.steps), stage([0.0; 3], self.steps)],
         };
@@ -588,7 +597,9 @@ impl ArchPanel {
             return Err(format!("refinement {} must lie in 1..=20", self.refinement));
         }
         if self.arch_span > self.width || self.arch_rise > self.arch_span / 2.0 {
-            return Err("arch span must fit in the width and the rise must not exceed half the span".into());
+            return Err(
+                "arch span must fit in the width and the rise must not exceed half the span".into(),
+            );
         }
         let (nx, ny) = self.cells();
         let (dx, dy) = (self.length / nx as f64, self.width / ny as f64);
@@ -607,7 +618,9 @@ impl ArchPanel {
         for (x, prefix) in self.arch_x.iter().zip(["AL", "AR"]) {
             let i = grid_line(*x, dx, nx)
                 .filter(|&i| i > 0 && i < nx)
-                .ok_or_else(|| format!("arch at x = {x} must lie on an interior grid line (spacing {dx})"))?;
+                .ok_or_else(|| {
+                    format!("arch at x = {x} must lie on an interior grid line (spacing {dx})")
+                })?;
             let film: Vec<usize> = (0..=ny)
                 .filter(|&j| (j as f64 * dy - yc).abs() <= self.arch_span / 2.0 + 1e-9)
                 .map(|j| id(i, j))
@@ -890,7 +903,9 @@ impl ArchEdge {
             ("film length", self.length),
         ])?;
         if self.arch_height > self.arch_half_span || self.cells_along < 2 {
-            return Err("arch height larger than the half span, or fewer than 2 cells along it".into());
+            return Err(
+                "arch height larger than the half span, or fewer than 2 cells along it".into(),
+            );
         }
         let ny = self.cells_along;
         let dy = self.arch_half_span / ny as f64;
@@ -990,7 +1005,8 @@ impl ArchEdge {
 /// The robustness benchmark's fixed sampling grid (no randomness), in family order:
 ///
 /// * specimen: `H` ∈ {0.15, 0.2, …, 0.45} m × `μ` ∈ {0, 0.1, 0.2, 0.4, 0.8} × 12 paths: down to
-///   `−H/2` in 1, 20 and 200 steps, in steps of 1.5 mm (the issue's reproduction 1), to `−H`
+///   `−H/2` in 1, 20 and 200 steps, in steps of 1.5 mm until `−H/2` is passed (the issue's
+///   reproduction 1), to `−H`
 ///   in 5 and 80 steps, down–up–down (to `−H/2` in 20 and to `−0.75 H` in 40), down and unload
 ///   (20 + 20), down then pulled 5 mm in `x` or `y`, lowered while pulled 5 mm in `x` and `y`
 ///   (420 paths);
@@ -1012,12 +1028,14 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
                 increments_per_step: ips,
                 ..SpecimenPath::monotone(h, mu, 0.5, 20)
             };
-            let fine = ((0.5 * h) / 0.0015).round() as usize;
+            // 1.5 mm per step until −H/2 is reached (reproduction 1 of issue 7).
+            let fine = ((0.5 * h) / 0.0015).ceil() as usize;
+            let fine_depth = fine as f64 * 0.0015 / h;
             let paths = [
                 (0.5, 1, PathShape::Monotone),
                 (0.5, 20, PathShape::Monotone),
                 (0.5, 200, PathShape::Monotone),
-                (0.5, fine, PathShape::Monotone),
+                (fine_depth, fine, PathShape::Monotone),
                 (1.0, 5, PathShape::Monotone),
                 (1.0, 80, PathShape::Monotone),
                 (0.5, 20, PathShape::Reversal),
@@ -1025,7 +1043,14 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
                 (0.5, 20, PathShape::Unload),
                 (0.5, 20, PathShape::Pull { dx: 0.005, dy: 0.0 }),
                 (0.5, 20, PathShape::Pull { dx: 0.0, dy: 0.005 }),
-                (0.5, 20, PathShape::PullWhileLowering { dx: 0.005, dy: 0.005 }),
+                (
+                    0.5,
+                    20,
+                    PathShape::PullWhileLowering {
+                        dx: 0.005,
+                        dy: 0.005,
+                    },
+                ),
             ];
             for (depth, steps, shape) in paths {
                 out.push(
