@@ -6,6 +6,7 @@
 //! | [`element`] | CST membrane triangle, eqs. (2.2)–(2.7) |
 //! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
 //! | [`model`] | model file format and validation |
+//! | [`restraint`] | rigid-body modes no restraint holds (singular models), found at validation |
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
 //! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
@@ -17,6 +18,7 @@ pub mod contact;
 pub mod element;
 pub mod linear;
 pub mod model;
+pub mod restraint;
 pub mod solver;
 pub mod specimen;
 pub mod vtk;
