@@ -56,7 +56,8 @@ use super::types::{
 };
 use super::variables::{Binding, Causality, Value, VarType, Variable};
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, ParallelArch, SolverSettings, StepError, StepReport, vtk,
+    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, Results, SolverSettings, StepError,
+    StepReport, model::MAX_FRICTION, solver::IncrementFailure, vtk,
 };
 use serde::{Deserialize, Serialize};
 
@@ -494,9 +495,9 @@ impl Instance {
                     v.name
                 )));
             }
-            if v.binding == Binding::Friction && x < 0.0 {
+            if v.binding == Binding::Friction && !(0.0..=MAX_FRICTION).contains(&x) {
                 return Err(Failure::error(format!(
-                    "mu = {x}: the friction coefficient must be ≥ 0"
+                    "mu = {x}: the friction coefficient must be ≥ 0 and ≤ {MAX_FRICTION}"
                 )));
             }
         }
@@ -560,8 +561,20 @@ impl Instance {
 
     // ---------------------------------------------------------------- analysis
 
-    /// Builds the analysis from the current parameter values.
+    /// Builds the analysis from the parameter values in `values`.
     fn build(&self, values: &[Value]) -> Result<Built, String> {
+        let (model, settings, increments) = self.model_for(values)?;
+        let analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
+        Ok(Built {
+            analysis,
+            parameters: parameters_of(&self.description.variables, values),
+            increments,
+        })
+    }
+
+    /// The model, solver settings and increments per step that the parameter values in
+    /// `values` give (the model is not validated here: `Analysis::new` does it).
+    fn model_for(&self, values: &[Value]) -> Result<(Model, SolverSettings, usize), String> {
         let table = &self.description.variables;
         let real = |b: Binding| {
             table.iter().zip(values).find_map(|(v, x)| match x {
@@ -635,12 +648,7 @@ impl Instance {
                 (b, x) => unreachable!("parameter {b:?} holds {x:?}"),
             }
         }
-        let analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
-        Ok(Built {
-            analysis,
-            parameters: parameters_of(table, values),
-            increments,
-        })
+        Ok((model, settings, increments))
     }
 
     /// Builds the analysis if there is none (initialization) and computes the initial outputs.
@@ -652,17 +660,23 @@ impl Instance {
             self.analysis = Some(built);
         }
         if !self.outputs_fresh {
-            self.refresh_outputs(None);
+            self.refresh_outputs(None)?;
         }
         Ok(())
     }
 
-    /// Writes the results of the converged state (and the step's statistics) into the outputs.
-    fn refresh_outputs(&mut self, report: Option<&StepReport>) {
+    /// Writes the results of the converged state (and the step's statistics) into the outputs;
+    /// refuses (fmi2Discard, outputs unchanged) when one of them would not be finite.
+    fn refresh_outputs(&mut self, report: Option<&StepReport>) -> Outcome {
         let Some(built) = self.analysis.as_mut() else {
-            return;
+            return Ok(());
         };
         let results = built.analysis.results();
+        check_results(built.analysis.model(), &results, report).map_err(|e| {
+            Failure::discard(format!(
+                "{e}: the outputs are not updated (the state is not one the solver can reach)"
+            ))
+        })?;
         let max_stress = results.von_mises_range().1;
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
@@ -695,6 +709,7 @@ impl Instance {
             };
         }
         self.outputs_fresh = true;
+        Ok(())
     }
 
     /// `fmi2DoStep`: moves every group to its inputs over `[t, t + h]`.
@@ -749,11 +764,16 @@ impl Instance {
             }
             _ => None,
         };
-        match built.analysis.step_to(&targets, built.increments) {
+        match checked_step(
+            &mut built.analysis,
+            &targets,
+            built.increments,
+            &self.logger,
+        ) {
             Ok(report) => {
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
-                self.refresh_outputs(Some(&report));
+                self.refresh_outputs(Some(&report))?;
                 self.event(|| {
                     format!(
                         "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N",
@@ -919,6 +939,12 @@ impl Instance {
                 s.phase
             ));
         }
+        if let Some(analysis) = &s.analysis {
+            let (model, _, _) = self
+                .model_for(&s.values)
+                .map_err(|e| format!("the state's parameters: {e}"))?;
+            state::check_analysis_state(&model, analysis)?;
+        }
         Ok(())
     }
 
@@ -1035,6 +1061,86 @@ impl Instance {
     /// Number of saved states held.
     pub fn saved_states(&self) -> usize {
         self.states.len()
+    }
+}
+
+/// `Analysis::step_to`, then a check that every output of the new state is finite; a state
+/// that is not is replaced by the one before the step and the step refused like a step that
+/// does not converge (fmi2Discard: the master may retry with a smaller change). Defence in
+/// depth: the solver itself rejects non-finite increments.
+fn checked_step(
+    analysis: &mut Analysis,
+    targets: &[[f64; 3]],
+    increments: usize,
+    logger: &Logger,
+) -> Result<StepReport, StepError> {
+    let before = analysis.state().clone();
+    let report = analysis.step_to(targets, increments)?;
+    let results = analysis.results();
+    match check_results(analysis.model(), &results, Some(&report)) {
+        Ok(()) => Ok(report),
+        Err(e) => {
+            if logger.is_enabled(Status::Discard) {
+                logger.log(
+                    Status::Discard,
+                    &format!("step refused: {e}; the state before the step is kept"),
+                );
+            }
+            analysis
+                .set_state(before)
+                .expect("the state before the step fits the analysis");
+            Err(StepError::NotConverged {
+                fraction_done: 0.0,
+                cutbacks: report.cutbacks,
+                last: IncrementFailure::Diverged {
+                    iteration: report.total_iterations(),
+                },
+            })
+        }
+    }
+}
+
+/// Whether every output made of `results` (and the step's residual) is finite; the error
+/// names the first that is not.
+pub fn check_results(
+    model: &Model,
+    results: &Results,
+    report: Option<&StepReport>,
+) -> Result<(), String> {
+    let bad = |what: String, v: f64| (!v.is_finite()).then(|| format!("{what} = {v}"));
+    let mut problems = results.gaps.iter().zip(&model.gaps).flat_map(|(r, g)| {
+        [
+            bad(format!("{}.slip", g.name), r.slip_x),
+            bad(format!("{}.slipY", g.name), r.slip_y),
+            bad(format!("{}.normalForce", g.name), r.normal_force),
+            bad(format!("{}.frictionForce", g.name), r.friction_force),
+            bad(format!("{}.frictionX", g.name), r.friction[0]),
+            bad(format!("{}.frictionY", g.name), r.friction[1]),
+        ]
+    });
+    if let Some(p) = problems.find_map(|p| p) {
+        return Err(p);
+    }
+    for (r, g) in results.reactions.iter().zip(&model.groups) {
+        for (c, axis) in ["Rx", "Ry", "Rz"].iter().enumerate() {
+            if let Some(p) = bad(format!("{}.{axis}", g.name), r[c]) {
+                return Err(p);
+            }
+        }
+    }
+    if let Some(e) = results
+        .elements
+        .iter()
+        .position(|e| !e.von_mises.is_finite())
+    {
+        return Err(format!(
+            "film.maxEquivalentStress: the stress of triangle {e} is {}",
+            results.elements[e].von_mises
+        ));
+    }
+    match report.map(|r| r.residual) {
+        Some(r) if !r.is_finite() => Err(format!("solver.residual = {r}")),
+        _ => Ok(()),
     }
 }
 
