@@ -56,8 +56,8 @@ use super::types::{
 };
 use super::variables::{Binding, Causality, Value, VarType, Variable};
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, Results, SolverSettings, StepError,
-    StepReport, model::MAX_FRICTION, solver::IncrementFailure, vtk,
+    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, SolverSettings, StepError,
+    StepReport, check_results, model::MAX_FRICTION, solver::IncrementFailure, vtk,
 };
 use serde::{Deserialize, Serialize};
 
@@ -672,11 +672,13 @@ impl Instance {
             return Ok(());
         };
         let results = built.analysis.results();
-        check_results(built.analysis.model(), &results, report).map_err(|e| {
-            Failure::discard(format!(
-                "{e}: the outputs are not updated (the state is not one the solver can reach)"
-            ))
-        })?;
+        check_results(built.analysis.model(), &results, report.map(|r| r.residual)).map_err(
+            |e| {
+                Failure::discard(format!(
+                    "{e}: the outputs are not updated (the state is not one the solver can reach)"
+                ))
+            },
+        )?;
         let max_stress = results.von_mises_range().1;
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
@@ -1077,7 +1079,7 @@ fn checked_step(
     let before = analysis.state().clone();
     let report = analysis.step_to(targets, increments)?;
     let results = analysis.results();
-    match check_results(analysis.model(), &results, Some(&report)) {
+    match check_results(analysis.model(), &results, Some(report.residual)) {
         Ok(()) => Ok(report),
         Err(e) => {
             if logger.is_enabled(Status::Discard) {
@@ -1097,50 +1099,6 @@ fn checked_step(
                 },
             })
         }
-    }
-}
-
-/// Whether every output made of `results` (and the step's residual) is finite; the error
-/// names the first that is not.
-pub fn check_results(
-    model: &Model,
-    results: &Results,
-    report: Option<&StepReport>,
-) -> Result<(), String> {
-    let bad = |what: String, v: f64| (!v.is_finite()).then(|| format!("{what} = {v}"));
-    let mut problems = results.gaps.iter().zip(&model.gaps).flat_map(|(r, g)| {
-        [
-            bad(format!("{}.slip", g.name), r.slip_x),
-            bad(format!("{}.slipY", g.name), r.slip_y),
-            bad(format!("{}.normalForce", g.name), r.normal_force),
-            bad(format!("{}.frictionForce", g.name), r.friction_force),
-            bad(format!("{}.frictionX", g.name), r.friction[0]),
-            bad(format!("{}.frictionY", g.name), r.friction[1]),
-        ]
-    });
-    if let Some(p) = problems.find_map(|p| p) {
-        return Err(p);
-    }
-    for (r, g) in results.reactions.iter().zip(&model.groups) {
-        for (c, axis) in ["Rx", "Ry", "Rz"].iter().enumerate() {
-            if let Some(p) = bad(format!("{}.{axis}", g.name), r[c]) {
-                return Err(p);
-            }
-        }
-    }
-    if let Some(e) = results
-        .elements
-        .iter()
-        .position(|e| !e.von_mises.is_finite())
-    {
-        return Err(format!(
-            "film.maxEquivalentStress: the stress of triangle {e} is {}",
-            results.elements[e].von_mises
-        ));
-    }
-    match report.map(|r| r.residual) {
-        Some(r) if !r.is_finite() => Err(format!("solver.residual = {r}")),
-        _ => Ok(()),
     }
 }
 

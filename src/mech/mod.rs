@@ -5,6 +5,7 @@
 //! |---|---|
 //! | [`element`] | CST membrane triangle, eqs. (2.2)–(2.7) |
 //! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
+//! | [`finite`] | finiteness check of reported results |
 //! | [`model`] | model file format and validation |
 //! | [`restraint`] | rigid-body modes no restraint holds (singular models), found at validation |
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
@@ -16,6 +17,7 @@
 pub mod assembly;
 pub mod contact;
 pub mod element;
+pub mod finite;
 pub mod linear;
 pub mod model;
 pub mod restraint;
@@ -25,6 +27,7 @@ pub mod vtk;
 
 pub use contact::{GapStatus, IterationMatrix};
 pub use element::Material;
+pub use finite::check_results;
 pub use model::{Model, ModelError};
 pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};
 pub use specimen::ParallelArch;
