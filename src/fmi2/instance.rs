@@ -944,6 +944,13 @@ impl Instance {
         if let Some(analysis) = &s.analysis {
             let (model, _, _) = self
                 .model_for(&s.values)
+                .and_then(|(model, settings, increments)| {
+                    model.validate().map_err(|e| e.to_string())?;
+                    settings
+                        .validate()
+                        .map_err(|e| format!("solver settings: {e}"))?;
+                    Ok((model, settings, increments))
+                })
                 .map_err(|e| format!("the state's parameters: {e}"))?;
             state::check_analysis_state(&model, analysis)?;
         }
