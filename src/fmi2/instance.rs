@@ -56,7 +56,7 @@ use super::types::{
 };
 use super::variables::{Binding, Causality, Value, VarType, Variable};
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, SolverSettings, StepError,
+    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, Results, SolverSettings, StepError,
     StepReport, check_results, model::MAX_FRICTION, solver::IncrementFailure, vtk,
 };
 use serde::{Deserialize, Serialize};
@@ -192,6 +192,9 @@ struct Built {
     /// The parameter values it was built with (table order, model parameters only).
     parameters: Vec<Value>,
     increments: usize,
+    /// The results of the state `checked_step` has just reached, already checked finite: the
+    /// outputs are made of them (taken by `refresh_outputs`, so never stale).
+    checked: Option<Results>,
 }
 
 /// One FMU instance.
@@ -569,6 +572,7 @@ impl Instance {
             analysis,
             parameters: parameters_of(&self.description.variables, values),
             increments,
+            checked: None,
         })
     }
 
@@ -671,14 +675,19 @@ impl Instance {
         let Some(built) = self.analysis.as_mut() else {
             return Ok(());
         };
-        let results = built.analysis.results();
-        check_results(built.analysis.model(), &results, report.map(|r| r.residual)).map_err(
-            |e| {
-                Failure::discard(format!(
-                    "{e}: the outputs are not updated (the state is not one the solver can reach)"
-                ))
-            },
-        )?;
+        let results = match built.checked.take() {
+            Some(results) => results,
+            None => {
+                let results = built.analysis.results();
+                let residual = report.map(|r| r.residual);
+                check_results(built.analysis.model(), &results, residual).map_err(|e| {
+                    Failure::discard(format!(
+                        "{e}: the outputs are not updated (the state is not one the solver can reach)"
+                    ))
+                })?;
+                results
+            }
+        };
         let max_stress = results.von_mises_range().1;
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
@@ -766,12 +775,7 @@ impl Instance {
             }
             _ => None,
         };
-        match checked_step(
-            &mut built.analysis,
-            &targets,
-            built.increments,
-            &self.logger,
-        ) {
+        match checked_step(built, &targets, &self.logger) {
             Ok(report) => {
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
@@ -1078,16 +1082,19 @@ impl Instance {
 /// does not converge (fmi2Discard: the master may retry with a smaller change). Defence in
 /// depth: the solver itself rejects non-finite increments.
 fn checked_step(
-    analysis: &mut Analysis,
+    built: &mut Built,
     targets: &[[f64; 3]],
-    increments: usize,
     logger: &Logger,
 ) -> Result<StepReport, StepError> {
+    let analysis = &mut built.analysis;
     let before = analysis.state().clone();
-    let report = analysis.step_to(targets, increments)?;
+    let report = analysis.step_to(targets, built.increments)?;
     let results = analysis.results();
     match check_results(analysis.model(), &results, Some(report.residual)) {
-        Ok(()) => Ok(report),
+        Ok(()) => {
+            built.checked = Some(results);
+            Ok(report)
+        }
         Err(e) => {
             if logger.is_enabled(Status::Discard) {
                 logger.log(
