@@ -27,6 +27,10 @@
 //! * `fmi2DoStep(t, h)` moves every group to its inputs in `solver.incrementsPerStep` increments
 //!   (`Analysis::step_to`). Time is a pseudo-time: only `t` = current time (to 1e-9 relative) and
 //!   `h > 0` are required, and time becomes `t + h`.
+//! * Never fmi2OK with a wrong answer: a step's outputs are checked finite (`checked_step`,
+//!   `mech::check_results`; a step whose outputs are not is a Discard and the state before it is
+//!   kept), and a deserialized state is checked against the model its parameters give
+//!   (`state::check_analysis_state`) at `fmi2DeSerializeFMUstate` already.
 //! * `results.directory` (String parameter, "" = off): after `fmi2ExitInitializationMode` and
 //!   after every successful `fmi2DoStep` the instance writes `<dir>/<id>_NNNN.vtu` (NNNN = 0000
 //!   for the initial state, then the number of steps since initialization) and rewrites
