@@ -12,6 +12,30 @@ use membrane_contact::mech::{
     Analysis, FrictionLaw, IterationMatrix, Model, ParallelArch, Results, SolverSettings,
 };
 
+/// `println!` for the results on standard output, through [`print_line`]: a reader that closes
+/// the pipe early (`… | head`) ends the program quietly instead of a panic.
+macro_rules! out {
+    ($($arg:tt)*) => { print_line(format_args!($($arg)*)) };
+}
+
+/// Writes one line to standard output. A closed pipe ends the program with status 0 and no
+/// message (the reader wanted no more, as with `head`); another write error ends it with
+/// status 1 and the error on stderr.
+fn print_line(args: std::fmt::Arguments<'_>) {
+    let mut stdout = std::io::stdout().lock();
+    let written = stdout
+        .write_fmt(args)
+        .and_then(|()| stdout.write_all(b"\n"));
+    match written {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => std::process::exit(0),
+        Err(e) => {
+            eprintln!("error: standard output: {e}");
+            std::process::exit(1)
+        }
+    }
+}
+
 const USAGE: &str = "\
 usage: membrane-contact specimen [--height MM] [options]
        membrane-contact model FILE.json [options]
@@ -140,7 +164,7 @@ fn run(o: &Options) -> Result<(), String> {
     let mut model = match o.command.as_str() {
         "specimen" => specimen(o)?.model()?,
         "export-specimen" => {
-            println!("{}", specimen(o)?.model()?.to_json());
+            out!("{}", specimen(o)?.model()?.to_json());
             return Ok(());
         }
         "model" => {
@@ -229,9 +253,11 @@ fn run(o: &Options) -> Result<(), String> {
     }
     let elapsed = started.elapsed();
     let results = analysis.results();
+    membrane_contact::mech::check_results(analysis.model(), &results, None)
+        .map_err(|e| format!("the results are not finite ({e}): refused"))?;
     report(o, &analysis, &results);
     let total: usize = iterations.iter().sum();
-    println!(
+    out!(
         "\nNewton: {} steps, {increments} increments, {cutbacks} cut-backs, {total} iterations \
          ({:.1} per increment), iterations per step {:?}; {:.1} ms",
         o.steps,
@@ -244,19 +270,23 @@ fn run(o: &Options) -> Result<(), String> {
 
 fn report(o: &Options, analysis: &Analysis, results: &Results) {
     let model = analysis.model();
-    println!(
+    out!(
         "{}: {} nodes, {} triangles, {} gaps",
         model.name,
         model.nodes.len(),
         model.triangles.len(),
         model.gaps.len()
     );
-    println!(
+    out!(
         "\n{:<8} {:>11} {:>11} {:>10} {:>10}  status",
-        "gap", "slip x mm", "slip y mm", "N (N)", "|T| (N)"
+        "gap",
+        "slip x mm",
+        "slip y mm",
+        "N (N)",
+        "|T| (N)"
     );
     for (g, r) in model.gaps.iter().zip(&results.gaps) {
-        println!(
+        out!(
             "{:<8} {:>11.3} {:>11.3} {:>10.3} {:>10.3}  {:?}",
             g.name,
             r.slip_x * 1e3,
@@ -267,13 +297,16 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
         );
     }
     for (g, r) in model.groups.iter().zip(&results.reactions) {
-        println!(
+        out!(
             "reaction of group {}: ({:.3}, {:.3}, {:.3}) N",
-            g.name, r[0], r[1], r[2]
+            g.name,
+            r[0],
+            r[1],
+            r[2]
         );
     }
     let (lo, hi) = results.von_mises_range();
-    println!(
+    out!(
         "equivalent (von Mises) stress: {:.3} … {:.3} MPa",
         lo / 1e6,
         hi / 1e6
@@ -286,10 +319,14 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
         let measured = table1()
             .into_iter()
             .find(|m| (m.arch_height_mm - o.height_mm).abs() < 1e-9);
-        println!("\nobserved points (paper §4.4: points 2–5 = G2, G4, G6, G8):");
-        println!(
+        out!("\nobserved points (paper §4.4: points 2–5 = G2, G4, G6, G8):");
+        out!(
             "{:<6} {:<5} {:>14} {:>14} {:>10}",
-            "point", "gap", "analysis mm", "Table 1 mm", "diff mm"
+            "point",
+            "gap",
+            "analysis mm",
+            "Table 1 mm",
+            "diff mm"
         );
         for (p, name) in OBSERVED_GAPS.iter().enumerate() {
             let Some(i) = model.gap_index(name) else {
@@ -297,7 +334,7 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
             };
             let slip = results.gaps[i].slip_x * 1e3;
             match &measured {
-                Some(m) => println!(
+                Some(m) => out!(
                     "{:<6} {:<5} {:>14.2} {:>14.1} {:>10.2}",
                     p + 1,
                     name,
@@ -305,7 +342,7 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
                     m.points[p],
                     slip - m.points[p]
                 ),
-                None => println!(
+                None => out!(
                     "{:<6} {:<5} {:>14.2} {:>14} {:>10}",
                     p + 1,
                     name,
@@ -316,7 +353,7 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
             }
         }
         if measured.is_none() {
-            println!("(Table 1 has only the 200, 300 and 400 mm specimens)");
+            out!("(Table 1 has only the 200, 300 and 400 mm specimens)");
         }
     }
 }
@@ -326,7 +363,7 @@ fn main() -> ExitCode {
     match parse(&args).and_then(|o| run(&o)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) if message.is_empty() => {
-            println!("{USAGE}");
+            out!("{USAGE}");
             if args.iter().any(|a| a == "-h" || a == "--help") {
                 ExitCode::SUCCESS
             } else {

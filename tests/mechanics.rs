@@ -1699,3 +1699,87 @@ fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
         }
     }
 }
+
+// Issue 12, item 2: models that validate but are singular. Source: statics (a body needs six
+// independent restraints; a node without stiffness has none).
+//
+//   patch 2 × 2 cells, 0.2 m, z = 0 (nodes 0..8 as in `patch`)
+//   (a) rim = group, plus node 9 off the film held only by a gap  → Unconnected (node 9)
+//   (b) no group, z fixed everywhere, x at nodes 0 and 6          → free along Y
+//   (c) held only by three gaps to points (all open at the start) → validates, but the first
+//       factorization is singular: the step fails naming nodes, never NaN
+#[test]
+fn singular_models_are_refused_at_validation_naming_nodes_and_motion() {
+    let mut lonely = pressed_node_model(0.0, 0.2);
+    lonely.nodes.push([0.1, 0.1, 0.05]);
+    lonely
+        .gaps
+        .push(gap_below("Lonely", 9, [0.1, 0.1, 0.05], 0.0, 0.2));
+    let message = lonely.validate().unwrap_err().to_string();
+    assert!(
+        message.contains("node 9") && message.contains("no triangle"),
+        "{message}"
+    );
+
+    let mut sliding = patch(2, 2, 0.2, 0.2);
+    for v in 0..9 {
+        sliding.supports.push(Support {
+            node: v,
+            fixed: vec![Axis::Z],
+        });
+    }
+    sliding.supports.push(Support {
+        node: 0,
+        fixed: vec![Axis::X],
+    });
+    sliding.supports.push(Support {
+        node: 6,
+        fixed: vec![Axis::X],
+    });
+    let message = sliding.validate().unwrap_err().to_string();
+    assert!(message.contains("can translate along Y"), "{message}");
+    assert!(
+        message.contains("nodes 0, 1, 2, 3, 4, 5, … (9 nodes)"),
+        "{message}"
+    );
+}
+
+#[test]
+fn model_held_only_by_open_gaps_gives_a_finite_answer_or_an_error_naming_nodes() {
+    let mut m = patch(2, 2, 0.2, 0.2);
+    for (name, v) in [("A", 0), ("B", 2), ("C", 6)] {
+        m.gaps.push(gap_below(name, v, m.nodes[v], 0.001, 0.2));
+    }
+    m.validate().unwrap(); // the documented limit of the structural check: gaps count
+    let mut a = Analysis::new(m, SolverSettings::default()).unwrap();
+    let before = a.state().clone();
+    match a.step_to(&[], 1) {
+        // LU may find a tiny pivot instead of a zero one: the rigid position is then arbitrary,
+        // but every number is finite.
+        Ok(_) => assert!(a.state().displacement.iter().all(|v| v.is_finite())),
+        Err(e) => {
+            let e = e.to_string();
+            assert!(
+                e.contains("singular Newton matrix") && e.contains("node "),
+                "{e}"
+            );
+            assert_eq!(a.state(), &before);
+        }
+    }
+}
+
+// Issue 12, item 4: text that goes into modelDescription.xml.
+#[test]
+fn control_characters_in_the_description_are_refused_naming_the_field() {
+    let mut m = pressed_node_model(0.0, 0.2);
+    m.description = "line one\nline two\ttabbed, ünïcödé & <xml>".into();
+    m.validate().unwrap();
+    for bad in ["\u{1}", "\u{7f}", "\u{9b}", "\u{fffe}", "\0"] {
+        m.description = format!("a{bad}b");
+        let message = m.validate().unwrap_err().to_string();
+        assert!(
+            message.starts_with("model description: character U+"),
+            "{message}"
+        );
+    }
+}

@@ -48,6 +48,7 @@ pub struct Description {
 /// Renders the description of an FMU of `source`.
 pub fn describe(source: &Source) -> Result<Description, String> {
     let model = source.model()?;
+    model.validate().map_err(|e| e.to_string())?;
     check_names(&model)?;
     let kind = match source {
         Source::ParallelArch(spec) => Kind::ParallelArch {
@@ -66,12 +67,9 @@ pub fn describe(source: &Source) -> Result<Description, String> {
             .join("\n")
     };
     let parts = [
-        ("MODEL_NAME", escape(model.name.as_str()).into_owned()),
+        ("MODEL_NAME", attribute_text(&model.name)),
         ("MODEL_IDENTIFIER", model.name.clone()),
-        (
-            "DESCRIPTION",
-            escape(model.description.as_str()).into_owned(),
-        ),
+        ("DESCRIPTION", attribute_text(&model.description)),
         ("VERSION", env!("CARGO_PKG_VERSION").to_string()),
         ("UNIT_DEFINITIONS", generated(write_units)),
         ("LOG_CATEGORIES", generated(write_log_categories)),
@@ -100,6 +98,16 @@ pub fn describe(source: &Source) -> Result<Description, String> {
         variables: table,
         model,
     })
+}
+
+/// `text` escaped for an attribute value in double quotes: the five markup characters, and tab,
+/// line feed and carriage return as character references (a parser would otherwise turn them
+/// into spaces). Control characters never get here: `Model::validate` refuses them.
+pub fn attribute_text(text: &str) -> String {
+    escape(text)
+        .replace('\t', "&#9;")
+        .replace('\n', "&#10;")
+        .replace('\r', "&#13;")
 }
 
 /// Replaces the `@KEY@` fields of `template` (keys: upper case and `_`); values are not scanned
@@ -385,6 +393,92 @@ mod tests {
         );
         let html = documentation_html(&d);
         assert!(html.contains("a &lt;b&gt;") && html.contains("<code>G1.slip</code>"));
+    }
+
+    /// The characters XML 1.0 allows (production `Char`).
+    fn is_xml_char(c: char) -> bool {
+        matches!(c, '\t' | '\n' | '\r' | '\u{20}'..='\u{D7FF}' | '\u{E000}'..='\u{FFFD}' | '\u{10000}'..)
+    }
+
+    /// Random descriptions (deterministic xorshift): markup characters, `@`, quotes, white
+    /// space, C0/C1 controls, U+FFFE/U+FFFF, BMP and astral code points. Property: validation
+    /// refuses exactly the strings with a character XML cannot carry, naming the field; for every
+    /// other string the rendered modelDescription.xml holds only XML characters, parses with
+    /// quick-xml to the end, and its `description` attribute reads back as the string.
+    #[test]
+    fn any_accepted_description_renders_well_formed_xml_that_reads_back() {
+        let base = ParallelArch::default().model().unwrap();
+        let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (mut accepted, mut refused) = (0, 0);
+        for _ in 0..300 {
+            let len = next() % 24;
+            let text: String = (0..len)
+                .filter_map(|_| {
+                    let r = next();
+                    let code = match r % 24 {
+                        0 => (r >> 8) as u32 % 0x20,
+                        1 => 0x7f + (r >> 8) as u32 % 0x21,
+                        2 | 7..=10 => [b'<', b'>', b'&', b'"', b'\'', b'@', b'%', b';']
+                            [(r >> 8) as usize % 8] as u32,
+                        3 => [0xFFFE, 0xFFFF, 0xFFFD, 0xE000, 0xD7FF][(r >> 8) as usize % 5],
+                        4 | 11..=13 => 0x10000 + (r >> 8) as u32 % 0x100000,
+                        5 | 14..=17 => (r >> 8) as u32 % 0xD800,
+                        _ => 0x20 + (r >> 8) as u32 % 0x5f,
+                    };
+                    char::from_u32(code)
+                })
+                .collect();
+            let mut model = base.clone();
+            model.description = text.clone();
+            let verdict = describe(&Source::Model(model));
+            let allowed = text
+                .chars()
+                .all(|c| is_xml_char(c) && (!c.is_control() || matches!(c, '\t' | '\n' | '\r')));
+            match verdict {
+                Err(e) => {
+                    refused += 1;
+                    assert!(!allowed, "{text:?} refused: {e}");
+                    assert!(e.starts_with("model description: character U+"), "{e}");
+                }
+                Ok(d) => {
+                    accepted += 1;
+                    assert!(allowed, "{text:?} accepted");
+                    assert!(d.xml.chars().all(is_xml_char), "{text:?}");
+                    let mut reader = quick_xml::Reader::from_str(&d.xml);
+                    let mut read_back = None;
+                    loop {
+                        match reader
+                            .read_event()
+                            .unwrap_or_else(|e| panic!("{text:?}: {e}"))
+                        {
+                            quick_xml::events::Event::Eof => break,
+                            quick_xml::events::Event::Start(e)
+                                if e.name().0 == "fmiModelDescription" =>
+                            {
+                                let a = e.try_get_attribute("description").unwrap().unwrap();
+                                read_back = Some(
+                                    a.normalized_value(quick_xml::XmlVersion::Explicit1_0)
+                                        .unwrap()
+                                        .into_owned(),
+                                );
+                            }
+                            _ => {}
+                        }
+                    }
+                    assert_eq!(read_back.as_deref(), Some(text.as_str()));
+                }
+            }
+        }
+        assert!(
+            accepted > 50 && refused > 50,
+            "{accepted} accepted, {refused} refused"
+        );
     }
 
     #[test]

@@ -295,10 +295,10 @@ pub unsafe extern "C" fn fmi2_free_fmu_state(
     // SAFETY: FMI 2.0 caller contract; `fmu_state` is NULL or points to NULL or a state.
     unsafe {
         with_instance(c, "fmi2FreeFMUstate", allowed::FMU_STATE, |i| {
-            // FMI 2.0 §2.1.8: a NULL state is ignored.
-            let Ok(slot) = out_ref(fmu_state, "FMUstate") else {
-                return Ok(());
-            };
+            // FMI 2.0 §2.1.8: a NULL *state* (`*FMUstate == NULL`) is ignored. A NULL pointer
+            // to the state (`FMUstate == NULL`) leaves nothing to free or to set to NULL: it is a
+            // NULL argument, an error like every other (docs/fmu.md).
+            let slot = out_ref(fmu_state, "FMUstate")?;
             if !slot.is_null() {
                 i.free_fmu_state(state_handle(*slot))?;
                 *slot = std::ptr::null_mut();

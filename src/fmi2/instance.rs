@@ -27,6 +27,10 @@
 //! * `fmi2DoStep(t, h)` moves every group to its inputs in `solver.incrementsPerStep` increments
 //!   (`Analysis::step_to`). Time is a pseudo-time: only `t` = current time (to 1e-9 relative) and
 //!   `h > 0` are required, and time becomes `t + h`.
+//! * Never fmi2OK with a wrong answer: a step's outputs are checked finite (`checked_step`,
+//!   `mech::check_results`; a step whose outputs are not is a Discard and the state before it is
+//!   kept), and a deserialized state is checked against the model its parameters give
+//!   (`state::check_analysis_state`) at `fmi2DeSerializeFMUstate` already.
 //! * `results.directory` (String parameter, "" = off): after `fmi2ExitInitializationMode` and
 //!   after every successful `fmi2DoStep` the instance writes `<dir>/<id>_NNNN.vtu` (NNNN = 0000
 //!   for the initial state, then the number of steps since initialization) and rewrites
@@ -58,7 +62,8 @@ use super::variables::{Binding, Causality, Value, VarType, Variable};
 use crate::mech::element::state_counts;
 use crate::mech::material::Wrinkling;
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, ParallelArch, SolverSettings, StepError, StepReport, vtk,
+    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, Results, SolverSettings, StepError,
+    StepReport, check_results, model::MAX_FRICTION, solver::IncrementFailure, vtk,
 };
 use serde::{Deserialize, Serialize};
 
@@ -193,6 +198,9 @@ struct Built {
     /// The parameter values it was built with (table order, model parameters only).
     parameters: Vec<Value>,
     increments: usize,
+    /// The results of the state `checked_step` has just reached, already checked finite: the
+    /// outputs are made of them (taken by `refresh_outputs`, so never stale).
+    checked: Option<Results>,
 }
 
 /// One FMU instance.
@@ -514,9 +522,9 @@ impl Instance {
                     v.name
                 )));
             }
-            if v.binding == Binding::Friction && x < 0.0 {
+            if v.binding == Binding::Friction && !(0.0..=MAX_FRICTION).contains(&x) {
                 return Err(Failure::error(format!(
-                    "mu = {x}: the friction coefficient must be ≥ 0"
+                    "mu = {x}: the friction coefficient must be ≥ 0 and ≤ {MAX_FRICTION}"
                 )));
             }
         }
@@ -580,8 +588,21 @@ impl Instance {
 
     // ---------------------------------------------------------------- analysis
 
-    /// Builds the analysis from the current parameter values.
+    /// Builds the analysis from the parameter values in `values`.
     fn build(&self, values: &[Value]) -> Result<Built, String> {
+        let (model, settings, increments) = self.model_for(values)?;
+        let analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
+        Ok(Built {
+            analysis,
+            parameters: parameters_of(&self.description.variables, values),
+            increments,
+            checked: None,
+        })
+    }
+
+    /// The model, solver settings and increments per step that the parameter values in
+    /// `values` give (the model is not validated here: `Analysis::new` does it).
+    fn model_for(&self, values: &[Value]) -> Result<(Model, SolverSettings, usize), String> {
         let table = &self.description.variables;
         let real = |b: Binding| {
             table.iter().zip(values).find_map(|(v, x)| match x {
@@ -666,12 +687,7 @@ impl Instance {
                 (b, x) => unreachable!("parameter {b:?} holds {x:?}"),
             }
         }
-        let analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
-        Ok(Built {
-            analysis,
-            parameters: parameters_of(table, values),
-            increments,
-        })
+        Ok((model, settings, increments))
     }
 
     /// Builds the analysis if there is none (initialization) and computes the initial outputs.
@@ -683,17 +699,30 @@ impl Instance {
             self.analysis = Some(built);
         }
         if !self.outputs_fresh {
-            self.refresh_outputs(None);
+            self.refresh_outputs(None)?;
         }
         Ok(())
     }
 
-    /// Writes the results of the converged state (and the step's statistics) into the outputs.
-    fn refresh_outputs(&mut self, report: Option<&StepReport>) {
+    /// Writes the results of the converged state (and the step's statistics) into the outputs;
+    /// refuses (fmi2Discard, outputs unchanged) when one of them would not be finite.
+    fn refresh_outputs(&mut self, report: Option<&StepReport>) -> Outcome {
         let Some(built) = self.analysis.as_mut() else {
-            return;
+            return Ok(());
         };
-        let results = built.analysis.results();
+        let results = match built.checked.take() {
+            Some(results) => results,
+            None => {
+                let results = built.analysis.results();
+                let residual = report.map(|r| r.residual);
+                check_results(built.analysis.model(), &results, residual).map_err(|e| {
+                    Failure::discard(format!(
+                        "{e}: the outputs are not updated (the state is not one the solver can reach)"
+                    ))
+                })?;
+                results
+            }
+        };
         let max_stress = results.von_mises_range().1;
         let [_, wrinkled, slack] = state_counts(&results.elements);
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
@@ -729,6 +758,7 @@ impl Instance {
             };
         }
         self.outputs_fresh = true;
+        Ok(())
     }
 
     /// `fmi2DoStep`: moves every group to its inputs over `[t, t + h]`.
@@ -793,12 +823,12 @@ impl Instance {
             }
             _ => None,
         };
-        match built.analysis.step_to(&targets, built.increments) {
+        match checked_step(built, &targets, &self.logger) {
             Ok(report) => {
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
                 self.discarded = None;
-                self.refresh_outputs(Some(&report));
+                self.refresh_outputs(Some(&report))?;
                 self.event(|| {
                     format!(
                         "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N",
@@ -999,6 +1029,19 @@ impl Instance {
                 s.phase
             ));
         }
+        if let Some(analysis) = &s.analysis {
+            let (model, _, _) = self
+                .model_for(&s.values)
+                .and_then(|(model, settings, increments)| {
+                    model.validate().map_err(|e| e.to_string())?;
+                    settings
+                        .validate()
+                        .map_err(|e| format!("solver settings: {e}"))?;
+                    Ok((model, settings, increments))
+                })
+                .map_err(|e| format!("the state's parameters: {e}"))?;
+            state::check_analysis_state(&model, analysis)?;
+        }
         Ok(())
     }
 
@@ -1117,6 +1160,45 @@ impl Instance {
     /// Number of saved states held.
     pub fn saved_states(&self) -> usize {
         self.states.len()
+    }
+}
+
+/// `Analysis::step_to`, then a check that every output of the new state is finite; a state
+/// that is not is replaced by the one before the step and the step refused like a step that
+/// does not converge (fmi2Discard: the master may retry with a smaller change). Defence in
+/// depth: the solver itself rejects non-finite increments.
+fn checked_step(
+    built: &mut Built,
+    targets: &[[f64; 3]],
+    logger: &Logger,
+) -> Result<StepReport, StepError> {
+    let analysis = &mut built.analysis;
+    let before = analysis.state().clone();
+    let report = analysis.step_to(targets, built.increments)?;
+    let results = analysis.results();
+    match check_results(analysis.model(), &results, Some(report.residual)) {
+        Ok(()) => {
+            built.checked = Some(results);
+            Ok(report)
+        }
+        Err(e) => {
+            if logger.is_enabled(Status::Discard) {
+                logger.log(
+                    Status::Discard,
+                    &format!("step refused: {e}; the state before the step is kept"),
+                );
+            }
+            analysis
+                .set_state(before)
+                .expect("the state before the step fits the analysis");
+            Err(StepError::NotConverged {
+                fraction_done: 0.0,
+                cutbacks: report.cutbacks,
+                last: IncrementFailure::Diverged {
+                    iteration: report.total_iterations(),
+                },
+            })
+        }
     }
 }
 

@@ -17,11 +17,18 @@
 //! | 4 | CRC-32 of all preceding bytes and the payload |
 //! | payload | the snapshot as JSON (serde_json with exact float round trip) |
 
+//!
+//! A state read back is checked as strictly as a model file ([`check_analysis_state`]): sizes that
+//! fit the model, finite values, magnitudes bounded by the model's size, `μ` in
+//! `[0, MAX_FRICTION]`, and gap statuses that the gap law gives again at the stored state.
+
+use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::instance::Phase;
 use super::variables::Value;
-use crate::mech::AnalysisState;
+use crate::mech::model::{GapSupport, MAX_FRICTION};
+use crate::mech::{AnalysisState, GapStatus, Model};
 
 /// Everything needed to continue an instance exactly.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -102,6 +109,134 @@ pub fn deserialize(bytes: &[u8], guid: &str) -> Result<Snapshot, String> {
         return Err("serialized state is corrupt (checksum mismatch)".into());
     }
     serde_json::from_slice(payload).map_err(|e| format!("serialized state payload: {e}"))
+}
+
+/// How far a displacement may be from the start, in diagonals of the model's bounding box
+/// (nodes and gap support points): a film that has moved farther is not a state the solver
+/// reached. Slip histories and increments are relative displacements: twice that.
+pub const MAX_DISPLACEMENT_IN_DIAGONALS: f64 = 10.0;
+
+/// Diagonal of the bounding box of the model's nodes and gap support points (m), at least 1 mm.
+pub fn model_size(model: &Model) -> f64 {
+    let points = model
+        .nodes
+        .iter()
+        .copied()
+        .chain(model.gaps.iter().filter_map(|g| match g.support {
+            GapSupport::Point(p) => Some(p),
+            GapSupport::Node(_) => None,
+        }));
+    let (lo, hi) = points.fold(
+        (
+            Vector3::repeat(f64::INFINITY),
+            Vector3::repeat(f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(&Vector3::from(p)), hi.sup(&Vector3::from(p))),
+    );
+    (hi - lo).norm().max(1e-3)
+}
+
+/// Checks a (deserialized) analysis state against `model`: sizes, finite and bounded values,
+/// `μ ∈ [0, MAX_FRICTION]`, and each gap's stored status against the gap law re-evaluated at
+/// the stored displacements and slip history (open ⇔ the law finds it open; stick ⇒ the law
+/// finds it stuck; slip ⇒ closed with the trial force on the Coulomb limit `μN`).
+pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), String> {
+    let (n, gaps, groups) = (model.dof_count(), model.gaps.len(), model.groups.len());
+    let sizes = [
+        ("displacements", state.displacement.len(), n),
+        ("slip histories", state.plastic_slip.len(), gaps),
+        ("group displacements", state.boundary.len(), groups),
+        ("friction coefficients", state.friction.len(), gaps),
+        ("gap statuses", state.status.len(), gaps),
+    ];
+    for (what, have, want) in sizes {
+        if have != want {
+            return Err(format!("the state has {have} {what}, the model {want}"));
+        }
+    }
+    if !(state.last_increment.is_empty() || state.last_increment.len() == n) {
+        return Err(format!(
+            "the state's last increment has {} values, the model {n} DOFs",
+            state.last_increment.len()
+        ));
+    }
+    let size = model_size(model);
+    let reach = MAX_DISPLACEMENT_IN_DIAGONALS * size;
+    let bounded = |what: &str, values: &mut dyn Iterator<Item = f64>, limit: f64| match values
+        .enumerate()
+        .find(|(_, v)| !(v.abs() <= limit))
+    {
+        None => Ok(()),
+        Some((i, v)) => Err(format!(
+            "the state's {what} [{i}] = {v:e} m is not finite or beyond {limit:e} m \
+                 ({MAX_DISPLACEMENT_IN_DIAGONALS}× the model's {size:.3} m size)"
+        )),
+    };
+    bounded(
+        "displacement",
+        &mut state.displacement.iter().copied(),
+        reach,
+    )?;
+    bounded(
+        "group displacement",
+        &mut state.boundary.iter().flatten().copied(),
+        reach,
+    )?;
+    bounded(
+        "slip history",
+        &mut state.plastic_slip.iter().flatten().copied(),
+        2.0 * reach,
+    )?;
+    bounded(
+        "last increment",
+        &mut state.last_increment.iter().copied(),
+        2.0 * reach,
+    )?;
+    if let Some((g, mu)) = state
+        .friction
+        .iter()
+        .enumerate()
+        .find(|(_, mu)| !(**mu >= 0.0 && **mu <= MAX_FRICTION))
+    {
+        return Err(format!(
+            "the state's friction coefficient of gap '{}' is {mu}, not in [0, {MAX_FRICTION}]",
+            model.gaps[g].name
+        ));
+    }
+    let at = |v: usize| Vector3::from_fn(|c, _| state.displacement[3 * v + c]);
+    for (g, spec) in model.gaps.iter().enumerate() {
+        let ub = match spec.support {
+            GapSupport::Node(b) => at(b),
+            GapSupport::Point(_) => Vector3::zeros(),
+        };
+        let d = spec.frame.rotation() * (at(spec.film_node) - ub);
+        let law = crate::mech::contact::GapLaw {
+            friction: state.friction[g],
+            ..spec.law()
+        };
+        let r = law.evaluate(d, Vector2::from(state.plastic_slip[g]));
+        let limit = law.friction * r.normal_force;
+        let on_limit = (r.trial_magnitude - limit).abs()
+            <= 1e-6 * limit.max(law.tangential_stiffness * 1e-9 * size);
+        let consistent = match state.status[g] {
+            GapStatus::Open => r.status == GapStatus::Open,
+            GapStatus::Stick => r.status == GapStatus::Stick,
+            GapStatus::Slip => r.status != GapStatus::Open && on_limit,
+        };
+        if !consistent {
+            return Err(format!(
+                "the state's status of gap '{}' is {:?}, but its stored displacements give {:?} \
+                 (gap {:e} m, trial friction {:e} N, limit μN = {:e} N)",
+                spec.name,
+                state.status[g],
+                r.status,
+                spec.initial_gap + d.z,
+                r.trial_magnitude,
+                limit
+            ));
+        }
+    }
+    Ok(())
 }
 
 struct Reader<'a> {

@@ -1093,3 +1093,168 @@ fn wrinkling_parameter_switches_the_film_and_counts_its_elements() {
     assert_eq!(counts(true, [0.5e6, -0.1e6]), [200, 0]);
     assert_eq!(counts(false, [0.5e6, -0.1e6]), [0, 0]);
 }
+
+// ---------------------------------------------------------------- issue 12: never fmi2OK with a wrong answer
+
+/// The serialized state `bytes` changed by `f`, with its length and CRC recomputed (a forgery
+/// that passes the format checks).
+fn forge(bytes: &[u8], guid: &str, f: impl FnOnce(&mut super::state::Snapshot)) -> Vec<u8> {
+    let mut s = super::state::deserialize(bytes, guid).unwrap();
+    f(&mut s);
+    super::state::serialize(&s, guid)
+}
+
+/// A serialized state of the specimen after 4 of 10 ramp steps.
+fn serialized_after_ramp(fmu: &Fmu) -> Vec<u8> {
+    fmu.ramp(0, 4, 10);
+    let mut state: Fmi2FmuState = std::ptr::null_mut();
+    let mut size = 0;
+    unsafe {
+        assert_eq!(fmi2_get_fmu_state(fmu.c, &mut state), 0);
+        assert_eq!(fmi2_serialized_fmu_state_size(fmu.c, state, &mut size), 0);
+    }
+    let mut bytes = vec![0 as Fmi2Byte; size];
+    unsafe {
+        assert_eq!(
+            fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size),
+            0
+        );
+        assert_eq!(fmi2_free_fmu_state(fmu.c, &mut state), 0);
+    }
+    bytes.iter().map(|&b| b as u8).collect()
+}
+
+fn deserialize_status(fmu: &Fmu, bytes: &[u8]) -> (c_int, Fmi2FmuState) {
+    let mut s: Fmi2FmuState = std::ptr::null_mut();
+    let status =
+        unsafe { fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr().cast(), bytes.len(), &mut s) };
+    (status, s)
+}
+
+/// Issue 12, item 3: forged states (scaled displacements with length and CRC recomputed, sizes
+/// that do not fit, gap statuses that contradict the displacements, μ out of range) are refused
+/// by fmi2DeSerializeFMUstate itself, with a message; a genuine one is accepted.
+#[test]
+fn forged_states_are_refused_at_deserialization_with_a_message() {
+    let (u, log) = (Unpacked::specimen("forged"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[("mu", 0.2)], &[]);
+    let bytes = serialized_after_ramp(&fmu);
+    let guid = u.guid.to_str().unwrap();
+    let (ok, s) = deserialize_status(&fmu, &bytes);
+    assert_eq!(ok, 0, "{:?}", log.take());
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, s) }, 0);
+
+    type Forgery = Box<dyn Fn(&mut super::state::Snapshot)>;
+    let analysis = |f: fn(&mut crate::mech::AnalysisState)| -> Forgery {
+        Box::new(move |s| f(s.analysis.as_mut().unwrap()))
+    };
+    let cases: Vec<(Forgery, &str)> = vec![
+        (
+            analysis(|a| a.displacement.iter_mut().for_each(|v| *v *= 1e150)),
+            "beyond",
+        ),
+        (analysis(|a| a.displacement[7] = 50.0), "displacement [7]"),
+        (analysis(|a| a.plastic_slip[0][0] = 1e9), "slip history"),
+        (
+            analysis(|a| a.boundary[0][2] = -1e100),
+            "group displacement",
+        ),
+        (
+            analysis(|a| a.displacement.truncate(30)),
+            "30 displacements",
+        ),
+        (
+            analysis(|a| a.status.push(crate::mech::GapStatus::Open)),
+            "10 gap statuses",
+        ),
+        (
+            analysis(|a| a.last_increment = vec![0.0; 5]),
+            "last increment",
+        ),
+        (
+            analysis(|a| a.friction[2] = 1e6),
+            "friction coefficient of gap 'G3'",
+        ),
+        (
+            analysis(|a| a.status[0] = crate::mech::GapStatus::Open),
+            "status of gap 'G1' is Open",
+        ),
+        (
+            analysis(|a| a.status[8] = crate::mech::GapStatus::Slip),
+            "status of gap 'G9' is Slip",
+        ),
+    ];
+    for (f, expected) in cases {
+        let forged = forge(&bytes, guid, f);
+        let (status, s) = deserialize_status(&fmu, &forged);
+        assert_eq!(status, Status::Error.raw(), "{expected}");
+        assert!(s.is_null());
+        assert!(
+            log.contains(Status::Error, expected),
+            "{expected}: {:?}",
+            log.take()
+        );
+        log.take();
+    }
+    // The instance is untouched and steps on.
+    fmu.ramp(4, 5, 10);
+}
+
+/// Issue 12, smaller item: fmi2FreeFMUstate(c, NULL) is a NULL argument (fmi2Error, docs/fmu.md);
+/// a pointer to a NULL state is ignored (FMI 2.0 §2.1.8).
+#[test]
+fn free_fmu_state_with_a_null_pointer_is_an_error() {
+    let (u, log) = (Unpacked::specimen("freenull"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    let status = unsafe { fmi2_free_fmu_state(fmu.c, std::ptr::null_mut()) };
+    assert_eq!(status, Status::Error.raw());
+    assert!(log.contains(Status::Error, "FMUstate"), "{:?}", log.take());
+    let mut none: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut none) }, 0);
+}
+
+/// Issue 12, item 1: a huge but finite input never gives fmi2OK with NaN outputs: the step is
+/// refused (fmi2Error or fmi2Discard) and the outputs stay those of the last converged state.
+#[test]
+fn huge_finite_input_is_refused_never_ok_with_nan() {
+    let (u, log) = (Unpacked::specimen("huge"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[("mu", 0.2)], &[]);
+    fmu.ramp(0, 2, 20);
+    assert_eq!(fmu.set_real("frame.dz", -1e100), 0);
+    let before = fmu.all_values();
+    let status = fmu.step(0.1, 0.05);
+    assert!(
+        status == Status::Error.raw() || status == Status::Discard.raw(),
+        "status {status}: {:?}",
+        log.take()
+    );
+    assert_eq!(
+        fmu.all_values().0.iter().filter(|v| !v.is_finite()).count(),
+        0
+    );
+    assert_eq!(fmu.all_values(), before);
+}
+
+/// Issue 12, item 2 through the FMU: a model with a rigid-body mode is refused at
+/// initialization with its nodes and free motion named; no step runs.
+#[test]
+fn singular_model_is_refused_before_any_step() {
+    let mut model = ParallelArch::default().model().unwrap();
+    model.groups.clear(); // the frame held the film: now it floats
+    model.name = "Floating".into();
+    let err = model.validate().unwrap_err().to_string();
+    // The symmetry planes hold x and y, the gaps (on the arch line x = 0.4 m, z = 0.3 m) the
+    // rest, except a rotation about that line.
+    assert!(
+        err.contains(
+            "(121 nodes) can rotate about an axis along Y through (0.4000, 0.5000, 0.3000)"
+        ),
+        "{err}"
+    );
+    // An FMU cannot be made of it: the description (what fmu-pack writes) refuses it too.
+    assert!(
+        describe(&Source::Model(model))
+            .unwrap_err()
+            .contains("can rotate")
+    );
+}

@@ -16,9 +16,9 @@ use faer::sparse::linalg::cholesky::{SymbolicCholesky, factorize_symbolic_choles
 use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::{Conj, MatMut, Par, Side};
 
-use super::assembly::System;
+use super::assembly::{Dof, System};
 
-/// A factorization failure (singular or non-finite matrix).
+/// A factorization failure (singular or non-finite matrix); the message names the nodes.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FactorizationError(pub String);
 
@@ -37,6 +37,8 @@ enum Kind {
 pub struct LinearSolver {
     kind: Kind,
     scratch: MemBuffer,
+    /// Global DOF (`3 × node + axis`) of each equation, to name nodes in errors.
+    equation_dofs: Arc<[u32]>,
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -62,7 +64,11 @@ impl Clone for LinearSolver {
             },
         };
         let scratch = MemBuffer::new(Self::scratch_req(&kind_ref(&kind)));
-        Self { kind, scratch }
+        Self {
+            kind,
+            scratch,
+            equation_dofs: self.equation_dofs.clone(),
+        }
     }
 }
 
@@ -110,7 +116,19 @@ impl LinearSolver {
             }
         };
         let scratch = MemBuffer::new(Self::scratch_req(&kind_ref(&kind)));
-        Ok(Self { kind, scratch })
+        let equation_dofs = system
+            .dofs
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| matches!(d, Dof::Free(_)))
+            .map(|(i, _)| u32::try_from(i))
+            .collect::<Result<Arc<[u32]>, _>>()
+            .map_err(|_| FactorizationError("more than 2^32 DOFs".into()))?;
+        Ok(Self {
+            kind,
+            scratch,
+            equation_dofs,
+        })
     }
 
     fn scratch_req(kind: &KindRef<'_>) -> faer::dyn_stack::StackReq {
@@ -135,8 +153,88 @@ impl LinearSolver {
     }
 
     /// Numeric factorization of `matrix` (same pattern as the symbolic analysis), then the
-    /// solution of `matrix · x = rhs` in place.
+    /// solution of `matrix · x = rhs` in place. A singular or non-finite matrix (a zero pivot
+    /// gives Inf/NaN in `rhs`) is an error naming the nodes involved, never a NaN solution.
     pub fn factorize_and_solve(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+    ) -> Result<(), FactorizationError> {
+        let solved = self.factorize_and_solve_unchecked(matrix, rhs);
+        if solved.is_ok() && rhs.iter().all(|v| v.is_finite()) {
+            return solved;
+        }
+        let why = solved
+            .err()
+            .map_or(String::new(), |e| format!(" ({})", e.0));
+        Err(FactorizationError(format!(
+            "{}{why}",
+            self.diagnose(matrix, rhs)
+        )))
+    }
+
+    /// Names the DOFs behind a failed solution: non-finite matrix entries, then DOFs without any
+    /// stiffness (a zero column: a node held only by open gaps), then the non-finite entries of
+    /// the solution (a singular matrix: a rigid-body mode, a mechanism).
+    fn diagnose(&self, matrix: SparseColMatRef<'_, usize, f64>, rhs: &[f64]) -> String {
+        let columns = |keep: &dyn Fn(usize) -> bool| -> Vec<usize> {
+            (0..matrix.ncols()).filter(|&j| keep(j)).collect()
+        };
+        let non_finite = columns(&|j| matrix.val_of_col(j).iter().any(|v| !v.is_finite()));
+        if !non_finite.is_empty() {
+            return format!(
+                "the Newton matrix holds non-finite entries at {}",
+                self.name_dofs(&non_finite)
+            );
+        }
+        let empty = columns(&|j| matrix.val_of_col(j).iter().all(|&v| v == 0.0));
+        if !empty.is_empty() {
+            return format!(
+                "singular Newton matrix: no stiffness at {} (held only by open gaps, or by nothing)",
+                self.name_dofs(&empty)
+            );
+        }
+        let bad: Vec<usize> = (0..rhs.len()).filter(|&i| !rhs[i].is_finite()).collect();
+        format!(
+            "singular Newton matrix (zero pivot): the solution is not finite at {} (a rigid-body \
+             mode or mechanism that no restraint holds)",
+            self.name_dofs(&bad)
+        )
+    }
+
+    /// "node 12 (x, z), node 40 (y), … (7 DOFs)" for equation numbers.
+    fn name_dofs(&self, equations: &[usize]) -> String {
+        const LISTED: usize = 6;
+        let mut nodes: Vec<(u32, String)> = Vec::new();
+        let mut covered = 0;
+        for &eq in equations {
+            let dof = self.equation_dofs[eq];
+            let (node, axis) = (dof / 3, ["x", "y", "z"][dof as usize % 3]);
+            let same = nodes.last().is_some_and(|(n, _)| *n == node);
+            if same {
+                let axes = &mut nodes.last_mut().expect("checked").1;
+                axes.push_str(", ");
+                axes.push_str(axis);
+            } else if nodes.len() == LISTED {
+                break;
+            } else {
+                nodes.push((node, axis.to_string()));
+            }
+            covered += 1;
+        }
+        let listed: Vec<String> = nodes
+            .iter()
+            .map(|(n, axes)| format!("node {n} ({axes})"))
+            .collect();
+        let more = if equations.len() > covered {
+            format!(", … ({} DOFs)", equations.len())
+        } else {
+            String::new()
+        };
+        format!("{}{more}", listed.join(", "))
+    }
+
+    fn factorize_and_solve_unchecked(
         &mut self,
         matrix: SparseColMatRef<'_, usize, f64>,
         rhs: &mut [f64],
@@ -167,5 +265,96 @@ impl LinearSolver {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mech::Model;
+
+    /// A free 0.1 m square (two triangles, nodes 0..3) whose node 0 is fixed in x, y, z: nine
+    /// equations, numbered node 1 (x, y, z), node 2, node 3.
+    fn system(lower_only: bool) -> System {
+        let model = Model::from_json(
+            r#"{ "name": "Sq", "nodes": [[0,0,0], [0.1,0,0], [0.1,0.1,0], [0,0.1,0]],
+                 "triangles": [[0,1,2], [0,2,3]],
+                 "material": { "youngs_modulus": 1e9, "poisson_ratio": 0.43, "thickness": 250e-6,
+                               "prestress": [5e5, 5e5, 0] },
+                 "supports": [{ "node": 0, "fixed": ["x", "y", "z"] }, { "node": 1, "fixed": ["y", "z"] },
+                              { "node": 3, "fixed": ["z"] }] }"#,
+        )
+        .unwrap();
+        System::new(&model, lower_only).unwrap()
+    }
+
+    /// Matrix values with `entries` (row, column, value) and zeros elsewhere.
+    fn values(system: &System, entries: &[(usize, usize, f64)]) -> Vec<f64> {
+        let pattern = system.pattern();
+        let mut v = vec![0.0; system.nonzeros()];
+        for &(i, j, x) in entries {
+            let rows = pattern.row_idx_of_col_raw(j);
+            let k = rows
+                .iter()
+                .position(|&r| r == i)
+                .expect("entry in the pattern");
+            v[pattern.col_ptr()[j] + k] += x;
+        }
+        v
+    }
+
+    fn solve(lower_only: bool, entries: &[(usize, usize, f64)]) -> Result<Vec<f64>, String> {
+        let system = system(lower_only);
+        let mut solver = LinearSolver::new(&system).unwrap();
+        let v = values(&system, entries);
+        let mut rhs = vec![1.0; system.free_count];
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut rhs)
+            .map(|()| rhs)
+            .map_err(|e| e.0)
+    }
+
+    fn diagonal_except(skip: &[usize]) -> Vec<(usize, usize, f64)> {
+        (0..6)
+            .filter(|i| !skip.contains(i))
+            .map(|i| (i, i, 2.0))
+            .collect()
+    }
+
+    #[test]
+    fn regular_matrix_is_solved() {
+        for lower_only in [false, true] {
+            let x = solve(lower_only, &diagonal_except(&[])).unwrap();
+            assert!(x.iter().all(|&v| v == 0.5), "{x:?}");
+        }
+    }
+
+    #[test]
+    fn dof_without_stiffness_is_named_by_node_and_axis() {
+        // Equations: 0 = node 1 x, 1 = node 2 x, 2 = node 2 y, 3 = node 2 z, 4 = node 3 x, 5 = node 3 y.
+        for lower_only in [false, true] {
+            let err = solve(lower_only, &diagonal_except(&[2, 3])).unwrap_err();
+            assert!(err.contains("no stiffness at node 2 (y, z)"), "{err}");
+        }
+    }
+
+    #[test]
+    fn zero_pivot_is_an_error_naming_nodes_not_a_nan_solution() {
+        // Node 3's x and y are coupled by the singular block [[1, 1], [1, 1]].
+        let mut entries = diagonal_except(&[4, 5]);
+        entries.extend([(4, 4, 1.0), (5, 5, 1.0), (5, 4, 1.0), (4, 5, 1.0)]);
+        let err = solve(false, &entries).unwrap_err();
+        assert!(
+            err.contains("zero pivot") && err.contains("node 3"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn non_finite_entry_is_named() {
+        let mut entries = diagonal_except(&[]);
+        entries.push((0, 0, f64::NAN));
+        let err = solve(false, &entries).unwrap_err();
+        assert!(err.contains("non-finite entries at node 1 (x)"), "{err}");
     }
 }

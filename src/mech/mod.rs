@@ -6,7 +6,9 @@
 //! | [`element`] | CST membrane triangle, eqs. (2.2)–(2.7) |
 //! | [`material`] | film law, eq. (2.3), and its tension-field (wrinkling) option |
 //! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
+//! | [`finite`] | finiteness check of reported results |
 //! | [`model`] | model file format and validation |
+//! | [`restraint`] | rigid-body modes no restraint holds (singular models), found at validation |
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
 //! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
@@ -17,15 +19,18 @@
 pub mod assembly;
 pub mod contact;
 pub mod element;
+pub mod finite;
 pub mod linear;
 pub mod material;
 pub mod model;
+pub mod restraint;
 pub mod scenarios;
 pub mod solver;
 pub mod specimen;
 pub mod vtk;
 
 pub use contact::{FrictionLaw, GapStatus, IterationMatrix};
+pub use finite::check_results;
 pub use material::{Material, Wrinkling, WrinklingState};
 pub use model::{Model, ModelError};
 pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};

@@ -2,8 +2,10 @@
 //! from a JSON model file (format in `docs/model-format.md`) and validated before any analysis.
 //!
 //! Validation names the offending item: an unknown node index, a degenerate triangle, `E ≤ 0`,
-//! `ν` outside `[0, 0.5)`, `η` outside `[0, 1)`, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node that
-//! is both constrained and prescribed. Nothing here panics on user input.
+//! `ν` outside `[0, 0.5)`, `η` outside `[0, 1)`, `μ < 0`, a non-orthonormal gap frame, a duplicate
+//! name, a node that is both constrained and prescribed, a control character in text bound for
+//! modelDescription.xml, a rigid-body mode no restraint holds (`restraint.rs`). Nothing here
+//! panics on user input.
 
 use std::collections::HashSet;
 use std::fmt;
@@ -169,8 +171,19 @@ pub enum ModelError {
     Name { item: String, message: String },
     /// A DOF that is constrained and prescribed, or prescribed twice.
     Conflict { node: usize, message: String },
-    /// A node with free DOFs that no triangle or gap holds.
+    /// A node with free DOFs that belongs to no triangle (see `restraint.rs`).
     Unconnected { node: usize },
+    /// A film component with a rigid-body mode that no restraint holds (see `restraint.rs`).
+    Unrestrained {
+        /// The component's first nodes.
+        nodes: Vec<usize>,
+        /// How many nodes it has.
+        node_count: usize,
+        /// The free motion in words ("can translate along Y").
+        motion: String,
+    },
+    /// Text that would go into modelDescription.xml holds a character XML cannot carry.
+    Text { field: String, message: String },
     /// Nothing to analyse.
     Empty { message: String },
 }
@@ -203,15 +216,41 @@ impl fmt::Display for ModelError {
             Self::Unconnected { node } => {
                 write!(
                     f,
-                    "node {node} has free DOFs but belongs to no triangle or gap (singular system)"
+                    "node {node} has free DOFs but belongs to no triangle: only gaps act on it and their \
+                     forces must balance, so they cannot hold it (singular system); hold it with a support, \
+                     symmetry plane or boundary group"
                 )
             }
+            Self::Unrestrained {
+                nodes,
+                node_count,
+                motion,
+            } => {
+                let listed: Vec<String> = nodes.iter().map(|v| v.to_string()).collect();
+                let more = if *node_count > nodes.len() {
+                    ", …"
+                } else {
+                    ""
+                };
+                write!(
+                    f,
+                    "the film part with nodes {}{more} ({node_count} nodes) {motion}: no support, symmetry \
+                     plane, boundary group or gap restrains it (singular system)",
+                    listed.join(", ")
+                )
+            }
+            Self::Text { field, message } => write!(f, "{field}: {message}"),
             Self::Empty { message } => write!(f, "model: {message}"),
         }
     }
 }
 
 impl std::error::Error for ModelError {}
+
+/// Largest friction coefficient accepted (model files, the FMU's `mu`, FMU states). Coulomb
+/// coefficients of real contact pairs are below about 1.5 (ETFE on steel: 0.1–0.5, the paper
+/// §4); at 10 a gap practically never slips, and larger values only risk overflowing `μN`.
+pub const MAX_FRICTION: f64 = 10.0;
 
 /// Whether `name` can be used as an FMU variable prefix and a C identifier.
 pub fn is_identifier(name: &str) -> bool {
@@ -294,11 +333,9 @@ impl Model {
                 message: format!("wrinkling_regularisation = {eta} must lie in [0, 1)"),
             });
         }
-        let mut connected = vec![false; n];
         for (t, tri) in self.triangles.iter().enumerate() {
             for &v in tri {
                 check_node(&|| format!("triangle {t}"), v)?;
-                connected[v] = true;
             }
             let x = tri.map(|v| Vector3::from(self.nodes[v]));
             if tri[0] == tri[1]
@@ -368,14 +405,12 @@ impl Model {
                 message,
             };
             check_node(&|| format!("gap '{}' film_node", gap.name), gap.film_node)?;
-            connected[gap.film_node] = true;
             match &gap.support {
                 GapSupport::Node(b) => {
                     check_node(&|| format!("gap '{}' support node", gap.name), *b)?;
                     if *b == gap.film_node {
                         return Err(bad("support node equals film node".into()));
                     }
-                    connected[*b] = true;
                 }
                 GapSupport::Point(p) => {
                     if p.iter().any(|v| !v.is_finite()) {
@@ -405,8 +440,11 @@ impl Model {
                     gap.tangential_stiffness
                 )));
             }
-            if !(gap.friction >= 0.0 && gap.friction.is_finite()) {
-                return Err(bad(format!("friction μ = {} must be ≥ 0", gap.friction)));
+            if !(gap.friction >= 0.0 && gap.friction <= MAX_FRICTION) {
+                return Err(bad(format!(
+                    "friction μ = {} must lie in [0, {MAX_FRICTION}]",
+                    gap.friction
+                )));
             }
             if !(gap.initial_gap >= 0.0 && gap.initial_gap.is_finite()) {
                 return Err(bad(format!(
@@ -415,13 +453,14 @@ impl Model {
                 )));
             }
         }
-        for (v, c) in constrained.iter().enumerate() {
-            let fully_held = in_group[v].is_some() || c.iter().all(|&x| x);
-            if !connected[v] && !fully_held {
-                return Err(ModelError::Unconnected { node: v });
-            }
+        check_xml_text("model description", &self.description)?;
+        for s in &self.symmetry {
+            check_xml_text(
+                &format!("symmetry plane name '{}'", s.name.escape_debug()),
+                &s.name,
+            )?;
         }
-        Ok(())
+        super::restraint::check(self)
     }
 
     /// Index of the gap named `name`.
@@ -448,6 +487,24 @@ impl Model {
     /// Number of DOFs (three per node).
     pub fn dof_count(&self) -> usize {
         3 * self.nodes.len()
+    }
+}
+
+/// Refuses text that modelDescription.xml could not carry: control characters (tab, line feed
+/// and carriage return excepted) and the non-characters U+FFFE, U+FFFF (XML 1.0 `Char`).
+pub fn check_xml_text(field: &str, text: &str) -> Result<(), ModelError> {
+    let bad = text.char_indices().find(|&(_, c)| {
+        (c.is_control() && !matches!(c, '\t' | '\n' | '\r')) || matches!(c, '\u{FFFE}' | '\u{FFFF}')
+    });
+    match bad {
+        None => Ok(()),
+        Some((at, c)) => Err(ModelError::Text {
+            field: field.to_string(),
+            message: format!(
+                "character U+{:04X} at byte {at} is a control character that modelDescription.xml cannot carry",
+                c as u32
+            ),
+        }),
     }
 }
 

@@ -1,0 +1,43 @@
+//! The command-line program as a shell user runs it.
+//!
+//! TEST GOAL (issue 12, item 5): `membrane-contact export-specimen --height 300 --refine 4 |
+//! head -c 10` ends quietly: the reader closes the pipe after 10 bytes of a ~1 MB output; the
+//! program must exit with status 0 (or the SIGPIPE status) and print no panic message.
+
+use std::io::Read;
+use std::process::{Command, Stdio};
+
+#[test]
+fn closed_pipe_ends_the_program_quietly() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["export-specimen", "--height", "300", "--refine", "4"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 10];
+    child.stdout.take().unwrap().read_exact(&mut first).unwrap(); // dropped: the pipe closes
+    assert_eq!(&first[..1], b"{");
+    let output = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    use std::os::unix::process::ExitStatusExt;
+    let sigpipe = output.status.signal() == Some(13);
+    assert!(
+        output.status.success() || sigpipe,
+        "{:?}: {stderr}",
+        output.status
+    );
+    assert!(stderr.is_empty(), "{stderr}");
+}
+
+#[test]
+fn full_output_still_arrives_when_the_reader_reads_everything() {
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["export-specimen", "--height", "300", "--refine", "4"])
+        .output()
+        .unwrap();
+    assert!(output.status.success());
+    let text = String::from_utf8(output.stdout).unwrap();
+    assert!(text.len() > 100_000, "{} bytes", text.len());
+    membrane_contact::mech::Model::from_json(&text).unwrap();
+}
