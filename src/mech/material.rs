@@ -6,8 +6,8 @@
 //!
 //! **`wrinkling: none`** (the paper): `S = D ε + S0`, `C = D`.
 //!
-//! **`wrinkling: tension-field`**, every formula derived and finite-difference checked in
-//! `docs/mechanics.md` § "Wrinkling":
+//! **`wrinkling: tension-field`** (summary and sources in `docs/mechanics.md` § "Wrinkling";
+//! derivations in the implementation note it cites):
 //! * the prestress is a strain shift, `ε̂ = ε + D⁻¹ S0`, so that `D ε̂ = D ε + S0` (a prestressed
 //!   film can still go slack);
 //! * principal strains `ê1 ≥ ê2` of `ε̂`, direction `n1 = (c, s)`, `θ = ½ atan2(2Exy, Exx − Eyy)`,
@@ -133,7 +133,8 @@ impl Material {
         self.youngs_modulus * self.thickness
     }
 
-    /// Stress, consistent tangent and state at the Green strain `strain` (module doc).
+    /// Stress and state at the Green strain `strain` (module doc); [`Material::tangent`] and
+    /// [`Material::iteration_tangent`] take the result.
     #[inline]
     pub fn response(&self, strain: &Vector3<f64>) -> MaterialResponse {
         let d = self.elasticity();
