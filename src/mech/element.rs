@@ -159,18 +159,45 @@ impl MembraneTriangle {
     }
 
     /// Internal force (2.6) and, when `with_tangent`, the tangent (2.7) in one pass.
-    #[allow(non_snake_case)]
     pub fn force_and_tangent(
         &self,
         material: &Material,
         u: &ElementVector,
         with_tangent: bool,
     ) -> (ElementVector, ElementMatrix) {
-        let volume = self.area * material.thickness;
         let f = self.deformation_gradient(u);
-        // S_mod enters the force and the geometric term; the material term gets C_mod (+ η D).
-        let response = material.response(&strain_from(&f));
-        let s = response.stress;
+        let strain = strain_from(&f);
+        // One monomorphized pass per material kind: the paper's film runs exactly its own code.
+        match material.wrinkling {
+            Wrinkling::None => self.force_and_tangent_with(
+                material,
+                &f,
+                material.stress(&strain),
+                with_tangent,
+                || material.elasticity(),
+            ),
+            Wrinkling::TensionField => {
+                // S_mod enters the force and the geometric term; the material term gets C_mod + η D.
+                let response = material.response(&strain);
+                self.force_and_tangent_with(material, &f, response.stress, with_tangent, || {
+                    material.iteration_tangent(&response)
+                })
+            }
+        }
+    }
+
+    /// Force and tangent from the stress `s` and the material tangent `tangent()`.
+    #[allow(non_snake_case)]
+    #[inline(always)]
+    fn force_and_tangent_with(
+        &self,
+        material: &Material,
+        f: &Matrix3x2<f64>,
+        s: Vector3<f64>,
+        with_tangent: bool,
+        tangent: impl FnOnce() -> Matrix3<f64>,
+    ) -> (ElementVector, ElementMatrix) {
+        let volume = self.area * material.thickness;
         let S = Matrix2::new(s.x, s.z, s.z, s.y);
         let FS = f * S;
         let mut r = ElementVector::zeros();
@@ -180,8 +207,8 @@ impl MembraneTriangle {
         }
         let mut kt = ElementMatrix::zeros();
         if with_tangent {
-            let C = material.iteration_tangent(&response);
-            let B = [0, 1, 2].map(|k| self.strain_operator(&f, k));
+            let C = tangent();
+            let B = [0, 1, 2].map(|k| self.strain_operator(f, k));
             let CB = B.map(|b| C * b);
             // The tangent is symmetric: compute the blocks l ≥ k and mirror them.
             for k in 0..3 {

@@ -6,8 +6,8 @@
 //!
 //! **`wrinkling: none`** (the paper): `S = D ε + S0`, `C = D`.
 //!
-//! **`wrinkling: tension-field`**, every formula derived and finite-difference checked in
-//! `docs/mechanics.md` § "Wrinkling":
+//! **`wrinkling: tension-field`** (summary and sources in `docs/mechanics.md` § "Wrinkling";
+//! derivations in the implementation note it cites):
 //! * the prestress is a strain shift, `ε̂ = ε + D⁻¹ S0`, so that `D ε̂ = D ε + S0` (a prestressed
 //!   film can still go slack);
 //! * principal strains `ê1 ≥ ê2` of `ε̂`, direction `n1 = (c, s)`, `θ = ½ atan2(2Exy, Exx − Eyy)`,
@@ -91,17 +91,18 @@ fn is_default_regularisation(eta: &f64) -> bool {
     *eta == DEFAULT_WRINKLING_REGULARISATION
 }
 
-/// Stress, consistent tangent and state of one material point.
+/// Stress and state of one material point ([`Material::tangent`] gives its tangent). Small on
+/// purpose: it is built for every element in every assembly.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaterialResponse {
     /// Second Piola–Kirchhoff stress `S_mod` (Pa), Voigt.
     pub stress: Vector3<f64>,
-    /// Consistent tangent `∂S_mod/∂ε` (Pa), without regularisation.
-    pub tangent: Matrix3<f64>,
     /// Taut, wrinkled or slack.
     pub state: WrinklingState,
     /// Tension direction `n1 = (c, s)` in the element frame when wrinkled, zero otherwise.
     pub direction: Vector2<f64>,
+    /// `κ = Y ê1/ρ` of the wrinkled tangent (Pa); zero otherwise.
+    pub kappa: f64,
 }
 
 impl Material {
@@ -132,29 +133,54 @@ impl Material {
         self.youngs_modulus * self.thickness
     }
 
-    /// Stress, consistent tangent and state at the Green strain `strain` (module doc).
+    /// Stress and state at the Green strain `strain` (module doc); [`Material::tangent`] and
+    /// [`Material::iteration_tangent`] take the result.
+    #[inline]
     pub fn response(&self, strain: &Vector3<f64>) -> MaterialResponse {
         let d = self.elasticity();
         match self.wrinkling {
             Wrinkling::None => MaterialResponse {
                 stress: d * strain + Vector3::from(self.prestress),
-                tangent: d,
                 state: WrinklingState::Taut,
                 direction: Vector2::zeros(),
+                kappa: 0.0,
             },
             Wrinkling::TensionField => self.tension_field(d, strain),
         }
     }
 
-    /// The Newton matrix's material part: the consistent tangent, plus `η D` when wrinkled or slack.
-    pub fn iteration_tangent(&self, response: &MaterialResponse) -> Matrix3<f64> {
+    /// Consistent tangent `C_mod = ∂S_mod/∂ε` (Pa) at `response`, without regularisation: `D`,
+    /// `Y m mᵀ + κ P Pᵀ` or `0` (module doc).
+    #[inline]
+    pub fn tangent(&self, response: &MaterialResponse) -> Matrix3<f64> {
         match response.state {
-            WrinklingState::Taut => response.tangent,
-            _ => response.tangent + self.elasticity() * self.wrinkling_regularisation,
+            WrinklingState::Taut => self.elasticity(),
+            WrinklingState::Wrinkled => self.wrinkled_tangent(response),
+            WrinklingState::Slack => Matrix3::zeros(),
         }
     }
 
-    /// Tension-field response (mixed criterion, closed form for isotropic SVK).
+    /// `Y m mᵀ + κ P Pᵀ`, out of line like [`Material::tension_field`].
+    #[inline(never)]
+    fn wrinkled_tangent(&self, response: &MaterialResponse) -> Matrix3<f64> {
+        let (c, s) = (response.direction.x, response.direction.y);
+        let m = Vector3::new(c * c, s * s, c * s);
+        let p = Vector3::new(-c * s, c * s, 0.5 * (c * c - s * s));
+        m * m.transpose() * self.youngs_modulus + p * p.transpose() * response.kappa
+    }
+
+    /// The Newton matrix's material part: the consistent tangent, plus `η D` when wrinkled or slack.
+    #[inline]
+    pub fn iteration_tangent(&self, response: &MaterialResponse) -> Matrix3<f64> {
+        match response.state {
+            WrinklingState::Taut => self.elasticity(),
+            _ => self.tangent(response) + self.elasticity() * self.wrinkling_regularisation,
+        }
+    }
+
+    /// Tension-field response (mixed criterion, closed form for isotropic SVK). Kept out of line
+    /// so that the `none` path of [`Material::response`] inlines into the element loop.
+    #[inline(never)]
     fn tension_field(&self, d: Matrix3<f64>, strain: &Vector3<f64>) -> MaterialResponse {
         let (y, nu) = (self.youngs_modulus, self.poisson_ratio);
         let s0 = self.prestress;
@@ -174,30 +200,28 @@ impl Material {
         if e1 <= tol {
             return MaterialResponse {
                 stress: Vector3::zeros(),
-                tangent: Matrix3::zeros(),
                 state: WrinklingState::Slack,
                 direction: Vector2::zeros(),
+                kappa: 0.0,
             };
         }
         if e2 + nu * e1 > tol {
             return MaterialResponse {
                 stress: d * e,
-                tangent: d,
                 state: WrinklingState::Taut,
                 direction: Vector2::zeros(),
+                kappa: 0.0,
             };
         }
         // Wrinkled: ρ ≥ (1 + ν) ê1 / 2 > 0, so θ and κ are well defined.
         let theta = 0.5 * e.z.atan2(e.x - e.y);
         let (s, c) = theta.sin_cos();
         let m = Vector3::new(c * c, s * s, c * s);
-        let p = Vector3::new(-c * s, c * s, 0.5 * (c * c - s * s));
-        let kappa = y * e1 / rho;
         MaterialResponse {
             stress: m * (y * e1),
-            tangent: m * m.transpose() * y + p * p.transpose() * kappa,
             state: WrinklingState::Wrinkled,
             direction: Vector2::new(c, s),
+            kappa: y * e1 / rho,
         }
     }
 }
@@ -271,7 +295,7 @@ mod tests {
                 return;
             };
             let scale = mat.elasticity().amax();
-            let err = (fd - r.tangent).amax();
+            let err = (fd - mat.tangent(r)).amax();
             assert!(err < 1e-6 * scale, "{:?} at {strain:?}: {err:e}", r.state);
         });
     }
@@ -320,10 +344,10 @@ mod tests {
             // Strain-like Voigt of n2⊗n2 is a null vector of C_w; S_mod has no n2n2 component.
             let w = Vector3::new(s * s, c * c, -2.0 * c * s);
             let scale = mat.elasticity().amax();
-            assert!((r.tangent * w).amax() < 1e-12 * scale);
+            assert!((mat.tangent(r) * w).amax() < 1e-12 * scale);
             assert!(r.stress.dot(&w).abs() < 1e-12 * r.stress.amax());
             // κ ∈ (0, 4G]: the tangent is positive semi-definite.
-            let eig = r.tangent.symmetric_eigenvalues();
+            let eig = mat.tangent(r).symmetric_eigenvalues();
             assert!(eig.min() > -1e-12 * scale, "{eig:?}");
         });
     }
@@ -337,7 +361,7 @@ mod tests {
         let strain = Vector3::new(-0.02, 0.01, 0.005);
         let r = mat.response(&strain);
         assert_eq!(r.stress, mat.stress(&strain));
-        assert_eq!(r.tangent, mat.elasticity());
+        assert_eq!(mat.tangent(&r), mat.elasticity());
         assert_eq!(r.state, WrinklingState::Taut);
         assert_eq!(mat.iteration_tangent(&r), mat.elasticity());
     }
@@ -359,7 +383,7 @@ mod tests {
                 r, r0,
                 "the stress and consistent tangent do not depend on η"
             );
-            let added = mat.iteration_tangent(&r) - r.tangent;
+            let added = mat.iteration_tangent(&r) - mat.tangent(&r);
             let expected = match r.state {
                 WrinklingState::Taut => Matrix3::zeros(),
                 _ => mat.elasticity() * eta,
