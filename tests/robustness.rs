@@ -11,9 +11,8 @@
 //! MESH / BOUNDARY CONDITIONS / PARAMETERS: see the module doc of `mech::scenarios` (ASCII
 //! sketches of the panel and the strip) and each test's comment.
 //!
-//! Tests that fail on the solver of the time they were written carry
-//! `#[ignore = "issue 7: fails before the Newton rework"]`; `cargo test --release --test
-//! robustness -- --include-ignored` runs them.
+//! A test that still fails carries `#[ignore = "issue 7: open, …"]` with the reason in its doc
+//! comment; `cargo test --release --test robustness -- --include-ignored` runs it.
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::scenarios::{
@@ -81,9 +80,10 @@ fn specimen_300mm_mu08_in_80_steps_to_half_height_converges() {
 // -------------------------------------------------------------------- reproduction 3 (panel)
 
 /// The panel's model file run as `membrane-contact model panel.json --steps 20` (one increment
-/// per step, group targets of the model).
+/// per step, group targets of the model). The panel's film is a tension field (`ArchPanel`
+/// default): jacking it compresses regions that ETFE wrinkles; see docs/benchmarks.md for the
+/// same panel without wrinkling.
 #[test]
-#[ignore = "issue 7: fails before the Newton rework"]
 fn panel_jacked_about_hinge_in_20_cli_steps_converges() {
     assert_converges(&ArchPanel::default().jacked(1, 20, None, 1).unwrap());
 }
@@ -91,7 +91,6 @@ fn panel_jacked_about_hinge_in_20_cli_steps_converges() {
 /// A staged master: `μ = 0.5`, three stages of the hinge rotation, five steps each, the FMU's
 /// increments per step.
 #[test]
-#[ignore = "issue 7: fails before the Newton rework"]
 fn panel_staged_with_mu_05_converges() {
     let panel = ArchPanel::default();
     assert_converges(&panel.jacked(3, 5, Some(0.5), fmu_increments()).unwrap());
@@ -119,10 +118,10 @@ fn strip_first_step_closes_all_38_gaps_and_converges() {
 
 // ---------------------------------------------------------------- reproduction 5 (arch edge)
 
-/// Written against the isotropic friction law (the sliding-direction law of §2.2 was not yet in
-/// main); switch the gaps to it when it lands.
+/// With the paper's sliding-direction law (§2.2) and a tension-field film, the `ArchEdge`
+/// defaults: the issue's isotropic cone slides the edge across the arch, and without wrinkling
+/// about 70 % of the elements are compressed and Newton stalls (docs/benchmarks.md).
 #[test]
-#[ignore = "issue 7: fails before the Newton rework"]
 fn film_edge_lying_on_arch_without_cross_prestress_converges() {
     let edge = ArchEdge::default();
     assert_converges(&edge.lowered(0.5, 20, fmu_increments()).unwrap());
@@ -171,13 +170,19 @@ fn benchmark_sample_of_specimen_paths_converges() {
 }
 
 #[test]
-#[ignore = "issue 7: fails before the Newton rework"]
-fn benchmark_sample_of_panel_strip_and_arch_edge_paths_converges() {
-    assert_all_converge(&benchmark_sample(&[
-        Family::Panel,
-        Family::Strip,
-        Family::ArchEdge,
-    ]));
+fn benchmark_sample_of_panel_and_strip_paths_converges() {
+    assert_all_converge(&benchmark_sample(&[Family::Panel, Family::Strip]));
+}
+
+/// Still open: the arch edge lowered in 80 steps is refused in its first step. The prestressed
+/// curved edge is out of balance at zero load (4.9 N on the touching gaps), its film is wrinkled
+/// or slack across the edge, and the nodes held only by slack elements have no unique position:
+/// the residual meets its tolerance, the displacement corrections stop shrinking (the tension
+/// field's η regularisation acts in the Newton matrix only). The 20-step path converges.
+#[test]
+#[ignore = "issue 7: open, the 80-step arch-edge path (see the doc comment)"]
+fn benchmark_sample_of_arch_edge_paths_converges() {
+    assert_all_converge(&benchmark_sample(&[Family::ArchEdge]));
 }
 
 // ------------------------------------------------------------------- the generators

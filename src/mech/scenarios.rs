@@ -64,7 +64,7 @@ use std::fmt;
 use nalgebra::Vector3;
 
 use super::contact::{FrictionLaw, GapFrame};
-use super::element::Material;
+use super::material::{Material, Wrinkling};
 use super::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Support, Symmetry};
 use super::solver::{Analysis, SolverSettings, StepError};
 use super::specimen::ParallelArch;
@@ -572,7 +572,12 @@ impl Default for ArchPanel {
             arch_rise: 0.2,
             arch_span: 1.5,
             arch_x: [1.0, 2.0],
-            material: ParallelArch::default().material,
+            // A jacked panel puts regions into compression; ETFE wrinkles there instead of
+            // carrying it (issue 7: without wrinkling its Newton stalls, see docs/benchmarks.md).
+            material: Material {
+                wrinkling: Wrinkling::TensionField,
+                ..ParallelArch::default().material
+            },
             friction: 0.2,
             corner_drop: 0.2,
         }
@@ -878,6 +883,9 @@ pub struct ArchEdge {
     /// default, as in reproduction 5 of issue 7; the isotropic cone lets the unprestressed edge
     /// slide across the arch.
     pub friction_law: FrictionLaw,
+    /// Compression model of the film: tension field by default (about 70 % of the elements
+    /// would be compressed otherwise, and Newton stalls, see docs/benchmarks.md).
+    pub wrinkling: Wrinkling,
 }
 
 impl Default for ArchEdge {
@@ -890,6 +898,7 @@ impl Default for ArchEdge {
             prestress_along: ParallelArch::default().material.prestress[1],
             friction: 0.2,
             friction_law: FrictionLaw::SlidingDirection,
+            wrinkling: Wrinkling::TensionField,
         }
     }
 }
@@ -924,6 +933,7 @@ impl ArchEdge {
         let id = |i, j| grid_id(nx, i, j);
         let material = Material {
             prestress: [0.0, self.prestress_along, 0.0],
+            wrinkling: self.wrinkling,
             ..ParallelArch::default().material
         };
         let film: Vec<usize> = (0..=ny).map(|j| id(0, j)).collect();

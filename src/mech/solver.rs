@@ -53,7 +53,7 @@ impl Default for SolverSettings {
             iteration_matrix: IterationMatrix::default(),
             displacement_tolerance: 1e-5,
             residual_tolerance: 1e-5,
-            max_iterations: 50,
+            max_iterations: 100,
             max_cutbacks: 12,
             line_search: true,
         }
