@@ -306,7 +306,8 @@ pub struct GapResult {
     pub slip_y: f64,
     /// Normal contact force `N ≥ 0` (N).
     pub normal_force: f64,
-    /// Friction force magnitude `|t| ≤ μN` (N).
+    /// Friction force magnitude `|t|` (N): `≤ μN` for the isotropic law; for the sliding-direction law only
+    /// `|t_x| ≤ μN`, the elastic `t_y` is not bounded.
     pub friction_force: f64,
     /// Friction force components (local x, y) of the gap's internal force on node A (eq. 2.8):
     /// the force the film exerts on the support; the support acts on the film with the opposite (N).
