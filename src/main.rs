@@ -207,7 +207,7 @@ fn run(o: &Options) -> Result<(), String> {
     let mut vtk_files = Vec::new();
     let progress = !o.quiet && std::io::stderr().is_terminal();
     let started = std::time::Instant::now();
-    let (mut iterations, mut cutbacks, mut increments) = (Vec::new(), 0, 0);
+    let (mut iterations, mut cutbacks, mut enlarged, mut increments) = (Vec::new(), 0, 0, 0);
     for step in 1..=o.steps {
         let fraction = step as f64 / o.steps as f64;
         let target: Vec<[f64; 3]> = targets.iter().map(|t| t.map(|v| v * fraction)).collect();
@@ -215,6 +215,7 @@ fn run(o: &Options) -> Result<(), String> {
             .step_to(&target, 1)
             .map_err(|e| format!("step {step}/{}: {e}", o.steps))?;
         cutbacks += report.cutbacks;
+        enlarged += report.enlarged;
         increments += report.iterations.len();
         iterations.push(report.total_iterations());
         let results = (o.csv.is_some() || o.vtk.is_some()).then(|| analysis.results());
@@ -258,8 +259,8 @@ fn run(o: &Options) -> Result<(), String> {
     report(o, &analysis, &results);
     let total: usize = iterations.iter().sum();
     out!(
-        "\nNewton: {} steps, {increments} increments, {cutbacks} cut-backs, {total} iterations \
-         ({:.1} per increment), iterations per step {:?}; {:.1} ms",
+        "\nNewton: {} steps, {increments} increments, {cutbacks} cut-backs, {enlarged} enlarged, \
+         {total} iterations ({:.1} per increment), iterations per step {:?}; {:.1} ms",
         o.steps,
         total as f64 / increments.max(1) as f64,
         iterations,

@@ -1318,7 +1318,11 @@ fn slack_film_gives_zero_reactions_without_a_singular_solve() {
             .all(|e| e.von_mises == 0.0 && e.tension_direction == [0.0; 3])
     );
     assert!(
-        results.elements.iter().filter(|e| e.state == WrinklingState::Slack).count()
+        results
+            .elements
+            .iter()
+            .filter(|e| e.state == WrinklingState::Slack)
+            .count()
             > results.elements.len() / 2
     );
     assert!(

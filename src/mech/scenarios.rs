@@ -161,6 +161,8 @@ pub struct StepOutcome {
     pub increments: usize,
     /// Halved increments.
     pub cutbacks: usize,
+    /// Increments made larger than asked because every smaller one failed.
+    pub enlarged: usize,
     /// The error text when the step was refused.
     pub error: Option<String>,
 }
@@ -215,6 +217,11 @@ impl RunOutcome {
         self.steps.iter().map(|s| s.cutbacks).sum()
     }
 
+    /// Enlarged increments over all steps.
+    pub fn enlarged(&self) -> usize {
+        self.steps.iter().map(|s| s.enlarged).sum()
+    }
+
     /// Most Newton iterations of one converged increment.
     pub fn max_increment_iterations(&self) -> usize {
         self.steps
@@ -260,6 +267,7 @@ impl Scenario {
                     max_increment_iterations: 0,
                     increments: 0,
                     cutbacks: 0,
+                    enlarged: 0,
                     error: None,
                 };
                 match analysis.step_to(&target, self.path.increments_per_step) {
@@ -269,6 +277,7 @@ impl Scenario {
                             report.iterations.iter().copied().max().unwrap_or(0);
                         record.increments = report.iterations.len();
                         record.cutbacks = report.cutbacks;
+                        record.enlarged = report.enlarged;
                         outcome.steps.push(record);
                     }
                     Err(e) => {

@@ -119,6 +119,10 @@ pub struct StepReport {
     pub iterations: Vec<usize>,
     /// Increments halved.
     pub cutbacks: usize,
+    /// Increments made larger than `1/increments` of the step because every smaller one had
+    /// failed (see `Analysis::step_to`).
+    #[serde(default)]
+    pub enlarged: usize,
     /// Final residual `‖R_free‖∞` (N).
     pub residual: f64,
     /// `‖R_free‖∞` at every iteration of the last converged increment (N).
@@ -162,7 +166,12 @@ pub enum IncrementFailure {
 /// `names` as a short list: the first few, then how many more.
 fn name_list(names: &[String]) -> String {
     const SHOWN: usize = 6;
-    let mut text = names.iter().take(SHOWN).cloned().collect::<Vec<_>>().join(", ");
+    let mut text = names
+        .iter()
+        .take(SHOWN)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
     if names.len() > SHOWN {
         text += &format!(" and {} more", names.len() - SHOWN);
     }
@@ -227,7 +236,10 @@ impl fmt::Display for IncrementFailure {
                 chatter(f, chattering)
             }
             Self::Diverged { iteration } => {
-                write!(f, "diverged (non-finite or runaway residual) at iteration {iteration}")
+                write!(
+                    f,
+                    "diverged (non-finite or runaway residual) at iteration {iteration}"
+                )
             }
             Self::Singular { message } => write!(f, "singular Newton matrix ({message})"),
         }
@@ -501,8 +513,16 @@ impl Analysis {
     /// Moves every boundary group to `target` (m), in increments of at most `1/increments` of
     /// the step (eq. 2.11–2.12 in each). The increment size adapts: it is halved when an
     /// increment fails (up to [`SolverSettings::max_cutbacks`] times below the largest size) or
-    /// needs many iterations, and doubled again, up to the largest, after easy ones. On error
-    /// the state is unchanged.
+    /// needs many iterations, and doubled again, up to the largest, after easy ones.
+    ///
+    /// When even the smallest increment fails, larger ones are tried from the same converged
+    /// state before the step is given up (twice the largest, four times, …, up to the rest of
+    /// the step; counted in [`StepReport::enlarged`]). A film whose start is a mechanism (slack
+    /// across, tensioned only once the boundary has moved far enough) converges in a larger
+    /// increment and in no smaller one: issue 7's arch edge lowered in 80 steps was refused in
+    /// its first step with 10 increments per step and passes in one increment per step. The
+    /// answer is still the converged equilibrium at the target; only the path between two
+    /// converged states is coarser, which friction may feel. On error the state is unchanged.
     pub fn step_to(
         &mut self,
         target: &[[f64; 3]],
@@ -522,8 +542,17 @@ impl Analysis {
         let (mut done, mut size) = (0.0_f64, largest);
         // Ju–Rowlands iterations converge linearly whatever the increment: never "hard".
         let hard = match self.settings.iteration_matrix {
-            IterationMatrix::Consistent => Self::HARD_ITERATIONS.min(self.settings.max_iterations / 2 + 1),
+            IterationMatrix::Consistent => {
+                Self::HARD_ITERATIONS.min(self.settings.max_iterations / 2 + 1)
+            }
             IterationMatrix::JuRowlands => usize::MAX,
+        };
+        // The group displacements at the fraction `f` of the step.
+        let at = |f: f64| -> Vec<[f64; 3]> {
+            base.iter()
+                .zip(target)
+                .map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * f))
+                .collect()
         };
         while done < 1.0 {
             let next = if done + size > 1.0 - 1e-12 {
@@ -531,12 +560,7 @@ impl Analysis {
             } else {
                 done + size
             };
-            let boundary: Vec<[f64; 3]> = base
-                .iter()
-                .zip(target)
-                .map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * next))
-                .collect();
-            match self.solve_increment(&current, &boundary) {
+            match self.solve_increment(&current, &at(next)) {
                 Ok((state, history)) => {
                     current = state;
                     done = next;
@@ -553,15 +577,35 @@ impl Analysis {
                     }
                 }
                 Err(last) => {
-                    if size / 2.0 < smallest * (1.0 - 1e-9) {
+                    if size / 2.0 >= smallest * (1.0 - 1e-9) {
+                        report.cutbacks += 1;
+                        size /= 2.0;
+                        continue;
+                    }
+                    // Every smaller increment failed: try larger ones before giving up.
+                    let mut larger = 2.0 * largest;
+                    let mut reached = None;
+                    while reached.is_none() && larger < 2.0 * (1.0 - done) {
+                        let next = (done + larger).min(1.0);
+                        if let Ok(converged) = self.solve_increment(&current, &at(next)) {
+                            reached = Some((next, converged));
+                        }
+                        larger *= 2.0;
+                    }
+                    let Some((next, (state, history))) = reached else {
                         return Err(StepError::NotConverged {
                             fraction_done: done,
                             cutbacks: report.cutbacks,
                             last,
                         });
-                    }
-                    report.cutbacks += 1;
-                    size /= 2.0;
+                    };
+                    report.enlarged += 1;
+                    current = state;
+                    done = next;
+                    report.iterations.push(history.len() - 1);
+                    report.residual = *history.last().unwrap_or(&0.0);
+                    report.residual_history = history;
+                    size = largest;
                 }
             }
         }
@@ -590,7 +634,9 @@ impl Analysis {
         for (g, t) in target.iter().enumerate() {
             let name = &self.model.groups[g].name;
             if t.iter().any(|v| !v.is_finite()) {
-                return invalid(format!("the target of group '{name}' {t:?} is NaN or infinite"));
+                return invalid(format!(
+                    "the target of group '{name}' {t:?} is NaN or infinite"
+                ));
             }
             if let Some(v) = t.iter().find(|v| v.abs() > limit) {
                 return invalid(format!(
@@ -712,7 +758,9 @@ impl Analysis {
             // two states repeats both to round-off and never makes it, while the slow approach
             // along a soft direction of the film (small residual, shrinking corrections) does. The Ju–Rowlands matrix converges
             // linearly and slowly by design (docs/mechanics.md): it is judged by the limit only.
-            if residual < Self::PROGRESS * best || correction_norm < Self::PROGRESS * best_correction {
+            if residual < Self::PROGRESS * best
+                || correction_norm < Self::PROGRESS * best_correction
+            {
                 best = best.min(residual);
                 best_correction = best_correction.min(correction_norm);
                 best_at = iteration;
@@ -733,7 +781,12 @@ impl Analysis {
             }
             if damping > 0.0 {
                 let values = &mut self.work.values;
-                let mean = self.work.diagonal.iter().map(|&d| values[d].abs()).sum::<f64>()
+                let mean = self
+                    .work
+                    .diagonal
+                    .iter()
+                    .map(|&d| values[d].abs())
+                    .sum::<f64>()
                     / self.work.diagonal.len() as f64;
                 for &d in &self.work.diagonal {
                     values[d] += damping * mean;
@@ -761,7 +814,11 @@ impl Analysis {
                     (4.0 * damping).max(Self::DAMPING_START)
                 } else if step == 1.0 && damping > 0.0 {
                     let lower = damping / 4.0;
-                    if lower < Self::DAMPING_START / 64.0 { 0.0 } else { lower }
+                    if lower < Self::DAMPING_START / 64.0 {
+                        0.0
+                    } else {
+                        lower
+                    }
                 } else {
                     damping
                 };
@@ -1017,7 +1074,9 @@ fn nan_max(m: f64, v: f64) -> f64 {
 
 /// `max |a − b|` over two equally long vectors, NaN-aware like [`max_abs`].
 fn max_abs_difference(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).fold(0.0, |m, (x, y)| nan_max(m, (x - y).abs()))
+    a.iter()
+        .zip(b)
+        .fold(0.0, |m, (x, y)| nan_max(m, (x - y).abs()))
 }
 
 /// Slot of each equation's diagonal entry in the value array (the pattern keeps them all).
@@ -1027,7 +1086,10 @@ fn diagonal_slots(system: &System) -> Vec<usize> {
     (0..system.free_count)
         .map(|j| {
             let rows = &row_idx[col_ptr[j]..col_ptr[j + 1]];
-            col_ptr[j] + rows.binary_search(&j).expect("the pattern keeps every diagonal")
+            col_ptr[j]
+                + rows
+                    .binary_search(&j)
+                    .expect("the pattern keeps every diagonal")
         })
         .collect()
 }
@@ -1042,8 +1104,5 @@ pub fn bounding_diagonal(nodes: &[[f64; 3]]) -> f64 {
             hi[c] = hi[c].max(p[c]);
         }
     }
-    (0..3)
-        .map(|c| (hi[c] - lo[c]).powi(2))
-        .sum::<f64>()
-        .sqrt()
+    (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt()
 }
