@@ -57,7 +57,7 @@ options:
   --csv FILE         write the gap results of every step as CSV
   --vtk DIR          write every step as VTK: DIR/<model>_film_NNNN.vtu (film) and
                      DIR/<model>_gaps_NNNN.vtu (gap lines), and a .pvd of each for ParaView
-  --vtk-format F     binary (default: raw appended data, about a third of the size) or ascii
+  --vtk-format F     binary (default: raw appended data, about half the size) or ascii
   --quiet            no progress indicator
   -h, --help         this text";
 
@@ -210,13 +210,20 @@ fn run(o: &Options) -> Result<(), String> {
         }
         None => None,
     };
-    let mut vtk_steps = Vec::new();
+    let (mut vtk_steps, mut vtk_written) = (Vec::new(), VtkWritten::default());
     if let Some(dir) = &o.vtk {
         std::fs::create_dir_all(dir).map_err(|e| format!("{dir}: {e}"))?;
         // State 0000: the undeformed, prestressed film (as the FMU writes at initialization).
         vtk_steps.push((0.0, 0));
         let results = analysis.results();
-        write_vtk(dir, &analysis, &results, &vtk_steps, o.vtk_format)?;
+        write_vtk(
+            dir,
+            &analysis,
+            &results,
+            &vtk_steps,
+            o.vtk_format,
+            &mut vtk_written,
+        )?;
     }
     let progress = !o.quiet && std::io::stderr().is_terminal();
     let started = std::time::Instant::now();
@@ -233,7 +240,14 @@ fn run(o: &Options) -> Result<(), String> {
         let results = (o.csv.is_some() || o.vtk.is_some()).then(|| analysis.results());
         if let (Some(dir), Some(results)) = (&o.vtk, &results) {
             vtk_steps.push((fraction, step));
-            write_vtk(dir, &analysis, results, &vtk_steps, o.vtk_format)?;
+            write_vtk(
+                dir,
+                &analysis,
+                results,
+                &vtk_steps,
+                o.vtk_format,
+                &mut vtk_written,
+            )?;
         }
         if progress {
             eprint!("\rstep {step}/{} ({:.0}%)", o.steps, 100.0 * fraction);
@@ -271,7 +285,25 @@ fn run(o: &Options) -> Result<(), String> {
         iterations,
         elapsed.as_secs_f64() * 1e3
     );
+    if o.vtk.is_some() {
+        out!(
+            "VTK ({}): {} .vtu files, {:.2} MB, {:.1} ms to encode and write",
+            o.vtk_format.name(),
+            vtk_written.files,
+            vtk_written.bytes as f64 / 1e6,
+            vtk_written.seconds * 1e3
+        );
+    }
     Ok(())
+}
+
+/// What the VTK output of a run wrote: `.vtu` files, their bytes, and the time spent encoding
+/// and writing them (`.pvd` files included).
+#[derive(Default)]
+struct VtkWritten {
+    files: usize,
+    bytes: usize,
+    seconds: f64,
 }
 
 /// Writes the last state of `steps` (`(fraction, step)` pairs) as the film and gaps `.vtu` files
@@ -282,14 +314,18 @@ fn write_vtk(
     results: &Results,
     steps: &[(f64, usize)],
     encoding: vtk::Encoding,
+    written: &mut VtkWritten,
 ) -> Result<(), String> {
+    let started = std::time::Instant::now();
     let (model, dir) = (analysis.model(), std::path::Path::new(dir));
     let step = steps.last().map_or(0, |&(_, k)| k);
     let u = &analysis.state().displacement;
     for block in vtk::Block::ALL {
         let file = dir.join(vtk::state_file_name(&model.name, block, step));
-        std::fs::write(&file, vtk::grid(block, model, u, results, encoding))
-            .map_err(|e| format!("{}: {e}", file.display()))?;
+        let bytes = vtk::grid(block, model, u, results, encoding);
+        std::fs::write(&file, &bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+        written.files += 1;
+        written.bytes += bytes.len();
         let entries: Vec<(f64, String)> = steps
             .iter()
             .map(|&(t, k)| (t, vtk::state_file_name(&model.name, block, k)))
@@ -298,6 +334,7 @@ fn write_vtk(
         std::fs::write(&pvd, vtk::collection(&entries))
             .map_err(|e| format!("{}: {e}", pvd.display()))?;
     }
+    written.seconds += started.elapsed().as_secs_f64();
     Ok(())
 }
 

@@ -459,14 +459,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "results.directory",
         Value::String(String::new()),
         None,
-        "directory for VTK output of every communication step (ParaView .vtu + .pvd); empty: none",
+        "directory for VTK output of every communication step (film and gaps .vtu + .pvd); empty: none",
         Binding::ResultsDirectory,
     );
     table.parameter(
         "results.vtkFormat",
         Value::String(crate::mech::vtk::Encoding::default().name().into()),
         None,
-        "encoding of the VTK files: binary (raw appended data, about a third of the size) or ascii",
+        "encoding of the VTK files: binary (raw appended data, about half the size) or ascii",
         Binding::VtkFormat,
     );
 
