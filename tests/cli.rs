@@ -104,3 +104,42 @@ fn vtk_writes_film_and_gaps_per_state_from_0000_in_the_chosen_encoding() {
         "{err}"
     );
 }
+
+#[test]
+fn a_model_without_gaps_writes_film_files_only() {
+    let root =
+        std::env::temp_dir().join(format!("membrane-contact-cli-nogap-{}", std::process::id()));
+    std::fs::create_dir_all(&root).unwrap();
+    let mut model = membrane_contact::mech::ParallelArch::with_height(0.2)
+        .model()
+        .unwrap();
+    model.gaps.clear();
+    let file = root.join("film only.json");
+    std::fs::write(&file, serde_json::to_string(&model).unwrap()).unwrap();
+    let dir = root.join("vtk");
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["model", file.to_str().unwrap(), "--steps", "1", "--quiet"])
+        .args(["--vtk", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    let name = &model.name;
+    assert_eq!(
+        names,
+        [
+            format!("{name}_film.pvd"),
+            format!("{name}_film_0000.vtu"),
+            format!("{name}_film_0001.vtu")
+        ]
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -940,7 +940,7 @@ impl Instance {
         let written = std::fs::create_dir_all(&dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))
             .and_then(|()| {
-                vtk::Block::ALL.into_iter().try_for_each(|block| {
+                vtk::Block::of(a.model()).iter().try_for_each(|&block| {
                     let vtu = dir.join(vtk::state_file_name(id, block, step));
                     let u = &a.state().displacement;
                     std::fs::write(&vtu, vtk::grid(block, a.model(), u, &results, encoding))
@@ -949,7 +949,8 @@ impl Instance {
             });
         let outcome = written.and_then(|()| {
             self.vtk_steps.push((self.time, step));
-            vtk::Block::ALL.into_iter().try_for_each(|block| {
+            let blocks = vtk::Block::of(built.analysis.model());
+            blocks.iter().try_for_each(|&block| {
                 let entries: Vec<(f64, String)> = self
                     .vtk_steps
                     .iter()

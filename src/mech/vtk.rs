@@ -15,7 +15,8 @@
 //!   (point `k` for gap `k`) followed by their support points (point `G + k`), cells one line
 //!   (VTK type 3) per gap from film node to support. Cell data `film_node` (index of the gap's
 //!   node in the film grid), `gap_slip_x`, `gap_slip_y` (m), `gap_normal_force`,
-//!   `gap_friction_force` (N) and `gap_status` (0 open, 1 stick, 2 slip).
+//!   `gap_friction_force` (N) and `gap_status` (0 open, 1 stick, 2 slip). Written only when the
+//!   model has gaps ([`Block::of`]).
 //!
 //! [`Encoding::Ascii`] writes the values as text in the `DataArray` elements;
 //! [`Encoding::Binary`] writes them after the XML as `<AppendedData encoding="raw">`: a `_`, then
@@ -73,6 +74,16 @@ pub enum Block {
 impl Block {
     /// Both blocks, in file order.
     pub const ALL: [Block; 2] = [Block::Film, Block::Gaps];
+
+    /// The blocks written for `model`: the film, and the gaps if it has any (a grid without
+    /// cells is valid VTK, but meshio 5.3 cannot read it).
+    pub fn of(model: &Model) -> &'static [Block] {
+        if model.gaps.is_empty() {
+            &Self::ALL[..1]
+        } else {
+            &Self::ALL
+        }
+    }
 
     /// The block's part of the file names (`film`, `gaps`).
     pub fn name(self) -> &'static str {
