@@ -1231,6 +1231,10 @@ fn forged_states_are_refused_at_deserialization_with_a_message() {
             analysis(|a| a.status[8] = crate::mech::GapStatus::Slip),
             "status of gap 'G9' is Slip",
         ),
+        (
+            Box::new(|s| s.vtk_steps.push((0.5, s.steps + 1))),
+            "VTK output beyond its 4 steps",
+        ),
     ];
     for (f, expected) in cases {
         let forged = forge(&bytes, guid, f);
