@@ -37,7 +37,8 @@ GAPS = [f"G{i}" for i in range(1, 10)]
 OBSERVED = {1: "G1", 2: "G2", 3: "G4", 4: "G6", 5: "G8"}
 STATUS = {0: "open", 1: "stick", 2: "slip"}
 FMI2_DISCARD = 2
-# String parameter of the FMU: write the film as VTK (.vtu per step + .pvd) into this directory.
+# String parameter of the FMU: write the film and the gaps as VTK (.vtu per step + .pvd) into this
+# directory (encoding: results.vtkFormat, binary by default).
 RESULTS_DIRECTORY = "results.directory"
 
 

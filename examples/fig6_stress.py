@@ -1,13 +1,15 @@
 """Paper Fig. 6: deformed film and element equivalent (von Mises) stress, 300 mm arch, mu = 0.2.
 
-The picture is read from a VTK XML unstructured grid (.vtu, ASCII) with the standard library's
-xml.etree: points = deformed positions (film nodes, then one point per gap support on the
-arch), cells = triangles (type 5) then gap lines (type 3), cell data ``von_mises`` etc.
+The picture is read from the VTK XML unstructured grids (.vtu, ASCII or raw appended binary)
+with the standard library's xml.etree and numpy: the film (points = deformed node positions,
+triangles, cell data ``von_mises`` etc.) and the gaps (one line per gap from its film node to its
+support on the arch, cell data ``gap_status``).
 
-Where the .vtu comes from (--source): the FMU, through its String parameter
-``results.directory`` (it writes <dir>/ParallelArch_NNNN.vtu after every step; the default when
-the FMU has it), or the core's CLI (``membrane-contact specimen --vtk DIR``, the same solver
-without FMI, one increment per step); or a file given with --vtu. The 1/4 model is mirrored about its two symmetry planes (x = 0 between the arches,
+Where the .vtu files come from (--source): the FMU, through its String parameter
+``results.directory`` (it writes <dir>/ParallelArch_film_NNNN.vtu and ..._gaps_NNNN.vtu after
+every step; the default when the FMU has it), or the core's CLI (``membrane-contact specimen
+--vtk DIR``, the same solver without FMI, one increment per step); or a film file given with
+--vtu (its ``_gaps_`` sibling is read if there). The 1/4 model is mirrored about its two symmetry planes (x = 0 between the arches,
 y = 0 through the crowns) to show the whole specimen.
 
 Writes fig6_stress.png and fig6_stress.csv (per triangle of the 1/4 model: centroid, von Mises
@@ -32,17 +34,34 @@ import archfmu  # noqa: E402
 VTK_TRIANGLE, VTK_LINE = 5, 3
 
 
+VTK_TYPES = {"Float64": "<f8", "Float32": "<f4", "Int64": "<i8", "Int32": "<i4", "UInt64": "<u8",
+             "UInt32": "<u4", "UInt8": "u1"}
+
+
 def read_vtu(path) -> dict:
-    """Arrays of an ASCII .vtu: points, connectivity/offsets/types, point and cell data."""
-    piece = ET.parse(path).getroot().find("UnstructuredGrid/Piece")
+    """Arrays of a .vtu (ASCII, or raw appended data with UInt64 block headers as the FMU and
+    the CLI write it): points, connectivity/offsets/types, point and cell data."""
+    data = Path(path).read_bytes()
+    # Raw appended data is not XML: parse what precedes it, read the blocks by their offsets.
+    head, marker, tail = data.partition(b"<AppendedData")
+    appended = tail[tail.index(b"_") + 1:] if marker else b""
+    root = ET.fromstring(head + b"</VTKFile>" if marker else data)
+    piece = root.find("UnstructuredGrid/Piece")
     if piece is None:
         raise ValueError(f"{path}: not a VTK UnstructuredGrid file")
+    header = np.dtype(VTK_TYPES[root.get("header_type", "UInt32")])
 
     def array(da):
-        if da.get("format", "ascii") != "ascii":
-            raise ValueError(f"{path}: only ASCII DataArrays are read")
-        a = np.array(da.text.split(), dtype=float)
         n = int(da.get("NumberOfComponents", "1"))
+        if da.get("format", "ascii") == "ascii":
+            a = np.array(da.text.split(), dtype=float)
+        elif da.get("format") == "appended" and marker:
+            at = int(da.get("offset"))
+            size = int(np.frombuffer(appended, header, 1, at)[0])
+            a = np.frombuffer(appended[at + header.itemsize:at + header.itemsize + size],
+                              VTK_TYPES[da.get("type")]).astype(float)
+        else:
+            raise ValueError(f"{path}: {da.get('format')} DataArrays are not read")
         return a.reshape(-1, n) if n > 1 else a
 
     cells = {da.get("Name"): array(da).astype(int) for da in piece.find("Cells")}
@@ -89,19 +108,27 @@ def fmu_writes_vtk(fmu_path) -> bool:
                and v.causality == "parameter" for v in md.modelVariables)
 
 
-def plot(vtu, title, path):
+def gap_lines(gaps):
+    """(film node positions, support positions, statuses) of the gap lines of ``gaps`` (the
+    gaps .vtu, or an older file holding film and gaps)."""
+    line_idx, lines = cells_of(gaps, VTK_LINE)
+    pts = gaps["points"]
+    status = gaps["cell_data"].get("gap_status")
+    status = status[line_idx] if status is not None else np.ones(len(lines))
+    ends = np.array(lines, dtype=int).reshape(-1, 2)
+    return pts[ends[:, 0]], pts[ends[:, 1]], status
+
+
+def plot(vtu, gaps, title, path):
     plt = archfmu.use_agg()
     from matplotlib import colors
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
     pts = vtu["points"]
     tri_idx, tris = cells_of(vtu, VTK_TRIANGLE)
-    _, lines = cells_of(vtu, VTK_LINE)
     tris = np.array(tris)
     vm = vtu["cell_data"]["von_mises"][tri_idx] / 1e6
-    gap_status = vtu["cell_data"].get("gap_status")
-    support_ids = np.array([l[1] for l in lines])
-    film_ids = np.array([l[0] for l in lines])
+    gap_nodes, supports, gap_status = gap_lines(gaps if gaps is not None else vtu)
     norm = colors.Normalize(vmin=vm.min(), vmax=vm.max())
     cmap = plt.get_cmap("jet")
 
@@ -113,12 +140,12 @@ def plot(vtu, title, path):
                                 linewidths=0.15)
         ax.add_collection3d(poly)
     # Arches: circle through the gap supports, mirrored to the full span.
-    if len(support_ids) >= 3:
-        yc, zc, r = arch_circle(pts[support_ids])
+    if len(supports) >= 3:
+        yc, zc, r = arch_circle(supports)
         half = math.sqrt(max(r ** 2 - zc ** 2, 0.0))  # foot at z = 0
         ys = np.linspace(-half, half, 60)
         zs = zc + np.sqrt(np.maximum(r ** 2 - (ys - yc) ** 2, 0.0))
-        x_arch = pts[support_ids[0], 0]
+        x_arch = supports[0, 0]
         segs = [np.column_stack([np.full_like(ys, sx * x_arch), ys, zs]) for sx in (1, -1)]
         ax.add_collection3d(Line3DCollection(segs, colors="0.25", linewidths=2.5))
     lo, hi = pts.min(axis=0), pts.max(axis=0)
@@ -138,14 +165,11 @@ def plot(vtu, title, path):
     bx = fig.add_subplot(grid[0, 1])
     tpc = bx.tripcolor(pts[:, 0], pts[:, 1], tris, facecolors=vm, cmap=cmap, norm=norm,
                        edgecolors="k", linewidth=0.15)
-    if len(lines):
-        gap_cells = [i for i, t in enumerate(vtu["types"]) if t == VTK_LINE]
-        status = (gap_status[gap_cells] if gap_status is not None
-                  else np.ones(len(gap_cells)))
-        for k, (n, s) in enumerate(zip(film_ids, status)):
+    if len(gap_nodes):
+        for k, (p, s) in enumerate(zip(gap_nodes, gap_status)):
             closed = s > 0
-            bx.plot(pts[n, 0], pts[n, 1], "o", ms=6, mec="k", mfc="w" if not closed else "k")
-            bx.annotate(f"G{k + 1}", (pts[n, 0], pts[n, 1]), textcoords="offset points",
+            bx.plot(p[0], p[1], "o", ms=6, mec="k", mfc="w" if not closed else "k")
+            bx.annotate(f"G{k + 1}", (p[0], p[1]), textcoords="offset points",
                         xytext=(5, -3), fontsize=7)
         bx.plot([], [], "ko", label="gap in contact")
         bx.plot([], [], "o", mec="k", mfc="w", label="gap open")
@@ -176,7 +200,8 @@ def main(argv=None):
     p = archfmu.example_parser(__doc__.splitlines()[0], steps=20)
     p.add_argument("--height", type=float, default=300.0, help="arch height in mm (default 300)")
     p.add_argument("--mu", type=float, default=0.2, help="friction coefficient (default 0.2)")
-    p.add_argument("--vtu", help="plot this .vtu instead of running the analysis")
+    p.add_argument("--vtu", help="plot this film .vtu (and its _gaps_ sibling) instead of "
+                                 "running the analysis")
     p.add_argument("--source", choices=["auto", "fmu", "cli"], default="auto",
                    help="who writes the .vtu: the FMU (its results.directory parameter), the "
                         "CLI (--vtk), or auto: the FMU if it has the parameter (default)")
@@ -193,8 +218,11 @@ def main(argv=None):
         else:
             vtk_dir = Path(tmp) / "vtk"
             archfmu.ramp(height, a.mu, a.steps, backend=source, fmu_path=a.fmu, vtk_dir=vtk_dir)
-            vtu_path = sorted(vtk_dir.glob("*.vtu"))[-1]  # <id>_NNNN.vtu: the last step
+            # <id>_film_NNNN.vtu: the last step
+            vtu_path = sorted(vtk_dir.glob("*_film_*.vtu"))[-1]
         vtu = read_vtu(vtu_path)
+        gaps_path = vtu_path.with_name(vtu_path.name.replace("_film_", "_gaps_"))
+        gaps = read_vtu(gaps_path) if gaps_path != vtu_path and gaps_path.is_file() else None
     source = {"fmu": f"FMU {archfmu.RESULTS_DIRECTORY}", "cli": "CLI --vtk"}.get(source, source)
     rows = element_rows(vtu)
     csv_path = archfmu.write_csv(out / "fig6_stress.csv",
@@ -205,7 +233,7 @@ def main(argv=None):
              f"μ = {a.mu:g}, frame dz = {-a.height / 2:.0f} mm ({a.steps} steps; .vtu from "
              f"{source})")
     png = out / "fig6_stress.png"
-    plot(vtu, title, png)
+    plot(vtu, gaps, title, png)
     print(f"{len(rows)} triangles, von Mises {vm.min():.2f} ... {vm.max():.2f} MPa "
           f"(.vtu from {source})")
     print(f"wrote {png} and {csv_path}")

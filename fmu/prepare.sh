@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Shared by the test runner and the example scripts: builds the crate, packs
 # target/fmu/ParallelArch.fmu, and creates/updates the Python environment .venv/ (fmpy,
-# libcosimpy, numpy, pytest, matplotlib). Idempotent; run from anywhere.
+# libcosimpy, numpy, pytest, matplotlib, meshio). Idempotent; run from anywhere.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 

@@ -55,7 +55,9 @@ options:
                      give it --max-iterations 3000)
   --max-iterations N Newton iterations per increment before it is halved (default 15)
   --csv FILE         write the gap results of every step as CSV
-  --vtk DIR          write the deformed film of every step as VTK (DIR/<model>_NNNN.vtu + .pvd)
+  --vtk DIR          write every step as VTK: DIR/<model>_film_NNNN.vtu (film) and
+                     DIR/<model>_gaps_NNNN.vtu (gap lines), and a .pvd of each for ParaView
+  --vtk-format F     binary (default: raw appended data, about half the size) or ascii
   --quiet            no progress indicator
   -h, --help         this text";
 
@@ -71,6 +73,7 @@ struct Options {
     max_iterations: Option<usize>,
     csv: Option<String>,
     vtk: Option<String>,
+    vtk_format: vtk::Encoding,
     quiet: bool,
 }
 
@@ -87,6 +90,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         max_iterations: None,
         csv: None,
         vtk: None,
+        vtk_format: vtk::Encoding::default(),
         quiet: false,
     };
     let mut it = args.iter();
@@ -140,6 +144,11 @@ fn parse(args: &[String]) -> Result<Options, String> {
             }
             "--csv" => o.csv = Some(value("--csv")?),
             "--vtk" => o.vtk = Some(value("--vtk")?),
+            "--vtk-format" => {
+                o.vtk_format = value("--vtk-format")?
+                    .parse()
+                    .map_err(|e| format!("--vtk-format: {e}"))?
+            }
             "--quiet" => o.quiet = true,
             s if s.starts_with('-') => return Err(format!("unknown option {s}")),
             s if o.command.is_empty() => o.command = s.to_string(),
@@ -201,10 +210,21 @@ fn run(o: &Options) -> Result<(), String> {
         }
         None => None,
     };
+    let (mut vtk_steps, mut vtk_written) = (Vec::new(), VtkWritten::default());
     if let Some(dir) = &o.vtk {
         std::fs::create_dir_all(dir).map_err(|e| format!("{dir}: {e}"))?;
+        // State 0000: the undeformed, prestressed film (as the FMU writes at initialization).
+        vtk_steps.push((0.0, 0));
+        let results = analysis.results();
+        write_vtk(
+            dir,
+            &analysis,
+            &results,
+            &vtk_steps,
+            o.vtk_format,
+            &mut vtk_written,
+        )?;
     }
-    let mut vtk_files = Vec::new();
     let progress = !o.quiet && std::io::stderr().is_terminal();
     let started = std::time::Instant::now();
     let (mut iterations, mut cutbacks, mut enlarged, mut increments) = (Vec::new(), 0, 0, 0);
@@ -220,15 +240,15 @@ fn run(o: &Options) -> Result<(), String> {
         iterations.push(report.total_iterations());
         let results = (o.csv.is_some() || o.vtk.is_some()).then(|| analysis.results());
         if let (Some(dir), Some(results)) = (&o.vtk, &results) {
-            let model = analysis.model();
-            let file = format!("{}_{step:04}.vtu", model.name);
-            let text = vtk::unstructured_grid(model, &analysis.state().displacement, results);
-            std::fs::write(std::path::Path::new(dir).join(&file), text)
-                .map_err(|e| format!("{dir}/{file}: {e}"))?;
-            vtk_files.push((fraction, file));
-            let pvd = std::path::Path::new(dir).join(format!("{}.pvd", model.name));
-            std::fs::write(&pvd, vtk::collection(&vtk_files))
-                .map_err(|e| format!("{}: {e}", pvd.display()))?;
+            vtk_steps.push((fraction, step));
+            write_vtk(
+                dir,
+                &analysis,
+                results,
+                &vtk_steps,
+                o.vtk_format,
+                &mut vtk_written,
+            )?;
         }
         if progress {
             eprint!("\rstep {step}/{} ({:.0}%)", o.steps, 100.0 * fraction);
@@ -266,6 +286,56 @@ fn run(o: &Options) -> Result<(), String> {
         iterations,
         elapsed.as_secs_f64() * 1e3
     );
+    if o.vtk.is_some() {
+        out!(
+            "VTK ({}): {} .vtu files, {:.2} MB, {:.1} ms to encode and write",
+            o.vtk_format.name(),
+            vtk_written.files,
+            vtk_written.bytes as f64 / 1e6,
+            vtk_written.seconds * 1e3
+        );
+    }
+    Ok(())
+}
+
+/// What the VTK output of a run wrote: `.vtu` files, their bytes, and the time spent encoding
+/// and writing them (`.pvd` files included).
+#[derive(Default)]
+struct VtkWritten {
+    files: usize,
+    bytes: usize,
+    seconds: f64,
+}
+
+/// Writes the last state of `steps` (`(fraction, step)` pairs) as the film and gaps `.vtu` files
+/// in `dir` and rewrites both `.pvd` collections.
+fn write_vtk(
+    dir: &str,
+    analysis: &Analysis,
+    results: &Results,
+    steps: &[(f64, usize)],
+    encoding: vtk::Encoding,
+    written: &mut VtkWritten,
+) -> Result<(), String> {
+    let started = std::time::Instant::now();
+    let (model, dir) = (analysis.model(), std::path::Path::new(dir));
+    let step = steps.last().map_or(0, |&(_, k)| k);
+    let u = &analysis.state().displacement;
+    for &block in vtk::Block::of(model) {
+        let file = dir.join(vtk::state_file_name(&model.name, block, step));
+        let bytes = vtk::grid(block, model, u, results, encoding);
+        std::fs::write(&file, &bytes).map_err(|e| format!("{}: {e}", file.display()))?;
+        written.files += 1;
+        written.bytes += bytes.len();
+        let entries: Vec<(f64, String)> = steps
+            .iter()
+            .map(|&(t, k)| (t, vtk::state_file_name(&model.name, block, k)))
+            .collect();
+        let pvd = dir.join(vtk::collection_file_name(&model.name, block));
+        std::fs::write(&pvd, vtk::collection(&entries))
+            .map_err(|e| format!("{}: {e}", pvd.display()))?;
+    }
+    written.seconds += started.elapsed().as_secs_f64();
     Ok(())
 }
 

@@ -41,3 +41,105 @@ fn full_output_still_arrives_when_the_reader_reads_everything() {
     assert!(text.len() > 100_000, "{} bytes", text.len());
     membrane_contact::mech::Model::from_json(&text).unwrap();
 }
+
+/// Runs `membrane-contact specimen --steps 2` with `args` added; (success, stdout, stderr).
+fn specimen(args: &[&str]) -> (bool, String, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["specimen", "--height", "200", "--steps", "2", "--quiet"])
+        .args(args)
+        .output()
+        .unwrap();
+    let text = |b: Vec<u8>| String::from_utf8(b).unwrap();
+    (
+        output.status.success(),
+        text(output.stdout),
+        text(output.stderr),
+    )
+}
+
+#[test]
+fn vtk_writes_film_and_gaps_per_state_from_0000_in_the_chosen_encoding() {
+    let root =
+        std::env::temp_dir().join(format!("membrane-contact-cli-vtk-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    for (format, binary) in [(None, true), (Some("ascii"), false), (Some("binary"), true)] {
+        let dir = root.join(format.unwrap_or("default"));
+        let mut args = vec!["--vtk", dir.to_str().unwrap()];
+        args.extend(format.iter().flat_map(|f| ["--vtk-format", f]));
+        let (ok, out, err) = specimen(&args);
+        assert!(ok, "{err}");
+        assert!(
+            out.contains(&format!(
+                "VTK ({}): 6 .vtu files",
+                if binary { "binary" } else { "ascii" }
+            )),
+            "{out}"
+        );
+        let mut names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        names.sort();
+        let mut expected: Vec<String> = ["film", "gaps"]
+            .iter()
+            .flat_map(|b| {
+                (0..3)
+                    .map(move |k| format!("ParallelArch_{b}_{k:04}.vtu"))
+                    .chain([format!("ParallelArch_{b}.pvd")])
+            })
+            .collect();
+        expected.sort();
+        assert_eq!(names, expected);
+        let film = std::fs::read(dir.join("ParallelArch_film_0002.vtu")).unwrap();
+        let appended = film.windows(13).any(|w| w == b"<AppendedData");
+        assert_eq!(appended, binary, "{format:?}");
+        let pvd = std::fs::read_to_string(dir.join("ParallelArch_gaps.pvd")).unwrap();
+        assert!(pvd.contains("timestep=\"0\" part=\"0\" file=\"ParallelArch_gaps_0000.vtu\""));
+        assert!(pvd.contains("timestep=\"1\" part=\"0\" file=\"ParallelArch_gaps_0002.vtu\""));
+    }
+    let _ = std::fs::remove_dir_all(&root);
+    let (ok, _, err) = specimen(&["--vtk-format", "xml"]);
+    assert!(
+        !ok && err.contains("--vtk-format: unknown VTK format 'xml'"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_model_without_gaps_writes_film_files_only() {
+    let root =
+        std::env::temp_dir().join(format!("membrane-contact-cli-nogap-{}", std::process::id()));
+    std::fs::create_dir_all(&root).unwrap();
+    let mut model = membrane_contact::mech::ParallelArch::with_height(0.2)
+        .model()
+        .unwrap();
+    model.gaps.clear();
+    let file = root.join("film only.json");
+    std::fs::write(&file, serde_json::to_string(&model).unwrap()).unwrap();
+    let dir = root.join("vtk");
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["model", file.to_str().unwrap(), "--steps", "1", "--quiet"])
+        .args(["--vtk", dir.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    let name = &model.name;
+    assert_eq!(
+        names,
+        [
+            format!("{name}_film.pvd"),
+            format!("{name}_film_0000.vtu"),
+            format!("{name}_film_0001.vtu")
+        ]
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

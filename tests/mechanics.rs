@@ -903,63 +903,236 @@ fn gap_frame_rotation_has_the_frame_as_rows() {
     assert!((Vector3::from(f.y) - Vector3::new(-1.0, 0.0, 0.0)).amax() < 1e-15);
 }
 
-#[test]
-fn vtk_output_is_well_formed_and_complete() {
-    use membrane_contact::mech::vtk;
-    let spec = ParallelArch::with_height(0.2);
-    let mut a = Analysis::new(spec.model().unwrap(), SolverSettings::default()).unwrap();
-    a.step_to(&[spec.target()], 4).unwrap();
-    let results = a.results();
-    let text = vtk::unstructured_grid(a.model(), &a.state().displacement, &results);
-    let (points, cells) = (121 + 9, 200 + 9);
-    assert!(text.contains(&format!(
-        "NumberOfPoints=\"{points}\" NumberOfCells=\"{cells}\""
-    )));
-    let mut reader = quick_xml::Reader::from_str(&text);
-    let mut arrays = std::collections::HashMap::new();
-    let mut current = None;
+/// A `.vtu` read back: piece sizes and every data array as numbers (`points` for the unnamed
+/// coordinates), from ASCII or raw appended data.
+struct Vtu {
+    points: usize,
+    cells: usize,
+    arrays: std::collections::HashMap<String, Vec<f64>>,
+}
+
+/// Parses a `.vtu` as `vtk::Encoding` writes it and checks its framing: well-formed XML before
+/// the appended data, one UInt64 byte count per block, offsets that tile the appended bytes.
+fn read_vtu(bytes: &[u8]) -> Vtu {
+    const APPENDED: &[u8] = b"<AppendedData encoding=\"raw\">\n_";
+    let (xml, appended) = match bytes.windows(APPENDED.len()).position(|w| w == APPENDED) {
+        Some(at) => {
+            let tail = &bytes[at + APPENDED.len()..];
+            let end = b"\n</AppendedData>\n</VTKFile>\n";
+            assert!(tail.ends_with(end), "appended data closes the file");
+            let mut xml = String::from_utf8(bytes[..at].to_vec()).unwrap();
+            xml.push_str("</VTKFile>");
+            (xml, &tail[..tail.len() - end.len()])
+        }
+        None => (String::from_utf8(bytes.to_vec()).unwrap(), &[][..]),
+    };
+    let mut reader = quick_xml::Reader::from_str(&xml);
+    let (mut vtu, mut current) = (
+        Vtu {
+            points: 0,
+            cells: 0,
+            arrays: Default::default(),
+        },
+        None,
+    );
+    let mut next_offset = 0;
     loop {
-        match reader.read_event().expect("well-formed XML") {
-            quick_xml::events::Event::Start(e) if e.name().0 == "DataArray" => {
-                let name = e
-                    .try_get_attribute("Name")
-                    .unwrap()
-                    .map(|a| a.value.to_string());
-                current = Some(name.unwrap_or_else(|| "points".into()));
-            }
+        let (e, empty) = match reader.read_event().expect("well-formed XML") {
+            quick_xml::events::Event::Start(e) => (e, false),
+            quick_xml::events::Event::Empty(e) => (e, true),
             quick_xml::events::Event::Text(t) => {
-                if let Some(name) = current.take() {
+                if let Some((name, _)) = current.take() {
                     let values: Vec<f64> = t
                         .into_inner()
                         .split_whitespace()
                         .map(|v| v.parse().unwrap())
                         .collect();
-                    assert!(values.iter().all(|v| v.is_finite()), "{name}");
-                    arrays.insert(name, values.len());
+                    vtu.arrays.insert(name, values);
                 }
+                continue;
             }
             quick_xml::events::Event::Eof => break,
+            _ => continue,
+        };
+        let attribute = |name: &str| {
+            e.try_get_attribute(name)
+                .unwrap()
+                .map(|a| a.value.to_string())
+        };
+        match e.name().0 {
+            "VTKFile" => assert_eq!(attribute("header_type").as_deref(), Some("UInt64")),
+            "Piece" => {
+                vtu.points = attribute("NumberOfPoints").unwrap().parse().unwrap();
+                vtu.cells = attribute("NumberOfCells").unwrap().parse().unwrap();
+            }
+            "DataArray" => {
+                let name = attribute("Name").unwrap_or_else(|| "points".into());
+                let kind = attribute("type").unwrap();
+                match attribute("format").unwrap().as_str() {
+                    "ascii" => current = Some((name, kind)),
+                    "appended" => {
+                        assert!(empty, "{name}: an appended DataArray has no text");
+                        let offset: usize = attribute("offset").unwrap().parse().unwrap();
+                        assert_eq!(offset, next_offset, "{name}: blocks follow each other");
+                        let block = &appended[offset..];
+                        let count = u64::from_le_bytes(block[..8].try_into().unwrap()) as usize;
+                        let data = &block[8..8 + count];
+                        next_offset = offset + 8 + count;
+                        let values: Vec<f64> = match kind.as_str() {
+                            "Float64" => data
+                                .chunks_exact(8)
+                                .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+                                .collect(),
+                            "Int64" => data
+                                .chunks_exact(8)
+                                .map(|b| i64::from_le_bytes(b.try_into().unwrap()) as f64)
+                                .collect(),
+                            "Int32" => data
+                                .chunks_exact(4)
+                                .map(|b| i32::from_le_bytes(b.try_into().unwrap()) as f64)
+                                .collect(),
+                            "UInt8" => data.iter().map(|&b| b as f64).collect(),
+                            other => panic!("{name}: type {other}"),
+                        };
+                        vtu.arrays.insert(name, values);
+                    }
+                    other => panic!("{name}: format {other}"),
+                }
+            }
             _ => {}
         }
     }
-    assert_eq!(arrays["points"], 3 * points);
-    assert_eq!(arrays["displacement"], 3 * points);
-    assert_eq!(arrays["connectivity"], 3 * 200 + 2 * 9);
-    for name in [
-        "von_mises",
-        "principal_1",
-        "principal_2",
-        "gap_slip_x",
-        "gap_normal_force",
-        "gap_status",
-        "wrinkling_state",
-        "types",
-        "offsets",
-    ] {
-        assert_eq!(arrays[name], cells, "{name}");
+    assert_eq!(
+        next_offset,
+        appended.len(),
+        "the blocks fill the appended data"
+    );
+    vtu
+}
+
+/// The specimen (200 mm) after 4 increments to its target, and its results.
+fn specimen_state() -> (Analysis, membrane_contact::mech::Results) {
+    let spec = ParallelArch::with_height(0.2);
+    let mut a = Analysis::new(spec.model().unwrap(), SolverSettings::default()).unwrap();
+    a.step_to(&[spec.target()], 4).unwrap();
+    let results = a.results();
+    (a, results)
+}
+
+#[test]
+fn vtk_film_and_gap_files_are_complete_without_placeholders() {
+    use membrane_contact::mech::vtk::{self, Encoding};
+    let (a, results) = specimen_state();
+    let (model, u) = (a.model(), &a.state().displacement);
+    for encoding in [Encoding::Ascii, Encoding::Binary] {
+        let film = read_vtu(&vtk::film_grid(model, u, &results, encoding));
+        assert_eq!((film.points, film.cells), (121, 200), "{encoding:?}");
+        let arrays = &film.arrays;
+        assert!(arrays.values().flatten().all(|v| v.is_finite()));
+        assert_eq!(arrays["points"].len(), 3 * 121);
+        assert_eq!(arrays["displacement"].len(), 3 * 121);
+        assert_eq!(arrays["connectivity"].len(), 3 * 200);
+        assert!(arrays["types"].iter().all(|&t| t == 5.0));
+        for name in [
+            "offsets",
+            "von_mises",
+            "principal_1",
+            "principal_2",
+            "principal_strain_1",
+            "principal_strain_2",
+            "wrinkling_state",
+        ] {
+            assert_eq!(arrays[name].len(), 200, "{name}");
+        }
+        for name in ["stress", "strain", "tension_direction"] {
+            assert_eq!(arrays[name].len(), 3 * 200, "{name}");
+        }
+        assert!(arrays["wrinkling_state"].iter().all(|&s| s >= 0.0));
+        assert!(
+            arrays["von_mises"].iter().all(|&s| s > 0.0),
+            "no zero filler"
+        );
+
+        let gaps = read_vtu(&vtk::gap_grid(model, u, &results, encoding));
+        assert_eq!((gaps.points, gaps.cells), (18, 9), "{encoding:?}");
+        let arrays = &gaps.arrays;
+        assert!(arrays["types"].iter().all(|&t| t == 3.0));
+        let lines: Vec<f64> = (0..9).flat_map(|k| [k as f64, 9.0 + k as f64]).collect();
+        assert_eq!(arrays["connectivity"], lines);
+        for (k, g) in model.gaps.iter().enumerate() {
+            assert_eq!(arrays["film_node"][k], g.film_node as f64);
+            let n = g.film_node;
+            for i in 0..3 {
+                assert_eq!(
+                    arrays["points"][3 * k + i],
+                    model.nodes[n][i] + u[3 * n + i]
+                );
+            }
+            let r = &results.gaps[k];
+            assert_eq!(arrays["gap_slip_x"][k], r.slip_x);
+            assert_eq!(arrays["gap_normal_force"][k], r.normal_force);
+            assert_eq!(arrays["gap_status"][k], r.status as i32 as f64);
+        }
+        for name in ["gap_slip_y", "gap_friction_force"] {
+            assert_eq!(arrays[name].len(), 9, "{name}");
+        }
+        assert!(!arrays.contains_key("von_mises") && !arrays.contains_key("displacement"));
     }
-    assert_eq!(arrays["tension_direction"], 3 * cells);
     assert!(vtk::collection(&[(0.5, "a.vtu".into())]).contains("timestep=\"0.5\""));
+    assert_eq!(
+        vtk::state_file_name("M", vtk::Block::Gaps, 7),
+        "M_gaps_0007.vtu"
+    );
+    assert_eq!(
+        vtk::collection_file_name("M", vtk::Block::Film),
+        "M_film.pvd"
+    );
+}
+
+#[test]
+fn binary_vtu_round_trips_points_and_fields() {
+    use membrane_contact::mech::vtk::{self, Encoding};
+    let (a, results) = specimen_state();
+    let (model, u) = (a.model(), &a.state().displacement);
+    let binary = vtk::film_grid(model, u, &results, Encoding::Binary);
+    let ascii = vtk::film_grid(model, u, &results, Encoding::Ascii);
+    let (b, t) = (read_vtu(&binary), read_vtu(&ascii));
+    // ASCII writes shortest round-trip floats: both encodings hold the same bits.
+    assert_eq!(b.arrays, t.arrays);
+    let points: Vec<f64> = model
+        .nodes
+        .iter()
+        .flatten()
+        .zip(u)
+        .map(|(x, u)| x + u)
+        .collect();
+    assert_eq!(b.arrays["points"], points);
+    assert_eq!(b.arrays["displacement"], u[..3 * model.nodes.len()]);
+    let field = |f: fn(&membrane_contact::mech::element::ElementStress) -> Vec<f64>| -> Vec<f64> {
+        results.elements.iter().flat_map(f).collect()
+    };
+    assert_eq!(b.arrays["von_mises"], field(|e| vec![e.von_mises]));
+    assert_eq!(b.arrays["stress"], field(|e| e.stress.to_vec()));
+    assert_eq!(b.arrays["strain"], field(|e| e.strain.to_vec()));
+    // Principal strains: invariants of the Voigt strain (trace, and e1 ≥ e2).
+    for (e, s) in results.elements.iter().enumerate() {
+        let (e1, e2) = (
+            b.arrays["principal_strain_1"][e],
+            b.arrays["principal_strain_2"][e],
+        );
+        assert!(e1 >= e2 && (e1 + e2 - s.strain[0] - s.strain[1]).abs() < 1e-15);
+        let det = s.strain[0] * s.strain[1] - 0.25 * s.strain[2] * s.strain[2];
+        assert!((e1 * e2 - det).abs() < 1e-12 * (e1 * e1 + e2 * e2).max(1e-30));
+    }
+    assert!(
+        binary.len() * 3 < ascii.len() * 2,
+        "binary {} bytes, ascii {} bytes",
+        binary.len(),
+        ascii.len()
+    );
+    let gaps = vtk::gap_grid(model, u, &results, Encoding::Binary);
+    let ascii_gaps = vtk::gap_grid(model, u, &results, Encoding::Ascii);
+    assert_eq!(read_vtu(&gaps).arrays, read_vtu(&ascii_gaps).arrays);
 }
 
 /// A small deterministic generator (xorshift) so the randomized checks are reproducible.
@@ -1232,11 +1405,13 @@ fn over_contracted_stretch_is_uniaxial_tension() {
         let right = edge_reaction(a.model(), &results.reactions, |p| {
             (p[0] - 1.0).abs() < 1e-12
         });
-        let text = membrane_contact::mech::vtk::unstructured_grid(
+        let text = membrane_contact::mech::vtk::film_grid(
             a.model(),
             &a.state().displacement,
             &results,
+            membrane_contact::mech::vtk::Encoding::Ascii,
         );
+        let text = String::from_utf8(text).unwrap();
         (results, right, text)
     };
     let (results, right, text) = run(Wrinkling::TensionField);

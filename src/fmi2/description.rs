@@ -313,8 +313,11 @@ set a smaller change and call <code>fmi2DoStep</code> again from the same time.<
 (and reports an invalid value with <code>fmi2Error</code>).</li>
 <li>FMU states can be saved, restored and serialized (<code>canGetAndSetFMUstate</code>, <code>canSerializeFMUstate</code>).</li>
 <li><code>results.directory</code> (set with <code>fmi2SetString</code> before <code>fmi2ExitInitializationMode</code>):
-the instance writes <code>&lt;dir&gt;/{id}_NNNN.vtu</code> for the initial state (0000) and after every step, and
-rewrites <code>&lt;dir&gt;/{id}.pvd</code> (open it in ParaView). A failed write returns <code>fmi2Warning</code>; the step is kept.</li>
+the instance writes <code>&lt;dir&gt;/{id}_film_NNNN.vtu</code> (film: displacement, stresses, strains, wrinkling) and
+<code>&lt;dir&gt;/{id}_gaps_NNNN.vtu</code> (gap lines: slip, forces, status) for the initial state (0000) and after every step, and
+rewrites <code>&lt;dir&gt;/{id}_film.pvd</code> and <code>&lt;dir&gt;/{id}_gaps.pvd</code> (open them in ParaView).
+<code>results.vtkFormat</code>: <code>binary</code> (raw appended data, the default) or <code>ascii</code>.
+A failed write returns <code>fmi2Warning</code>; the step is kept.</li>
 </ul>
 <h2>Variables</h2>
 <table>

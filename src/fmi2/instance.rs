@@ -32,16 +32,17 @@
 //!   kept), and a deserialized state is checked against the model its parameters give
 //!   (`state::check_analysis_state`) at `fmi2DeSerializeFMUstate` already.
 //! * `results.directory` (String parameter, "" = off): after `fmi2ExitInitializationMode` and
-//!   after every successful `fmi2DoStep` the instance writes `<dir>/<id>_NNNN.vtu` (NNNN = 0000
-//!   for the initial state, then the number of steps since initialization) and rewrites
-//!   `<dir>/<id>.pvd` listing every file written so far with its time (`<id>` =
-//!   `modelIdentifier`; the directory is created if missing, a relative one is relative to the
-//!   importer's working directory). A failed write is logged and returns `fmi2Warning`: the step
-//!   (or initialization) itself stands. FMU states hold the step count and the file list, so after
-//!   `fmi2SetFMUstate` the next step writes the file that follows the restored state (overwriting
-//!   the one of the abandoned branch) and the `.pvd` lists that branch only; until that step the
-//!   `.pvd` on disk is the old one, and files of the abandoned branch beyond it stay on disk.
-//!   `fmi2Reset` empties the list. Instances of one FMU writing to one directory overwrite each
+//!   after every successful `fmi2DoStep` the instance writes `<dir>/<id>_film_NNNN.vtu` and
+//!   `<dir>/<id>_gaps_NNNN.vtu` (NNNN = 0000 for the initial state, then the number of steps
+//!   since initialization; encoded as `results.vtkFormat` says) and rewrites
+//!   `<dir>/<id>_film.pvd` and `<dir>/<id>_gaps.pvd` listing every state written so far with its
+//!   time (`<id>` = `modelIdentifier`; the directory is created if missing, a relative one is
+//!   relative to the importer's working directory). A failed write is logged and returns
+//!   `fmi2Warning`: the step (or initialization) itself stands. FMU states hold the step count
+//!   and the list of states written, so after `fmi2SetFMUstate` the next step writes the files
+//!   that follow the restored state (overwriting those of the abandoned branch) and the `.pvd`
+//!   files list that branch only; until that step the `.pvd` files on disk are the old ones, and
+//!   files of the abandoned branch beyond it stay on disk. `fmi2Reset` empties the list. Instances of one FMU writing to one directory overwrite each
 //!   other's files: give each its own directory.
 //! * `fmi2GetString` returns pointers into buffers of the instance that stay valid until the next
 //!   `fmi2GetString` on the instance or `fmi2FreeInstance` (FMI 2.0 only promises "until the next
@@ -218,8 +219,9 @@ pub struct Instance {
     outputs_fresh: bool,
     /// Successful steps since initialization: the number of the next VTK file.
     steps: usize,
-    /// The VTK files written since initialization, with their times (what the `.pvd` lists).
-    vtk_files: Vec<(f64, String)>,
+    /// The states written as VTK since initialization: `(time, state number)` (what the
+    /// `.pvd` files list).
+    vtk_steps: Vec<(f64, usize)>,
     /// The strings handed out by the last `fmi2GetString`; the pointers stay valid until the
     /// next `fmi2GetString` replaces them (or the instance is freed).
     strings_out: Vec<CString>,
@@ -299,7 +301,7 @@ impl Instance {
             analysis: None,
             outputs_fresh: false,
             steps: 0,
-            vtk_files: Vec::new(),
+            vtk_steps: Vec::new(),
             strings_out: Vec::new(),
             states: HashMap::new(),
             discarded: None,
@@ -363,7 +365,7 @@ impl Instance {
         self.initial_outputs()?;
         self.phase = Phase::StepComplete;
         self.steps = 0;
-        self.vtk_files.clear();
+        self.vtk_steps.clear();
         self.event(|| {
             let m = self.analysis.as_ref().map(|b| b.analysis.model());
             let (nodes, gaps) = m.map_or((0, 0), |m| (m.nodes.len(), m.gaps.len()));
@@ -396,7 +398,7 @@ impl Instance {
         self.analysis = None;
         self.outputs_fresh = false;
         self.steps = 0;
-        self.vtk_files.clear();
+        self.vtk_steps.clear();
         self.discarded = None;
         Ok(())
     }
@@ -506,6 +508,10 @@ impl Instance {
             let v = self.settable(vr, VarType::String)?;
             if v.binding == Binding::FrictionLaw && !x.is_empty() {
                 x.parse::<crate::mech::FrictionLaw>()
+                    .map_err(|e| Failure::error(format!("{}: {e}", v.name)))?;
+            }
+            if v.binding == Binding::VtkFormat {
+                x.parse::<vtk::Encoding>()
                     .map_err(|e| Failure::error(format!("{}: {e}", v.name)))?;
             }
         }
@@ -905,29 +911,55 @@ impl Instance {
             })
     }
 
-    /// Writes the converged state as `<dir>/<id>_NNNN.vtu` (NNNN = steps since initialization)
-    /// and rewrites `<dir>/<id>.pvd`, if `results.directory` is set. A failure is a warning:
-    /// the analysis, time and outputs stand; a `.vtu` that could not be written is not listed.
+    /// The value of `results.vtkFormat` (checked when it was set).
+    fn vtk_encoding(&self) -> vtk::Encoding {
+        self.description
+            .variables
+            .iter()
+            .zip(&self.values)
+            .find_map(|(v, x)| match (v.binding, x) {
+                (Binding::VtkFormat, Value::String(name)) => name.parse().ok(),
+                _ => None,
+            })
+            .unwrap_or_default()
+    }
+
+    /// Writes the converged state as `<dir>/<id>_film_NNNN.vtu` and `<dir>/<id>_gaps_NNNN.vtu`
+    /// (NNNN = steps since initialization) and rewrites `<dir>/<id>_film.pvd` and
+    /// `<dir>/<id>_gaps.pvd`, if `results.directory` is set. A failure is a warning: the
+    /// analysis, time and outputs stand; a state whose files could not be written is not listed.
     fn write_results(&mut self) -> Outcome {
+        let encoding = self.vtk_encoding();
         let (Some(dir), Some(built)) = (self.results_directory(), self.analysis.as_mut()) else {
             return Ok(());
         };
         let id = &self.description.model_identifier;
-        let file = format!("{id}_{:04}.vtu", self.steps);
+        let step = self.steps;
         let a = &mut built.analysis;
         let results = a.results();
-        let vtu = dir.join(&file);
         let written = std::fs::create_dir_all(&dir)
             .map_err(|e| format!("cannot create {}: {e}", dir.display()))
             .and_then(|()| {
-                let text = vtk::unstructured_grid(a.model(), &a.state().displacement, &results);
-                std::fs::write(&vtu, text).map_err(|e| format!("{}: {e}", vtu.display()))
+                vtk::Block::of(a.model()).iter().try_for_each(|&block| {
+                    let vtu = dir.join(vtk::state_file_name(id, block, step));
+                    let u = &a.state().displacement;
+                    std::fs::write(&vtu, vtk::grid(block, a.model(), u, &results, encoding))
+                        .map_err(|e| format!("{}: {e}", vtu.display()))
+                })
             });
-        let pvd = dir.join(format!("{id}.pvd"));
         let outcome = written.and_then(|()| {
-            self.vtk_files.push((self.time, file));
-            replace_file(&pvd, &vtk::collection(&self.vtk_files))
-                .map_err(|e| format!("{}: {e}", pvd.display()))
+            self.vtk_steps.push((self.time, step));
+            let blocks = vtk::Block::of(built.analysis.model());
+            blocks.iter().try_for_each(|&block| {
+                let entries: Vec<(f64, String)> = self
+                    .vtk_steps
+                    .iter()
+                    .map(|&(t, k)| (t, vtk::state_file_name(id, block, k)))
+                    .collect();
+                let pvd = dir.join(vtk::collection_file_name(id, block));
+                replace_file(&pvd, &vtk::collection(&entries))
+                    .map_err(|e| format!("{}: {e}", pvd.display()))
+            })
         });
         outcome.map_err(|e| {
             Failure::warning(format!(
@@ -990,7 +1022,7 @@ impl Instance {
             outputs_fresh: self.outputs_fresh,
             analysis: self.analysis.as_ref().map(|b| b.analysis.state().clone()),
             steps: self.steps,
-            vtk_files: self.vtk_files.clone(),
+            vtk_steps: self.vtk_steps.clone(),
         }
     }
 
@@ -1015,9 +1047,15 @@ impl Instance {
             }
         }
         let times = [s.time, s.start_time, s.stop_time.unwrap_or(0.0)];
-        let file_times = s.vtk_files.iter().map(|(t, _)| *t);
+        let file_times = s.vtk_steps.iter().map(|(t, _)| *t);
         if times.into_iter().chain(file_times).any(|t| !t.is_finite()) {
             return Err("the state's times are not finite".into());
+        }
+        if s.vtk_steps.iter().any(|&(_, k)| k > s.steps) {
+            return Err(format!(
+                "the state lists VTK output beyond its {} steps",
+                s.steps
+            ));
         }
         let needs_analysis = matches!(
             s.phase,
@@ -1082,7 +1120,7 @@ impl Instance {
         self.discarded = None;
         self.outputs_fresh = s.outputs_fresh && self.analysis.is_some();
         self.steps = s.steps;
-        self.vtk_files = s.vtk_files.clone();
+        self.vtk_steps = s.vtk_steps.clone();
         Ok(())
     }
 

@@ -3,10 +3,12 @@
 //! A [`Snapshot`] holds everything a restored instance needs to continue exactly as the original
 //! would: the phase, every variable value (parameters, inputs, the last outputs and solver
 //! statistics), the time, the experiment setup, the converged [`AnalysisState`], and the VTK
-//! output written so far (step count and file list, so the `.pvd` continues from the state).
+//! output written so far (step count and the states written, so the `.pvd` files continue from
+//! the state).
 //!
-//! Serialized form (little endian), version 2 (version 1 had no String values and no VTK
-//! output; its states are refused, as they came from an FMU with another GUID anyway):
+//! Serialized form (little endian), version 3 (version 1 had no String values and no VTK
+//! output, version 2 listed VTK file names instead of state numbers; their states are refused,
+//! as they came from an FMU with another GUID anyway):
 //!
 //! | bytes | content |
 //! |---|---|
@@ -47,12 +49,13 @@ pub struct Snapshot {
     pub analysis: Option<AnalysisState>,
     /// Successful steps since initialization (the number of the next VTK file).
     pub steps: usize,
-    /// The VTK files written since initialization and their times (the `.pvd` entries).
-    pub vtk_files: Vec<(f64, String)>,
+    /// The states written as VTK since initialization: `(time, state number)` (the `.pvd`
+    /// entries).
+    pub vtk_steps: Vec<(f64, usize)>,
 }
 
 const MAGIC: &[u8; 8] = b"MCFMI2ST";
-const VERSION: u32 = 2;
+const VERSION: u32 = 3;
 
 /// The serialized bytes of `snapshot` for the FMU with `guid`.
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
@@ -297,7 +300,7 @@ mod tests {
             outputs_fresh: true,
             analysis: Some(converged_state()),
             steps: 7,
-            vtk_files: vec![(0.0, "M_0000.vtu".into()), (0.1 + 0.2, "M_0007.vtu".into())],
+            vtk_steps: vec![(0.0, 0), (0.1 + 0.2, 7)],
         }
     }
 

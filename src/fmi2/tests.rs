@@ -827,14 +827,27 @@ fn pvd_entries(path: &std::path::Path) -> Vec<(f64, String)> {
 /// Checks that `dir` holds the listed `.vtu` files, each a complete VTK file.
 fn assert_vtu_files(dir: &std::path::Path, entries: &[(f64, String)]) {
     for (_, file) in entries {
-        let text =
-            std::fs::read_to_string(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
-        assert!(text.contains("<UnstructuredGrid"), "{file}");
-        assert!(
-            text.trim_end().ends_with("</VTKFile>"),
-            "{file} is complete"
+        let bytes = std::fs::read(dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let head = String::from_utf8_lossy(&bytes[..bytes.len().min(300)]).into_owned();
+        assert!(head.contains("<UnstructuredGrid"), "{file}");
+        assert!(bytes.ends_with(b"</VTKFile>\n"), "{file} is complete");
+    }
+}
+
+/// The `.pvd` entries of the film and the gaps in `dir`, checked to list the same states.
+fn film_and_gap_entries(dir: &std::path::Path) -> Vec<(f64, String)> {
+    let film = pvd_entries(&dir.join("ParallelArch_film.pvd"));
+    let gaps = pvd_entries(&dir.join("ParallelArch_gaps.pvd"));
+    assert_eq!(film.len(), gaps.len());
+    for ((t, f), (tg, g)) in film.iter().zip(&gaps) {
+        assert_eq!(
+            (t, g.as_str()),
+            (tg, f.replace("_film_", "_gaps_").as_str())
         );
     }
+    assert_vtu_files(dir, &film);
+    assert_vtu_files(dir, &gaps);
+    film
 }
 
 #[test]
@@ -846,30 +859,67 @@ fn results_directory_writes_every_step_as_vtk() {
     assert_eq!(fmu.initialized_with_output(&dir), 0, "{:?}", log.take());
     assert_eq!(fmu.string("results.directory"), dir.to_str().unwrap());
     fmu.ramp(0, 3, 10);
-    let pvd = dir.join("ParallelArch.pvd");
-    let entries = pvd_entries(&pvd);
+    let entries = film_and_gap_entries(&dir);
     let files: Vec<&str> = entries.iter().map(|(_, f)| f.as_str()).collect();
     assert_eq!(
         files,
         [
-            "ParallelArch_0000.vtu",
-            "ParallelArch_0001.vtu",
-            "ParallelArch_0002.vtu",
-            "ParallelArch_0003.vtu"
+            "ParallelArch_film_0000.vtu",
+            "ParallelArch_film_0001.vtu",
+            "ParallelArch_film_0002.vtu",
+            "ParallelArch_film_0003.vtu"
         ]
     );
     for (k, (t, _)) in entries.iter().enumerate() {
         assert!((t - k as f64 / 10.0).abs() < 1e-12, "entry {k}: t = {t}");
     }
     assert_eq!(entries[3].0, fmu.real("time"));
-    assert_vtu_files(&dir, &entries);
-    assert!(!dir.join("ParallelArch.pvd.tmp").exists());
+    assert!(!dir.join("ParallelArch_film.pvd.tmp").exists());
+    // The default encoding is binary (raw appended data).
+    let last = std::fs::read(dir.join("ParallelArch_film_0003.vtu")).unwrap();
+    assert!(
+        last.windows(29)
+            .any(|w| w == b"<AppendedData encoding=\"raw\">")
+    );
     // The parameter is fixed once initialized.
     assert_eq!(
         fmu.set_string("results.directory", "elsewhere"),
         Status::Error.raw()
     );
     assert!(log.contains(Status::Error, "results.directory is a fixed parameter"));
+}
+
+#[test]
+fn vtk_format_ascii_writes_text_and_an_unknown_format_is_refused() {
+    let (u, log) = (Unpacked::specimen("vtk ascii"), Log::default());
+    let dir = u.dir.parent().unwrap().join("vtk ascii");
+    let fmu = Fmu::new(&u, &log);
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(fmu.string("results.vtkFormat"), "binary");
+    assert_eq!(
+        fmu.set_string("results.vtkFormat", "Binary"),
+        Status::Error.raw()
+    );
+    assert!(log.contains(Status::Error, "unknown VTK format 'Binary'"));
+    assert_eq!(fmu.string("results.vtkFormat"), "binary", "unchanged");
+    assert_eq!(fmu.set_string("results.vtkFormat", "ascii"), 0);
+    assert_eq!(
+        fmu.set_string("results.directory", dir.to_str().unwrap()),
+        0
+    );
+    assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+    fmu.ramp(0, 1, 10);
+    for file in ["ParallelArch_film_0001.vtu", "ParallelArch_gaps_0001.vtu"] {
+        let text = std::fs::read_to_string(dir.join(file)).unwrap();
+        assert!(
+            text.contains("format=\"ascii\"") && !text.contains("AppendedData"),
+            "{file}"
+        );
+    }
+    assert_eq!(film_and_gap_entries(&dir).len(), 2);
 }
 
 #[test]
@@ -934,38 +984,36 @@ fn a_restored_state_continues_the_pvd_and_reset_starts_it_again() {
     let mut state: Fmi2FmuState = std::ptr::null_mut();
     assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
     fmu.ramp(1, 4, 10);
-    let pvd = dir.join("ParallelArch.pvd");
-    assert_eq!(pvd_entries(&pvd).len(), 5);
-    let long_branch = std::fs::read_to_string(dir.join("ParallelArch_0002.vtu")).unwrap();
+    assert_eq!(film_and_gap_entries(&dir).len(), 5);
+    let long_branch = std::fs::read(dir.join("ParallelArch_film_0002.vtu")).unwrap();
 
     // Back to t = 0.1 (step 1) and another input: step 2 again, file 0002 rewritten.
     assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, state) }, 0);
     assert_eq!(fmu.set_real("frame.dz", -0.001), 0);
     assert_eq!(fmu.step(0.1, 0.1), 0);
-    let entries = pvd_entries(&pvd);
+    let entries = film_and_gap_entries(&dir);
     let files: Vec<&str> = entries.iter().map(|(_, f)| f.as_str()).collect();
     assert_eq!(
         files,
         [
-            "ParallelArch_0000.vtu",
-            "ParallelArch_0001.vtu",
-            "ParallelArch_0002.vtu"
+            "ParallelArch_film_0000.vtu",
+            "ParallelArch_film_0001.vtu",
+            "ParallelArch_film_0002.vtu"
         ]
     );
     assert!((entries[2].0 - 0.2).abs() < 1e-12);
     assert_ne!(
-        std::fs::read_to_string(dir.join("ParallelArch_0002.vtu")).unwrap(),
+        std::fs::read(dir.join("ParallelArch_film_0002.vtu")).unwrap(),
         long_branch
     );
-    assert_vtu_files(&dir, &entries);
     assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
 
     // Reset: the parameter is back to "" (no output) and the list starts again.
     assert_eq!(unsafe { fmi2_reset(fmu.c) }, 0);
     assert_eq!(fmu.initialized_with_output(&dir), 0);
     assert_eq!(
-        pvd_entries(&pvd),
-        [(0.0, "ParallelArch_0000.vtu".to_string())]
+        film_and_gap_entries(&dir),
+        [(0.0, "ParallelArch_film_0000.vtu".to_string())]
     );
     assert_eq!(unsafe { fmi2_reset(fmu.c) }, 0);
     unsafe {
@@ -1182,6 +1230,10 @@ fn forged_states_are_refused_at_deserialization_with_a_message() {
         (
             analysis(|a| a.status[8] = crate::mech::GapStatus::Slip),
             "status of gap 'G9' is Slip",
+        ),
+        (
+            Box::new(|s| s.vtk_steps.push((0.5, s.steps + 1))),
+            "VTK output beyond its 4 steps",
         ),
     ];
     for (f, expected) in cases {

@@ -19,6 +19,7 @@
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap; start: the model's when uniform, else "" (each gap keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
+//! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
 //! | `<gap>.frictionX/.frictionY` | Real | output | N | friction force on the film, local x, y (signed) |
 //! | `<gap>.status` | Integer | output | | 0 open, 1 stick, 2 slip |
@@ -166,6 +167,9 @@ pub enum Binding {
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
     /// it does not change the analysis, and no output depends on it.
     ResultsDirectory,
+    /// Encoding of the VTK files (a String parameter, `binary` or `ascii`). Not a model
+    /// parameter either.
+    VtkFormat,
     SlipX(usize),
     SlipY(usize),
     NormalForce(usize),
@@ -205,10 +209,11 @@ pub struct Variable {
 }
 
 impl Variable {
-    /// Whether the variable is a parameter of the analysis (everything but `results.directory`):
+    /// Whether the variable is a parameter of the analysis (everything but `results.*`):
     /// changing one rebuilds the analysis, and the outputs' initial values depend on them.
     pub fn is_model_parameter(&self) -> bool {
-        self.causality == Causality::Parameter && self.binding != Binding::ResultsDirectory
+        self.causality == Causality::Parameter
+            && !matches!(self.binding, Binding::ResultsDirectory | Binding::VtkFormat)
     }
 
     /// `initial` as written in the XML (`None`: omitted, the default applies).
@@ -454,8 +459,15 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "results.directory",
         Value::String(String::new()),
         None,
-        "directory for VTK output of every communication step (ParaView .vtu + .pvd); empty: none",
+        "directory for VTK output of every communication step (film and gaps .vtu + .pvd); empty: none",
         Binding::ResultsDirectory,
+    );
+    table.parameter(
+        "results.vtkFormat",
+        Value::String(crate::mech::vtk::Encoding::default().name().into()),
+        None,
+        "encoding of the VTK files: binary (raw appended data, about half the size) or ascii",
+        Binding::VtkFormat,
     );
 
     for (i, g) in model.gaps.iter().enumerate() {
@@ -753,6 +765,9 @@ mod tests {
         );
         assert_eq!(dir.start, Some(Value::String(String::new())));
         assert!(!dir.is_model_parameter() && find("film.E").is_model_parameter());
+        let format = find("results.vtkFormat");
+        assert_eq!(format.start, Some(Value::String("binary".into())));
+        assert!(!format.is_model_parameter());
         let outputs = table
             .iter()
             .filter(|v| v.causality == Causality::Output)

@@ -1,127 +1,217 @@
-//! VTK output of the deformed film (the paper's Fig. 6): a ParaView-readable XML unstructured
-//! grid (`.vtu`) per state and a `.pvd` collection over pseudo-time. Text only; the caller
-//! writes the files.
+//! VTK output of the deformed film (the paper's Fig. 6): ParaView- and meshio-readable XML
+//! unstructured grids (`.vtu`) per state, one for the film and one for the gaps, and a `.pvd`
+//! collection of each over pseudo-time. Bytes only; the caller writes the files.
 //!
-//! Points are the deformed node positions followed by one point per gap support. Cells are the
-//! triangles (VTK type 5) followed by one line (type 3) per gap from its film node to its
-//! support. Point data: `displacement`. Cell data (triangles | gaps): `von_mises`,
-//! `principal_1`, `principal_2`, `stress` (σx, σy, τxy in the element frame) | zero, and
-//! `gap_slip_x`, `gap_slip_y`, `gap_normal_force`, `gap_friction_force`, `gap_status`
-//! (0 open, 1 stick, 2 slip) | zero / −1 on triangles; `wrinkling_state` (0 taut, 1 wrinkled,
-//! 2 slack) | −1, and `tension_direction` (unit vector along the tension rays of a wrinkled
-//! triangle, global axes, deformed film; zero when taut or slack) | zero.
+//! The film and the gaps are separate grids so that no array carries placeholders (a colour
+//! range over von Mises stress sees triangles only):
+//!
+//! * **film** ([`Block::Film`]): points are the deformed node positions, cells the triangles
+//!   (VTK type 5). Point data `displacement`. Cell data `von_mises`, `principal_1`,
+//!   `principal_2` (Pa), `stress` (σx, σy, τxy in the element frame), `strain` (Green–Lagrange
+//!   εx, εy, γxy in the element frame), `principal_strain_1`, `principal_strain_2`,
+//!   `wrinkling_state` (0 taut, 1 wrinkled, 2 slack) and `tension_direction` (unit vector along
+//!   the tension rays of a wrinkled triangle, global axes, deformed film; zero when taut or slack).
+//! * **gaps** ([`Block::Gaps`]): points are the deformed positions of the gaps' film nodes
+//!   (point `k` for gap `k`) followed by their support points (point `G + k`), cells one line
+//!   (VTK type 3) per gap from film node to support. Cell data `film_node` (index of the gap's
+//!   node in the film grid), `gap_slip_x`, `gap_slip_y` (m), `gap_normal_force`,
+//!   `gap_friction_force` (N) and `gap_status` (0 open, 1 stick, 2 slip). Written only when the
+//!   model has gaps ([`Block::of`]).
+//!
+//! [`Encoding::Ascii`] writes the values as text in the `DataArray` elements;
+//! [`Encoding::Binary`] writes them after the XML as `<AppendedData encoding="raw">`: a `_`, then
+//! per array a UInt64 byte count and the little-endian values, each `DataArray` giving the offset
+//! of its block from the first byte after the `_` (the VTK XML format with
+//! `header_type="UInt64"`). Raw appended data is not well-formed XML; VTK, ParaView and meshio
+//! read it.
 
 use std::fmt::Write;
+use std::str::FromStr;
 
 use super::model::{GapSupport, Model};
 use super::solver::Results;
 
-/// The `.vtu` text of one state (`displacement`: three per node).
-pub fn unstructured_grid(model: &Model, displacement: &[f64], results: &Results) -> String {
-    let nodes = model.nodes.len();
-    let mut points = Vec::with_capacity(nodes + model.gaps.len());
-    for (i, p) in model.nodes.iter().enumerate() {
-        points.push([
-            p[0] + displacement[3 * i],
-            p[1] + displacement[3 * i + 1],
-            p[2] + displacement[3 * i + 2],
-        ]);
+/// How the values of the data arrays are stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// As text inside the XML (readable, about three times the size).
+    Ascii,
+    /// Raw little-endian bytes appended after the XML.
+    #[default]
+    Binary,
+}
+
+impl Encoding {
+    /// The name of the setting (`ascii`, `binary`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Ascii => "ascii",
+            Self::Binary => "binary",
+        }
     }
-    for g in &model.gaps {
-        points.push(match &g.support {
-            GapSupport::Point(p) => *p,
-            GapSupport::Node(b) => points[*b],
-        });
+}
+
+impl FromStr for Encoding {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "ascii" => Ok(Self::Ascii),
+            "binary" => Ok(Self::Binary),
+            other => Err(format!("unknown VTK format '{other}' (ascii or binary)")),
+        }
     }
-    let (tris, gaps) = (model.triangles.len(), model.gaps.len());
-    let mut s = String::with_capacity(200 * (points.len() + tris));
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n");
-    let _ = writeln!(
-        s,
-        "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",
-        points.len(),
-        tris + gaps
-    );
-    s.push_str(
-        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-    );
-    for p in &points {
-        let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
+}
+
+/// The two grids of a state, each in its own files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Block {
+    /// The film triangles.
+    Film,
+    /// The gap lines.
+    Gaps,
+}
+
+impl Block {
+    /// Both blocks, in file order.
+    pub const ALL: [Block; 2] = [Block::Film, Block::Gaps];
+
+    /// The blocks written for `model`: the film, and the gaps if it has any (a grid without
+    /// cells is valid VTK, but meshio 5.3 cannot read it).
+    pub fn of(model: &Model) -> &'static [Block] {
+        if model.gaps.is_empty() {
+            &Self::ALL[..1]
+        } else {
+            &Self::ALL
+        }
     }
-    s.push_str("</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-    for t in &model.triangles {
-        let _ = writeln!(s, "{} {} {}", t[0], t[1], t[2]);
+
+    /// The block's part of the file names (`film`, `gaps`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Film => "film",
+            Self::Gaps => "gaps",
+        }
     }
-    for (k, g) in model.gaps.iter().enumerate() {
-        let _ = writeln!(s, "{} {}", g.film_node, nodes + k);
+}
+
+/// The `.vtu` file name of `block` at state number `step`: `<prefix>_<block>_NNNN.vtu`.
+pub fn state_file_name(prefix: &str, block: Block, step: usize) -> String {
+    format!("{prefix}_{}_{step:04}.vtu", block.name())
+}
+
+/// The `.pvd` file name of `block`'s collection: `<prefix>_<block>.pvd`.
+pub fn collection_file_name(prefix: &str, block: Block) -> String {
+    format!("{prefix}_{}.pvd", block.name())
+}
+
+/// The `.vtu` bytes of `block` for one state (`displacement`: three per node).
+pub fn grid(
+    block: Block,
+    model: &Model,
+    displacement: &[f64],
+    results: &Results,
+    encoding: Encoding,
+) -> Vec<u8> {
+    match block {
+        Block::Film => film_grid(model, displacement, results, encoding),
+        Block::Gaps => gap_grid(model, displacement, results, encoding),
     }
-    s.push_str("</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
-    let offsets: Vec<String> = (1..=tris)
-        .map(|i| (3 * i).to_string())
-        .chain((1..=gaps).map(|k| (3 * tris + 2 * k).to_string()))
-        .collect();
-    s.push_str(&offsets.join(" "));
-    s.push_str("\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-    let types: Vec<&str> = std::iter::repeat_n("5", tris)
-        .chain(std::iter::repeat_n("3", gaps))
-        .collect();
-    s.push_str(&types.join(" "));
-    s.push_str("\n</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">\n");
-    s.push_str("<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for i in 0..nodes {
-        let _ = writeln!(
-            s,
-            "{:e} {:e} {:e}",
-            displacement[3 * i],
-            displacement[3 * i + 1],
-            displacement[3 * i + 2]
-        );
-    }
-    for _ in 0..gaps {
-        s.push_str("0 0 0\n");
-    }
-    s.push_str("</DataArray>\n</PointData>\n<CellData Scalars=\"von_mises\">\n");
-    let mut scalar = |name: &str, tri: &dyn Fn(usize) -> f64, gap: &dyn Fn(usize) -> f64| {
-        let _ = writeln!(
-            s,
-            "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-        );
-        let values: Vec<String> = (0..tris)
-            .map(|e| format!("{:e}", tri(e)))
-            .chain((0..gaps).map(|k| format!("{:e}", gap(k))))
-            .collect();
-        s.push_str(&values.join(" "));
-        s.push_str("\n</DataArray>\n");
-    };
+}
+
+/// The film `.vtu` of one state: triangles, displacement, stresses, strains, wrinkling.
+pub fn film_grid(
+    model: &Model,
+    displacement: &[f64],
+    results: &Results,
+    encoding: Encoding,
+) -> Vec<u8> {
     let el = &results.elements;
-    let gp = &results.gaps;
-    scalar("von_mises", &|e| el[e].von_mises, &|_| 0.0);
-    scalar("principal_1", &|e| el[e].principal[0], &|_| 0.0);
-    scalar("principal_2", &|e| el[e].principal[1], &|_| 0.0);
-    scalar("gap_slip_x", &|_| 0.0, &|k| gp[k].slip_x);
-    scalar("gap_slip_y", &|_| 0.0, &|k| gp[k].slip_y);
-    scalar("gap_normal_force", &|_| 0.0, &|k| gp[k].normal_force);
-    scalar("gap_friction_force", &|_| 0.0, &|k| gp[k].friction_force);
-    scalar("gap_status", &|_| -1.0, &|k| gp[k].status as i32 as f64);
-    scalar("wrinkling_state", &|e| el[e].state as i32 as f64, &|_| -1.0);
-    let mut vector = |name: &str, tri: &dyn Fn(usize) -> [f64; 3]| {
-        let _ = writeln!(
-            s,
-            "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">"
-        );
-        for e in 0..tris {
-            let v = tri(e);
-            let _ = writeln!(s, "{:e} {:e} {:e}", v[0], v[1], v[2]);
-        }
-        for _ in 0..gaps {
-            s.push_str("0 0 0\n");
-        }
-        s.push_str("</DataArray>\n");
+    let tris = model.triangles.len();
+    let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..tris).map(f).collect());
+    let cell3 = |f: &dyn Fn(usize) -> [f64; 3]| Values::F64((0..tris).flat_map(f).collect());
+    let principal_strains: Vec<[f64; 2]> = el.iter().map(|e| principal(e.strain)).collect();
+    let piece = Piece {
+        points: deformed(model, displacement),
+        connectivity: model
+            .triangles
+            .iter()
+            .flatten()
+            .map(|&n| n as i64)
+            .collect(),
+        offsets: (1..=tris as i64).map(|i| 3 * i).collect(),
+        types: vec![5; tris],
+        point_data: vec![(
+            "displacement",
+            3,
+            Values::F64(displacement[..3 * model.nodes.len()].to_vec()),
+        )],
+        cell_data: vec![
+            ("von_mises", 1, cell(&|e| el[e].von_mises)),
+            ("principal_1", 1, cell(&|e| el[e].principal[0])),
+            ("principal_2", 1, cell(&|e| el[e].principal[1])),
+            ("stress", 3, cell3(&|e| el[e].stress)),
+            ("strain", 3, cell3(&|e| el[e].strain)),
+            ("principal_strain_1", 1, cell(&|e| principal_strains[e][0])),
+            ("principal_strain_2", 1, cell(&|e| principal_strains[e][1])),
+            (
+                "wrinkling_state",
+                1,
+                Values::I32(el.iter().map(|e| e.state as i32).collect()),
+            ),
+            ("tension_direction", 3, cell3(&|e| el[e].tension_direction)),
+        ],
+        point_vectors: Some("displacement"),
+        cell_scalars: Some("von_mises"),
     };
-    vector("stress", &|e| el[e].stress);
-    vector("tension_direction", &|e| el[e].tension_direction);
-    s.push_str("</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n");
-    s
+    piece.encode(encoding)
+}
+
+/// The gaps `.vtu` of one state: a line per gap from its film node to its support, with the
+/// gap results.
+pub fn gap_grid(
+    model: &Model,
+    displacement: &[f64],
+    results: &Results,
+    encoding: Encoding,
+) -> Vec<u8> {
+    let film = deformed(model, displacement);
+    let node = |n: usize| [film[3 * n], film[3 * n + 1], film[3 * n + 2]];
+    let gaps = model.gaps.len();
+    let mut points: Vec<f64> = model.gaps.iter().flat_map(|g| node(g.film_node)).collect();
+    points.extend(model.gaps.iter().flat_map(|g| match &g.support {
+        GapSupport::Point(p) => *p,
+        GapSupport::Node(b) => node(*b),
+    }));
+    let gp = &results.gaps;
+    let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..gaps).map(f).collect());
+    let piece = Piece {
+        points,
+        connectivity: (0..gaps as i64)
+            .flat_map(|k| [k, gaps as i64 + k])
+            .collect(),
+        offsets: (1..=gaps as i64).map(|k| 2 * k).collect(),
+        types: vec![3; gaps],
+        point_data: Vec::new(),
+        cell_data: vec![
+            (
+                "film_node",
+                1,
+                Values::I64(model.gaps.iter().map(|g| g.film_node as i64).collect()),
+            ),
+            ("gap_slip_x", 1, cell(&|k| gp[k].slip_x)),
+            ("gap_slip_y", 1, cell(&|k| gp[k].slip_y)),
+            ("gap_normal_force", 1, cell(&|k| gp[k].normal_force)),
+            ("gap_friction_force", 1, cell(&|k| gp[k].friction_force)),
+            (
+                "gap_status",
+                1,
+                Values::I32(gp.iter().map(|g| g.status as i32).collect()),
+            ),
+        ],
+        point_vectors: None,
+        cell_scalars: Some("gap_normal_force"),
+    };
+    piece.encode(encoding)
 }
 
 /// The `.pvd` collection text listing `(time, file name)` pairs.
@@ -140,9 +230,199 @@ pub fn collection(entries: &[(f64, String)]) -> String {
     s
 }
 
+/// Principal values `[e1 ≥ e2]` of a Voigt strain `[εx, εy, γxy]` (engineering shear).
+fn principal(strain: [f64; 3]) -> [f64; 2] {
+    let centre = 0.5 * (strain[0] + strain[1]);
+    let radius = (0.5 * (strain[0] - strain[1])).hypot(0.5 * strain[2]);
+    [centre + radius, centre - radius]
+}
+
+/// Deformed node positions, three per node.
+fn deformed(model: &Model, displacement: &[f64]) -> Vec<f64> {
+    model
+        .nodes
+        .iter()
+        .flatten()
+        .zip(displacement)
+        .map(|(x, u)| x + u)
+        .collect()
+}
+
+/// The values of one data array.
+enum Values {
+    F64(Vec<f64>),
+    I64(Vec<i64>),
+    I32(Vec<i32>),
+    U8(Vec<u8>),
+}
+
+impl Values {
+    fn vtk_type(&self) -> &'static str {
+        match self {
+            Self::F64(_) => "Float64",
+            Self::I64(_) => "Int64",
+            Self::I32(_) => "Int32",
+            Self::U8(_) => "UInt8",
+        }
+    }
+
+    /// Appends the values as text, separated by spaces (floats round-trip exactly).
+    fn write_ascii(&self, out: &mut String) {
+        fn join<T: std::fmt::Display>(out: &mut String, values: &[T]) {
+            for (i, v) in values.iter().enumerate() {
+                let _ = write!(out, "{}{v}", if i == 0 { "" } else { " " });
+            }
+        }
+        match self {
+            Self::F64(v) => {
+                for (i, x) in v.iter().enumerate() {
+                    let sep = if i == 0 { "" } else { " " };
+                    let _ = write!(out, "{sep}{x:e}");
+                }
+            }
+            Self::I64(v) => join(out, v),
+            Self::I32(v) => join(out, v),
+            Self::U8(v) => join(out, v),
+        }
+    }
+
+    /// Appends the UInt64 byte count and the little-endian values.
+    fn write_raw(&self, out: &mut Vec<u8>) {
+        let bytes = match self {
+            Self::F64(v) => 8 * v.len(),
+            Self::I64(v) => 8 * v.len(),
+            Self::I32(v) => 4 * v.len(),
+            Self::U8(v) => v.len(),
+        };
+        out.reserve(8 + bytes);
+        out.extend_from_slice(&(bytes as u64).to_le_bytes());
+        match self {
+            Self::F64(v) => v
+                .iter()
+                .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
+            Self::I64(v) => v
+                .iter()
+                .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
+            Self::I32(v) => v
+                .iter()
+                .for_each(|x| out.extend_from_slice(&x.to_le_bytes())),
+            Self::U8(v) => out.extend_from_slice(v),
+        }
+    }
+}
+
+/// One unstructured grid: geometry, cells and named arrays `(name, components, values)`.
+struct Piece {
+    /// Three coordinates per point.
+    points: Vec<f64>,
+    connectivity: Vec<i64>,
+    offsets: Vec<i64>,
+    types: Vec<u8>,
+    point_data: Vec<(&'static str, usize, Values)>,
+    cell_data: Vec<(&'static str, usize, Values)>,
+    /// The active vectors of the point data and scalars of the cell data.
+    point_vectors: Option<&'static str>,
+    cell_scalars: Option<&'static str>,
+}
+
+impl Piece {
+    fn encode(self, encoding: Encoding) -> Vec<u8> {
+        let mut xml = String::with_capacity(match encoding {
+            Encoding::Ascii => 24 * (self.points.len() + 12 * self.types.len()) + 4096,
+            Encoding::Binary => 4096,
+        });
+        let mut appended = Vec::new();
+        let mut array = |xml: &mut String, name: Option<&str>, components: usize, v: &Values| {
+            let _ = write!(xml, "<DataArray type=\"{}\"", v.vtk_type());
+            if let Some(name) = name {
+                let _ = write!(xml, " Name=\"{name}\"");
+            }
+            if components > 1 {
+                let _ = write!(xml, " NumberOfComponents=\"{components}\"");
+            }
+            match encoding {
+                Encoding::Ascii => {
+                    xml.push_str(" format=\"ascii\">\n");
+                    v.write_ascii(xml);
+                    xml.push_str("\n</DataArray>\n");
+                }
+                Encoding::Binary => {
+                    let _ = writeln!(xml, " format=\"appended\" offset=\"{}\"/>", appended.len());
+                    v.write_raw(&mut appended);
+                }
+            }
+        };
+        let cells = self.types.len();
+        let _ = write!(
+            xml,
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" \
+             byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n\
+             <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">\n<Points>\n",
+            self.points.len() / 3
+        );
+        array(&mut xml, None, 3, &Values::F64(self.points));
+        xml.push_str("</Points>\n<Cells>\n");
+        array(
+            &mut xml,
+            Some("connectivity"),
+            1,
+            &Values::I64(self.connectivity),
+        );
+        array(&mut xml, Some("offsets"), 1, &Values::I64(self.offsets));
+        array(&mut xml, Some("types"), 1, &Values::U8(self.types));
+        xml.push_str("</Cells>\n");
+        for (tag, attribute, active, arrays) in [
+            ("PointData", "Vectors", self.point_vectors, &self.point_data),
+            ("CellData", "Scalars", self.cell_scalars, &self.cell_data),
+        ] {
+            let _ = write!(xml, "<{tag}");
+            if let Some(active) = active {
+                let _ = write!(xml, " {attribute}=\"{active}\"");
+            }
+            xml.push_str(">\n");
+            for (name, components, values) in arrays {
+                array(&mut xml, Some(name), *components, values);
+            }
+            let _ = writeln!(xml, "</{tag}>");
+        }
+        xml.push_str("</Piece>\n</UnstructuredGrid>\n");
+        let mut out = xml.into_bytes();
+        if encoding == Encoding::Binary {
+            out.reserve(appended.len() + 64);
+            out.extend_from_slice(b"<AppendedData encoding=\"raw\">\n_");
+            out.extend_from_slice(&appended);
+            out.extend_from_slice(b"\n</AppendedData>\n");
+        }
+        out.extend_from_slice(b"</VTKFile>\n");
+        out
+    }
+}
+
 fn xml_escape(text: &str) -> String {
     text.replace('&', "&amp;")
         .replace('"', "&quot;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn principal_strains_are_the_mohr_circle_extremes() {
+        let [e1, e2] = principal([0.03, 0.01, 0.02]);
+        // centre 0.02, radius √(0.01² + 0.01²)
+        assert!((e1 - (0.02 + 0.01 * 2f64.sqrt())).abs() < 1e-15);
+        assert!((e1 + e2 - 0.04).abs() < 1e-15);
+        assert_eq!(principal([0.0, 0.0, 0.0]), [0.0, 0.0]);
+    }
+
+    #[test]
+    fn encoding_names_parse_back() {
+        for e in [Encoding::Ascii, Encoding::Binary] {
+            assert_eq!(e.name().parse::<Encoding>(), Ok(e));
+        }
+        assert!("Binary".parse::<Encoding>().is_err());
+    }
 }
