@@ -669,7 +669,10 @@ impl Analysis {
             }
         }
         if old > 0.0 && dot > 0.99 * (old * new).sqrt() {
-            let ratio = dot / old;
+            // Not beyond twice the last increment: an enlarged increment (see `step_to`) would
+            // otherwise extrapolate the film far outside the range where the last one tells
+            // anything (residuals of 1e11 N were measured at its first iterate).
+            let ratio = (dot / old).min(Self::PREDICTOR_LIMIT);
             for (i, d) in self.system.dofs.iter().enumerate() {
                 if let Dof::Free(_) = d {
                     u[i] += ratio * start.last_increment[i];
@@ -826,6 +829,9 @@ impl Analysis {
         }
         unreachable!("the loop returns at max_iterations")
     }
+
+    /// Largest ratio of the predictor's extrapolation to the last converged increment.
+    const PREDICTOR_LIMIT: f64 = 2.0;
 
     /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).
     const DAMPING_START: f64 = 1e-4;
