@@ -30,6 +30,7 @@ fn etfe() -> Material {
         poisson_ratio: 0.43,
         thickness: 250e-6,
         prestress: [0.5e6, 0.5e6, 0.0],
+        density: 0.0,
         wrinkling: Wrinkling::None,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     }
@@ -52,6 +53,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         }
     }
     Model {
+        loads: Default::default(),
         name: "Patch".into(),
         description: String::new(),
         nodes,
@@ -1107,6 +1109,7 @@ fn tension_field_film(eta: f64, prestress: f64) -> Material {
         poisson_ratio: 0.3,
         thickness: 1.0,
         prestress: [prestress, prestress, 0.0],
+        density: 0.0,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: eta,
     }
@@ -1318,7 +1321,11 @@ fn slack_film_gives_zero_reactions_without_a_singular_solve() {
             .all(|e| e.von_mises == 0.0 && e.tension_direction == [0.0; 3])
     );
     assert!(
-        results.elements.iter().filter(|e| e.state == WrinklingState::Slack).count()
+        results
+            .elements
+            .iter()
+            .filter(|e| e.state == WrinklingState::Slack)
+            .count()
             > results.elements.len() / 2
     );
     assert!(
@@ -1608,6 +1615,7 @@ fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
         poisson_ratio: nu,
         thickness: t,
         prestress: [s0, s0, 0.0],
+        density: 0.0,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     };

@@ -304,7 +304,13 @@ fn strip_has_38_gaps_that_touch_the_cylinder_and_carry_nothing_at_first() {
     // Touching (g = 0 to round-off): open, or closed with N = 0 where g is exactly 0 (such a gap
     // resists penetration from the first iteration, see `mech::contact`); none carries a force.
     let mut analysis = Analysis::new(model, SolverSettings::default()).unwrap();
-    assert!(analysis.state().status.iter().all(|s| *s != GapStatus::Slip));
+    assert!(
+        analysis
+            .state()
+            .status
+            .iter()
+            .all(|s| *s != GapStatus::Slip)
+    );
     assert!(
         analysis
             .results()

@@ -654,6 +654,7 @@ impl ArchPanel {
             })
             .collect();
         validated(Model {
+            loads: Default::default(),
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",
@@ -819,6 +820,7 @@ impl CylinderStrip {
             target: [sign * self.out, 0.0, -self.down],
         };
         validated(Model {
+            loads: Default::default(),
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,
@@ -958,6 +960,7 @@ impl ArchEdge {
             .map(|(i, j)| id(i, j))
             .collect();
         validated(Model {
+            loads: Default::default(),
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",
