@@ -41,3 +41,34 @@ fn full_output_still_arrives_when_the_reader_reads_everything() {
     assert!(text.len() > 100_000, "{} bytes", text.len());
     membrane_contact::mech::Model::from_json(&text).unwrap();
 }
+
+#[test]
+fn model_command_ramps_the_loads_of_the_file_and_prints_their_level() {
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args([
+            "model",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/examples/circular_membrane.json"
+            ),
+            "--steps",
+            "4",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for expected in [
+        "load: pressure set top at 200.000000 Pa on 96 triangles",
+        "load: force set lamp at (0.000000, 0.000000, -5.000000) N on each of 1 nodes",
+        "load: self-weight 1.358800 kg",
+        "reaction of group rim:",
+    ] {
+        assert!(text.contains(expected), "'{expected}' missing in:\n{text}");
+    }
+}

@@ -15,6 +15,7 @@ use membrane_contact::mech::model::{
     AllElements, Axis, BoundaryGroup, ElementSelection, ForceSet, LoadSpec, Model, PressureSet,
     Support,
 };
+use membrane_contact::mech::scenarios::CircularMembrane;
 use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings, StepError};
 use nalgebra::{DMatrix, Vector3};
 
@@ -425,61 +426,16 @@ fn hencky_ode_reproduces_the_published_coefficients() {
     assert!((cw - 0.6534).abs() < 2e-4, "w0 coefficient {cw}");
 }
 
-/// A disc of radius `a`: the centre and `rings` rings of `6k` nodes, triangles with normals
-/// +Z, the outer ring clamped.
+/// A disc of radius `a` in `rings` rings (scenarios.rs), rim held, no pressure yet.
 fn disc(a: f64, rings: usize, material: Material) -> Model {
-    let mut nodes = vec![[0.0, 0.0, 0.0]];
-    let mut ring_nodes: Vec<Vec<usize>> = vec![vec![0]];
-    for k in 1..=rings {
-        let n = 6 * k;
-        let r = a * k as f64 / rings as f64;
-        let first = nodes.len();
-        for j in 0..n {
-            let phi = 2.0 * std::f64::consts::PI * j as f64 / n as f64;
-            nodes.push([r * phi.cos(), r * phi.sin(), 0.0]);
-        }
-        ring_nodes.push((first..first + n).collect());
-    }
-    // Ring nodes start at angle 0 and are equally spaced: node `turn` of `count` is at this angle.
-    let angle = |turn: usize, count: usize| turn as f64 / count as f64;
-    let mut triangles = vec![];
-    for k in 1..=rings {
-        let (inner, outer) = (&ring_nodes[k - 1], &ring_nodes[k]);
-        let (m, n) = (inner.len(), outer.len());
-        if m == 1 {
-            for j in 0..n {
-                triangles.push([0, outer[j], outer[(j + 1) % n]]);
-            }
-            continue;
-        }
-        // Zip the rings by angle.
-        let (mut i, mut j) = (0, 0);
-        while i < m || j < n {
-            let next_outer = angle(j + 1, n);
-            let next_inner = angle(i + 1, m);
-            if j < n && (i == m || next_outer <= next_inner + 1e-12) {
-                triangles.push([inner[i % m], outer[j], outer[(j + 1) % n]]);
-                j += 1;
-            } else {
-                triangles.push([inner[i % m], outer[j % n], inner[(i + 1) % m]]);
-                i += 1;
-            }
-        }
-    }
-    let mut model = Model {
-        name: "Disc".into(),
-        description: String::new(),
-        nodes,
-        triangles,
+    CircularMembrane {
+        radius: a,
+        rings,
         material,
-        supports: vec![],
-        symmetry: vec![],
-        gaps: vec![],
-        groups: vec![],
-        loads: LoadSpec::default(),
-    };
-    clamp(&mut model, ring_nodes[rings].clone());
-    model
+        pressure: 0.0,
+    }
+    .model()
+    .unwrap()
 }
 
 /// Centre deflection and mean in-plane stress of the centre triangles after pressure `q`,
@@ -498,7 +454,7 @@ fn inflate(model: &Model, q: f64, path: &[f64]) -> (f64, f64) {
     let full = LoadLevels::of_model(&model);
     for &fraction in path {
         analysis
-            .step_to_with_loads(&[], &full.scaled(fraction), 1)
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(fraction), 1)
             .unwrap();
     }
     let results = analysis.results();
@@ -585,24 +541,30 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
             ..settings
         })
         .unwrap();
-    analysis.step_to_with_loads(&[], &levels, 1).unwrap();
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
     analysis.set_limits(settings).unwrap();
     let before = analysis.state().clone();
     levels.pressure[0] = 1.0e5;
-    let error = analysis.step_to_with_loads(&[], &levels, 1).unwrap_err();
+    let error = analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap_err();
     assert!(matches!(error, StepError::NotConverged { .. }), "{error}");
     assert_eq!(analysis.state(), &before);
     assert_eq!(analysis.state().loads.pressure, vec![10.0]);
     // Non-finite and mis-sized load targets are refused before solving.
     levels.pressure[0] = f64::NAN;
-    let error = analysis.step_to_with_loads(&[], &levels, 1).unwrap_err();
+    let error = analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap_err();
     assert!(
         error.to_string().contains("pressure of set 'top'"),
         "{error}"
     );
     levels.pressure.clear();
     assert!(matches!(
-        analysis.step_to_with_loads(&[], &levels, 1),
+        analysis.step_to_with_loads(&[[0.0; 3]], &levels, 1),
         Err(StepError::InvalidInput { .. })
     ));
     assert_eq!(analysis.state(), &before);
@@ -620,7 +582,9 @@ fn ju_rowlands_matrix_with_the_symmetric_part_reaches_the_same_inflated_state() 
             ..SolverSettings::default()
         };
         let mut analysis = Analysis::new(model.clone(), settings).unwrap();
-        analysis.step_to_with_loads(&[], &levels, 4).unwrap();
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+            .unwrap();
         deflection.push(analysis.node_displacement(0).z);
     }
     assert!(
@@ -722,4 +686,59 @@ fn model_files_read_and_write_the_loads_section() {
     let plain = patch(1, 1, 1.0, 1.0);
     assert!(!plain.to_json().contains("loads"));
     assert!(!plain.to_json().contains("density"));
+}
+
+/// The example of docs/model-format.md and README: the circular membrane of scenarios.rs with
+/// ETFE's density, a pressure and a nodal force. `UPDATE_EXAMPLES=1` rewrites the file.
+fn example_membrane() -> Model {
+    let mut model = CircularMembrane {
+        radius: 1.0,
+        rings: 4,
+        material: Material {
+            density: 1750.0,
+            prestress: [0.5e6, 0.5e6, 0.0],
+            poisson_ratio: 0.43,
+            thickness: 250e-6,
+            ..film(0.0)
+        },
+        pressure: 200.0,
+    }
+    .model()
+    .unwrap();
+    model.loads.forces.push(ForceSet {
+        name: "lamp".into(),
+        nodes: vec![0],
+        force: [0.0, 0.0, -5.0],
+    });
+    model
+}
+
+#[test]
+fn example_model_file_is_the_generated_circular_membrane_and_runs() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/circular_membrane.json"
+    );
+    let model = example_membrane();
+    if std::env::var_os("UPDATE_EXAMPLES").is_some() {
+        std::fs::write(path, model.to_json() + "\n").unwrap();
+    }
+    let text = std::fs::read_to_string(path).unwrap();
+    assert_eq!(Model::from_json(&text).unwrap(), model);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let levels = LoadLevels::of_model(&model);
+    for k in 1..=4 {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels.scaled(k as f64 / 4.0), 1)
+            .unwrap();
+    }
+    // The rim carries p A_polygon up, the weight and the lamp down.
+    let area = 0.5 * 24.0 * (std::f64::consts::TAU / 24.0).sin();
+    let weight = analysis.loads().mass() * 9.81;
+    let rz = analysis.results().reactions[0][2];
+    assert!(
+        (rz + 200.0 * area - weight - 5.0).abs() < 1e-6 * 200.0 * area,
+        "{rz}"
+    );
+    assert!(analysis.node_displacement(0).z > 0.0);
 }
