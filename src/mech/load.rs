@@ -135,6 +135,8 @@ pub struct FollowerPressure {
 pub struct SelfWeight {
     /// Lumped mass `Σ ρ t A0 / 3` of each node (kg).
     nodal_mass: Vec<f64>,
+    /// Whether every mass is zero (density 0).
+    weightless: bool,
 }
 
 /// Dead forces on sets of nodes.
@@ -180,7 +182,10 @@ impl Loads {
         }
         Self {
             pressure: FollowerPressure { sets, reference },
-            self_weight: SelfWeight { nodal_mass },
+            self_weight: SelfWeight {
+                weightless: nodal_mass.iter().all(|&m| m == 0.0),
+                nodal_mass,
+            },
             nodal: NodalForces {
                 sets: model.loads.forces.iter().map(|f| f.nodes.clone()).collect(),
             },
@@ -278,7 +283,8 @@ impl ExternalLoad for SelfWeight {
         residual: &mut [f64],
         _values: Option<&mut [f64]>,
     ) {
-        if levels.gravity == [0.0; 3] {
+        // A weightless film (density 0, the default) costs nothing.
+        if levels.gravity == [0.0; 3] || self.weightless {
             return;
         }
         for (v, &m) in self.nodal_mass.iter().enumerate() {
