@@ -9,8 +9,9 @@ the loads exactly (the resultant of a pressure on a surface with a fixed rim is 
 projected area); the final state agrees with the CLI, which ramps the file's loads; a NaN
 pressure is fmi2Error with a message; FMU states keep the load levels.
 
-BOUNDARY CONDITIONS: rim held at zero; ``top.pressure`` ramped 0 → 200 Pa in 4 steps; gravity
-and the lamp load applied in the first step.
+BOUNDARY CONDITIONS: rim held at zero; ``top.pressure`` ramped 0 → 200 Pa in 4 steps (through
+fmpy, and through libcosim, which must give the same numbers bit for bit); gravity and the lamp
+load applied in the first step.
 """
 
 from __future__ import annotations
@@ -100,3 +101,24 @@ def test_nan_pressure_is_an_error_and_states_keep_the_load_level(membrane_fmu):
         assert status == ERROR
         assert s.logged(ERROR, "top.pressure = NaN")
         assert s.snapshot() == reference
+
+
+def test_libcosim_drives_the_pressure_to_the_same_results_as_fmpy(membrane_fmu):
+    from cosim_runner import run_with_libcosim
+
+    observed = ["rim.Rz", "film.maxEquivalentStress", "solver.residual"]
+    with Slave(membrane_fmu) as s:
+        vr = {n: s.vr(n) for n in [*observed, "top.pressure"]}
+        pressures = [PRESSURE * (k + 1) / STEPS for k in range(STEPS)]
+        s.initialize(inputs={"top.pressure": pressures[0]})
+        fmpy_values = {n: [] for n in observed}
+        for k, p in enumerate(pressures):
+            s.set({"top.pressure": p})
+            assert s.step(k * 0.25, 0.25) == OK
+            for n in observed:
+                fmpy_values[n].append(s.get(n))
+    cosim = run_with_libcosim(str(membrane_fmu), {vr["top.pressure"]: pressures}, 0.25, STEPS,
+                              real_outputs=[vr[n] for n in observed], integer_outputs=[])
+    for n in observed:
+        assert cosim["real"][vr[n]] == fmpy_values[n], n  # bit for bit
+    assert cosim["real"][vr["rim.Rz"]][-1] == pytest.approx(rim_balance(PRESSURE), rel=1e-6)
