@@ -56,7 +56,10 @@ options:
   --steps N          load steps to the target (default 20)
   --matrix M         consistent (default) or ju-rowlands (the paper's; converges linearly:
                      give it --max-iterations 3000)
-  --max-iterations N Newton iterations per increment before it is halved (default 15)
+  --max-iterations N Newton iterations per increment before it is halved (default 100)
+  --no-line-search   plain Newton steps: about half the iterations when each step starts near
+                     its answer (a prestressed film under a gradually raised pressure), but no
+                     safeguard for a first step from a slack flat film or gaps opening/closing
   --csv FILE         write the gap results of every step as CSV
   --vtk DIR          write the deformed film of every step as VTK (DIR/<model>_NNNN.vtu + .pvd)
   --quiet            no progress indicator
@@ -72,6 +75,7 @@ struct Options {
     steps: usize,
     matrix: IterationMatrix,
     max_iterations: Option<usize>,
+    line_search: bool,
     csv: Option<String>,
     vtk: Option<String>,
     quiet: bool,
@@ -88,6 +92,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         steps: 20,
         matrix: IterationMatrix::Consistent,
         max_iterations: None,
+        line_search: true,
         csv: None,
         vtk: None,
         quiet: false,
@@ -141,6 +146,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
                     .map_err(|_| "--max-iterations needs a positive integer".to_string())?;
                 o.max_iterations = Some(n);
             }
+            "--no-line-search" => o.line_search = false,
             "--csv" => o.csv = Some(value("--csv")?),
             "--vtk" => o.vtk = Some(value("--vtk")?),
             "--quiet" => o.quiet = true,
@@ -185,6 +191,7 @@ fn run(o: &Options) -> Result<(), String> {
     let settings = SolverSettings {
         iteration_matrix: o.matrix,
         max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
+        line_search: o.line_search,
         ..defaults
     };
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;

@@ -684,6 +684,7 @@ impl Instance {
                 (Binding::FrictionLaw, Value::String(name)) => {
                     model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
                 }
+                (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
                 (Binding::UseJuRowlands, Value::Boolean(b)) => {
                     settings.iteration_matrix = if b {
                         IterationMatrix::JuRowlands

@@ -21,7 +21,7 @@
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap; start: the model's when uniform, else "" (each gap keeps its own) |
-//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch` | | parameter | | Newton settings |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
 //! | `<gap>.frictionX/.frictionY` | Real | output | N | friction force on the film, local x, y (signed) |
@@ -178,6 +178,8 @@ pub enum Binding {
     MaxCutbacks,
     IncrementsPerStep,
     UseJuRowlands,
+    /// Backtracking line search on (true) or off.
+    LineSearch,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
     /// it does not change the analysis, and no output depends on it.
     ResultsDirectory,
@@ -473,7 +475,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          slides along the gap's local x only); empty: each gap keeps the model file's",
         Binding::FrictionLaw,
     );
-    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 6] = [
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 7] = [
         (
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
@@ -515,6 +517,15 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             None,
             "true: the paper's symmetric Ju-Rowlands iteration matrix; false: the consistent tangent",
             Binding::UseJuRowlands,
+        ),
+        (
+            "lineSearch",
+            Value::Boolean(solver.line_search),
+            None,
+            "true: backtracking line search on the residual (safe first steps from a flat film, gaps opening \
+             and closing); false: plain Newton steps, about half the iterations when each step starts near \
+             its answer (a prestressed film under a gradually raised pressure)",
+            Binding::LineSearch,
         ),
     ];
     for (name, start, unit, description, binding) in solver_parameters {

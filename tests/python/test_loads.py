@@ -122,3 +122,19 @@ def test_libcosim_drives_the_pressure_to_the_same_results_as_fmpy(membrane_fmu):
     for n in observed:
         assert cosim["real"][vr[n]] == fmpy_values[n], n  # bit for bit
     assert cosim["real"][vr["rim.Rz"]][-1] == pytest.approx(rim_balance(PRESSURE), rel=1e-6)
+
+
+def test_line_search_parameter_reaches_the_same_state_in_fewer_iterations(membrane_fmu):
+    results = {}
+    for line_search in (True, False):
+        with Slave(membrane_fmu) as s:
+            s.initialize(parameters={"solver.lineSearch": line_search, "solver.incrementsPerStep": 1},
+                         inputs={"top.pressure": 0.0})
+            iterations = 0
+            for k in range(STEPS):
+                s.set({"top.pressure": PRESSURE * (k + 1) / STEPS})
+                assert s.step(k / STEPS, 1 / STEPS) == OK, s.messages[-3:]
+                iterations += s.get("solver.iterations")
+            results[line_search] = (s.get("film.maxEquivalentStress"), iterations)
+    assert results[False][0] == pytest.approx(results[True][0], rel=1e-6)
+    assert results[False][1] < results[True][1]
