@@ -742,3 +742,46 @@ fn example_model_file_is_the_generated_circular_membrane_and_runs() {
     );
     assert!(analysis.node_displacement(0).z > 0.0);
 }
+
+/// Two prestressed discs sealed at a common rim (the rim held), the lower one with reversed
+/// triangles so that its normals point down: a cushion. A small inside pressure `p` bulges each
+/// film into a spherical cap: Laplace `p = 2 N0/R` for a film under tension `N0 = σ_pre t`, so
+/// the crown rises `h = a²/(2R) = p a²/(4 N0)` (the linear limit of the prestressed membrane
+/// above); the pressures on the closed cushion cancel, so the rim carries no net force.
+#[test]
+fn inflated_cushion_reaches_the_spherical_cap_and_its_pressure_has_no_resultant() {
+    let (a, sigma_pre, p) = (1.0, 1.0e6, 1.0);
+    let top = disc(a, 12, film(sigma_pre));
+    let rim: Vec<usize> = top.groups[0].nodes.clone();
+    let interior = top.nodes.len() - rim.len();
+    let mut model = top.clone();
+    model.name = "Cushion".into();
+    // The interior nodes are the first ones (rings 0 … 11): copy them for the lower film.
+    assert!(rim.iter().all(|&v| v >= interior));
+    model.nodes.extend_from_slice(&top.nodes[..interior]);
+    let lower = |v: usize| if v < interior { top.nodes.len() + v } else { v };
+    for t in &top.triangles {
+        model
+            .triangles
+            .push([lower(t[0]), lower(t[2]), lower(t[1])]);
+    }
+    model.loads.pressures = vec![pressure_everywhere("inside", p)];
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &LoadLevels::of_model(&model), 2)
+        .unwrap();
+    let cap = p * a * a / (4.0 * sigma_pre * film(sigma_pre).thickness);
+    let (up, down) = (
+        analysis.node_displacement(0).z,
+        analysis.node_displacement(top.nodes.len()).z,
+    );
+    println!("cushion: crown {up:.6e} m and {down:.6e} m, spherical cap {cap:.6e} m");
+    assert!((up / cap - 1.0).abs() < 0.005, "{up} vs {cap}");
+    assert!((down / cap + 1.0).abs() < 0.005, "{down} vs {cap}");
+    let reaction = analysis.results().reactions[0];
+    let pushed = p * std::f64::consts::PI * a * a;
+    assert!(
+        reaction.iter().all(|r| r.abs() < 1e-6 * pushed),
+        "{reaction:?}"
+    );
+}

@@ -334,7 +334,8 @@ pub struct GapResult {
 pub struct Results {
     /// One per gap.
     pub gaps: Vec<GapResult>,
-    /// Total reaction of each boundary group (N), global axes.
+    /// Total reaction of each boundary group (N), global axes: the force the group applies to the
+    /// film, `Σ (f_int − f_ext)` over its DOFs (it balances the loads on its nodes too).
     pub reactions: Vec<[f64; 3]>,
     /// Stress state of each triangle.
     pub elements: Vec<ElementStress>,
