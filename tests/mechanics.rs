@@ -1604,6 +1604,9 @@ fn hub_rotation(model: &Model, phi: f64) -> Vec<[f64; 3]> {
 }
 
 #[test]
+// M_cr = 2π a² t σ0 happens to be 2π N·m here: the literal 6.283 checks the comment's worked
+// number, it is not an approximation of τ.
+#[allow(clippy::approx_constant)]
 fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
     // In-plane torsion of an annulus (note §2.3; Mikulas 1964, Miller & Hedgepeth 1982): hub
     // a = 0.1, rim b = 0.5, t = 1e-4, Y = 1 GPa, ν = 0.3, σ0 = 1 MPa isotropic. Taut (linear):
