@@ -6,10 +6,12 @@ use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 use membrane_contact::mech::element::state_counts;
+use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
 use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
-    Analysis, FrictionLaw, IterationMatrix, Model, ParallelArch, Results, SolverSettings,
+    Analysis, FrictionLaw, IterationMatrix, LoadLevels, Model, ParallelArch, Results,
+    SolverSettings,
 };
 
 /// `println!` for the results on standard output, through [`print_line`]: a reader that closes
@@ -41,7 +43,8 @@ usage: membrane-contact specimen [--height MM] [options]
        membrane-contact model FILE.json [options]
        membrane-contact export-specimen [--height MM] [--refine N] [--friction-law L]   (prints the model JSON)
 
-Runs the analysis: every boundary group is moved to its target displacement in --steps steps.
+Runs the analysis: every boundary group is moved to its target displacement, and every load
+(pressures, nodal forces, self-weight) raised from zero to its model-file value, in --steps steps.
 
 options:
   --height MM        arch height of the specimen in mm (200, 300, 400; default 300)
@@ -53,7 +56,10 @@ options:
   --steps N          load steps to the target (default 20)
   --matrix M         consistent (default) or ju-rowlands (the paper's; converges linearly:
                      give it --max-iterations 3000)
-  --max-iterations N Newton iterations per increment before it is halved (default 15)
+  --max-iterations N Newton iterations per increment before it is halved (default 100)
+  --no-line-search   plain Newton steps: about half the iterations when each step starts near
+                     its answer (a prestressed film under a gradually raised pressure), but no
+                     safeguard for a first step from a slack flat film or gaps opening/closing
   --csv FILE         write the gap results of every step as CSV
   --vtk DIR          write every step as VTK: DIR/<model>_film_NNNN.vtu (film) and
                      DIR/<model>_gaps_NNNN.vtu (gap lines), and a .pvd of each for ParaView
@@ -71,6 +77,7 @@ struct Options {
     steps: usize,
     matrix: IterationMatrix,
     max_iterations: Option<usize>,
+    line_search: bool,
     csv: Option<String>,
     vtk: Option<String>,
     vtk_format: vtk::Encoding,
@@ -88,6 +95,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         steps: 20,
         matrix: IterationMatrix::Consistent,
         max_iterations: None,
+        line_search: true,
         csv: None,
         vtk: None,
         vtk_format: vtk::Encoding::default(),
@@ -142,6 +150,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
                     .map_err(|_| "--max-iterations needs a positive integer".to_string())?;
                 o.max_iterations = Some(n);
             }
+            "--no-line-search" => o.line_search = false,
             "--csv" => o.csv = Some(value("--csv")?),
             "--vtk" => o.vtk = Some(value("--vtk")?),
             "--vtk-format" => {
@@ -191,6 +200,7 @@ fn run(o: &Options) -> Result<(), String> {
     let settings = SolverSettings {
         iteration_matrix: o.matrix,
         max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
+        line_search: o.line_search,
         ..defaults
     };
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
@@ -198,6 +208,7 @@ fn run(o: &Options) -> Result<(), String> {
         analysis.set_friction(mu)?;
     }
     let targets: Vec<[f64; 3]> = analysis.model().groups.iter().map(|g| g.target).collect();
+    let loads = LoadLevels::of_model(analysis.model());
     let mut csv = match &o.csv {
         Some(path) => {
             let mut f = std::fs::File::create(path).map_err(|e| format!("{path}: {e}"))?;
@@ -232,7 +243,7 @@ fn run(o: &Options) -> Result<(), String> {
         let fraction = step as f64 / o.steps as f64;
         let target: Vec<[f64; 3]> = targets.iter().map(|t| t.map(|v| v * fraction)).collect();
         let report = analysis
-            .step_to(&target, 1)
+            .step_to_with_loads(&target, &loads.scaled(fraction), 1)
             .map_err(|e| format!("step {step}/{}: {e}", o.steps))?;
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;
@@ -339,6 +350,46 @@ fn write_vtk(
     Ok(())
 }
 
+/// Prints the load levels of the converged state (the model file's at the last step).
+fn report_loads(analysis: &Analysis) {
+    let model = analysis.model();
+    let levels = &analysis.state().loads;
+    for (set, p) in model.loads.pressures.iter().zip(&levels.pressure) {
+        let count = match &set.elements {
+            ElementSelection::All(_) => model.triangles.len(),
+            ElementSelection::List(list) => list.len(),
+        };
+        out!(
+            "load: pressure set {} at {:.6} Pa on {count} triangles",
+            set.name,
+            p
+        );
+    }
+    for (set, f) in model.loads.forces.iter().zip(&levels.force) {
+        out!(
+            "load: force set {} at ({:.6}, {:.6}, {:.6}) N on each of {} nodes",
+            set.name,
+            f[0],
+            f[1],
+            f[2],
+            set.nodes.len()
+        );
+    }
+    let mass = analysis.loads().mass();
+    if mass > 0.0 {
+        let g = levels.gravity;
+        out!(
+            "load: self-weight {mass:.6} kg at gravity ({:.4}, {:.4}, {:.4}) m/s² = ({:.6}, {:.6}, {:.6}) N",
+            g[0],
+            g[1],
+            g[2],
+            mass * g[0],
+            mass * g[1],
+            mass * g[2]
+        );
+    }
+}
+
 fn report(o: &Options, analysis: &Analysis, results: &Results) {
     let model = analysis.model();
     out!(
@@ -348,14 +399,17 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
         model.triangles.len(),
         model.gaps.len()
     );
-    out!(
-        "\n{:<8} {:>11} {:>11} {:>10} {:>10}  status",
-        "gap",
-        "slip x mm",
-        "slip y mm",
-        "N (N)",
-        "|T| (N)"
-    );
+    report_loads(analysis);
+    if !model.gaps.is_empty() {
+        out!(
+            "\n{:<8} {:>11} {:>11} {:>10} {:>10}  status",
+            "gap",
+            "slip x mm",
+            "slip y mm",
+            "N (N)",
+            "|T| (N)"
+        );
+    }
     for (g, r) in model.gaps.iter().zip(&results.gaps) {
         out!(
             "{:<8} {:>11.3} {:>11.3} {:>10.3} {:>10.3}  {:?}",

@@ -143,3 +143,70 @@ fn a_model_without_gaps_writes_film_files_only() {
     );
     let _ = std::fs::remove_dir_all(&root);
 }
+
+#[test]
+fn model_command_ramps_the_loads_of_the_file_and_prints_their_level() {
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args([
+            "model",
+            concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/examples/circular_membrane.json"
+            ),
+            "--steps",
+            "4",
+            "--quiet",
+        ])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    for expected in [
+        "load: pressure set top at 200.000000 Pa on 96 triangles",
+        "load: force set lamp at (0.000000, 0.000000, -5.000000) N on each of 1 nodes",
+        "load: self-weight 1.358800 kg",
+        "reaction of group rim:",
+    ] {
+        assert!(text.contains(expected), "'{expected}' missing in:\n{text}");
+    }
+}
+
+#[test]
+fn no_line_search_option_reaches_the_same_inflated_state() {
+    let run = |extra: &[&str]| {
+        let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+            .args([
+                "model",
+                concat!(
+                    env!("CARGO_MANIFEST_DIR"),
+                    "/examples/circular_membrane.json"
+                ),
+                "--steps",
+                "4",
+                "--quiet",
+            ])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(output.status.success());
+        let text = String::from_utf8(output.stdout).unwrap();
+        // "equivalent (von Mises) stress: 2.640 … 3.804 MPa": the numbers, to print precision.
+        let line = text
+            .lines()
+            .find(|l| l.starts_with("equivalent (von Mises) stress"))
+            .unwrap()
+            .to_string();
+        line.split([' ', ':'])
+            .filter_map(|w| w.parse::<f64>().ok())
+            .collect::<Vec<_>>()
+    };
+    let (with, without) = (run(&[]), run(&["--no-line-search"]));
+    assert_eq!(with.len(), 2);
+    for (a, b) in with.iter().zip(&without) {
+        assert!((a - b).abs() <= 1e-3, "{with:?} vs {without:?}");
+    }
+}

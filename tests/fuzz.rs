@@ -9,9 +9,10 @@
 //!   ramp of `frame.dz`), mutated by bit flips (CRC left as is), payload byte changes and JSON
 //!   number replacements with the length and CRC recomputed (forgeries that pass the format
 //!   checks), and structured edits of the decoded snapshot (scaled or replaced displacements,
-//!   slip histories, group displacements, friction, statuses, sizes, phase, times, variable
-//!   values), serialized again;
-//! * models: the 2 × 2-cell pressed-node patch and the specimen as JSON, mutated by replaced
+//!   slip histories, group displacements, friction, statuses, sizes, load levels, phase, times,
+//!   variable values), serialized again;
+//! * models: the 2 × 2-cell pressed-node patch (also with a `loads` section: pressure, nodal
+//!   force, density and gravity) and the specimen as JSON, mutated by replaced
 //!   numbers (indices and values: 0, ±1, huge, tiny, subnormal, random), deleted fields,
 //!   truncated or emptied arrays, and strings with control characters.
 //!
@@ -106,7 +107,8 @@ fn outputs(inst: &mut Instance) -> Option<Vec<f64>> {
     inst.get_real(&vrs, &mut out).ok().map(|()| out)
 }
 
-/// Sets every group input to `scale` × its model target and steps from the instance's time;
+/// Sets every group input to `scale` × its model target, and every load input (pressure,
+/// nodal force) to `scale` × its start value (the model's), and steps from the instance's time;
 /// classifies the outcome.
 fn step_and_classify(inst: &mut Instance, scale: f64, counts: &mut Counts) {
     if !allowed::DO_STEP.allows(inst.phase()) {
@@ -125,17 +127,21 @@ fn step_and_classify(inst: &mut Instance, scale: f64, counts: &mut Counts) {
         .iter()
         .filter(|v| v.causality == Causality::Input && v.name != "mu")
         .map(|v| {
-            let (group, axis) = v.name.rsplit_once('.').expect("group input");
-            let g = model
-                .groups
-                .iter()
-                .find(|g| g.name == group)
-                .expect("group");
-            let axis = ["dx", "dy", "dz"]
-                .iter()
-                .position(|a| *a == axis)
-                .expect("axis");
-            (v.value_reference, scale * g.target[axis])
+            let (prefix, axis) = v.name.rsplit_once('.').expect("prefixed input");
+            let target = match model.groups.iter().find(|g| g.name == prefix) {
+                Some(g) => {
+                    let axis = ["dx", "dy", "dz"]
+                        .iter()
+                        .position(|a| *a == axis)
+                        .expect("axis");
+                    g.target[axis]
+                }
+                None => match v.start {
+                    Some(Value::Real(x)) => x,
+                    _ => panic!("input {} has no real start", v.name),
+                },
+            };
+            (v.value_reference, scale * target)
         })
         .collect();
     for (vr, x) in inputs {
@@ -229,8 +235,16 @@ fn edit_snapshot(s: &mut Snapshot, rng: &mut Rng) {
         s.time = rng.number();
         return;
     };
-    match rng.below(14) {
+    match rng.below(15) {
         0 => a.displacement.iter_mut().for_each(|v| *v *= factor),
+        13 => {
+            // Load levels: a gravity component, or a pressure level the model has no set for.
+            if rng.next() & 1 == 0 {
+                a.loads.gravity[rng.below(3)] = rng.number();
+            } else {
+                a.loads.pressure.push(rng.number());
+            }
+        }
         1 => {
             let i = rng.below(a.displacement.len());
             a.displacement[i] = rng.number();
@@ -453,15 +467,25 @@ fn mutated_models_are_refused_or_step_to_finite_outputs_or_discard() {
                  "frame": { "x": [1,0,0], "y": [0,1,0], "z": [0,0,1] }, "initial_gap": 0.001,
                  "normal_stiffness": 2.5e8, "tangential_stiffness": 2.5e7, "friction": 0.2 }],
       "groups": [{ "name": "rim", "nodes": [0, 1, 2, 3, 5, 6, 7, 8], "target": [0, 0, -0.01] }] }"#;
+    let loaded = patch.replace(
+        r#""prestress": [5e5, 5e5, 0] },"#,
+        r#""prestress": [5e5, 5e5, 0], "density": 1750 },
+      "loads": { "pressures": [{ "name": "top", "elements": "all", "pressure": 300 },
+                               { "name": "gust", "elements": [2, 3], "pressure": -100 }],
+                 "forces": [{ "name": "lamp", "nodes": [4], "force": [0.5, 0, -2] }],
+                 "gravity": [0, 0, -9.81] },"#,
+    );
+    assert_ne!(loaded, patch);
     let specimen = ParallelArch::default().model().unwrap().to_json();
-    let bases: Vec<Json> = [patch, specimen.as_str()]
+    let bases: Vec<Json> = [patch, loaded.as_str(), specimen.as_str()]
         .iter()
         .map(|t| serde_json::from_str(t).unwrap())
         .collect();
     let mut counts = Counts::default();
     for case in 0..MODEL_CASES {
-        // Mostly the small patch (fast); every fifth case the specimen.
-        let mut json = bases[usize::from(case % 5 == 4)].clone();
+        // Mostly the small patch (fast), plain or loaded; every fifth case the specimen.
+        let base = if case % 5 == 4 { 2 } else { case % 2 };
+        let mut json = bases[base].clone();
         for _ in 0..1 + rng.below(2) {
             mutate_model(&mut json, &mut rng);
         }

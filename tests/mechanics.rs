@@ -30,6 +30,7 @@ fn etfe() -> Material {
         poisson_ratio: 0.43,
         thickness: 250e-6,
         prestress: [0.5e6, 0.5e6, 0.0],
+        density: 0.0,
         wrinkling: Wrinkling::None,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     }
@@ -52,6 +53,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         }
     }
     Model {
+        loads: Default::default(),
         name: "Patch".into(),
         description: String::new(),
         nodes,
@@ -1280,6 +1282,7 @@ fn tension_field_film(eta: f64, prestress: f64) -> Material {
         poisson_ratio: 0.3,
         thickness: 1.0,
         prestress: [prestress, prestress, 0.0],
+        density: 0.0,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: eta,
     }
@@ -1776,6 +1779,9 @@ fn hub_rotation(model: &Model, phi: f64) -> Vec<[f64; 3]> {
 }
 
 #[test]
+// M_cr = 2π a² t σ0 happens to be 2π N·m here: the literal 6.283 checks the comment's worked
+// number, it is not an approximation of τ.
+#[allow(clippy::approx_constant)]
 fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
     // In-plane torsion of an annulus (note §2.3; Mikulas 1964, Miller & Hedgepeth 1982): hub
     // a = 0.1, rim b = 0.5, t = 1e-4, Y = 1 GPa, ν = 0.3, σ0 = 1 MPa isotropic. Taut (linear):
@@ -1787,6 +1793,7 @@ fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
         poisson_ratio: nu,
         thickness: t,
         prestress: [s0, s0, 0.0],
+        density: 0.0,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     };

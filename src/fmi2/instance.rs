@@ -24,8 +24,10 @@
 //!   output is read in initialization mode.
 //! * The initial outputs are those of the undeformed, prestressed film; inputs set during
 //!   initialization are reached by the first step.
-//! * `fmi2DoStep(t, h)` moves every group to its inputs in `solver.incrementsPerStep` increments
-//!   (`Analysis::step_to`). Time is a pseudo-time: only `t` = current time (to 1e-9 relative) and
+//! * `fmi2DoStep(t, h)` moves every group to its inputs, and the pressures and nodal forces to
+//!   theirs, in `solver.incrementsPerStep` increments (`Analysis::step_to_with_loads`). The
+//!   analysis starts unloaded: the first step ramps the loads from zero, gravity (a parameter,
+//!   `gravity.x/.y/.z` with `film.density`) included. Time is a pseudo-time: only `t` = current time (to 1e-9 relative) and
 //!   `h > 0` are required, and time becomes `t + h`.
 //! * Never fmi2OK with a wrong answer: a step's outputs are checked finite (`checked_step`,
 //!   `mech::check_results`; a step whose outputs are not is a Discard and the state before it is
@@ -63,8 +65,8 @@ use super::variables::{Binding, Causality, Value, VarType, Variable};
 use crate::mech::element::state_counts;
 use crate::mech::material::Wrinkling;
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, Model, ParallelArch, Results, SolverSettings, StepError,
-    StepReport, check_results, model::MAX_FRICTION, solver::IncrementFailure, vtk,
+    Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SolverSettings,
+    StepError, StepReport, check_results, model::MAX_FRICTION, solver::IncrementFailure, vtk,
 };
 use serde::{Deserialize, Serialize};
 
@@ -634,11 +636,14 @@ impl Instance {
                 .iter()
                 .map(|g| g.name.clone())
                 .chain(m.groups.iter().map(|g| g.name.clone()))
+                .chain(m.loads.pressures.iter().map(|p| p.name.clone()))
+                .chain(m.loads.forces.iter().map(|f| f.name.clone()))
                 .collect()
         };
         if names(&model) != names(base) {
             return Err(
-                "the regenerated model's gaps and groups differ from the FMU's variables".into(),
+                "the regenerated model's gaps, groups and load sets differ from the FMU's variables"
+                    .into(),
             );
         }
         let mut settings = SolverSettings::default();
@@ -659,6 +664,8 @@ impl Instance {
                 (Binding::PoissonRatio, Value::Real(x)) => model.material.poisson_ratio = x,
                 (Binding::Thickness, Value::Real(x)) => model.material.thickness = x,
                 (Binding::Prestress(c), Value::Real(x)) => model.material.prestress[c] = x,
+                (Binding::Density, Value::Real(x)) => model.material.density = x,
+                (Binding::Gravity(c), Value::Real(x)) => model.loads.gravity[c] = x,
                 (Binding::Wrinkling, Value::Boolean(b)) => {
                     model.material.wrinkling = if b {
                         Wrinkling::TensionField
@@ -683,6 +690,7 @@ impl Instance {
                 (Binding::FrictionLaw, Value::String(name)) => {
                     model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
                 }
+                (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
                 (Binding::UseJuRowlands, Value::Boolean(b)) => {
                     settings.iteration_matrix = if b {
                         IterationMatrix::JuRowlands
@@ -806,12 +814,15 @@ impl Instance {
         }
         let table = &self.description.variables;
         let mut targets = vec![[0.0; 3]; self.description.model.groups.len()];
+        let mut loads = LoadLevels::zero(&self.description.model);
         let mut mu = None;
         for (v, x) in table.iter().zip(&self.values) {
             match (v.binding, x) {
                 (Binding::GroupDisplacement { group, axis }, &Value::Real(x)) => {
                     targets[group][axis] = x
                 }
+                (Binding::Pressure(set), &Value::Real(x)) => loads.pressure[set] = x,
+                (Binding::NodalForce { set, axis }, &Value::Real(x)) => loads.force[set][axis] = x,
                 (Binding::Friction, &Value::Real(x)) if self.mu_set => mu = Some(x),
                 _ => {}
             }
@@ -820,6 +831,8 @@ impl Instance {
             .analysis
             .as_mut()
             .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
+        // Gravity is a parameter: the built model holds it, and the first step ramps it in.
+        loads.gravity = built.analysis.model().loads.gravity;
         // μ changes the state's friction before the step; a refused step must not keep it.
         let before = match mu {
             Some(mu) if built.analysis.state().friction.iter().any(|&f| f != mu) => {
@@ -829,7 +842,7 @@ impl Instance {
             }
             _ => None,
         };
-        match checked_step(built, &targets, &self.logger) {
+        match checked_step(built, &targets, &loads, &self.logger) {
             Ok(report) => {
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
@@ -1201,18 +1214,19 @@ impl Instance {
     }
 }
 
-/// `Analysis::step_to`, then a check that every output of the new state is finite; a state
+/// `Analysis::step_to_with_loads`, then a check that every output of the new state is finite; a state
 /// that is not is replaced by the one before the step and the step refused like a step that
 /// does not converge (fmi2Discard: the master may retry with a smaller change). Defence in
 /// depth: the solver itself rejects non-finite increments.
 fn checked_step(
     built: &mut Built,
     targets: &[[f64; 3]],
+    loads: &LoadLevels,
     logger: &Logger,
 ) -> Result<StepReport, StepError> {
     let analysis = &mut built.analysis;
     let before = analysis.state().clone();
-    let report = analysis.step_to(targets, built.increments)?;
+    let report = analysis.step_to_with_loads(targets, loads, built.increments)?;
     let results = analysis.results();
     match check_results(analysis.model(), &results, Some(report.residual)) {
         Ok(()) => {

@@ -6,9 +6,9 @@
 //! output written so far (step count and the states written, so the `.pvd` files continue from
 //! the state).
 //!
-//! Serialized form (little endian), version 3 (version 1 had no String values and no VTK
-//! output, version 2 listed VTK file names instead of state numbers; their states are refused,
-//! as they came from an FMU with another GUID anyway):
+//! Serialized form (little endian), version 4 (version 3 had either no load levels or VTK file
+//! names instead of state numbers, version 2 neither, version 1 no String values and no VTK
+//! output; older states are refused, as they came from an FMU with another GUID anyway):
 //!
 //! | bytes | content |
 //! |---|---|
@@ -22,7 +22,7 @@
 //!
 //! A state read back is checked as strictly as a model file ([`check_analysis_state`]): sizes that
 //! fit the model, finite values, magnitudes bounded by the model's size, `μ` in
-//! `[0, MAX_FRICTION]`, and gap statuses that the gap law gives again at the stored state.
+//! `[0, MAX_FRICTION]`, finite load levels of the model's sizes, and gap statuses that the gap law gives again at the stored state.
 
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -55,7 +55,7 @@ pub struct Snapshot {
 }
 
 const MAGIC: &[u8; 8] = b"MCFMI2ST";
-const VERSION: u32 = 3;
+const VERSION: u32 = 4;
 
 /// The serialized bytes of `snapshot` for the FMU with `guid`.
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
@@ -156,6 +156,29 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
         if have != want {
             return Err(format!("the state has {have} {what}, the model {want}"));
         }
+    }
+    let loads = &state.loads;
+    let load_sizes = [
+        (
+            "pressure levels",
+            loads.pressure.len(),
+            model.loads.pressures.len(),
+        ),
+        (
+            "nodal force levels",
+            loads.force.len(),
+            model.loads.forces.len(),
+        ),
+    ];
+    for (what, have, want) in load_sizes {
+        if have != want {
+            return Err(format!("the state has {have} {what}, the model {want}"));
+        }
+    }
+    if let Some(v) = loads.values().find(|v| !v.is_finite()) {
+        return Err(format!(
+            "the state's load levels hold {v}, not a finite number"
+        ));
     }
     if !(state.last_increment.is_empty() || state.last_increment.len() == n) {
         return Err(format!(

@@ -1310,3 +1310,133 @@ fn singular_model_is_refused_before_any_step() {
             .contains("can rotate")
     );
 }
+
+/// Issue 8 through the FMU: `top.pressure` and `lamp.Fz` inputs (starts from the model) and the
+/// `gravity.*` / `film.density` parameters load a circular membrane. The rim reaction balances
+/// them exactly (the pressure's resultant on a surface with a fixed rim is `p` times the rim's
+/// projected area, `A_polygon`), equals the core's, and FMU states round-trip the load levels.
+#[test]
+fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels() {
+    use super::variables::{Causality, Value};
+    use crate::mech::model::ForceSet;
+    use crate::mech::scenarios::CircularMembrane;
+    use crate::mech::{Analysis, LoadLevels, SolverSettings};
+
+    let membrane = CircularMembrane {
+        radius: 1.0,
+        rings: 4,
+        material: crate::mech::Material {
+            prestress: [1e6, 1e6, 0.0],
+            density: 1750.0,
+            ..ParallelArch::default().material
+        },
+        pressure: 100.0,
+    };
+    let mut model = membrane.model().unwrap();
+    model.loads.forces.push(ForceSet {
+        name: "lamp".into(),
+        nodes: vec![0],
+        force: [0.0, 0.0, -2.0],
+    });
+    let (u, log) = (
+        Unpacked::new("pressure", Source::Model(model.clone())),
+        Log::default(),
+    );
+    let var = |name: &str| u.variables.iter().find(|v| v.name == name).unwrap();
+    assert_eq!(var("top.pressure").causality, Causality::Input);
+    assert_eq!(var("top.pressure").start, Some(Value::Real(100.0)));
+    assert_eq!(var("lamp.Fz").start, Some(Value::Real(-2.0)));
+    assert_eq!(var("gravity.z").start, Some(Value::Real(-9.81)));
+    assert_eq!(var("film.density").causality, Causality::Parameter);
+
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    assert_eq!(fmu.real("rim.Rz"), 0.0, "the analysis starts unloaded");
+    assert_eq!(fmu.set_real("top.pressure", 50.0), 0);
+    assert_eq!(fmu.step(0.0, 0.5), 0, "{:?}", log.take());
+    let sides = 6.0 * membrane.rings as f64;
+    let area = 0.5 * sides * (std::f64::consts::TAU / sides).sin();
+    let mass = 1750.0 * membrane.material.thickness * area;
+    let balance = -(50.0 * area - 9.81 * mass - 2.0);
+    let rz = fmu.real("rim.Rz");
+    assert!(
+        (rz - balance).abs() < 1e-6 * balance.abs(),
+        "{rz} vs {balance}"
+    );
+
+    // The core, driven the same way, gives the same numbers.
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let levels = LoadLevels {
+        pressure: vec![50.0],
+        force: vec![[0.0, 0.0, -2.0]],
+        gravity: [0.0, 0.0, -9.81],
+    };
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 2)
+        .unwrap();
+    assert_eq!(analysis.results().reactions[0][2], rz);
+
+    // A state saved here continues exactly, in place and after (de)serialization.
+    let mut state: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+    let at_save = fmu.all_values();
+    assert_eq!(fmu.set_real("top.pressure", 100.0), 0);
+    assert_eq!(fmu.step(0.5, 0.5), 0);
+    let reference = fmu.all_values();
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, state) }, 0);
+    assert_eq!(fmu.all_values(), at_save, "inputs and load levels restored");
+    assert_eq!(fmu.set_real("top.pressure", 100.0), 0);
+    assert_eq!(fmu.step(0.5, 0.5), 0);
+    assert_eq!(fmu.all_values(), reference);
+    let mut size = 0;
+    assert_eq!(
+        unsafe { fmi2_serialized_fmu_state_size(fmu.c, state, &mut size) },
+        0
+    );
+    let mut bytes = vec![0 as Fmi2Byte; size];
+    assert_eq!(
+        unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size) },
+        0
+    );
+    let other = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    let mut restored: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(other.c, bytes.as_ptr(), size, &mut restored) },
+        0,
+        "{:?}",
+        log.take()
+    );
+    assert_eq!(unsafe { fmi2_set_fmu_state(other.c, restored) }, 0);
+    assert_eq!(other.set_real("top.pressure", 100.0), 0);
+    assert_eq!(other.step(0.5, 0.5), 0);
+    assert_eq!(other.all_values(), reference, "the load level was restored");
+
+    // A forged state whose load levels do not fit the model is refused.
+    let raw: Vec<u8> = bytes.iter().map(|&b| b as u8).collect();
+    let forged = forge(&raw, u.guid.to_str().unwrap(), |s| {
+        s.analysis.as_mut().unwrap().loads.pressure.push(1.0)
+    });
+    let (status, _) = deserialize_status(&other, &forged);
+    assert_eq!(status, Status::Error.raw());
+    assert!(
+        log.contains(Status::Error, "pressure levels"),
+        "{:?}",
+        log.take()
+    );
+
+    // Non-finite input: fmi2Error naming the variable, nothing changes.
+    assert_eq!(fmu.set_real("top.pressure", f64::NAN), Status::Error.raw());
+    assert!(log.contains(Status::Error, "top.pressure = NaN"));
+
+    // Gravity off (a parameter): the rim carries the pressure and the lamp only.
+    let weightless = Fmu::initialized(&u, &log, &[("gravity.z", 0.0)], &[]);
+    assert_eq!(weightless.set_real("top.pressure", 50.0), 0);
+    assert_eq!(weightless.step(0.0, 1.0), 0);
+    let balance = -(50.0 * area - 2.0);
+    let rz = weightless.real("rim.Rz");
+    assert!(
+        (rz - balance).abs() < 1e-6 * balance.abs(),
+        "{rz} vs {balance}"
+    );
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
+    assert_eq!(unsafe { fmi2_free_fmu_state(other.c, &mut restored) }, 0);
+}

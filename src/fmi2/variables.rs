@@ -12,12 +12,16 @@
 //! | `time` | Real | independent | | pseudo-time of the load path |
 //! | `mu` | Real | input | 1 | friction coefficient of every gap (applied once set) |
 //! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step |
+//! | `<pressureSet>.pressure` | Real | input | Pa | follower pressure of the set reached at the end of a step (start: the model's) |
+//! | `<forceSet>.Fx/.Fy/.Fz` | Real | input | N | force on each node of the set reached at the end of a step (start: the model's) |
 //! | `archHeight` | Real | parameter | m | ParallelArch only: the model is regenerated from it |
 //! | `film.E`, `film.nu`, `film.thickness`, `film.prestressX/Y/XY` | Real | parameter | Pa, 1, m, Pa | film |
 //! | `film.wrinkling` | Boolean | parameter | | tension-field film (start: the model's `wrinkling`) |
+//! | `film.density` | Real | parameter | kg/m3 | film density for self-weight (start: the model's) |
+//! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap; start: the model's when uniform, else "" (each gap keeps its own) |
-//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands` | | parameter | | Newton settings |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch` | | parameter | | Newton settings |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
@@ -146,6 +150,17 @@ pub enum Binding {
         group: usize,
         axis: usize,
     },
+    /// Input pressure of a pressure set.
+    Pressure(usize),
+    /// Input force per node of a force set along axis 0, 1, 2.
+    NodalForce {
+        set: usize,
+        axis: usize,
+    },
+    /// Film density (self-weight).
+    Density,
+    /// Gravity component along axis 0, 1, 2.
+    Gravity(usize),
     ArchHeight,
     YoungsModulus,
     PoissonRatio,
@@ -164,6 +179,8 @@ pub enum Binding {
     MaxCutbacks,
     IncrementsPerStep,
     UseJuRowlands,
+    /// Backtracking line search on (true) or off.
+    LineSearch,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
     /// it does not change the analysis, and no output depends on it.
     ResultsDirectory,
@@ -232,8 +249,10 @@ impl Variable {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 3]); 5] = [
+pub const UNITS: [(&str, [i32; 3]); 7] = [
     ("m", [0, 1, 0]),
+    ("m/s2", [0, 1, -2]),
+    ("kg/m3", [1, -3, 0]),
     ("N", [1, 1, -2]),
     ("Pa", [1, -1, -2]),
     ("N/m", [1, 0, -2]),
@@ -241,8 +260,9 @@ pub const UNITS: [(&str, [i32; 3]); 5] = [
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
-pub const RESERVED_NAMES: [&str; 7] = [
+pub const RESERVED_NAMES: [&str; 8] = [
     "time",
+    "gravity",
     "mu",
     "frictionLaw",
     "archHeight",
@@ -254,13 +274,21 @@ pub const RESERVED_NAMES: [&str; 7] = [
 /// Default of `solver.incrementsPerStep`.
 pub const DEFAULT_INCREMENTS_PER_STEP: i32 = 10;
 
-/// Checks that the model's gap and group names can prefix variable names.
+/// Checks that the model's gap, group, pressure-set and force-set names can prefix variable names.
 pub fn check_names(model: &Model) -> Result<(), String> {
     let names = model
         .gaps
         .iter()
         .map(|g| ("gap", &g.name))
-        .chain(model.groups.iter().map(|g| ("boundary group", &g.name)));
+        .chain(model.groups.iter().map(|g| ("boundary group", &g.name)))
+        .chain(
+            model
+                .loads
+                .pressures
+                .iter()
+                .map(|p| ("pressure set", &p.name)),
+        )
+        .chain(model.loads.forces.iter().map(|f| ("force set", &f.name)));
     for (kind, name) in names {
         if RESERVED_NAMES.contains(&name.as_str()) {
             return Err(format!(
@@ -306,6 +334,32 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                     g.name
                 ),
                 Binding::GroupDisplacement { group, axis },
+            );
+        }
+    }
+    for (set, p) in model.loads.pressures.iter().enumerate() {
+        table.input(
+            &format!("{}.pressure", p.name),
+            p.pressure,
+            "Pa",
+            &format!(
+                "follower pressure on pressure set '{}' (positive along the triangles' normals), reached at the end of a step",
+                p.name
+            ),
+            Binding::Pressure(set),
+        );
+    }
+    for (set, f) in model.loads.forces.iter().enumerate() {
+        for (axis, a) in ["Fx", "Fy", "Fz"].iter().enumerate() {
+            table.input(
+                &format!("{}.{a}", f.name),
+                f.force[axis],
+                "N",
+                &format!(
+                    "force on each node of force set '{}' along {}, reached at the end of a step",
+                    f.name, axes[axis]
+                ),
+                Binding::NodalForce { set, axis },
             );
         }
     }
@@ -380,6 +434,24 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "true: tension-field film (no compression; elements taut, wrinkled or slack); false: linear elastic, the paper's",
         Binding::Wrinkling,
     );
+    table.parameter(
+        "film.density",
+        Value::Real(m.density),
+        Some("kg/m3"),
+        "film density for self-weight (ETFE about 1750); 0: weightless",
+        Binding::Density,
+    );
+    for (axis, a) in axes.iter().enumerate() {
+        table.parameter(
+            &format!("gravity.{a}"),
+            Value::Real(model.loads.gravity[axis]),
+            Some("m/s2"),
+            &format!(
+                "gravity acceleration along {a} acting on the film's mass; ramped in over the first step"
+            ),
+            Binding::Gravity(axis),
+        );
+    }
     for (i, g) in model.gaps.iter().enumerate() {
         table.parameter(
             &format!("{}.kn", g.name),
@@ -408,7 +480,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          slides along the gap's local x only); empty: each gap keeps the model file's",
         Binding::FrictionLaw,
     );
-    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 6] = [
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 7] = [
         (
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
@@ -450,6 +522,15 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             None,
             "true: the paper's symmetric Ju-Rowlands iteration matrix; false: the consistent tangent",
             Binding::UseJuRowlands,
+        ),
+        (
+            "lineSearch",
+            Value::Boolean(solver.line_search),
+            None,
+            "true: backtracking line search on the residual (safe first steps from a flat film, gaps opening \
+             and closing); false: plain Newton steps, about half the iterations when each step starts near \
+             its answer (a prestressed film under a gradually raised pressure)",
+            Binding::LineSearch,
         ),
     ];
     for (name, start, unit, description, binding) in solver_parameters {

@@ -10,7 +10,7 @@
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
 
-use super::element::{ElementVector, Material, MembraneTriangle};
+use super::element::{ElementMatrix, ElementVector, Material, MembraneTriangle};
 use super::model::{GapSupport, Model};
 
 const NO_SLOT: u32 = u32::MAX;
@@ -211,6 +211,18 @@ impl System {
     /// A matrix view over `values` (which must have [`System::nonzeros`] entries).
     pub fn matrix<'a>(&'a self, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
         SparseColMatRef::new(self.symbolic.as_ref(), values)
+    }
+
+    /// Adds a 9×9 matrix on the DOFs of triangle `e` (column-major, like the element tangent)
+    /// into `values` through the triangle's slots: entries on constrained DOFs, and above the
+    /// diagonal of a lower-only pattern, are dropped.
+    pub fn add_element_matrix(&self, e: usize, k: &ElementMatrix, values: &mut [f64]) {
+        let slots = &self.slots[81 * e..81 * (e + 1)];
+        for (s, kij) in slots.iter().zip(k.iter()) {
+            if *s != NO_SLOT {
+                values[*s as usize] += kij;
+            }
+        }
     }
 
     /// Relative displacement `d = R (u_A − u_B)` of gap `g` in its local frame.

@@ -269,6 +269,7 @@ mod tests {
             poisson_ratio: 0.43,
             thickness: 250e-6,
             prestress: [1.0e6, 0.5e6, 0.2e6],
+            density: 0.0,
             wrinkling: Wrinkling::None,
             wrinkling_regularisation: 1e-5,
         }

@@ -72,6 +72,9 @@ pub struct Material {
     /// Initial stress `σ0 = [σx, σy, τxy]` (Pa) in each element's local frame (e1 ∥ global X).
     #[serde(default)]
     pub prestress: [f64; 3],
+    /// Density `ρ` (kg/m³) for self-weight (ETFE ≈ 1750); 0 (the default): weightless film.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub density: f64,
     /// Compression model: `"none"` (default, the paper) or `"tension-field"`.
     #[serde(default, skip_serializing_if = "Wrinkling::is_none")]
     pub wrinkling: Wrinkling,
@@ -81,6 +84,10 @@ pub struct Material {
         skip_serializing_if = "is_default_regularisation"
     )]
     pub wrinkling_regularisation: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn default_regularisation() -> f64 {
@@ -237,6 +244,7 @@ mod tests {
             poisson_ratio: 0.3,
             thickness: 1.0,
             prestress,
+            density: 0.0,
             wrinkling: Wrinkling::TensionField,
             wrinkling_regularisation: 0.0,
         }

@@ -8,6 +8,7 @@
 //! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
 //! | [`finite`] | finiteness check of reported results |
 //! | [`model`] | model file format and validation |
+//! | [`load`] | follower pressure, self-weight, nodal forces and their load stiffness |
 //! | [`restraint`] | rigid-body modes no restraint holds (singular models), found at validation |
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
@@ -21,6 +22,7 @@ pub mod contact;
 pub mod element;
 pub mod finite;
 pub mod linear;
+pub mod load;
 pub mod material;
 pub mod model;
 pub mod restraint;
@@ -31,6 +33,7 @@ pub mod vtk;
 
 pub use contact::{FrictionLaw, GapStatus, IterationMatrix};
 pub use finite::check_results;
+pub use load::LoadLevels;
 pub use material::{Material, Wrinkling, WrinklingState};
 pub use model::{Model, ModelError};
 pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};

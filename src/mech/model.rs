@@ -119,6 +119,88 @@ pub struct BoundaryGroup {
     pub target: [f64; 3],
 }
 
+/// Which triangles a pressure set covers: `"all"` or a list of triangle indices.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ElementSelection {
+    /// Every triangle of the model (written `"all"`).
+    All(AllElements),
+    /// The listed triangles (0-based).
+    List(Vec<usize>),
+}
+
+/// The word `"all"` of an [`ElementSelection`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum AllElements {
+    /// Every triangle.
+    #[serde(rename = "all")]
+    All,
+}
+
+/// A follower pressure on a named set of triangles (normal to the deformed film).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureSet {
+    /// Name (an identifier: it becomes the FMU variable prefix `<name>.pressure`).
+    pub name: String,
+    /// The triangles it acts on.
+    pub elements: ElementSelection,
+    /// Pressure of a standard run (Pa); positive pushes along the triangle normal
+    /// `(x2 − x1) × (x3 − x1)` of its node order.
+    pub pressure: f64,
+}
+
+/// A dead force on each node of a named node set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceSet {
+    /// Name (an identifier: it becomes the FMU variable prefix `<name>.Fx/.Fy/.Fz`).
+    pub name: String,
+    /// The nodes it acts on.
+    pub nodes: Vec<usize>,
+    /// Force on EACH node of a standard run, global axes (N).
+    pub force: [f64; 3],
+}
+
+/// The gravity acceleration of the model file when none is given (m/s², global −Z).
+pub const DEFAULT_GRAVITY: [f64; 3] = [0.0, 0.0, -9.81];
+
+fn default_gravity() -> [f64; 3] {
+    DEFAULT_GRAVITY
+}
+
+/// External loads of a model file (`"loads"`): applied over the same increments as the groups.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Follower pressures.
+    #[serde(default)]
+    pub pressures: Vec<PressureSet>,
+    /// Nodal forces.
+    #[serde(default)]
+    pub forces: Vec<ForceSet>,
+    /// Gravity acceleration acting on the film's mass (`material.density`) (m/s²).
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+}
+
+impl Default for LoadSpec {
+    fn default() -> Self {
+        Self {
+            pressures: Vec::new(),
+            forces: Vec::new(),
+            gravity: DEFAULT_GRAVITY,
+        }
+    }
+}
+
+impl LoadSpec {
+    /// Whether the section holds nothing but the default gravity (then it is not written).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
 /// A complete membrane + gap model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -146,6 +228,9 @@ pub struct Model {
     /// Prescribed boundary groups.
     #[serde(default)]
     pub groups: Vec<BoundaryGroup>,
+    /// Pressures, nodal forces and gravity.
+    #[serde(default, skip_serializing_if = "LoadSpec::is_default")]
+    pub loads: LoadSpec,
 }
 
 /// Why a model is rejected. Every variant names the offending item.
@@ -184,6 +269,8 @@ pub enum ModelError {
     },
     /// Text that would go into modelDescription.xml holds a character XML cannot carry.
     Text { field: String, message: String },
+    /// A load set out of range (unknown triangle, empty set, non-finite value).
+    Load { item: String, message: String },
     /// Nothing to analyse.
     Empty { message: String },
 }
@@ -240,6 +327,7 @@ impl fmt::Display for ModelError {
                 )
             }
             Self::Text { field, message } => write!(f, "{field}: {message}"),
+            Self::Load { item, message } => write!(f, "{item}: {message}"),
             Self::Empty { message } => write!(f, "model: {message}"),
         }
     }
@@ -331,6 +419,11 @@ impl Model {
         if !(0.0..1.0).contains(&eta) {
             return Err(ModelError::Material {
                 message: format!("wrinkling_regularisation = {eta} must lie in [0, 1)"),
+            });
+        }
+        if !(m.density >= 0.0 && m.density.is_finite()) {
+            return Err(ModelError::Material {
+                message: format!("density = {} must be ≥ 0 (kg/m³)", m.density),
             });
         }
         for (t, tri) in self.triangles.iter().enumerate() {
@@ -453,6 +546,7 @@ impl Model {
                 )));
             }
         }
+        self.validate_loads(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -461,6 +555,83 @@ impl Model {
             )?;
         }
         super::restraint::check(self)
+    }
+
+    /// Checks the `loads` section; set names join the gap and group namespace.
+    fn validate_loads(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        let l = &self.loads;
+        if l.gravity.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::NotFinite {
+                item: "loads gravity".into(),
+            });
+        }
+        for p in &l.pressures {
+            check_name(names, "pressure set", &p.name)?;
+            let item = || format!("pressure set '{}'", p.name);
+            if !p.pressure.is_finite() {
+                return Err(ModelError::NotFinite {
+                    item: format!("{} pressure", item()),
+                });
+            }
+            if let ElementSelection::List(list) = &p.elements {
+                if list.is_empty() {
+                    return Err(ModelError::Load {
+                        item: item(),
+                        message: "has no elements (write \"all\" for every triangle)".into(),
+                    });
+                }
+                let mut seen = HashSet::new();
+                for &e in list {
+                    if e >= self.triangles.len() {
+                        return Err(ModelError::Load {
+                            item: item(),
+                            message: format!(
+                                "triangle {e} does not exist (the model has {} triangles, 0-based)",
+                                self.triangles.len()
+                            ),
+                        });
+                    }
+                    if !seen.insert(e) {
+                        return Err(ModelError::Load {
+                            item: item(),
+                            message: format!("lists triangle {e} twice"),
+                        });
+                    }
+                }
+            }
+        }
+        for f in &l.forces {
+            check_name(names, "force set", &f.name)?;
+            let item = || format!("force set '{}'", f.name);
+            if f.force.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NotFinite {
+                    item: format!("{} force", item()),
+                });
+            }
+            if f.nodes.is_empty() {
+                return Err(ModelError::Load {
+                    item: item(),
+                    message: "has no nodes".into(),
+                });
+            }
+            let mut seen = HashSet::new();
+            for &v in &f.nodes {
+                if v >= self.nodes.len() {
+                    return Err(ModelError::UnknownNode {
+                        item: item(),
+                        node: v,
+                        node_count: self.nodes.len(),
+                    });
+                }
+                if !seen.insert(v) {
+                    return Err(ModelError::Load {
+                        item: item(),
+                        message: format!("lists node {v} twice"),
+                    });
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Index of the gap named `name`.
@@ -519,7 +690,8 @@ fn check_name(names: &mut HashSet<String>, kind: &str, name: &str) -> Result<(),
     if !names.insert(name.to_string()) {
         return Err(ModelError::Name {
             item,
-            message: "name is used twice (gap and group names share one namespace)".into(),
+            message: "name is used twice (gap, group, pressure-set and force-set names share one namespace)"
+                .into(),
         });
     }
     Ok(())

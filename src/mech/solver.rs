@@ -1,6 +1,7 @@
 //! Newton–Raphson analysis with friction gaps (paper §2.3, eqs. 2.11–2.12, procedure §3).
 //!
-//! Prescribed boundary displacements are applied in increments. Each increment runs Newton on
+//! Prescribed boundary displacements and external loads ([`super::load`]) are applied in
+//! increments. Each increment runs Newton on
 //! `(K_m + K_g) ΔU = −(R_m + R_g)` over the free DOFs; it converges when both the displacement
 //! correction (the paper's step (g)) and the residual force are small. A failed increment is
 //! halved, up to [`SolverSettings::max_cutbacks`] times; a step that still fails returns an error
@@ -15,6 +16,7 @@ use super::assembly::{Dof, PatternError, System, node_vector};
 use super::contact::{GapLaw, GapResponse, GapStatus, IterationMatrix};
 use super::element::{ElementStress, ElementVector};
 use super::linear::LinearSolver;
+use super::load::{ExternalLoad, LoadLevels, Loads};
 use super::model::{Model, ModelError};
 
 /// Newton and increment-control settings.
@@ -89,6 +91,8 @@ pub struct AnalysisState {
     pub plastic_slip: Vec<[f64; 2]>,
     /// Current imposed displacement of each boundary group (m).
     pub boundary: Vec<[f64; 3]>,
+    /// Current level of each load (pressures, nodal forces, gravity).
+    pub loads: LoadLevels,
     /// Friction coefficient of each gap.
     pub friction: Vec<f64>,
     /// Status of each gap at convergence.
@@ -109,6 +113,7 @@ impl AnalysisState {
             .chain(&self.friction)
             .chain(&self.last_increment)
             .all(|v| v.is_finite())
+            && self.loads.is_finite()
     }
 }
 
@@ -333,7 +338,8 @@ pub struct GapResult {
 pub struct Results {
     /// One per gap.
     pub gaps: Vec<GapResult>,
-    /// Total reaction of each boundary group (N), global axes.
+    /// Total reaction of each boundary group (N), global axes: the force the group applies to the
+    /// film, `Σ (f_int − f_ext)` over its DOFs (it balances the loads on its nodes too).
     pub reactions: Vec<[f64; 3]>,
     /// Stress state of each triangle.
     pub elements: Vec<ElementStress>,
@@ -362,6 +368,7 @@ pub struct Analysis {
     laws: Vec<GapLaw>,
     settings: SolverSettings,
     linear: LinearSolver,
+    loads: Loads,
     state: AnalysisState,
     work: Workspace,
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
@@ -402,6 +409,7 @@ impl Analysis {
             displacement: vec![0.0; model.dof_count()],
             plastic_slip: vec![[0.0; 2]; model.gaps.len()],
             boundary: vec![[0.0; 3]; model.groups.len()],
+            loads: LoadLevels::zero(&model),
             friction: laws.iter().map(|l| l.friction).collect(),
             status: laws
                 .iter()
@@ -421,6 +429,7 @@ impl Analysis {
             closed: vec![false; laws.len()],
             diagonal: diagonal_slots(&system),
         };
+        let loads = Loads::new(&model, &system);
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * model.material.membrane_stiffness() * length_scale;
         Ok(Self {
@@ -429,6 +438,7 @@ impl Analysis {
             laws,
             settings,
             linear,
+            loads,
             state,
             work,
             length_scale,
@@ -481,6 +491,7 @@ impl Analysis {
             || state.status.len() != s.status.len()
             || !(state.last_increment.is_empty()
                 || state.last_increment.len() == s.displacement.len())
+            || !state.loads.fits(&self.model)
         {
             return Err("state does not match this model's sizes".into());
         }
@@ -490,7 +501,8 @@ impl Analysis {
             .chain(state.plastic_slip.iter().flatten())
             .chain(state.boundary.iter().flatten())
             .chain(&state.friction)
-            .all(|v| v.is_finite());
+            .all(|v| v.is_finite())
+            && state.loads.is_finite();
         if !finite || state.friction.iter().any(|&m| m < 0.0) {
             return Err("state holds non-finite values or a negative friction coefficient".into());
         }
@@ -510,10 +522,23 @@ impl Analysis {
     /// Largest boundary target accepted, as a multiple of the model's size.
     pub const MAX_TARGET_PER_SIZE: f64 = 10.0;
 
-    /// Moves every boundary group to `target` (m), in increments of at most `1/increments` of
-    /// the step (eq. 2.11–2.12 in each). The increment size adapts: it is halved when an
-    /// increment fails (up to [`SolverSettings::max_cutbacks`] times below the largest size) or
-    /// needs many iterations, and doubled again, up to the largest, after easy ones.
+    /// Moves every boundary group to `target` (m) with the loads kept at their current levels;
+    /// see [`Self::step_to_with_loads`].
+    pub fn step_to(
+        &mut self,
+        target: &[[f64; 3]],
+        increments: usize,
+    ) -> Result<StepReport, StepError> {
+        let loads = self.state.loads.clone();
+        self.step_to_with_loads(target, &loads, increments)
+    }
+
+    /// Moves every boundary group to `target` (m) and the loads to `loads`, both interpolated
+    /// linearly between the converged state and the targets, in increments of at most
+    /// `1/increments` of the step (eq. 2.11–2.12 in each). The increment size adapts: it is
+    /// halved when an increment fails (up to [`SolverSettings::max_cutbacks`] times below the
+    /// largest size) or needs many iterations, and doubled again, up to the largest, after easy
+    /// ones.
     ///
     /// When even the smallest increment fails, larger ones are tried from the same converged
     /// state before the step is given up (twice the largest, four times, …, up to the rest of
@@ -522,19 +547,23 @@ impl Analysis {
     /// increment and in no smaller one: issue 7's arch edge lowered in 80 steps was refused in
     /// its first step with 10 increments per step and passes in one increment per step. The
     /// answer is still the converged equilibrium at the target; only the path between two
-    /// converged states is coarser, which friction may feel. On error the state is unchanged.
-    pub fn step_to(
+    /// converged states is coarser, which friction may feel. On error the state (displacements
+    /// and load levels) is unchanged.
+    pub fn step_to_with_loads(
         &mut self,
         target: &[[f64; 3]],
+        loads: &LoadLevels,
         increments: usize,
     ) -> Result<StepReport, StepError> {
         self.check_targets(target)?;
+        self.check_loads(loads)?;
         if increments == 0 {
             return Err(StepError::InvalidInput {
                 message: "increments must be at least 1".into(),
             });
         }
         let base = self.state.boundary.clone();
+        let base_loads = self.state.loads.clone();
         let mut current = self.state.clone();
         let mut report = StepReport::default();
         let largest = 1.0 / increments as f64;
@@ -560,7 +589,8 @@ impl Analysis {
             } else {
                 done + size
             };
-            match self.solve_increment(&current, &at(next)) {
+            let levels = base_loads.interpolate(loads, next);
+            match self.solve_increment(&current, &at(next), &levels) {
                 Ok((state, history)) => {
                     current = state;
                     done = next;
@@ -587,7 +617,8 @@ impl Analysis {
                     let mut reached = None;
                     while reached.is_none() && larger < 2.0 * (1.0 - done) {
                         let next = (done + larger).min(1.0);
-                        if let Ok(converged) = self.solve_increment(&current, &at(next)) {
+                        let levels = base_loads.interpolate(loads, next);
+                        if let Ok(converged) = self.solve_increment(&current, &at(next), &levels) {
                             reached = Some((next, converged));
                         }
                         larger *= 2.0;
@@ -650,11 +681,47 @@ impl Analysis {
         Ok(())
     }
 
-    /// Newton–Raphson for one increment from the converged `start` to the boundary `boundary`.
+    /// Refuses load targets of the wrong sizes or not finite.
+    fn check_loads(&self, loads: &LoadLevels) -> Result<(), StepError> {
+        let invalid = |message| Err(StepError::InvalidInput { message });
+        if !loads.fits(&self.model) {
+            return invalid(format!(
+                "{} pressures and {} nodal forces given, the model has {} pressure sets and {} force sets",
+                loads.pressure.len(),
+                loads.force.len(),
+                self.model.loads.pressures.len(),
+                self.model.loads.forces.len()
+            ));
+        }
+        for (p, set) in loads.pressure.iter().zip(&self.model.loads.pressures) {
+            if !p.is_finite() {
+                return invalid(format!(
+                    "the pressure of set '{}' ({p}) is NaN or infinite",
+                    set.name
+                ));
+            }
+        }
+        for (f, set) in loads.force.iter().zip(&self.model.loads.forces) {
+            if f.iter().any(|v| !v.is_finite()) {
+                return invalid(format!(
+                    "the force of set '{}' {f:?} is NaN or infinite",
+                    set.name
+                ));
+            }
+        }
+        if loads.gravity.iter().any(|v| !v.is_finite()) {
+            return invalid(format!("gravity {:?} is NaN or infinite", loads.gravity));
+        }
+        Ok(())
+    }
+
+    /// Newton–Raphson for one increment from the converged `start` to the boundary `boundary`
+    /// and the load levels `levels`.
     fn solve_increment(
         &mut self,
         start: &AnalysisState,
         boundary: &[[f64; 3]],
+        levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
         let mut u = start.displacement.clone();
         // Predictor: when the boundary keeps moving the same way, extrapolate the free DOFs
@@ -696,7 +763,7 @@ impl Analysis {
             let residual = if assembled {
                 self.free_norm_inf()
             } else {
-                self.assemble_at(&u, &laws, &history, Some(iteration))
+                self.assemble_at(&u, &laws, &history, levels, Some(iteration))
             };
             if !residual.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
@@ -724,6 +791,7 @@ impl Analysis {
                         .map(|r| r.plastic_slip.into())
                         .collect(),
                     boundary: boundary.to_vec(),
+                    loads: levels.clone(),
                     friction: start.friction.clone(),
                     status: self.work.responses.iter().map(|r| r.status).collect(),
                     last_increment: u
@@ -804,7 +872,7 @@ impl Analysis {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             let (step, with_tangent, decreased) =
-                self.line_search(&mut u, &laws, &history, iteration + 1);
+                self.line_search(&mut u, &laws, &history, levels, iteration + 1);
             assembled = with_tangent;
             correction_norm *= step;
             // Levenberg–Marquardt: a direction that cannot lower the residual (a mechanism of an
@@ -859,6 +927,7 @@ impl Analysis {
         u: &mut [f64],
         laws: &[GapLaw],
         history: &[Vector2<f64>],
+        levels: &LoadLevels,
         next_iteration: usize,
     ) -> (f64, bool, bool) {
         let apply = |u: &mut [f64], dofs: &[Dof], delta: &[f64], scale: f64| {
@@ -883,7 +952,7 @@ impl Analysis {
             applied = scale;
             // The full step is usually accepted: assemble its tangent too, for the next iteration.
             let tangent = (trial == 0).then_some(next_iteration);
-            self.assemble_at(u, laws, history, tangent);
+            self.assemble_at(u, laws, history, levels, tangent);
             let phi = 0.5 * self.free_norm2().powi(2);
             if phi <= (1.0 - 2e-4 * scale) * phi0 {
                 self.work.rhs = delta;
@@ -939,13 +1008,15 @@ impl Analysis {
             .sqrt()
     }
 
-    /// Assembles internal forces (and the Newton matrix when `iteration` is given) at `u`;
-    /// returns `‖R_free‖∞`. Gap responses are left in the workspace.
+    /// Assembles the residual `f_int − f_ext` over all DOFs (and the Newton matrix when
+    /// `iteration` is given) at `u` with the loads at `levels`; returns `‖R_free‖∞`. Gap
+    /// responses are left in the workspace.
     fn assemble_at(
         &mut self,
         u: &[f64],
         laws: &[GapLaw],
         history: &[Vector2<f64>],
+        levels: &LoadLevels,
         iteration: Option<usize>,
     ) -> f64 {
         let mode = self.settings.iteration_matrix;
@@ -957,42 +1028,44 @@ impl Analysis {
             closed,
             ..
         } = &mut self.work;
-        let values = iteration.map(|_| values.as_mut_slice());
-        self.system.assemble(u, internal, values, |g, d| {
-            let law = &laws[g];
-            let response = law.evaluate(d, history[g]);
-            responses[g] = response;
-            let matrix = match mode {
-                IterationMatrix::Consistent => law.consistent_tangent(&response),
-                IterationMatrix::JuRowlands => {
-                    // §3(b): stick in the first iteration; §3(f): once slipping, the slip matrix is
-                    // kept, with the slip direction (and its sign) found when the gap started
-                    // slipping, until the loop ends.
-                    // A latched gap keeps the slip matrix even if the law finds it open, and a gap
-                    // that has closed in this loop keeps at least the stick matrix: both stop the
-                    // open ↔ closed chatter of a symmetric matrix that has no cone direction.
-                    closed[g] |= response.status != GapStatus::Open;
-                    if response.status == GapStatus::Slip
-                        && iteration != Some(0)
-                        && latched[g].is_none()
-                    {
-                        latched[g] = Some(response.direction);
+        let mut values = iteration.map(|_| values.as_mut_slice());
+        self.system
+            .assemble(u, internal, values.as_deref_mut(), |g, d| {
+                let law = &laws[g];
+                let response = law.evaluate(d, history[g]);
+                responses[g] = response;
+                let matrix = match mode {
+                    IterationMatrix::Consistent => law.consistent_tangent(&response),
+                    IterationMatrix::JuRowlands => {
+                        // §3(b): stick in the first iteration; §3(f): once slipping, the slip matrix is
+                        // kept, with the slip direction (and its sign) found when the gap started
+                        // slipping, until the loop ends.
+                        // A latched gap keeps the slip matrix even if the law finds it open, and a gap
+                        // that has closed in this loop keeps at least the stick matrix: both stop the
+                        // open ↔ closed chatter of a symmetric matrix that has no cone direction.
+                        closed[g] |= response.status != GapStatus::Open;
+                        if response.status == GapStatus::Slip
+                            && iteration != Some(0)
+                            && latched[g].is_none()
+                        {
+                            latched[g] = Some(response.direction);
+                        }
+                        match (latched[g], response.status, iteration) {
+                            (Some(direction), _, _) => {
+                                law.ju_rowlands_matrix(GapStatus::Slip, direction)
+                            }
+                            (None, GapStatus::Open, _) if !closed[g] => {
+                                law.ju_rowlands_matrix(GapStatus::Open, response.direction)
+                            }
+                            (None, _, _) => {
+                                law.ju_rowlands_matrix(GapStatus::Stick, response.direction)
+                            }
+                        }
                     }
-                    match (latched[g], response.status, iteration) {
-                        (Some(direction), _, _) => {
-                            law.ju_rowlands_matrix(GapStatus::Slip, direction)
-                        }
-                        (None, GapStatus::Open, _) if !closed[g] => {
-                            law.ju_rowlands_matrix(GapStatus::Open, response.direction)
-                        }
-                        (None, _, _) => {
-                            law.ju_rowlands_matrix(GapStatus::Stick, response.direction)
-                        }
-                    }
-                }
-            };
-            (response.force, matrix)
-        });
+                };
+                (response.force, matrix)
+            });
+        self.loads.add_to(&self.system, levels, u, internal, values);
         self.free_norm_inf()
     }
 
@@ -1016,7 +1089,8 @@ impl Analysis {
     pub fn results(&mut self) -> Results {
         let (laws, history) = self.laws_and_history(&self.state);
         let u = std::mem::take(&mut self.state.displacement);
-        self.assemble_at(&u, &laws, &history, None);
+        let levels = self.state.loads.clone();
+        self.assemble_at(&u, &laws, &history, &levels, None);
         self.state.displacement = u;
         // The law at the converged point with the updated history gives the same forces; the
         // status is the one found when the increment converged.
@@ -1055,6 +1129,11 @@ impl Analysis {
             reactions,
             elements,
         }
+    }
+
+    /// The model's external loads.
+    pub fn loads(&self) -> &Loads {
+        &self.loads
     }
 
     /// Displacement of node `v` (m).

@@ -83,6 +83,7 @@ impl Default for ParallelArch {
                 poisson_ratio: 0.43,
                 thickness: 250e-6,
                 prestress: [0.5e6, 0.5e6, 0.0],
+                density: 0.0,
                 wrinkling: Wrinkling::None,
                 wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
             },
@@ -220,6 +221,7 @@ impl ParallelArch {
             })
             .collect();
         let model = Model {
+            loads: Default::default(),
             name: "ParallelArch".into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",
