@@ -11,7 +11,9 @@
 //!   `results.directory`, which only says where the VTK files go).
 //!
 //! The GUID is the UUID v5 (OID namespace) of the rendered text with the GUID field left as it
-//! is in the template, formatted `{…}`. `fmu-pack` writes the XML; `fmi2Instantiate` renders it
+//! is in the template followed by the model as its model file (JSON), formatted `{…}`: two FMUs
+//! whose interfaces agree but whose models differ (an initial gap, a node position) never share
+//! a GUID, so a saved state of one is refused by the other (the state header carries the GUID). `fmu-pack` writes the XML; `fmi2Instantiate` renders it
 //! again from the FMU's resources and compares GUIDs, so a binary and an XML that disagree on the
 //! interface refuse to run together.
 
@@ -85,11 +87,10 @@ pub fn describe(source: &Source) -> Result<Description, String> {
                 .map(|(_, v)| v.as_str()),
         })
     };
-    let unhashed = render("@GUID@")?;
-    let guid = format!(
-        "{{{}}}",
-        Uuid::new_v5(&Uuid::NAMESPACE_OID, unhashed.as_bytes())
-    );
+    let mut hashed = render("@GUID@")?.into_bytes();
+    hashed.push(b'\n');
+    hashed.extend_from_slice(model.to_json().as_bytes());
+    let guid = format!("{{{}}}", Uuid::new_v5(&Uuid::NAMESPACE_OID, &hashed));
     let xml = render(&guid)?;
     Ok(Description {
         model_identifier: model.name.clone(),
@@ -362,6 +363,22 @@ mod tests {
             a.guid, b.guid,
             "a different start value is a different interface"
         );
+    }
+
+    #[test]
+    fn guid_changes_with_the_model_content_behind_the_same_interface() {
+        let model = ParallelArch::default().model().unwrap();
+        let mut moved = model.clone();
+        moved.gaps[2].initial_gap += 1e-4;
+        let a = describe(&Source::Model(model)).unwrap();
+        let b = describe(&Source::Model(moved)).unwrap();
+        let interface = |d: &Description| d.xml.replace(&d.guid, "");
+        assert_eq!(
+            interface(&a),
+            interface(&b),
+            "the same variables and start values"
+        );
+        assert_ne!(a.guid, b.guid, "an initial gap is part of the model");
     }
 
     #[test]
