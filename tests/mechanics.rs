@@ -1266,8 +1266,8 @@ fn gap_tangent_matches_finite_difference_on_random_states_of_both_laws() {
 
 // ------------------------------------------------------------------ wrinkling (tension field)
 //
-// Source: the implementation note /work/shared/notes/wrinkling-and-contact.md §1–2, summarised
-// in docs/mechanics.md § "Wrinkling". Film Y = 1000, ν = 0.3, t = 1 on a unit square unless said.
+// Source: docs/mechanics.md § "Wrinkling: tension-field film" (the formulation, its criterion and tangent). Film
+// Y = 1000, ν = 0.3, t = 1 on a unit square unless said.
 //
 //   n × n unit patch (here n = 4)       boundary nodes: one group each, target = map(X) − X
 //   20 - 21 - 22 - 23 - 24              interior nodes: free in x, y; z held (a flat membrane has
