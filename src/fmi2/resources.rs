@@ -6,7 +6,7 @@
 //! | `parallel_arch.json` | the default FMU (`ParallelArch`) | the [`ParallelArch`] parameters (serde) |
 //! | `model.json` | `fmu-pack model.json` | the validated model, as `Model::to_json` writes it |
 //!
-//! URI forms accepted (FMI 2.0 §2.1.5 and what importers really send, the URI list in `fmi2Instantiate` of docs/fmu.md):
+//! URI forms accepted (FMI 2.0 §2.1.5 and what importers really send):
 //! `file:///abs/path` (percent-encoded: fmpy, FMIL, libcosim), `file:/abs/path`,
 //! `file://localhost/abs/path`, OMSimulator's `file:////abs/path` with no encoding at all, a
 //! trailing slash, a case-insensitive scheme. Percent-decoding acts only on valid `%XX`; when the
