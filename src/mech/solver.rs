@@ -144,10 +144,13 @@ impl StepReport {
 /// Why one increment failed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum IncrementFailure {
-    /// No convergence within the iteration limit while the residual was still decreasing.
+    /// No convergence within the iteration limit (with the consistent tangent: while the
+    /// residual was still decreasing, or the stall test would have stopped it earlier).
     MaxIterations {
         /// `‖R_free‖∞` at the first and the last iteration (N).
         residuals: (f64, f64),
+        /// The iteration matrix that ran out of iterations.
+        matrix: IterationMatrix,
         /// Gaps whose status changed in the last iterations.
         chattering: Vec<String>,
     },
@@ -187,8 +190,21 @@ impl IncrementFailure {
     /// What a user can change to get past this failure.
     pub fn advice(&self) -> String {
         match self {
-            Self::MaxIterations { .. } => "the residual was still falling: raise the iteration limit \
+            Self::MaxIterations {
+                matrix: IterationMatrix::JuRowlands,
+                ..
+            } => "the Ju–Rowlands matrix converges linearly (hundreds to thousands of iterations per increment \
+                once a gap slips, docs/mechanics.md): use the consistent tangent (solver.useJuRowlands = false, \
+                --matrix consistent) or raise the iteration limit a lot (solver.maxIterations, --max-iterations)"
+                .into(),
+            Self::MaxIterations {
+                residuals: (first, last),
+                ..
+            } if last < first => "the residual was still falling: raise the iteration limit \
                 (solver.maxIterations in the FMU, --max-iterations on the command line) or move the inputs by less per step"
+                .into(),
+            Self::MaxIterations { .. } => "the residual did not fall below its start: move the inputs by less per \
+                step or raise solver.incrementsPerStep (--steps on the command line)"
                 .into(),
             Self::Stalled { chattering, .. } if !chattering.is_empty() => format!(
                 "gaps {} kept changing status (open/closed or stick/slip) between iterations: move the inputs by \
@@ -221,6 +237,7 @@ impl fmt::Display for IncrementFailure {
             Self::MaxIterations {
                 residuals: (first, last),
                 chattering,
+                ..
             } => {
                 write!(
                     f,
@@ -819,6 +836,7 @@ impl Analysis {
             if iteration == s.max_iterations {
                 return Err(IncrementFailure::MaxIterations {
                     residuals: (residuals[0], residual),
+                    matrix: s.iteration_matrix,
                     chattering: chattering(),
                 });
             }
@@ -1190,4 +1208,31 @@ pub fn bounding_diagonal(nodes: &[[f64; 3]]) -> f64 {
         }
     }
     (0..3).map(|c| (hi[c] - lo[c]).powi(2)).sum::<f64>().sqrt()
+}
+
+#[cfg(test)]
+mod advice_tests {
+    use super::*;
+
+    fn out_of_iterations(first: f64, last: f64, matrix: IterationMatrix) -> String {
+        IncrementFailure::MaxIterations {
+            residuals: (first, last),
+            matrix,
+            chattering: vec![],
+        }
+        .advice()
+    }
+
+    #[test]
+    fn advice_to_raise_the_limit_only_while_the_residual_falls() {
+        let consistent = IterationMatrix::Consistent;
+        assert!(out_of_iterations(1.0, 1e-3, consistent).contains("still falling"));
+        let rose = out_of_iterations(9.4e-3, 2.9e-2, consistent);
+        assert!(
+            !rose.contains("still falling") && rose.contains("less per step"),
+            "{rose}"
+        );
+        let jr = out_of_iterations(4.9, 3.4, IterationMatrix::JuRowlands);
+        assert!(jr.contains("consistent tangent"), "{jr}");
+    }
 }
