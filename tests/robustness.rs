@@ -417,3 +417,24 @@ fn arch_edge_first_step_reports_its_enlarged_increment() {
     assert!(report.enlarged >= 1, "{report:?}");
     assert!(report.residual.is_finite());
 }
+
+/// A refused increment of a tension-field film names the elements whose state (taut,
+/// wrinkled, slack) flips between the last iterates, as it names chattering gaps (issue 7,
+/// item 4).
+#[test]
+fn refused_step_names_film_elements_that_flip_wrinkling_state() {
+    let edge = ArchEdge::default();
+    let scenario = edge.lowered(0.5, 80, fmu_increments()).unwrap();
+    let settings = SolverSettings {
+        max_iterations: 6,
+        max_cutbacks: 0,
+        ..SolverSettings::default()
+    };
+    let mut analysis = Analysis::new(scenario.model, settings).unwrap();
+    let target = [[0.0, 0.0, -0.5 * edge.arch_height / 80.0]];
+    let message = analysis.step_to(&target, 1).unwrap_err().to_string();
+    assert!(
+        message.contains("film elements changing wrinkling state"),
+        "{message}"
+    );
+}

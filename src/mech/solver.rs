@@ -12,11 +12,12 @@ use std::fmt;
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::assembly::{Dof, PatternError, System, node_vector};
+use super::assembly::{Dof, PatternError, System, node_dofs, node_vector};
 use super::contact::{GapLaw, GapResponse, GapStatus, IterationMatrix};
-use super::element::{ElementStress, ElementVector};
+use super::element::{ElementStress, ElementVector, MembraneTriangle};
 use super::linear::LinearSolver;
 use super::load::{ExternalLoad, LoadLevels, Loads};
+use super::material::Wrinkling;
 use super::model::{Model, ModelError};
 
 /// Newton and increment-control settings.
@@ -153,6 +154,9 @@ pub enum IncrementFailure {
         matrix: IterationMatrix,
         /// Gaps whose status changed in the last iterations.
         chattering: Vec<String>,
+        /// Film elements whose tension-field state (taut, wrinkled, slack) differs between the
+        /// last two iterates.
+        flipping: Vec<usize>,
     },
     /// The residual stopped decreasing (a cycle between states or a plateau).
     Stalled {
@@ -164,6 +168,8 @@ pub enum IncrementFailure {
         tolerance: f64,
         /// Gaps whose status changed in the last iterations.
         chattering: Vec<String>,
+        /// Film elements whose tension-field state differs between the last two iterates.
+        flipping: Vec<usize>,
     },
     /// NaN/Inf or runaway corrections.
     Diverged { iteration: usize },
@@ -211,6 +217,12 @@ impl IncrementFailure {
                  less per step or raise solver.incrementsPerStep (--steps on the command line)",
                 name_list(chattering)
             ),
+            Self::Stalled { flipping, .. } if !flipping.is_empty() => format!(
+                "{} film elements switched between taut, wrinkled and slack between the last iterations \
+                 (a region on the verge of wrinkling): move the inputs by less per step or raise \
+                 solver.incrementsPerStep; more prestress keeps a film taut",
+                flipping.len()
+            ),
             Self::Stalled { .. } => "Newton stopped making progress: move the inputs by less per step, or loosen \
                 solver.residualTolerance if the residual reached is acceptable for your model"
                 .into(),
@@ -226,36 +238,45 @@ impl IncrementFailure {
 
 impl fmt::Display for IncrementFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let chatter = |f: &mut fmt::Formatter<'_>, names: &[String]| {
-            if names.is_empty() {
-                Ok(())
-            } else {
-                write!(f, "; gaps changing status: {}", name_list(names))
+        let chatter = |f: &mut fmt::Formatter<'_>, names: &[String], elements: &[usize]| {
+            if !names.is_empty() {
+                write!(f, "; gaps changing status: {}", name_list(names))?;
             }
+            if !elements.is_empty() {
+                let numbers: Vec<String> = elements.iter().map(|e| e.to_string()).collect();
+                write!(
+                    f,
+                    "; film elements changing wrinkling state: {}",
+                    name_list(&numbers)
+                )?;
+            }
+            Ok(())
         };
         match self {
             Self::MaxIterations {
                 residuals: (first, last),
                 chattering,
+                flipping,
                 ..
             } => {
                 write!(
                     f,
                     "no convergence within the iteration limit (residual {first:.3e} N → {last:.3e} N)"
                 )?;
-                chatter(f, chattering)
+                chatter(f, chattering, flipping)
             }
             Self::Stalled {
                 iteration,
                 best,
                 tolerance,
                 chattering,
+                flipping,
             } => {
                 write!(
                     f,
                     "residual stalled at {best:.3e} N (tolerance {tolerance:.3e} N) by iteration {iteration}"
                 )?;
-                chatter(f, chattering)
+                chatter(f, chattering, flipping)
             }
             Self::Diverged { iteration } => {
                 write!(
@@ -767,6 +788,8 @@ impl Analysis {
         self.work.latched.iter_mut().for_each(|l| *l = None);
         self.work.closed.iter_mut().for_each(|c| *c = false);
         let mut correction_norm = f64::INFINITY;
+        // The iterate before the last correction (to name elements whose state flips).
+        let mut previous_u = u.clone();
         let mut residuals = Vec::new();
         let mut assembled = false;
         // Status of every gap at the previous iteration and the last iteration it changed.
@@ -838,6 +861,7 @@ impl Analysis {
                     residuals: (residuals[0], residual),
                     matrix: s.iteration_matrix,
                     chattering: chattering(),
+                    flipping: self.flipping_elements(&previous_u, &u),
                 });
             }
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
@@ -861,6 +885,7 @@ impl Analysis {
                     best,
                     tolerance,
                     chattering: chattering(),
+                    flipping: self.flipping_elements(&previous_u, &u),
                 });
             }
             for (i, d) in self.system.dofs.iter().enumerate() {
@@ -889,6 +914,7 @@ impl Analysis {
             if !correction_norm.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
+            previous_u.clone_from(&u);
             let (step, with_tangent, decreased) =
                 self.line_search(&mut u, &laws, &history, levels, iteration + 1);
             assembled = with_tangent;
@@ -914,6 +940,26 @@ impl Analysis {
             }
         }
         unreachable!("the loop returns at max_iterations")
+    }
+
+    /// Film elements whose tension-field state differs between the displacements `a` and `b`
+    /// (none without wrinkling). Called once when an increment fails, never per iteration.
+    fn flipping_elements(&self, a: &[f64], b: &[f64]) -> Vec<usize> {
+        if self.system.material.wrinkling == Wrinkling::None {
+            return vec![];
+        }
+        let state = |u: &[f64], nodes: &[usize; 3], tri: &MembraneTriangle| {
+            let dofs = node_dofs(nodes);
+            let ue = ElementVector::from_fn(|i, _| u[dofs[i]]);
+            tri.stress_state(&self.system.material, &ue).state
+        };
+        self.system
+            .triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, (nodes, tri))| state(a, nodes, tri) != state(b, nodes, tri))
+            .map(|(e, _)| e)
+            .collect()
     }
 
     /// Largest ratio of the predictor's extrapolation to the last converged increment.
@@ -1219,6 +1265,7 @@ mod advice_tests {
             residuals: (first, last),
             matrix,
             chattering: vec![],
+            flipping: vec![],
         }
         .advice()
     }
