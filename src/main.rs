@@ -436,6 +436,28 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
         lo / 1e6,
         hi / 1e6
     );
+    for (p, u) in model.outputs.points.iter().zip(&results.points) {
+        out!(
+            "output point {} (node {}): displacement ({:.6}, {:.6}, {:.6}) m",
+            p.name,
+            p.node,
+            u[0],
+            u[1],
+            u[2]
+        );
+    }
+    for (set, s) in model.outputs.element_sets.iter().zip(&results.sets) {
+        out!(
+            "element set {}: principal stress {:.3} … {:.3} MPa, von Mises ≤ {:.3} MPa, \
+             principal strain ≤ {:.6}, compressed area {:.6} m²",
+            set.name,
+            s.min_principal_stress / 1e6,
+            s.max_principal_stress / 1e6,
+            s.max_equivalent_stress / 1e6,
+            s.max_strain,
+            s.compressed_area
+        );
+    }
     if !model.material.wrinkling.is_none() {
         let [taut, wrinkled, slack] = state_counts(&results.elements);
         println!("tension-field film: {taut} taut, {wrinkled} wrinkled, {slack} slack elements");

@@ -72,6 +72,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         gaps: vec![],
         groups: vec![],
         loads: LoadSpec::default(),
+        outputs: Default::default(),
     }
 }
 

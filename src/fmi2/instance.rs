@@ -768,6 +768,12 @@ impl Instance {
                 Binding::MaxEquivalentStress => Value::Real(max_stress),
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
+                Binding::PointDisplacement { point, axis } => {
+                    Value::Real(results.points[point][axis])
+                }
+                Binding::SetSummary { set, quantity } => {
+                    Value::Real(quantity.of(&results.sets[set]))
+                }
                 _ => continue,
             };
         }

@@ -1440,3 +1440,59 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
     assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
     assert_eq!(unsafe { fmi2_free_fmu_state(other.c, &mut restored) }, 0);
 }
+
+/// Output points and element-set summaries of the model file are FMU outputs equal to the
+/// core's (`<point>.ux/.uy/.uz`, `<set>.maxPrincipalStress`, …).
+#[test]
+fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
+    use super::variables::{Causality, SummaryQuantity};
+    use crate::mech::scenarios::CircularMembrane;
+    use crate::mech::{Analysis, LoadLevels, SolverSettings};
+
+    let membrane = CircularMembrane {
+        radius: 1.0,
+        rings: 4,
+        material: crate::mech::Material {
+            prestress: [1e6, 1e6, 0.0],
+            ..ParallelArch::default().material
+        },
+        pressure: 100.0,
+    };
+    let model = membrane.model().unwrap();
+    let (u, log) = (
+        Unpacked::new("outputs", Source::Model(model.clone())),
+        Log::default(),
+    );
+    for name in [
+        "centre.uz",
+        "disc.maxPrincipalStress",
+        "disc.compressedArea",
+    ] {
+        let v = u.variables.iter().find(|v| v.name == name).unwrap();
+        assert_eq!(v.causality, Causality::Output, "{name}");
+    }
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    assert_eq!(fmu.set_real("top.pressure", 80.0), 0);
+    assert_eq!(fmu.step(0.0, 1.0), 0, "{:?}", log.take());
+
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let levels = LoadLevels {
+        pressure: vec![80.0],
+        force: vec![],
+        gravity: model.loads.gravity,
+    };
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 2)
+        .unwrap();
+    let results = analysis.results();
+    let uz = fmu.real("centre.uz");
+    assert!(uz > 1e-3, "the centre rises under pressure: {uz}");
+    assert_eq!(uz, analysis.node_displacement(0).z);
+    for (quantity, suffix, _, _) in SummaryQuantity::ALL {
+        assert_eq!(
+            fmu.real(&format!("disc.{suffix}")),
+            quantity.of(&results.sets[0]),
+            "{suffix}"
+        );
+    }
+}

@@ -31,6 +31,8 @@
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
 //! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
 //! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
+//! | `<point>.ux/.uy/.uz` | Real | output | m | displacement of a named output point |
+//! | `<set>.maxPrincipalStress/.minPrincipalStress/.maxEquivalentStress/.maxStrain/.compressedArea` | Real | output | Pa, 1, m2 | field summary of a named element set |
 
 use serde::{Deserialize, Serialize};
 
@@ -208,6 +210,73 @@ pub enum Binding {
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,
+    /// Displacement of an output point along axis 0, 1, 2.
+    PointDisplacement {
+        point: usize,
+        axis: usize,
+    },
+    /// One quantity of an element set's field summary.
+    SetSummary {
+        set: usize,
+        quantity: SummaryQuantity,
+    },
+}
+
+/// The quantities of a [`crate::mech::summary::FieldSummary`], each an FMU output per element set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SummaryQuantity {
+    MaxPrincipalStress,
+    MinPrincipalStress,
+    MaxEquivalentStress,
+    MaxStrain,
+    CompressedArea,
+}
+
+impl SummaryQuantity {
+    /// Every quantity with its variable-name suffix, unit and description.
+    pub const ALL: [(Self, &'static str, &'static str, &'static str); 5] = [
+        (
+            Self::MaxPrincipalStress,
+            "maxPrincipalStress",
+            "Pa",
+            "largest major principal stress",
+        ),
+        (
+            Self::MinPrincipalStress,
+            "minPrincipalStress",
+            "Pa",
+            "smallest minor principal stress (negative: compressed)",
+        ),
+        (
+            Self::MaxEquivalentStress,
+            "maxEquivalentStress",
+            "Pa",
+            "largest von Mises stress",
+        ),
+        (
+            Self::MaxStrain,
+            "maxStrain",
+            "1",
+            "largest major principal Green-Lagrange strain",
+        ),
+        (
+            Self::CompressedArea,
+            "compressedArea",
+            "m2",
+            "reference area of the triangles wrinkled or slack (tension field) or with a negative minor principal stress",
+        ),
+    ];
+
+    /// This quantity of `summary`.
+    pub fn of(self, summary: &crate::mech::summary::FieldSummary) -> f64 {
+        match self {
+            Self::MaxPrincipalStress => summary.max_principal_stress,
+            Self::MinPrincipalStress => summary.min_principal_stress,
+            Self::MaxEquivalentStress => summary.max_equivalent_stress,
+            Self::MaxStrain => summary.max_strain,
+            Self::CompressedArea => summary.compressed_area,
+        }
+    }
 }
 
 /// One ScalarVariable.
@@ -249,8 +318,9 @@ impl Variable {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 3]); 7] = [
+pub const UNITS: [(&str, [i32; 3]); 8] = [
     ("m", [0, 1, 0]),
+    ("m2", [0, 2, 0]),
     ("m/s2", [0, 1, -2]),
     ("kg/m3", [1, -3, 0]),
     ("N", [1, 1, -2]),
@@ -288,7 +358,21 @@ pub fn check_names(model: &Model) -> Result<(), String> {
                 .iter()
                 .map(|p| ("pressure set", &p.name)),
         )
-        .chain(model.loads.forces.iter().map(|f| ("force set", &f.name)));
+        .chain(model.loads.forces.iter().map(|f| ("force set", &f.name)))
+        .chain(
+            model
+                .outputs
+                .points
+                .iter()
+                .map(|p| ("output point", &p.name)),
+        )
+        .chain(
+            model
+                .outputs
+                .element_sets
+                .iter()
+                .map(|e| ("element set", &e.name)),
+        );
     for (kind, name) in names {
         if RESERVED_NAMES.contains(&name.as_str()) {
             return Err(format!(
@@ -608,6 +692,29 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                     g.name, axes[axis]
                 ),
                 Binding::Reaction { group, axis },
+            );
+        }
+    }
+    for (point, p) in model.outputs.points.iter().enumerate() {
+        for (axis, a) in ["ux", "uy", "uz"].iter().enumerate() {
+            table.output(
+                &format!("{}.{a}", p.name),
+                "m",
+                &format!(
+                    "displacement of output point '{}' (node {}) along {}",
+                    p.name, p.node, axes[axis]
+                ),
+                Binding::PointDisplacement { point, axis },
+            );
+        }
+    }
+    for (set, e) in model.outputs.element_sets.iter().enumerate() {
+        for (quantity, suffix, unit, what) in SummaryQuantity::ALL {
+            table.output(
+                &format!("{}.{suffix}", e.name),
+                unit,
+                &format!("{what} of element set '{}'", e.name),
+                Binding::SetSummary { set, quantity },
             );
         }
     }

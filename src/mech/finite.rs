@@ -45,6 +45,23 @@ pub fn check_results(
             results.elements[e].von_mises
         ));
     }
+    for (p, spec) in results.points.iter().zip(&model.outputs.points) {
+        if let Some(v) = p.iter().find(|v| !v.is_finite()) {
+            return Err(format!("displacement of output point {} = {v}", spec.name));
+        }
+    }
+    for (s, spec) in results.sets.iter().zip(&model.outputs.element_sets) {
+        let values = [
+            s.max_principal_stress,
+            s.min_principal_stress,
+            s.max_equivalent_stress,
+            s.max_strain,
+            s.compressed_area,
+        ];
+        if let Some(v) = values.iter().find(|v| !v.is_finite()) {
+            return Err(format!("field summary of element set {} = {v}", spec.name));
+        }
+    }
     match residual {
         Some(r) if !r.is_finite() => Err(format!("final residual = {r}")),
         _ => Ok(()),

@@ -13,6 +13,7 @@
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
 //! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
+//! | [`summary`] | output points and field summaries over element sets |
 //! | [`specimen`] | the parallel-arch specimens of §4 and every assumption about them |
 //! | [`scenarios`] | load-path generators (specimen family, arch panel, cylinder strip, arch edge) |
 //! | [`vtk`] | VTK text of the deformed film and its stresses (Fig. 6) |
@@ -29,6 +30,7 @@ pub mod restraint;
 pub mod scenarios;
 pub mod solver;
 pub mod specimen;
+pub mod summary;
 pub mod vtk;
 
 pub use contact::{FrictionLaw, GapStatus, IterationMatrix};

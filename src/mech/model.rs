@@ -201,6 +201,45 @@ impl LoadSpec {
     }
 }
 
+/// A node whose displacement is reported (FMU outputs `<name>.ux/.uy/.uz`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputPoint {
+    /// Name (an identifier: the FMU variable prefix).
+    pub name: String,
+    /// The node (0-based).
+    pub node: usize,
+}
+
+/// A named set of triangles whose field summary is reported (see `summary.rs`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ElementSet {
+    /// Name (an identifier: the FMU variable prefix `<name>.maxPrincipalStress`, …).
+    pub name: String,
+    /// Its triangles.
+    pub elements: ElementSelection,
+}
+
+/// What a model reports beyond gaps and group reactions (`"outputs"`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Named output points.
+    #[serde(default)]
+    pub points: Vec<OutputPoint>,
+    /// Named element sets with field summaries.
+    #[serde(default)]
+    pub element_sets: Vec<ElementSet>,
+}
+
+impl OutputSpec {
+    /// Whether nothing is asked (then the section is not written).
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty() && self.element_sets.is_empty()
+    }
+}
+
 /// A complete membrane + gap model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -231,6 +270,9 @@ pub struct Model {
     /// Pressures, nodal forces and gravity.
     #[serde(default, skip_serializing_if = "LoadSpec::is_default")]
     pub loads: LoadSpec,
+    /// Output points and element sets.
+    #[serde(default, skip_serializing_if = "OutputSpec::is_empty")]
+    pub outputs: OutputSpec,
 }
 
 /// Why a model is rejected. Every variant names the offending item.
@@ -271,6 +313,8 @@ pub enum ModelError {
     Text { field: String, message: String },
     /// A load set out of range (unknown triangle, empty set, non-finite value).
     Load { item: String, message: String },
+    /// An output element set out of range (unknown triangle, empty set).
+    Output { item: String, message: String },
     /// Nothing to analyse.
     Empty { message: String },
 }
@@ -327,7 +371,9 @@ impl fmt::Display for ModelError {
                 )
             }
             Self::Text { field, message } => write!(f, "{field}: {message}"),
-            Self::Load { item, message } => write!(f, "{item}: {message}"),
+            Self::Load { item, message } | Self::Output { item, message } => {
+                write!(f, "{item}: {message}")
+            }
             Self::Empty { message } => write!(f, "model: {message}"),
         }
     }
@@ -547,6 +593,7 @@ impl Model {
             }
         }
         self.validate_loads(&mut names)?;
+        self.validate_outputs(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -555,6 +602,60 @@ impl Model {
             )?;
         }
         super::restraint::check(self)
+    }
+
+    /// Checks an element selection: a non-empty list of existing triangles, each once.
+    fn check_selection(&self, selection: &ElementSelection) -> Result<(), String> {
+        let ElementSelection::List(list) = selection else {
+            return Ok(());
+        };
+        if list.is_empty() {
+            return Err("has no elements (write \"all\" for every triangle)".into());
+        }
+        let mut seen = HashSet::new();
+        for &e in list {
+            if e >= self.triangles.len() {
+                return Err(format!(
+                    "triangle {e} does not exist (the model has {} triangles, 0-based)",
+                    self.triangles.len()
+                ));
+            }
+            if !seen.insert(e) {
+                return Err(format!("lists triangle {e} twice"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the `outputs` section; its names join the gap and group namespace.
+    fn validate_outputs(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        for p in &self.outputs.points {
+            check_name(names, "output point", &p.name)?;
+            if p.node >= self.nodes.len() {
+                return Err(ModelError::UnknownNode {
+                    item: format!("output point '{}'", p.name),
+                    node: p.node,
+                    node_count: self.nodes.len(),
+                });
+            }
+        }
+        for set in &self.outputs.element_sets {
+            check_name(names, "element set", &set.name)?;
+            self.check_selection(&set.elements)
+                .map_err(|message| ModelError::Output {
+                    item: format!("element set '{}'", set.name),
+                    message,
+                })?;
+        }
+        Ok(())
+    }
+
+    /// The triangles of `selection`.
+    pub fn selected_triangles(&self, selection: &ElementSelection) -> Vec<usize> {
+        match selection {
+            ElementSelection::All(_) => (0..self.triangles.len()).collect(),
+            ElementSelection::List(list) => list.clone(),
+        }
     }
 
     /// Checks the `loads` section; set names join the gap and group namespace.
@@ -573,32 +674,11 @@ impl Model {
                     item: format!("{} pressure", item()),
                 });
             }
-            if let ElementSelection::List(list) = &p.elements {
-                if list.is_empty() {
-                    return Err(ModelError::Load {
-                        item: item(),
-                        message: "has no elements (write \"all\" for every triangle)".into(),
-                    });
-                }
-                let mut seen = HashSet::new();
-                for &e in list {
-                    if e >= self.triangles.len() {
-                        return Err(ModelError::Load {
-                            item: item(),
-                            message: format!(
-                                "triangle {e} does not exist (the model has {} triangles, 0-based)",
-                                self.triangles.len()
-                            ),
-                        });
-                    }
-                    if !seen.insert(e) {
-                        return Err(ModelError::Load {
-                            item: item(),
-                            message: format!("lists triangle {e} twice"),
-                        });
-                    }
-                }
-            }
+            self.check_selection(&p.elements)
+                .map_err(|message| ModelError::Load {
+                    item: item(),
+                    message,
+                })?;
         }
         for f in &l.forces {
             check_name(names, "force set", &f.name)?;
@@ -690,8 +770,9 @@ fn check_name(names: &mut HashSet<String>, kind: &str, name: &str) -> Result<(),
     if !names.insert(name.to_string()) {
         return Err(ModelError::Name {
             item,
-            message: "name is used twice (gap, group, pressure-set and force-set names share one namespace)"
-                .into(),
+            message:
+                "name is used twice (gap, group, load-set and output names share one namespace)"
+                    .into(),
         });
     }
     Ok(())

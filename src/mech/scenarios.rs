@@ -71,8 +71,8 @@ use nalgebra::Vector3;
 use super::contact::{FrictionLaw, GapFrame};
 use super::material::{Material, Wrinkling};
 use super::model::{
-    AllElements, Axis, BoundaryGroup, ElementSelection, GapSpec, GapSupport, LoadSpec, Model,
-    PressureSet, Support, Symmetry,
+    AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, GapSpec, GapSupport, LoadSpec,
+    Model, OutputPoint, OutputSpec, PressureSet, Support, Symmetry,
 };
 use super::solver::{Analysis, SolverSettings, StepError};
 use super::specimen::ParallelArch;
@@ -672,6 +672,7 @@ impl ArchPanel {
             .collect();
         validated(Model {
             loads: Default::default(),
+            outputs: Default::default(),
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",
@@ -838,6 +839,7 @@ impl CylinderStrip {
         };
         validated(Model {
             loads: Default::default(),
+            outputs: Default::default(),
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,
@@ -978,6 +980,7 @@ impl ArchEdge {
             .collect();
         validated(Model {
             loads: Default::default(),
+            outputs: Default::default(),
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",
@@ -1229,6 +1232,17 @@ impl CircularMembrane {
                     pressure: self.pressure,
                 }],
                 ..LoadSpec::default()
+            },
+            // The centre's rise and the whole film's stress extremes.
+            outputs: OutputSpec {
+                points: vec![OutputPoint {
+                    name: "centre".into(),
+                    node: 0,
+                }],
+                element_sets: vec![ElementSet {
+                    name: "disc".into(),
+                    elements: ElementSelection::All(AllElements::All),
+                }],
             },
         })
     }

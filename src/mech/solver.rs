@@ -19,6 +19,7 @@ use super::linear::LinearSolver;
 use super::load::{ExternalLoad, LoadLevels, Loads};
 use super::material::Wrinkling;
 use super::model::{Model, ModelError};
+use super::summary::{FieldSummary, summarize};
 
 /// Newton and increment-control settings.
 ///
@@ -381,6 +382,10 @@ pub struct Results {
     pub reactions: Vec<[f64; 3]>,
     /// Stress state of each triangle.
     pub elements: Vec<ElementStress>,
+    /// Displacement of each output point of the model (m).
+    pub points: Vec<[f64; 3]>,
+    /// Field summary of each element set of the model.
+    pub sets: Vec<FieldSummary>,
 }
 
 impl Results {
@@ -1187,11 +1192,37 @@ impl Analysis {
                 let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
                 tri.stress_state(&self.system.material, &ue)
             })
+            .collect::<Vec<_>>();
+        let outputs = &self.model.outputs;
+        let points = outputs
+            .points
+            .iter()
+            .map(|p| node_vector(u, p.node).into())
             .collect();
+        let sets = if outputs.element_sets.is_empty() {
+            vec![]
+        } else {
+            let areas: Vec<f64> = self
+                .system
+                .triangles
+                .iter()
+                .map(|(_, t)| t.area())
+                .collect();
+            outputs
+                .element_sets
+                .iter()
+                .map(|set| {
+                    let triangles = self.model.selected_triangles(&set.elements);
+                    summarize(&elements, &areas, &triangles)
+                })
+                .collect()
+        };
         Results {
             gaps,
             reactions,
             elements,
+            points,
+            sets,
         }
     }
 

@@ -222,6 +222,7 @@ impl ParallelArch {
             .collect();
         let model = Model {
             loads: Default::default(),
+            outputs: Default::default(),
             name: "ParallelArch".into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

@@ -1,0 +1,154 @@
+//! Output points and field summaries over element sets (issue 8, item 3).
+//!
+//! TEST GOAL: the reported values are what they say — a point's displacement is its node's, a
+//! set's summary is the extreme over exactly its triangles (recomputed here by brute force),
+//! the compressed area counts the right triangles — and the model file names a bad item.
+//!
+//! MODEL: the ring-meshed circular membrane (`scenarios::CircularMembrane`, rim held) inflated
+//! by its pressure, with a point at the centre and a set of the inner rings.
+
+use membrane_contact::mech::model::{ElementSelection, ElementSet, OutputPoint};
+use membrane_contact::mech::scenarios::CircularMembrane;
+use membrane_contact::mech::{Analysis, LoadLevels, Material, Model, ParallelArch, SolverSettings};
+
+/// A 4-ring disc of radius 1 m, the specimen's ETFE film prestressed to 1 MPa, 100 Pa.
+fn disc(pressure: f64) -> CircularMembrane {
+    CircularMembrane {
+        radius: 1.0,
+        rings: 4,
+        material: Material {
+            prestress: [1e6, 1e6, 0.0],
+            ..ParallelArch::default().material
+        },
+        pressure,
+    }
+}
+
+fn inflated(model: &Model) -> Analysis {
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let levels = LoadLevels::of_model(model);
+    for k in 1..=2 {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels.scaled(k as f64 / 2.0), 1)
+            .unwrap();
+    }
+    analysis
+}
+
+fn reference_area(model: &Model, t: usize) -> f64 {
+    let [a, b, c] = model.triangles[t].map(|v| nalgebra::Vector3::from(model.nodes[v]));
+    0.5 * (b - a).cross(&(c - a)).norm()
+}
+
+#[test]
+fn set_summary_is_the_extreme_over_exactly_its_triangles() {
+    let mut model = disc(100.0).model().unwrap();
+    let inner: Vec<usize> = (0..24).collect();
+    model.outputs.element_sets.push(ElementSet {
+        name: "inner".into(),
+        elements: ElementSelection::List(inner.clone()),
+    });
+    model.outputs.points.push(OutputPoint {
+        name: "edge".into(),
+        node: 7,
+    });
+    let mut analysis = inflated(&model);
+    let results = analysis.results();
+    assert_eq!(results.sets.len(), 2);
+    let all: Vec<usize> = (0..model.triangles.len()).collect();
+    for (set, triangles) in results.sets.iter().zip([all, inner]) {
+        let pick = |f: &dyn Fn(usize) -> f64| triangles.iter().map(|&t| f(t)).collect::<Vec<_>>();
+        let max = |v: Vec<f64>| v.into_iter().fold(f64::NEG_INFINITY, f64::max);
+        let e = &results.elements;
+        assert_eq!(set.max_principal_stress, max(pick(&|t| e[t].principal[0])));
+        assert_eq!(
+            set.min_principal_stress,
+            -max(pick(&|t| -e[t].principal[1]))
+        );
+        assert_eq!(set.max_equivalent_stress, max(pick(&|t| e[t].von_mises)));
+        let strain = |t: usize| {
+            let [x, y, g] = e[t].strain;
+            0.5 * (x + y) + (0.25 * (x - y).powi(2) + 0.25 * g * g).sqrt()
+        };
+        assert!((set.max_strain - max(pick(&strain))).abs() < 1e-15);
+        let compressed: f64 = triangles
+            .iter()
+            .filter(|&&t| e[t].principal[1] < 0.0)
+            .map(|&t| reference_area(&model, t))
+            .sum();
+        assert!((set.compressed_area - compressed).abs() < 1e-12);
+    }
+    // The inflated, prestressed disc is taut everywhere; its stress peaks are tension.
+    assert!(results.sets[0].min_principal_stress > 0.0);
+    assert_eq!(results.sets[0].compressed_area, 0.0);
+    for (p, u) in model.outputs.points.iter().zip(&results.points) {
+        let node = analysis.node_displacement(p.node);
+        assert_eq!(*u, [node.x, node.y, node.z], "{}", p.name);
+    }
+    assert!(results.points[0][2] > 0.0, "the centre rises");
+}
+
+#[test]
+fn compressed_area_counts_the_triangles_pushed_into_compression() {
+    // No prestress, no wrinkling, pulled in by a rim moved inwards: every triangle compressed.
+    let mut model = disc(0.0).model().unwrap();
+    model.material.prestress = [1e5, 1e5, 0.0];
+    let total: f64 = (0..model.triangles.len())
+        .map(|t| reference_area(&model, t))
+        .sum();
+    let rim: Vec<usize> = model.groups[0].nodes.clone();
+    // Shrink the rim radially by 0.1 %: one group per rim node.
+    model.groups = rim
+        .iter()
+        .map(|&v| membrane_contact::mech::model::BoundaryGroup {
+            name: format!("r{v}"),
+            nodes: vec![v],
+            target: [0.0; 3],
+        })
+        .collect();
+    let targets: Vec<[f64; 3]> = rim
+        .iter()
+        .map(|&v| {
+            let p = model.nodes[v];
+            [-1e-3 * p[0], -1e-3 * p[1], 0.0]
+        })
+        .collect();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    analysis.step_to(&targets, 1).unwrap();
+    let results = analysis.results();
+    let s = &results.sets[0];
+    assert!(s.max_principal_stress < 0.0, "{s:?}");
+    assert!((s.compressed_area - total).abs() < 1e-9 * total, "{s:?}");
+}
+
+#[test]
+fn output_sections_name_the_bad_item() {
+    let base = disc(100.0).model().unwrap();
+    let check = |edit: &dyn Fn(&mut Model), expect: &str| {
+        let mut m = base.clone();
+        edit(&mut m);
+        let err = m.validate().unwrap_err().to_string();
+        assert!(err.contains(expect), "{expect}: {err}");
+    };
+    check(
+        &|m| m.outputs.points[0].node = 100_000,
+        "output point 'centre': node 100000 does not exist",
+    );
+    check(
+        &|m| m.outputs.element_sets[0].elements = ElementSelection::List(vec![3, 99_999]),
+        "element set 'disc': triangle 99999 does not exist",
+    );
+    check(
+        &|m| m.outputs.element_sets[0].elements = ElementSelection::List(vec![]),
+        "element set 'disc': has no elements",
+    );
+    check(
+        &|m| m.outputs.points[0].name = "rim".into(),
+        "name is used twice",
+    );
+    let text = base.to_json();
+    assert!(text.contains("\"outputs\""));
+    assert_eq!(Model::from_json(&text).unwrap(), base);
+    let typo = text.replace("\"element_sets\"", "\"elementsets\"");
+    assert!(Model::from_json(&typo).is_err());
+}
