@@ -203,6 +203,9 @@ fn run(o: &Options) -> Result<(), String> {
         line_search: o.line_search,
         ..defaults
     };
+    for w in membrane_contact::mech::summary::model_warnings(&model) {
+        eprintln!("warning: {w}");
+    }
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
@@ -288,6 +291,9 @@ fn run(o: &Options) -> Result<(), String> {
     membrane_contact::mech::check_results(analysis.model(), &results, None)
         .map_err(|e| format!("the results are not finite ({e}): refused"))?;
     report(o, &analysis, &results);
+    for w in membrane_contact::mech::summary::result_warnings(analysis.model(), &results) {
+        eprintln!("warning: {w}");
+    }
     let total: usize = iterations.iter().sum();
     out!(
         "\nNewton: {} steps, {increments} increments, {cutbacks} cut-backs, {enlarged} enlarged, \

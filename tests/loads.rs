@@ -42,6 +42,7 @@ fn film(prestress: f64) -> Material {
         density: 0.0,
         wrinkling: Wrinkling::None,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+        yield_stress: None,
     }
 }
 

@@ -33,6 +33,7 @@ fn etfe() -> Material {
         density: 0.0,
         wrinkling: Wrinkling::None,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+        yield_stress: None,
     }
 }
 
@@ -1285,6 +1286,7 @@ fn tension_field_film(eta: f64, prestress: f64) -> Material {
         prestress: [prestress, prestress, 0.0],
         density: 0.0,
         wrinkling: Wrinkling::TensionField,
+        yield_stress: None,
         wrinkling_regularisation: eta,
     }
 }
@@ -1795,6 +1797,7 @@ fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
         thickness: t,
         prestress: [s0, s0, 0.0],
         density: 0.0,
+        yield_stress: None,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     };

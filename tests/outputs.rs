@@ -9,6 +9,7 @@
 
 use membrane_contact::mech::model::{ElementSelection, ElementSet, OutputPoint};
 use membrane_contact::mech::scenarios::CircularMembrane;
+use membrane_contact::mech::summary;
 use membrane_contact::mech::{Analysis, LoadLevels, Material, Model, ParallelArch, SolverSettings};
 
 /// A 4-ring disc of radius 1 m, the specimen's ETFE film prestressed to 1 MPa, 100 Pa.
@@ -151,4 +152,51 @@ fn output_sections_name_the_bad_item() {
     assert_eq!(Model::from_json(&text).unwrap(), base);
     let typo = text.replace("\"element_sets\"", "\"elementsets\"");
     assert!(Model::from_json(&typo).is_err());
+}
+
+// ------------------------------------------------------------------ warnings
+
+#[test]
+fn the_specimen_gives_no_model_warning() {
+    for h in [0.2, 0.3, 0.4] {
+        let model = ParallelArch::with_height(h).model().unwrap();
+        assert_eq!(summary::model_warnings(&model), Vec::<String>::new());
+    }
+}
+
+#[test]
+fn a_modulus_in_mpa_and_an_inconsistent_initial_gap_warn_naming_the_item() {
+    let mut model = ParallelArch::default().model().unwrap();
+    model.material.youngs_modulus = 800.0;
+    model.gaps[3].initial_gap += 0.01;
+    let warnings = summary::model_warnings(&model);
+    assert_eq!(warnings.len(), 2, "{warnings:#?}");
+    assert!(warnings[0].contains("looks like a value in MPa"));
+    assert!(warnings[1].contains("gap 'G4'") && warnings[1].contains("farther"));
+    // A gap consistent to well below a micrometre does not warn.
+    let mut model = ParallelArch::default().model().unwrap();
+    model.gaps[3].initial_gap += 1e-9;
+    assert!(summary::model_warnings(&model).is_empty());
+}
+
+#[test]
+fn stress_above_the_yield_stress_warns_and_below_does_not() {
+    let mut model = ParallelArch::default().model().unwrap();
+    let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
+    model.material.yield_stress = Some(15e6);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    analysis.step_to(&targets, 20).unwrap();
+    let results = analysis.results();
+    let peak = results.von_mises_range().1;
+    assert!(
+        peak > 15e6,
+        "the 300 mm specimen passes ETFE's first yield: {peak}"
+    );
+    let warnings = summary::result_warnings(&model, &results);
+    assert_eq!(warnings.len(), 1, "{warnings:#?}");
+    assert!(warnings[0].contains("above the material's yield_stress 15.000 MPa"));
+    model.material.yield_stress = Some(1.01 * peak);
+    assert!(summary::result_warnings(&model, &results).is_empty());
+    model.material.yield_stress = None;
+    assert!(summary::result_warnings(&model, &results).is_empty());
 }

@@ -66,7 +66,11 @@ use crate::mech::element::state_counts;
 use crate::mech::material::Wrinkling;
 use crate::mech::{
     Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SolverSettings,
-    StepError, StepReport, check_results, model::MAX_FRICTION, solver::IncrementFailure, vtk,
+    StepError, StepReport, check_results,
+    model::MAX_FRICTION,
+    solver::IncrementFailure,
+    summary::{model_warnings, result_warnings},
+    vtk,
 };
 use serde::{Deserialize, Serialize};
 
@@ -204,6 +208,8 @@ struct Built {
     /// The results of the state `checked_step` has just reached, already checked finite: the
     /// outputs are made of them (taken by `refresh_outputs`, so never stale).
     checked: Option<Results>,
+    /// What the last outputs leave of the model's assumptions (`summary::result_warnings`).
+    warnings: Vec<String>,
 }
 
 /// One FMU instance.
@@ -380,7 +386,43 @@ impl Instance {
                 self.time
             )
         });
-        self.write_results()
+        let written = self.write_results();
+        let doubts = self
+            .analysis
+            .as_ref()
+            .map_or_else(Vec::new, |b| model_warnings(b.analysis.model()));
+        let written = if doubts.is_empty() {
+            written
+        } else {
+            let mut message = format!("the model looks wrong: {}", doubts.join("; "));
+            if let Err(f) = written {
+                message = format!("{}; {message}", f.message);
+            }
+            Err(Failure::warning(message))
+        };
+        self.warn_about_assumptions(written)
+    }
+
+    /// `outcome`, or `fmi2Warning` with the reasons when the current outputs leave the model's
+    /// assumptions (a stress above the yield stress, strains beyond the small-strain range):
+    /// the state and outputs stand, the importer is told once per step.
+    fn warn_about_assumptions(&self, outcome: Outcome) -> Outcome {
+        let warnings = self.analysis.as_ref().map_or(&[][..], |b| &b.warnings[..]);
+        if warnings.is_empty() {
+            return outcome;
+        }
+        let mut message = format!(
+            "t = {}: the result is outside the model's assumptions: {}",
+            self.time,
+            warnings.join("; ")
+        );
+        if let Err(f) = outcome {
+            if f.status != Status::Warning {
+                return Err(f);
+            }
+            message = format!("{}; {message}", f.message);
+        }
+        Err(Failure::warning(message))
     }
 
     pub fn terminate(&mut self) -> Outcome {
@@ -605,6 +647,7 @@ impl Instance {
             parameters: parameters_of(&self.description.variables, values),
             increments,
             checked: None,
+            warnings: vec![],
         })
     }
 
@@ -737,6 +780,7 @@ impl Instance {
                 results
             }
         };
+        built.warnings = result_warnings(built.analysis.model(), &results);
         let max_stress = results.von_mises_range().1;
         let [_, wrinkled, slack] = state_counts(&results.elements);
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
@@ -865,7 +909,8 @@ impl Instance {
                     )
                 });
                 self.steps += 1;
-                self.write_results()
+                let written = self.write_results();
+                self.warn_about_assumptions(written)
             }
             Err(e) => {
                 if let Some(before) = before {

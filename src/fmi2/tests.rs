@@ -1496,3 +1496,31 @@ fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
         );
     }
 }
+
+/// A step whose result leaves the model's assumptions (stress above `yield_stress`) returns
+/// fmi2Warning with the reason in the log, and keeps its state and outputs; a model that looks
+/// wrong (E in MPa) warns at fmi2ExitInitializationMode.
+#[test]
+fn result_beyond_the_yield_stress_is_a_warning_not_an_error() {
+    let mut model = ParallelArch::default().model().unwrap();
+    model.material.yield_stress = Some(15e6);
+    let (u, log) = (
+        Unpacked::new("yield", Source::Model(model.clone())),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    assert_eq!(fmu.set_real("frame.dz", -0.15), 0);
+    assert_eq!(fmu.step(0.0, 1.0), Status::Warning.raw());
+    assert!(
+        log.contains(
+            Status::Warning,
+            "above the material's yield_stress 15.000 MPa"
+        ),
+        "{:?}",
+        log.take()
+    );
+    assert!(fmu.real("film.maxEquivalentStress") > 15e6);
+    // The step stood: the next one continues from t = 1.
+    assert_eq!(fmu.set_real("frame.dz", -0.14), 0);
+    assert_ne!(fmu.step(1.0, 1.0), Status::Error.raw());
+}

@@ -272,6 +272,7 @@ mod tests {
             density: 0.0,
             wrinkling: Wrinkling::None,
             wrinkling_regularisation: 1e-5,
+            yield_stress: None,
         }
     }
 

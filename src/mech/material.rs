@@ -84,6 +84,11 @@ pub struct Material {
         skip_serializing_if = "is_default_regularisation"
     )]
     pub wrinkling_regularisation: f64,
+    /// Equivalent (von Mises) stress above which the linear law (2.3) no longer describes the
+    /// film (Pa): ETFE's first yield, about 14–16 MPa at 23 °C. A converged state beyond it is
+    /// reported with a warning (`summary::assumption_warnings`); none: no check.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yield_stress: Option<f64>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -247,6 +252,7 @@ mod tests {
             density: 0.0,
             wrinkling: Wrinkling::TensionField,
             wrinkling_regularisation: 0.0,
+            yield_stress: None,
         }
     }
 

@@ -472,6 +472,13 @@ impl Model {
                 message: format!("density = {} must be ≥ 0 (kg/m³)", m.density),
             });
         }
+        if let Some(y) = m.yield_stress
+            && !(y > 0.0 && y.is_finite())
+        {
+            return Err(ModelError::Material {
+                message: format!("yield_stress = {y} must be > 0 (Pa)"),
+            });
+        }
         for (t, tri) in self.triangles.iter().enumerate() {
             for &v in tri {
                 check_node(&|| format!("triangle {t}"), v)?;

@@ -86,6 +86,7 @@ impl Default for ParallelArch {
                 density: 0.0,
                 wrinkling: Wrinkling::None,
                 wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+                yield_stress: None,
             },
             normal_penalty_factor: 1000.0,
             tangential_penalty_ratio: 0.1,
