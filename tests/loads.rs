@@ -346,6 +346,7 @@ fn nodal_forces_act_on_each_node_of_the_set_and_group_reactions_balance_them() {
         name: "edge".into(),
         nodes: vec![0, 1, 2, 3, 5, 6, 7, 8],
         target: [0.0; 3],
+        components: None,
     }];
     model.loads.forces = vec![ForceSet {
         name: "hook".into(),

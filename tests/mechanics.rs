@@ -91,6 +91,7 @@ fn pressed_node_model(g0: f64, mu: f64) -> Model {
         name: "rim".into(),
         nodes: vec![0, 1, 2, 3, 5, 6, 7, 8],
         target: [0.0; 3],
+        components: None,
     });
     m
 }
@@ -390,11 +391,13 @@ fn newton_converges_quadratically_where_no_status_changes() {
         name: "left".into(),
         nodes: left,
         target: [0.0; 3],
+        components: None,
     });
     m.groups.push(BoundaryGroup {
         name: "right".into(),
         nodes: right,
         target: [0.0; 3],
+        components: None,
     });
     let mut a = Analysis::new(
         m,
@@ -633,6 +636,7 @@ fn film_edge_on_arch(law: FrictionLaw, prestress_across: f64) -> Model {
         name: "edge".into(),
         nodes: edge,
         target: [0.0, 0.0, -0.1],
+        components: None,
     });
     m
 }
@@ -1312,6 +1316,7 @@ fn mapped_boundary_patch(
                 name: format!("b{v}"),
                 nodes: vec![v],
                 target,
+                components: None,
             });
             targets.push(target);
         } else {
@@ -1548,6 +1553,7 @@ fn shear_panel(n: usize, material: Material) -> Model {
         name: "top".into(),
         nodes: top,
         target: [0.05, 0.005, 0.0],
+        components: None,
     });
     m
 }
@@ -1753,6 +1759,7 @@ fn annulus(a: f64, b: f64, nr: usize, nt: usize, material: Material) -> Model {
             name: format!("h{j}"),
             nodes: vec![id(0, j)],
             target: [0.0; 3],
+            components: None,
         });
         m.supports.push(Support {
             node: id(nr, j),

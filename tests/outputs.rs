@@ -105,6 +105,7 @@ fn compressed_area_counts_the_triangles_pushed_into_compression() {
             name: format!("r{v}"),
             nodes: vec![v],
             target: [0.0; 3],
+            components: None,
         })
         .collect();
     let targets: Vec<[f64; 3]> = rim

@@ -11,7 +11,7 @@
 //! |---|---|---|---|---|
 //! | `time` | Real | independent | | pseudo-time of the load path |
 //! | `mu` | Real | input | 1 | friction coefficient of every gap (applied once set) |
-//! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step |
+//! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step (prescribed components only) |
 //! | `<pressureSet>.pressure` | Real | input | Pa | follower pressure of the set reached at the end of a step (start: the model's) |
 //! | `<forceSet>.Fx/.Fy/.Fz` | Real | input | N | force on each node of the set reached at the end of a step (start: the model's) |
 //! | `archHeight` | Real | parameter | m | ParallelArch only: the model is regenerated from it |
@@ -27,7 +27,7 @@
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
 //! | `<gap>.frictionX/.frictionY` | Real | output | N | friction force on the film, local x, y (signed) |
 //! | `<gap>.status` | Integer | output | | 0 open, 1 stick, 2 slip |
-//! | `<group>.Rx/.Ry/.Rz` | Real | output | N | total reaction of the group |
+//! | `<group>.Rx/.Ry/.Rz` | Real | output | N | total reaction of the group (prescribed components only) |
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
 //! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
 //! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
@@ -408,7 +408,8 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         Binding::Friction,
     );
     for (group, g) in model.groups.iter().enumerate() {
-        for (axis, a) in axes.iter().enumerate() {
+        let prescribed = g.prescribes();
+        for (axis, a) in axes.iter().enumerate().filter(|(c, _)| prescribed[*c]) {
             table.input(
                 &format!("{}.d{a}", g.name),
                 0.0,
@@ -683,7 +684,12 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         );
     }
     for (group, g) in model.groups.iter().enumerate() {
-        for (axis, a) in ["Rx", "Ry", "Rz"].iter().enumerate() {
+        let prescribed = g.prescribes();
+        for (axis, a) in ["Rx", "Ry", "Rz"]
+            .iter()
+            .enumerate()
+            .filter(|(c, _)| prescribed[*c])
+        {
             table.output(
                 &format!("{}.{a}", g.name),
                 "N",

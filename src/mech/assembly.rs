@@ -80,8 +80,9 @@ impl System {
             }
         }
         for (group, g) in model.groups.iter().enumerate() {
+            let prescribed = g.prescribes();
             for &v in &g.nodes {
-                for component in 0..3 {
+                for component in (0..3).filter(|&c| prescribed[c]) {
                     dofs[3 * v + component] = Dof::Prescribed { group, component };
                 }
             }

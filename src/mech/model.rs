@@ -117,6 +117,20 @@ pub struct BoundaryGroup {
     /// Target displacement of a standard run (m); the CLI and the FMU's default experiment use it.
     #[serde(default)]
     pub target: [f64; 3],
+    /// The components the group prescribes (e.g. `["z"]`: x and y stay free); omitted: all
+    /// three. Its free components are ordinary film DOFs; their targets are ignored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub components: Option<Vec<Axis>>,
+}
+
+impl BoundaryGroup {
+    /// Whether the group prescribes each of x, y, z.
+    pub fn prescribes(&self) -> [bool; 3] {
+        match &self.components {
+            None => [true; 3],
+            Some(axes) => std::array::from_fn(|c| axes.iter().any(|a| a.index() == c)),
+        }
+    }
 }
 
 /// Which triangles a pressure set covers: `"all"` or a list of triangle indices.
@@ -524,6 +538,17 @@ impl Model {
                     item: format!("boundary group '{}' target", g.name),
                 });
             }
+            if let Some(axes) = &g.components {
+                let listed = axes.len();
+                if listed == 0 || g.prescribes().iter().filter(|&&p| p).count() != listed {
+                    return Err(ModelError::Name {
+                        item: format!("boundary group '{}'", g.name),
+                        message: "components must list each of \"x\", \"y\", \"z\" at most once, and at least one"
+                            .into(),
+                    });
+                }
+            }
+            let prescribed = g.prescribes();
             for &v in &g.nodes {
                 check_node(&|| format!("boundary group '{}'", g.name), v)?;
                 if let Some(other) = in_group[v] {
@@ -532,7 +557,7 @@ impl Model {
                         message: format!("is in boundary groups '{other}' and '{}'", g.name),
                     });
                 }
-                if constrained[v].iter().any(|&c| c) {
+                if (0..3).any(|c| constrained[v][c] && prescribed[c]) {
                     return Err(ModelError::Conflict {
                         node: v,
                         message: format!(

@@ -133,7 +133,10 @@ fn held_axes(model: &Model) -> Vec<[bool; 3]> {
             .for_each(|&v| held[v][s.normal.index()] = true);
     }
     for g in &model.groups {
-        g.nodes.iter().for_each(|&v| held[v] = [true; 3]);
+        let prescribed = g.prescribes();
+        for &v in &g.nodes {
+            (0..3).for_each(|c| held[v][c] |= prescribed[c]);
+        }
     }
     held
 }

@@ -668,6 +668,7 @@ impl ArchPanel {
                 name: format!("J{j}"),
                 nodes: vec![id(nx, j)],
                 target,
+                components: None,
             })
             .collect();
         validated(Model {
@@ -836,6 +837,7 @@ impl CylinderStrip {
             name: name.into(),
             nodes: vec![id(s, 0), id(s, 1)],
             target: [sign * self.out, 0.0, -self.down],
+            components: None,
         };
         validated(Model {
             loads: Default::default(),
@@ -1000,6 +1002,7 @@ impl ArchEdge {
                 name: "frame".into(),
                 nodes: frame,
                 target: [0.0, 0.0, -h / 2.0],
+                components: None,
             }],
         })
     }
@@ -1224,6 +1227,7 @@ impl CircularMembrane {
                 name: "rim".into(),
                 nodes: self.ring(self.rings).collect(),
                 target: [0.0; 3],
+                components: None,
             }],
             loads: LoadSpec {
                 pressures: vec![PressureSet {

@@ -240,6 +240,7 @@ impl ParallelArch {
                 name: "frame".into(),
                 nodes: frame,
                 target: self.target(),
+                components: None,
             }],
         };
         model.validate().map_err(|e| e.to_string())?;

@@ -1,0 +1,146 @@
+//! Groups that prescribe chosen components only (issue 8, item 2).
+//!
+//! TEST GOAL: a group with `components: ["z"]` prescribes z and leaves x and y to the film (they
+//! move, and the group carries no x/y reaction); validation accepts a roller (z-only group on a
+//! node whose x and y a support fixes) and refuses a component prescribed and fixed at once;
+//! a film held in-plane by nothing is still refused as singular; the FMU has inputs and
+//! reactions for the prescribed components only.
+//!
+//! MODEL: a flat 1 m × 0.2 m strip of the specimen's prestressed ETFE (8 × 2 cells); its left
+//! edge is a full group (held), its right edge a z-only group lifted by 50 mm.
+
+use membrane_contact::fmi2::description::describe;
+use membrane_contact::fmi2::resources::Source;
+use membrane_contact::mech::model::{Axis, BoundaryGroup, Model, Support};
+use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+
+const NX: usize = 8;
+const NY: usize = 2;
+
+fn id(i: usize, j: usize) -> usize {
+    j * (NX + 1) + i
+}
+
+fn strip() -> Model {
+    let mut nodes = vec![];
+    for j in 0..=NY {
+        for i in 0..=NX {
+            nodes.push([i as f64 / NX as f64, 0.2 * j as f64 / NY as f64, 0.0]);
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..NY {
+        for i in 0..NX {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let edge = |i: usize| (0..=NY).map(|j| id(i, j)).collect::<Vec<_>>();
+    Model {
+        name: "Strip".into(),
+        description: String::new(),
+        nodes,
+        triangles,
+        material: ParallelArch::default().material,
+        supports: vec![],
+        symmetry: vec![],
+        gaps: vec![],
+        groups: vec![
+            BoundaryGroup {
+                name: "held".into(),
+                nodes: edge(0),
+                target: [0.0; 3],
+                components: None,
+            },
+            BoundaryGroup {
+                name: "lift".into(),
+                nodes: edge(NX),
+                target: [0.3, 0.0, 0.05],
+                components: Some(vec![Axis::Z]),
+            },
+        ],
+        loads: Default::default(),
+        outputs: Default::default(),
+    }
+}
+
+#[test]
+fn z_only_group_prescribes_z_and_leaves_x_and_y_to_the_film() {
+    let run = |model: Model| {
+        let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
+        let mut analysis = Analysis::new(model, SolverSettings::default()).unwrap();
+        analysis.step_to(&targets, 5).unwrap();
+        let results = analysis.results();
+        (analysis, results)
+    };
+    let model = strip();
+    model.validate().unwrap();
+    let (analysis, results) = run(model.clone());
+    // The strip tilted rigidly would move its lifted edge by √(1 − 0.05²) − 1 along x; free in
+    // x, it also gives up its prestress along the strip and contracts further. The x target
+    // (0.3 m) is ignored.
+    let tilt = (1.0f64 - 0.05 * 0.05).sqrt() - 1.0;
+    for j in 0..=NY {
+        let u = analysis.node_displacement(id(NX, j));
+        assert!((u.z - 0.05).abs() < 1e-15, "z is prescribed: {u}");
+        assert!(u.x < tilt && u.x > -0.05, "x is free: {u}");
+    }
+    let [rx, ry, _] = results.reactions[1];
+    assert_eq!((rx, ry), (0.0, 0.0), "no reaction along a free component");
+    let released = results.reactions[0][0].abs();
+
+    // The same edge as a full group (x and y held where they were): the strip stays
+    // prestressed along its length and the held edge carries σx t w.
+    let mut full = model;
+    full.groups[1].components = None;
+    full.groups[1].target = [0.0, 0.0, 0.05];
+    let (_, held) = run(full);
+    let material = ParallelArch::default().material;
+    let pull = material.prestress[0] * material.thickness * 0.2;
+    let carried = held.reactions[0][0].abs();
+    assert!(carried > 0.5 * pull, "{carried} vs σx t w = {pull}");
+    assert!(released < 1e-6 * carried, "{released} vs {carried}");
+}
+
+#[test]
+fn a_roller_validates_and_a_component_both_prescribed_and_fixed_is_refused() {
+    let mut model = strip();
+    model.supports.push(Support {
+        node: id(NX, 0),
+        fixed: vec![Axis::X, Axis::Y],
+    });
+    model.validate().unwrap();
+    model.supports[0].fixed.push(Axis::Z);
+    let err = model.validate().unwrap_err().to_string();
+    assert!(err.contains("prescribed by group 'lift'"), "{err}");
+
+    let mut model = strip();
+    model.groups[1].components = Some(vec![Axis::Z, Axis::Z]);
+    let err = model.validate().unwrap_err().to_string();
+    assert!(err.contains("boundary group 'lift': components"), "{err}");
+    model.groups[1].components = Some(vec![]);
+    assert!(model.validate().is_err());
+}
+
+#[test]
+fn a_film_held_in_plane_by_nothing_is_still_refused() {
+    let mut model = strip();
+    model.groups[0].components = Some(vec![Axis::Z]);
+    let err = model.validate().unwrap_err().to_string();
+    assert!(err.contains("no support"), "{err}");
+}
+
+#[test]
+fn the_fmu_has_inputs_and_reactions_for_prescribed_components_only() {
+    let d = describe(&Source::Model(strip())).unwrap();
+    let names: Vec<&str> = d.variables.iter().map(|v| v.name.as_str()).collect();
+    for present in ["held.dx", "held.dz", "held.Rx", "lift.dz", "lift.Rz"] {
+        assert!(names.contains(&present), "{present}");
+    }
+    for absent in ["lift.dx", "lift.dy", "lift.Rx", "lift.Ry"] {
+        assert!(!names.contains(&absent), "{absent}");
+    }
+    let json = strip().to_json();
+    assert!(json.contains("\"components\":[\"z\"]") || json.contains("\"components\": [\n"));
+    assert_eq!(Model::from_json(&json).unwrap(), strip());
+}
