@@ -436,6 +436,21 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
             r[2]
         );
     }
+    for (name, r) in model.support_sets().iter().zip(&results.support_reactions) {
+        out!(
+            "reaction of support set {name}: ({:.3}, {:.3}, {:.3}) N",
+            r[0],
+            r[1],
+            r[2]
+        );
+    }
+    let t = results.total_reaction;
+    out!(
+        "total reaction (supports, symmetry planes, groups): ({:.3}, {:.3}, {:.3}) N",
+        t[0],
+        t[1],
+        t[2]
+    );
     let (lo, hi) = results.von_mises_range();
     out!(
         "equivalent (von Mises) stress: {:.3} … {:.3} MPa",

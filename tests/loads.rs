@@ -90,6 +90,7 @@ fn clamp(model: &mut Model, nodes: impl IntoIterator<Item = usize>) {
         model.supports.push(Support {
             node,
             fixed: vec![Axis::X, Axis::Y, Axis::Z],
+            name: None,
         });
     }
 }

@@ -155,6 +155,7 @@ fn assembled_tangent_matches_finite_difference_in_every_gap_status_of_both_laws(
         m.supports.push(Support {
             node: 0,
             fixed: vec![Axis::X, Axis::Y, Axis::Z],
+            name: None,
         });
         m.validate().unwrap();
         let system = System::new(&m, false).unwrap();
@@ -1323,6 +1324,7 @@ fn mapped_boundary_patch(
             m.supports.push(Support {
                 node: v,
                 fixed: vec![Axis::Z],
+                name: None,
             });
         }
     }
@@ -1546,7 +1548,11 @@ fn shear_panel(n: usize, material: Material) -> Model {
             vec![Axis::Z]
         };
         if !top.contains(&v) {
-            m.supports.push(Support { node: v, fixed });
+            m.supports.push(Support {
+                node: v,
+                fixed,
+                name: None,
+            });
         }
     }
     m.groups.push(BoundaryGroup {
@@ -1764,11 +1770,13 @@ fn annulus(a: f64, b: f64, nr: usize, nt: usize, material: Material) -> Model {
         m.supports.push(Support {
             node: id(nr, j),
             fixed: vec![Axis::X, Axis::Y, Axis::Z],
+            name: None,
         });
         for i in 1..nr {
             m.supports.push(Support {
                 node: id(i, j),
                 fixed: vec![Axis::Z],
+                name: None,
             });
         }
     }
@@ -1923,15 +1931,18 @@ fn singular_models_are_refused_at_validation_naming_nodes_and_motion() {
         sliding.supports.push(Support {
             node: v,
             fixed: vec![Axis::Z],
+            name: None,
         });
     }
     sliding.supports.push(Support {
         node: 0,
         fixed: vec![Axis::X],
+        name: None,
     });
     sliding.supports.push(Support {
         node: 6,
         fixed: vec![Axis::X],
+        name: None,
     });
     let message = sliding.validate().unwrap_err().to_string();
     assert!(message.contains("can translate along Y"), "{message}");

@@ -108,6 +108,7 @@ fn a_roller_validates_and_a_component_both_prescribed_and_fixed_is_refused() {
     model.supports.push(Support {
         node: id(NX, 0),
         fixed: vec![Axis::X, Axis::Y],
+        name: None,
     });
     model.validate().unwrap();
     model.supports[0].fixed.push(Axis::Z);
@@ -143,4 +144,74 @@ fn the_fmu_has_inputs_and_reactions_for_prescribed_components_only() {
     let json = strip().to_json();
     assert!(json.contains("\"components\":[\"z\"]") || json.contains("\"components\": [\n"));
     assert_eq!(Model::from_json(&json).unwrap(), strip());
+}
+
+// ------------------------------------------------------------------ named support sets
+
+/// The ring-meshed disc of `scenarios::CircularMembrane` under 100 Pa, its rim held by
+/// supports instead of a group: the northern half named `north`, the southern `south`.
+fn disc_on_named_supports() -> (Model, f64) {
+    use membrane_contact::mech::scenarios::CircularMembrane;
+    let disc = CircularMembrane {
+        radius: 1.0,
+        rings: 4,
+        material: ParallelArch::default().material,
+        pressure: 100.0,
+    };
+    let mut model = disc.model().unwrap();
+    let rim = model.groups.remove(0).nodes;
+    for v in rim {
+        model.supports.push(Support {
+            node: v,
+            fixed: vec![Axis::X, Axis::Y, Axis::Z],
+            name: Some(
+                if model.nodes[v][1] >= 0.0 {
+                    "north"
+                } else {
+                    "south"
+                }
+                .into(),
+            ),
+        });
+    }
+    let sides = 6.0 * disc.rings as f64;
+    let area = 0.5 * sides * (std::f64::consts::TAU / sides).sin();
+    (model, 100.0 * area)
+}
+
+#[test]
+fn named_support_sets_report_their_reactions_and_the_total_balances_the_load() {
+    use membrane_contact::mech::LoadLevels;
+    let (model, load) = disc_on_named_supports();
+    assert_eq!(model.support_sets(), ["north", "south"]);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let levels = LoadLevels::of_model(&model);
+    analysis.step_to_with_loads(&[], &levels, 2).unwrap();
+    let results = analysis.results();
+    let [north, south] = [results.support_reactions[0], results.support_reactions[1]];
+    let total = results.total_reaction;
+    for c in 0..3 {
+        assert!((north[c] + south[c] - total[c]).abs() < 1e-9 * load, "{c}");
+    }
+    // The rim carries the pressure resultant p·A (the film pushes up, the supports pull down).
+    assert!((total[2] + load).abs() < 1e-6 * load, "{total:?} vs {load}");
+    assert!(north[2] < 0.0 && south[2] < 0.0);
+}
+
+#[test]
+fn support_set_names_are_checked_and_become_fmu_outputs() {
+    let (model, _) = disc_on_named_supports();
+    let d = describe(&Source::Model(model.clone())).unwrap();
+    let names: Vec<&str> = d.variables.iter().map(|v| v.name.as_str()).collect();
+    for present in ["north.Rz", "south.Rx", "reactions.Rz"] {
+        assert!(names.contains(&present), "{present}");
+    }
+    let mut clash = model.clone();
+    clash.supports[0].name = Some("top".into()); // the pressure set's name
+    let err = clash.validate().unwrap_err().to_string();
+    assert!(err.contains("name is used twice"), "{err}");
+    let mut reserved = model;
+    reserved.supports[0].name = Some("reactions".into());
+    let err = describe(&Source::Model(reserved)).unwrap_err();
+    assert!(err.contains("reserved"), "{err}");
 }

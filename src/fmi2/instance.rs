@@ -812,6 +812,10 @@ impl Instance {
                 Binding::MaxEquivalentStress => Value::Real(max_stress),
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
+                Binding::SupportReaction { set, axis } => {
+                    Value::Real(results.support_reactions[set][axis])
+                }
+                Binding::TotalReaction(axis) => Value::Real(results.total_reaction[axis]),
                 Binding::PointDisplacement { point, axis } => {
                     Value::Real(results.points[point][axis])
                 }

@@ -31,6 +31,8 @@
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
 //! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
 //! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
+//! | `<support set>.Rx/.Ry/.Rz` | Real | output | N | total reaction of a named support set |
+//! | `reactions.Rx/.Ry/.Rz` | Real | output | N | sum of all restraint forces (supports, symmetry, groups) |
 //! | `<point>.ux/.uy/.uz` | Real | output | m | displacement of a named output point |
 //! | `<set>.maxPrincipalStress/.minPrincipalStress/.maxEquivalentStress/.maxStrain/.compressedArea` | Real | output | Pa, 1, m2 | field summary of a named element set |
 
@@ -210,6 +212,13 @@ pub enum Binding {
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,
+    /// Total reaction of a named support set along axis 0, 1, 2.
+    SupportReaction {
+        set: usize,
+        axis: usize,
+    },
+    /// Sum of all restraint forces along axis 0, 1, 2.
+    TotalReaction(usize),
     /// Displacement of an output point along axis 0, 1, 2.
     PointDisplacement {
         point: usize,
@@ -330,8 +339,9 @@ pub const UNITS: [(&str, [i32; 3]); 8] = [
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
-pub const RESERVED_NAMES: [&str; 8] = [
+pub const RESERVED_NAMES: [&str; 9] = [
     "time",
+    "reactions",
     "gravity",
     "mu",
     "frictionLaw",
@@ -373,6 +383,8 @@ pub fn check_names(model: &Model) -> Result<(), String> {
                 .iter()
                 .map(|e| ("element set", &e.name)),
         );
+    let support_sets = model.support_sets();
+    let names = names.chain(support_sets.iter().map(|n| ("support set", n)));
     for (kind, name) in names {
         if RESERVED_NAMES.contains(&name.as_str()) {
             return Err(format!(
@@ -701,6 +713,30 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
+    for (set, name) in model.support_sets().iter().enumerate() {
+        for (axis, a) in ["Rx", "Ry", "Rz"].iter().enumerate() {
+            table.output(
+                &format!("{name}.{a}"),
+                "N",
+                &format!(
+                    "total reaction of support set '{name}' along {} (its fixed components)",
+                    axes[axis]
+                ),
+                Binding::SupportReaction { set, axis },
+            );
+        }
+    }
+    for (axis, a) in ["Rx", "Ry", "Rz"].iter().enumerate() {
+        table.output(
+            &format!("reactions.{a}"),
+            "N",
+            &format!(
+                "sum of all restraint forces on the film along {} (supports, symmetry planes, groups; not the gaps)",
+                axes[axis]
+            ),
+            Binding::TotalReaction(axis),
+        );
+    }
     for (point, p) in model.outputs.points.iter().enumerate() {
         for (axis, a) in ["ux", "uy", "uz"].iter().enumerate() {
             table.output(
@@ -966,7 +1002,11 @@ mod tests {
             .iter()
             .filter(|v| v.causality == Causality::Output)
             .count();
-        assert_eq!(outputs, 9 * 7 + 3 + 4 + 2);
+        assert_eq!(
+            outputs,
+            9 * 7 + 3 + 3 + 4 + 2,
+            "gaps, group and total reactions, statistics, film"
+        );
         assert_eq!(find("film.wrinkling").start, Some(Value::Boolean(false)));
         assert_eq!(find("film.slackElements").var_type, VarType::Integer);
         // A user model has no archHeight, but the same results.directory.

@@ -45,6 +45,15 @@ pub fn check_results(
             results.elements[e].von_mises
         ));
     }
+    let sets = model.support_sets();
+    for (r, name) in results.support_reactions.iter().zip(&sets) {
+        if let Some(v) = r.iter().find(|v| !v.is_finite()) {
+            return Err(format!("reaction of support set {name} = {v}"));
+        }
+    }
+    if let Some(v) = results.total_reaction.iter().find(|v| !v.is_finite()) {
+        return Err(format!("total reaction = {v}"));
+    }
     for (p, spec) in results.points.iter().zip(&model.outputs.points) {
         if let Some(v) = p.iter().find(|v| !v.is_finite()) {
             return Err(format!("displacement of output point {} = {v}", spec.name));

@@ -43,6 +43,10 @@ pub struct Support {
     pub node: usize,
     /// Fixed components.
     pub fixed: Vec<Axis>,
+    /// Reaction set: supports with the same name report their summed reaction (FMU outputs
+    /// `<name>.Rx/.Ry/.Rz`); none: the support only counts in the total `reactions.*`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
 }
 
 /// A symmetry plane normal to a global axis: the normal displacement of its nodes is zero.
@@ -511,6 +515,10 @@ impl Model {
         }
         // Constrained DOFs: 0 free, 1 fixed (support or symmetry), 2 prescribed by a group.
         let mut constrained = vec![[false; 3]; n];
+        let mut names = HashSet::new();
+        for name in self.support_sets() {
+            check_name(&mut names, "support set", &name)?;
+        }
         for s in &self.supports {
             check_node(&|| "support".to_string(), s.node)?;
             for a in &s.fixed {
@@ -523,7 +531,6 @@ impl Model {
                 constrained[v][s.normal.index()] = true;
             }
         }
-        let mut names = HashSet::new();
         let mut in_group = vec![None::<&str>; n];
         for g in &self.groups {
             check_name(&mut names, "boundary group", &g.name)?;
@@ -680,6 +687,17 @@ impl Model {
                 })?;
         }
         Ok(())
+    }
+
+    /// The names of the support sets, in the order of their first support.
+    pub fn support_sets(&self) -> Vec<String> {
+        let mut sets: Vec<String> = vec![];
+        for name in self.supports.iter().filter_map(|s| s.name.as_ref()) {
+            if !sets.contains(name) {
+                sets.push(name.clone());
+            }
+        }
+        sets
     }
 
     /// The triangles of `selection`.

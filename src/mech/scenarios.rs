@@ -658,6 +658,7 @@ impl ArchPanel {
             .map(|j| Support {
                 node: id(0, j),
                 fixed: vec![Axis::X, Axis::Y, Axis::Z],
+                name: None,
             })
             .collect();
         let groups = self

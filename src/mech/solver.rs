@@ -380,6 +380,11 @@ pub struct Results {
     /// Total reaction of each boundary group (N), global axes: the force the group applies to the
     /// film, `Σ (f_int − f_ext)` over its DOFs (it balances the loads on its nodes too).
     pub reactions: Vec<[f64; 3]>,
+    /// Total reaction of each named support set (N), global axes, over its fixed components.
+    pub support_reactions: Vec<[f64; 3]>,
+    /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the
+    /// gaps' forces on their support points are reported per gap, not here).
+    pub total_reaction: [f64; 3],
     /// Stress state of each triangle.
     pub elements: Vec<ElementStress>,
     /// Displacement of each output point of the model (m).
@@ -1178,9 +1183,28 @@ impl Analysis {
             })
             .collect();
         let mut reactions = vec![[0.0; 3]; self.model.groups.len()];
+        let mut total_reaction = [0.0; 3];
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { group, component } = d {
                 reactions[*group][*component] += self.work.internal[i];
+            }
+            if !matches!(d, Dof::Free(_)) {
+                total_reaction[i % 3] += self.work.internal[i];
+            }
+        }
+        let sets = self.model.support_sets();
+        let mut support_reactions = vec![[0.0; 3]; sets.len()];
+        for s in &self.model.supports {
+            let Some(set) = s
+                .name
+                .as_ref()
+                .and_then(|n| sets.iter().position(|m| m == n))
+            else {
+                continue;
+            };
+            for a in &s.fixed {
+                let c = a.index();
+                support_reactions[set][c] += self.work.internal[3 * s.node + c];
             }
         }
         let u = &self.state.displacement;
@@ -1199,7 +1223,7 @@ impl Analysis {
             .iter()
             .map(|p| node_vector(u, p.node).into())
             .collect();
-        let sets = if outputs.element_sets.is_empty() {
+        let summaries = if outputs.element_sets.is_empty() {
             vec![]
         } else {
             let areas: Vec<f64> = self
@@ -1220,9 +1244,11 @@ impl Analysis {
         Results {
             gaps,
             reactions,
+            support_reactions,
+            total_reaction,
             elements,
             points,
-            sets,
+            sets: summaries,
         }
     }
 
