@@ -57,6 +57,11 @@ options:
   --matrix M         consistent (default) or ju-rowlands (the paper's; converges linearly:
                      give it --max-iterations 3000)
   --max-iterations N Newton iterations per increment before it is halved (default 100)
+  --increments N     largest increment = 1/N of a step (default 1; the FMU's
+                     solver.incrementsPerStep); increments halve on failure and grow back
+  --max-cutbacks N   halvings of an increment before a step fails (default 12)
+  --displacement-tolerance X, --residual-tolerance X
+                     relative Newton tolerances (default 1e-5 each; docs/mechanics.md)
   --no-line-search   plain Newton steps: about half the iterations when each step starts near
                      its answer (a prestressed film under a gradually raised pressure), but no
                      safeguard for a first step from a slack flat film or gaps opening/closing
@@ -77,6 +82,10 @@ struct Options {
     steps: usize,
     matrix: IterationMatrix,
     max_iterations: Option<usize>,
+    max_cutbacks: Option<usize>,
+    displacement_tolerance: Option<f64>,
+    residual_tolerance: Option<f64>,
+    increments: usize,
     line_search: bool,
     csv: Option<String>,
     vtk: Option<String>,
@@ -95,6 +104,10 @@ fn parse(args: &[String]) -> Result<Options, String> {
         steps: 20,
         matrix: IterationMatrix::Consistent,
         max_iterations: None,
+        max_cutbacks: None,
+        displacement_tolerance: None,
+        residual_tolerance: None,
+        increments: 1,
         line_search: true,
         csv: None,
         vtk: None,
@@ -150,6 +163,27 @@ fn parse(args: &[String]) -> Result<Options, String> {
                     .map_err(|_| "--max-iterations needs a positive integer".to_string())?;
                 o.max_iterations = Some(n);
             }
+            "--max-cutbacks" => {
+                let n = value("--max-cutbacks")?
+                    .parse()
+                    .map_err(|_| "--max-cutbacks needs a non-negative integer".to_string())?;
+                o.max_cutbacks = Some(n);
+            }
+            "--increments" => {
+                o.increments = value("--increments")?
+                    .parse()
+                    .ok()
+                    .filter(|&n| n >= 1)
+                    .ok_or("--increments needs a positive integer")?;
+            }
+            "--displacement-tolerance" => {
+                let v = value("--displacement-tolerance")?;
+                o.displacement_tolerance = Some(number("--displacement-tolerance", v)?);
+            }
+            "--residual-tolerance" => {
+                let v = value("--residual-tolerance")?;
+                o.residual_tolerance = Some(number("--residual-tolerance", v)?);
+            }
             "--no-line-search" => o.line_search = false,
             "--csv" => o.csv = Some(value("--csv")?),
             "--vtk" => o.vtk = Some(value("--vtk")?),
@@ -200,6 +234,11 @@ fn run(o: &Options) -> Result<(), String> {
     let settings = SolverSettings {
         iteration_matrix: o.matrix,
         max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
+        max_cutbacks: o.max_cutbacks.unwrap_or(defaults.max_cutbacks),
+        displacement_tolerance: o
+            .displacement_tolerance
+            .unwrap_or(defaults.displacement_tolerance),
+        residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
         line_search: o.line_search,
         ..defaults
     };
@@ -246,7 +285,7 @@ fn run(o: &Options) -> Result<(), String> {
         let fraction = step as f64 / o.steps as f64;
         let target: Vec<[f64; 3]> = targets.iter().map(|t| t.map(|v| v * fraction)).collect();
         let report = analysis
-            .step_to_with_loads(&target, &loads.scaled(fraction), 1)
+            .step_to_with_loads(&target, &loads.scaled(fraction), o.increments)
             .map_err(|e| format!("step {step}/{}: {e}", o.steps))?;
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;

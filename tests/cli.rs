@@ -210,3 +210,47 @@ fn no_line_search_option_reaches_the_same_inflated_state() {
         assert!((a - b).abs() <= 1e-3, "{with:?} vs {without:?}");
     }
 }
+
+/// The solver settings the FMU has are CLI options too: increments per step, cut-backs and
+/// both tolerances; a bad value is refused naming the setting.
+#[test]
+fn solver_settings_of_the_fmu_are_cli_options() {
+    let newton = |out: &str| {
+        out.lines()
+            .find(|l| l.starts_with("Newton:"))
+            .unwrap_or_default()
+            .to_string()
+    };
+    let increments = |line: &str| -> usize {
+        line.split(", ")
+            .find_map(|w| w.strip_suffix(" increments"))
+            .and_then(|n| n.parse().ok())
+            .unwrap()
+    };
+    let (ok, one, err) = specimen(&[]);
+    assert!(ok, "{err}");
+    let (ok, four, err) = specimen(&[
+        "--increments",
+        "4",
+        "--max-cutbacks",
+        "6",
+        "--displacement-tolerance",
+        "1e-6",
+        "--residual-tolerance",
+        "1e-6",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        increments(&newton(&four)) > increments(&newton(&one)),
+        "{}\n{}",
+        newton(&one),
+        newton(&four)
+    );
+    let (ok, _, err) = specimen(&["--residual-tolerance", "-1"]);
+    assert!(!ok && err.contains("solver settings: tolerances"), "{err}");
+    let (ok, _, err) = specimen(&["--increments", "0"]);
+    assert!(
+        !ok && err.contains("--increments needs a positive integer"),
+        "{err}"
+    );
+}
