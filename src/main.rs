@@ -483,6 +483,14 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
             r[2]
         );
     }
+    for (c, r) in model.cables.iter().zip(&results.cables) {
+        out!(
+            "cable {}: largest axial force {:.3} N, {} slack segments",
+            c.name,
+            r.max_force,
+            r.slack_segments
+        );
+    }
     let t = results.total_reaction;
     out!(
         "total reaction (supports, symmetry planes, groups): ({:.3}, {:.3}, {:.3}) N",

@@ -74,6 +74,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         groups: vec![],
         loads: LoadSpec::default(),
         outputs: Default::default(),
+        cables: vec![],
     }
 }
 

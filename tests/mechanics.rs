@@ -56,6 +56,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
     Model {
         loads: Default::default(),
         outputs: Default::default(),
+        cables: vec![],
         name: "Patch".into(),
         description: String::new(),
         nodes,

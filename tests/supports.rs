@@ -61,6 +61,7 @@ fn strip() -> Model {
         ],
         loads: Default::default(),
         outputs: Default::default(),
+        cables: vec![],
     }
 }
 

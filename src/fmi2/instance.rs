@@ -816,6 +816,7 @@ impl Instance {
                     Value::Real(results.support_reactions[set][axis])
                 }
                 Binding::TotalReaction(axis) => Value::Real(results.total_reaction[axis]),
+                Binding::CableForce(c) => Value::Real(results.cables[c].max_force),
                 Binding::PointDisplacement { point, axis } => {
                     Value::Real(results.points[point][axis])
                 }

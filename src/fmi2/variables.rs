@@ -33,6 +33,7 @@
 //! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
 //! | `<support set>.Rx/.Ry/.Rz` | Real | output | N | total reaction of a named support set |
 //! | `reactions.Rx/.Ry/.Rz` | Real | output | N | sum of all restraint forces (supports, symmetry, groups) |
+//! | `<cable>.maxForce` | Real | output | N | largest axial force of a tension-only cable |
 //! | `<point>.ux/.uy/.uz` | Real | output | m | displacement of a named output point |
 //! | `<set>.maxPrincipalStress/.minPrincipalStress/.maxEquivalentStress/.maxStrain/.compressedArea` | Real | output | Pa, 1, m2 | field summary of a named element set |
 
@@ -219,6 +220,8 @@ pub enum Binding {
     },
     /// Sum of all restraint forces along axis 0, 1, 2.
     TotalReaction(usize),
+    /// Largest axial force of a cable.
+    CableForce(usize),
     /// Displacement of an output point along axis 0, 1, 2.
     PointDisplacement {
         point: usize,
@@ -384,7 +387,9 @@ pub fn check_names(model: &Model) -> Result<(), String> {
                 .map(|e| ("element set", &e.name)),
         );
     let support_sets = model.support_sets();
-    let names = names.chain(support_sets.iter().map(|n| ("support set", n)));
+    let names = names
+        .chain(support_sets.iter().map(|n| ("support set", n)))
+        .chain(model.cables.iter().map(|c| ("cable", &c.name)));
     for (kind, name) in names {
         if RESERVED_NAMES.contains(&name.as_str()) {
             return Err(format!(
@@ -735,6 +740,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 axes[axis]
             ),
             Binding::TotalReaction(axis),
+        );
+    }
+    for (cable, c) in model.cables.iter().enumerate() {
+        table.output(
+            &format!("{}.maxForce", c.name),
+            "N",
+            &format!("largest axial force of cable '{}' (0 when slack)", c.name),
+            Binding::CableForce(cable),
         );
     }
     for (point, p) in model.outputs.points.iter().enumerate() {

@@ -45,6 +45,11 @@ pub fn check_results(
             results.elements[e].von_mises
         ));
     }
+    for (r, c) in results.cables.iter().zip(&model.cables) {
+        if !r.max_force.is_finite() {
+            return Err(format!("axial force of cable {} = {}", c.name, r.max_force));
+        }
+    }
     let sets = model.support_sets();
     for (r, name) in results.support_reactions.iter().zip(&sets) {
         if let Some(v) = r.iter().find(|v| !v.is_finite()) {

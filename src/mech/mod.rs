@@ -5,6 +5,7 @@
 //! |---|---|
 //! | [`element`] | CST membrane triangle, eqs. (2.2)–(2.7) |
 //! | [`material`] | film law, eq. (2.3), and its tension-field (wrinkling) option |
+//! | [`cable`] | tension-only edge cables (2-node truss segments along triangle edges) |
 //! | [`contact`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
 //! | [`finite`] | finiteness check of reported results |
 //! | [`model`] | model file format and validation |
@@ -19,6 +20,7 @@
 //! | [`vtk`] | VTK text of the deformed film and its stresses (Fig. 6) |
 
 pub mod assembly;
+pub mod cable;
 pub mod contact;
 pub mod element;
 pub mod finite;

@@ -258,6 +258,23 @@ impl OutputSpec {
     }
 }
 
+/// A tension-only cable through a chain of film nodes (see `cable.rs`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CableSpec {
+    /// Name (an identifier: the FMU variable prefix `<name>.maxForce`).
+    pub name: String,
+    /// The film nodes it runs through, in order; each consecutive pair must be a triangle edge.
+    pub nodes: Vec<usize>,
+    /// Cross-section area (m²).
+    pub area: f64,
+    /// Young's modulus (Pa).
+    pub youngs_modulus: f64,
+    /// Axial force in the reference configuration (N), `≥ 0`.
+    #[serde(default)]
+    pub prestress_force: f64,
+}
+
 /// A complete membrane + gap model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -291,6 +308,9 @@ pub struct Model {
     /// Output points and element sets.
     #[serde(default, skip_serializing_if = "OutputSpec::is_empty")]
     pub outputs: OutputSpec,
+    /// Tension-only edge cables.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cables: Vec<CableSpec>,
 }
 
 /// Why a model is rejected. Every variant names the offending item.
@@ -633,6 +653,7 @@ impl Model {
         }
         self.validate_loads(&mut names)?;
         self.validate_outputs(&mut names)?;
+        self.validate_cables(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -685,6 +706,68 @@ impl Model {
                     item: format!("element set '{}'", set.name),
                     message,
                 })?;
+        }
+        Ok(())
+    }
+
+    /// For every triangle edge `[a, b]` (both orientations): a triangle that has it and the
+    /// positions of `a` and `b` in that triangle. Built in one pass (cables look their segments
+    /// up in it).
+    pub fn edge_triangles(&self) -> std::collections::HashMap<[usize; 2], (usize, [usize; 2])> {
+        let mut edges = std::collections::HashMap::with_capacity(3 * self.triangles.len());
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+                edges.entry([tri[i], tri[j]]).or_insert((t, [i, j]));
+                edges.entry([tri[j], tri[i]]).or_insert((t, [j, i]));
+            }
+        }
+        edges
+    }
+
+    /// Checks the `cables` section; cable names join the namespace.
+    fn validate_cables(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        if self.cables.is_empty() {
+            return Ok(());
+        }
+        let edges = self.edge_triangles();
+        for c in &self.cables {
+            check_name(names, "cable", &c.name)?;
+            let item = || format!("cable '{}'", c.name);
+            let bad = |message: String| ModelError::Output {
+                item: item(),
+                message,
+            };
+            if c.nodes.len() < 2 {
+                return Err(bad("needs at least two nodes".into()));
+            }
+            for &v in &c.nodes {
+                if v >= self.nodes.len() {
+                    return Err(ModelError::UnknownNode {
+                        item: item(),
+                        node: v,
+                        node_count: self.nodes.len(),
+                    });
+                }
+            }
+            for (what, v) in [("area", c.area), ("youngs_modulus", c.youngs_modulus)] {
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(bad(format!("{what} = {v} must be > 0")));
+                }
+            }
+            if !(c.prestress_force >= 0.0 && c.prestress_force.is_finite()) {
+                return Err(bad(format!(
+                    "prestress_force = {} must be ≥ 0 (N; a cable carries no compression)",
+                    c.prestress_force
+                )));
+            }
+            for pair in c.nodes.windows(2) {
+                if !edges.contains_key(&[pair[0], pair[1]]) {
+                    return Err(bad(format!(
+                        "nodes {} and {} are not an edge of one triangle: a cable runs along film edges",
+                        pair[0], pair[1]
+                    )));
+                }
+            }
         }
         Ok(())
     }

@@ -675,6 +675,7 @@ impl ArchPanel {
         validated(Model {
             loads: Default::default(),
             outputs: Default::default(),
+            cables: vec![],
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",
@@ -843,6 +844,7 @@ impl CylinderStrip {
         validated(Model {
             loads: Default::default(),
             outputs: Default::default(),
+            cables: vec![],
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,
@@ -984,6 +986,7 @@ impl ArchEdge {
         validated(Model {
             loads: Default::default(),
             outputs: Default::default(),
+            cables: vec![],
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",
@@ -1249,6 +1252,7 @@ impl CircularMembrane {
                     elements: ElementSelection::All(AllElements::All),
                 }],
             },
+            cables: vec![],
         })
     }
 }

@@ -13,6 +13,7 @@ use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::assembly::{Dof, PatternError, System, node_dofs, node_vector};
+use super::cable::{CableResult, Cables};
 use super::contact::{GapLaw, GapResponse, GapStatus, IterationMatrix};
 use super::element::{ElementStress, ElementVector, MembraneTriangle};
 use super::linear::LinearSolver;
@@ -380,6 +381,8 @@ pub struct Results {
     /// Total reaction of each boundary group (N), global axes: the force the group applies to the
     /// film, `Σ (f_int − f_ext)` over its DOFs (it balances the loads on its nodes too).
     pub reactions: Vec<[f64; 3]>,
+    /// Largest axial force and slack segments of each cable.
+    pub cables: Vec<CableResult>,
     /// Total reaction of each named support set (N), global axes, over its fixed components.
     pub support_reactions: Vec<[f64; 3]>,
     /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the
@@ -417,6 +420,8 @@ pub struct Analysis {
     settings: SolverSettings,
     linear: LinearSolver,
     loads: Loads,
+    /// Tension-only edge cables.
+    cables: Cables,
     state: AnalysisState,
     work: Workspace,
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
@@ -478,6 +483,7 @@ impl Analysis {
             diagonal: diagonal_slots(&system),
         };
         let loads = Loads::new(&model, &system);
+        let cables = Cables::new(&model);
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * model.material.membrane_stiffness() * length_scale;
         Ok(Self {
@@ -487,6 +493,7 @@ impl Analysis {
             settings,
             linear,
             loads,
+            cables,
             state,
             work,
             length_scale,
@@ -1139,7 +1146,10 @@ impl Analysis {
                 };
                 (response.force, matrix)
             });
-        self.loads.add_to(&self.system, levels, u, internal, values);
+        self.loads
+            .add_to(&self.system, levels, u, internal, values.as_deref_mut());
+        self.cables
+            .add_to(&self.system, levels, u, internal, values);
         self.free_norm_inf()
     }
 
@@ -1241,9 +1251,11 @@ impl Analysis {
                 })
                 .collect()
         };
+        let cables = self.cables.results(u);
         Results {
             gaps,
             reactions,
+            cables,
             support_reactions,
             total_reaction,
             elements,

@@ -224,6 +224,7 @@ impl ParallelArch {
         let model = Model {
             loads: Default::default(),
             outputs: Default::default(),
+            cables: vec![],
             name: "ParallelArch".into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

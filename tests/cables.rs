@@ -1,0 +1,197 @@
+//! Tension-only edge cables (issue 8, item 2): `mech::cable`.
+//!
+//! TEST GOAL: the segment tangent is the derivative of its force (central differences, random
+//! taut configurations) and zero when slack; in a strip stretched homogeneously, two edge cables
+//! add exactly `2 N l/L` to the end reaction with `N = N0 + EA ε` (Green strain), and a
+//! compressed cable adds nothing; the model file names a cable that leaves the film's edges; the
+//! FMU reports `<cable>.maxForce`.
+//!
+//! MODEL: a flat strip `L × W` = 1 m × 0.2 m, 8 × 2 cells, the specimen's ETFE film; x-only
+//! groups at both ends (the right one moved by δ), every node held in z, one corner in y, so
+//! the strip stretches homogeneously with free lateral contraction. Cables along both long edges.
+
+use membrane_contact::mech::cable::{axial_force, segment_force_and_tangent};
+use membrane_contact::mech::model::{Axis, BoundaryGroup, CableSpec, Model, Support};
+use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use nalgebra::Vector3;
+
+const NX: usize = 8;
+const NY: usize = 2;
+const EA: f64 = 2.0e5;
+
+fn id(i: usize, j: usize) -> usize {
+    j * (NX + 1) + i
+}
+
+fn strip(cables: bool, n0: f64) -> Model {
+    let mut nodes = vec![];
+    for j in 0..=NY {
+        for i in 0..=NX {
+            nodes.push([i as f64 / NX as f64, 0.2 * j as f64 / NY as f64, 0.0]);
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..NY {
+        for i in 0..NX {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let edge = |i: usize| (0..=NY).map(|j| id(i, j)).collect::<Vec<_>>();
+    let group = |name: &str, i: usize| BoundaryGroup {
+        name: name.into(),
+        nodes: edge(i),
+        target: [0.0; 3],
+        components: Some(vec![Axis::X]),
+    };
+    let mut supports: Vec<Support> = (0..nodes.len())
+        .map(|v| Support {
+            node: v,
+            fixed: vec![Axis::Z],
+            name: None,
+        })
+        .collect();
+    supports[0].fixed.push(Axis::Y);
+    let cable = |name: &str, j: usize| CableSpec {
+        name: name.into(),
+        nodes: (0..=NX).map(|i| id(i, j)).collect(),
+        area: 1e-5,
+        youngs_modulus: EA / 1e-5,
+        prestress_force: n0,
+    };
+    Model {
+        name: "CableStrip".into(),
+        description: String::new(),
+        nodes,
+        triangles,
+        material: ParallelArch::default().material,
+        supports,
+        symmetry: vec![],
+        gaps: vec![],
+        groups: vec![group("left", 0), group("right", NX)],
+        loads: Default::default(),
+        outputs: Default::default(),
+        cables: if cables {
+            vec![cable("south", 0), cable("north", NY)]
+        } else {
+            vec![]
+        },
+    }
+}
+
+fn stretched(model: Model, delta: f64) -> (f64, Vec<f64>) {
+    let mut analysis = Analysis::new(model, SolverSettings::default()).unwrap();
+    analysis.step_to(&[[0.0; 3], [delta, 0.0, 0.0]], 4).unwrap();
+    let r = analysis.results();
+    (
+        r.reactions[1][0],
+        r.cables.iter().map(|c| c.max_force).collect(),
+    )
+}
+
+#[test]
+fn segment_tangent_matches_central_differences_and_is_zero_when_slack() {
+    let mut seed = 0x9e3779b97f4a7c15_u64;
+    let mut unit = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    for _ in 0..50 {
+        let a = Vector3::new(unit(), unit(), unit());
+        let b = a + Vector3::new(1.0 + unit(), unit(), unit());
+        let l = (a - b).norm();
+        let (l0, ea, n0) = (
+            l * (0.95 + 0.04 * unit()),
+            1e4 * (1.5 + unit()),
+            10.0 * (0.5 + unit()),
+        );
+        let (_, k) = segment_force_and_tangent(&a, &b, l0, ea, n0);
+        assert!(axial_force(&a, &b, l0, ea, n0) > 0.0);
+        let h = 1e-6;
+        for j in 0..6 {
+            let shift = |s: f64| {
+                let (mut pa, mut pb) = (a, b);
+                if j < 3 {
+                    pa[j] += s;
+                } else {
+                    pb[j - 3] += s;
+                }
+                segment_force_and_tangent(&pa, &pb, l0, ea, n0).0
+            };
+            let column = (shift(h) - shift(-h)) / (2.0 * h);
+            let error = (column - k.column(j)).norm();
+            assert!(error < 1e-6 * k.norm(), "column {j}: {error}");
+        }
+    }
+    // Shortened below the length where N0 + EA ε = 0: no force, no stiffness.
+    let (a, b) = (Vector3::zeros(), Vector3::new(0.9, 0.0, 0.0));
+    let (f, k) = segment_force_and_tangent(&a, &b, 1.0, 100.0, 1.0);
+    assert_eq!((f.norm(), k.norm()), (0.0, 0.0));
+}
+
+#[test]
+fn edge_cables_add_exactly_their_green_strain_force_to_a_homogeneous_stretch() {
+    let (delta, n0) = (0.01, 50.0);
+    let (film_only, _) = stretched(strip(false, n0), delta);
+    let (with_cables, forces) = stretched(strip(true, n0), delta);
+    let stretch = 1.0 + delta;
+    let n = n0 + EA * 0.5 * (stretch * stretch - 1.0);
+    assert!((forces[0] - n).abs() < 1e-9 * n, "{forces:?} vs {n}");
+    assert!((forces[1] - n).abs() < 1e-9 * n);
+    let added = with_cables - film_only;
+    assert!(
+        (added - 2.0 * n * stretch).abs() < 1e-7 * n,
+        "{added} vs {}",
+        2.0 * n * stretch
+    );
+}
+
+#[test]
+fn a_compressed_cable_carries_nothing() {
+    let (film_only, _) = stretched(strip(false, 0.0), -0.005);
+    let mut analysis = Analysis::new(strip(true, 0.0), SolverSettings::default()).unwrap();
+    analysis
+        .step_to(&[[0.0; 3], [-0.005, 0.0, 0.0]], 4)
+        .unwrap();
+    let r = analysis.results();
+    assert_eq!(r.cables[0].max_force, 0.0);
+    assert_eq!(r.cables[0].slack_segments, NX);
+    assert!((r.reactions[1][0] - film_only).abs() <= 1e-9 * film_only.abs());
+}
+
+#[test]
+fn a_cable_that_leaves_the_film_edges_is_refused_naming_it() {
+    let mut model = strip(true, 0.0);
+    model.cables[0].nodes = vec![id(0, 0), id(2, 0)];
+    let err = model.validate().unwrap_err().to_string();
+    assert!(
+        err.contains("cable 'south'") && err.contains("not an edge"),
+        "{err}"
+    );
+    let mut model = strip(true, 0.0);
+    model.cables[1].prestress_force = -1.0;
+    assert!(
+        model
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("prestress_force")
+    );
+    let text = strip(true, 5.0).to_json();
+    assert_eq!(Model::from_json(&text).unwrap(), strip(true, 5.0));
+}
+
+#[test]
+fn the_fmu_reports_the_largest_cable_force() {
+    use membrane_contact::fmi2::description::describe;
+    use membrane_contact::fmi2::resources::Source;
+    let d = describe(&Source::Model(strip(true, 5.0))).unwrap();
+    let v = d
+        .variables
+        .iter()
+        .find(|v| v.name == "north.maxForce")
+        .unwrap();
+    assert_eq!(v.unit, Some("N"));
+}
