@@ -250,6 +250,12 @@ fn run(o: &Options) -> Result<(), String> {
         analysis.set_friction(mu)?;
     }
     let targets: Vec<[f64; 3]> = analysis.model().groups.iter().map(|g| g.target).collect();
+    let angles: Vec<f64> = analysis
+        .model()
+        .groups
+        .iter()
+        .map(|g| g.hinge.as_ref().map_or(0.0, |h| h.target_angle))
+        .collect();
     let loads = LoadLevels::of_model(analysis.model());
     let mut csv = match &o.csv {
         Some(path) => {
@@ -284,8 +290,9 @@ fn run(o: &Options) -> Result<(), String> {
     for step in 1..=o.steps {
         let fraction = step as f64 / o.steps as f64;
         let target: Vec<[f64; 3]> = targets.iter().map(|t| t.map(|v| v * fraction)).collect();
+        let angle: Vec<f64> = angles.iter().map(|a| a * fraction).collect();
         let report = analysis
-            .step_to_with_loads(&target, &loads.scaled(fraction), o.increments)
+            .step_to_motion(&target, &angle, &loads.scaled(fraction), o.increments)
             .map_err(|e| format!("step {step}/{}: {e}", o.steps))?;
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;
@@ -466,7 +473,7 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
             r.status
         );
     }
-    for (g, r) in model.groups.iter().zip(&results.reactions) {
+    for (i, (g, r)) in model.groups.iter().zip(&results.reactions).enumerate() {
         out!(
             "reaction of group {}: ({:.3}, {:.3}, {:.3}) N",
             g.name,
@@ -474,6 +481,14 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
             r[1],
             r[2]
         );
+        if g.hinge.is_some() {
+            out!(
+                "moment of group {} about its hinge: {:.4} N·m at {:.6} rad",
+                g.name,
+                results.moments[i],
+                analysis.state().angles[i]
+            );
+        }
     }
     for (name, r) in model.support_sets().iter().zip(&results.support_reactions) {
         out!(

@@ -43,6 +43,7 @@ fn strip(cables: bool, n0: f64) -> Model {
         nodes: edge(i),
         target: [0.0; 3],
         components: Some(vec![Axis::X]),
+        hinge: None,
     };
     let mut supports: Vec<Support> = (0..nodes.len())
         .map(|v| Support {

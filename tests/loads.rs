@@ -12,12 +12,15 @@ use membrane_contact::mech::load::{
 };
 use membrane_contact::mech::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
 use membrane_contact::mech::model::{
-    AllElements, Axis, BoundaryGroup, ElementSelection, ForceSet, LoadSpec, Model, PressureSet,
-    Support,
+    AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, ForceSet, LoadSpec, Model,
+    OutputPoint, OutputSpec, PressureSet, Support,
 };
 use membrane_contact::mech::scenarios::CircularMembrane;
 use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings, StepError};
 use nalgebra::{DMatrix, Vector3};
+
+mod common;
+use common::{assert_example_file, flat_grid};
 
 /// A small deterministic generator (xorshift64*) for random configurations.
 struct Random(u64);
@@ -48,20 +51,7 @@ fn film(prestress: f64) -> Material {
 
 /// A flat `lx × ly` patch of `nx × ny` cells (two triangles each, normals +Z), all loads empty.
 fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
-    let mut nodes = vec![];
-    for j in 0..=ny {
-        for i in 0..=nx {
-            nodes.push([lx * i as f64 / nx as f64, ly * j as f64 / ny as f64, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| j * (nx + 1) + i;
-    let mut triangles = vec![];
-    for j in 0..ny {
-        for i in 0..nx {
-            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
+    let (nodes, triangles) = flat_grid(nx, ny, lx, ly);
     Model {
         name: "Patch".into(),
         description: String::new(),
@@ -349,6 +339,7 @@ fn nodal_forces_act_on_each_node_of_the_set_and_group_reactions_balance_them() {
         nodes: vec![0, 1, 2, 3, 5, 6, 7, 8],
         target: [0.0; 3],
         components: None,
+        hinge: None,
     }];
     model.loads.forces = vec![ForceSet {
         name: "hook".into(),
@@ -720,16 +711,8 @@ fn example_membrane() -> Model {
 
 #[test]
 fn example_model_file_is_the_generated_circular_membrane_and_runs() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/circular_membrane.json"
-    );
     let model = example_membrane();
-    if std::env::var_os("UPDATE_EXAMPLES").is_some() {
-        std::fs::write(path, model.to_json() + "\n").unwrap();
-    }
-    let text = std::fs::read_to_string(path).unwrap();
-    assert_eq!(Model::from_json(&text).unwrap(), model);
+    assert_example_file("circular_membrane.json", &model);
     let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
     let levels = LoadLevels::of_model(&model);
     for k in 1..=4 {
@@ -753,15 +736,15 @@ fn example_model_file_is_the_generated_circular_membrane_and_runs() {
 /// film into a spherical cap: Laplace `p = 2 N0/R` for a film under tension `N0 = σ_pre t`, so
 /// the crown rises `h = a²/(2R) = p a²/(4 N0)` (the linear limit of the prestressed membrane
 /// above); the pressures on the closed cushion cancel, so the rim carries no net force.
-#[test]
-fn inflated_cushion_reaches_the_spherical_cap_and_its_pressure_has_no_resultant() {
-    let (a, sigma_pre, p) = (1.0, 1.0e6, 1.0);
-    let top = disc(a, 12, film(sigma_pre));
+/// Two copies of the disc `top` sealed at its rim (group `rim`), the lower one with reversed
+/// triangles (normals down), under the inside pressure `p` (set `inside`).
+fn cushion(top: &Model, p: f64) -> Model {
     let rim: Vec<usize> = top.groups[0].nodes.clone();
     let interior = top.nodes.len() - rim.len();
     let mut model = top.clone();
     model.name = "Cushion".into();
-    // The interior nodes are the first ones (rings 0 … 11): copy them for the lower film.
+    // The interior nodes are the first ones (ring by ring from the centre): copy them for the
+    // lower film.
     assert!(rim.iter().all(|&v| v >= interior));
     model.nodes.extend_from_slice(&top.nodes[..interior]);
     let lower = |v: usize| if v < interior { top.nodes.len() + v } else { v };
@@ -771,6 +754,75 @@ fn inflated_cushion_reaches_the_spherical_cap_and_its_pressure_has_no_resultant(
             .push([lower(t[0]), lower(t[2]), lower(t[1])]);
     }
     model.loads.pressures = vec![pressure_everywhere("inside", p)];
+    model
+}
+
+/// `examples/cushion.json`: a round ETFE cushion of 2 m diameter (two 250 µm films, 1 MPa
+/// prestress, ETFE density and first yield), its rim clamped in the frame (group `rim`),
+/// inflated to 300 Pa (set `inside`), with the crowns and both films as outputs.
+fn example_cushion() -> Model {
+    let material = Material {
+        density: 1750.0,
+        prestress: [1.0e6, 1.0e6, 0.0],
+        poisson_ratio: 0.43,
+        thickness: 250e-6,
+        yield_stress: Some(15.0e6),
+        ..film(0.0)
+    };
+    let top = disc(1.0, 8, material);
+    let mut model = cushion(&top, 300.0);
+    model.description =
+        "ETFE cushion, 2 m diameter, inflated to 300 Pa (examples/cushion.json)".into();
+    let films = top.triangles.len();
+    model.outputs = OutputSpec {
+        points: vec![
+            OutputPoint {
+                name: "crownTop".into(),
+                node: 0,
+            },
+            OutputPoint {
+                name: "crownBottom".into(),
+                node: top.nodes.len(),
+            },
+        ],
+        element_sets: vec![
+            ElementSet {
+                name: "upper".into(),
+                elements: ElementSelection::List((0..films).collect()),
+            },
+            ElementSet {
+                name: "lower".into(),
+                elements: ElementSelection::List((films..2 * films).collect()),
+            },
+        ],
+    };
+    model
+}
+
+#[test]
+fn example_cushion_file_is_generated_and_inflates_symmetrically() {
+    let model = example_cushion();
+    assert_example_file("cushion.json", &model);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for k in 1..=5 {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(k as f64 / 5.0), 1)
+            .unwrap_or_else(|e| panic!("step {k}: {e}"));
+    }
+    let results = analysis.results();
+    let (up, down) = (results.points[0][2], results.points[1][2]);
+    println!("cushion at 300 Pa: crowns {up:.4} m, {down:.4} m");
+    // Gravity pulls both films down a little; the pressure pushes them apart symmetrically.
+    assert!(up > 0.05 && down < -0.05, "{up} {down}");
+    assert!((up + down).abs() < 0.02 * up, "{up} {down}");
+}
+
+#[test]
+fn inflated_cushion_reaches_the_spherical_cap_and_its_pressure_has_no_resultant() {
+    let (a, sigma_pre, p) = (1.0, 1.0e6, 1.0);
+    let top = disc(a, 12, film(sigma_pre));
+    let model = cushion(&top, p);
     let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
     analysis
         .step_to_with_loads(&[[0.0; 3]], &LoadLevels::of_model(&model), 2)

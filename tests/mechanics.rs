@@ -93,6 +93,7 @@ fn pressed_node_model(g0: f64, mu: f64) -> Model {
         nodes: vec![0, 1, 2, 3, 5, 6, 7, 8],
         target: [0.0; 3],
         components: None,
+        hinge: None,
     });
     m
 }
@@ -394,12 +395,14 @@ fn newton_converges_quadratically_where_no_status_changes() {
         nodes: left,
         target: [0.0; 3],
         components: None,
+        hinge: None,
     });
     m.groups.push(BoundaryGroup {
         name: "right".into(),
         nodes: right,
         target: [0.0; 3],
         components: None,
+        hinge: None,
     });
     let mut a = Analysis::new(
         m,
@@ -639,6 +642,7 @@ fn film_edge_on_arch(law: FrictionLaw, prestress_across: f64) -> Model {
         nodes: edge,
         target: [0.0, 0.0, -0.1],
         components: None,
+        hinge: None,
     });
     m
 }
@@ -1319,6 +1323,7 @@ fn mapped_boundary_patch(
                 nodes: vec![v],
                 target,
                 components: None,
+                hinge: None,
             });
             targets.push(target);
         } else {
@@ -1561,6 +1566,7 @@ fn shear_panel(n: usize, material: Material) -> Model {
         nodes: top,
         target: [0.05, 0.005, 0.0],
         components: None,
+        hinge: None,
     });
     m
 }
@@ -1767,6 +1773,7 @@ fn annulus(a: f64, b: f64, nr: usize, nt: usize, material: Material) -> Model {
             nodes: vec![id(0, j)],
             target: [0.0; 3],
             components: None,
+            hinge: None,
         });
         m.supports.push(Support {
             node: id(nr, j),

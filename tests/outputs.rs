@@ -106,6 +106,7 @@ fn compressed_area_counts_the_triangles_pushed_into_compression() {
             nodes: vec![v],
             target: [0.0; 3],
             components: None,
+            hinge: None,
         })
         .collect();
     let targets: Vec<[f64; 3]> = rim

@@ -146,14 +146,14 @@ fn fill<'a>(template: &str, value: impl Fn(&str) -> Option<&'a str>) -> Result<S
 fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
     w.create_element("UnitDefinitions")
         .write_inner_content(|w| {
-            for (name, [kg, m, s]) in UNITS {
+            for (name, [kg, m, s, rad]) in UNITS {
                 if !table.iter().any(|v| v.unit == Some(name)) {
                     continue;
                 }
                 w.create_element("Unit")
                     .with_attribute(("name", name))
                     .write_inner_content(|w| {
-                        let exponents = [("kg", kg), ("m", m), ("s", s)];
+                        let exponents = [("kg", kg), ("m", m), ("s", s), ("rad", rad)];
                         let exps: Vec<(&str, String)> = exponents
                             .iter()
                             .filter(|(_, e)| *e != 0)
@@ -162,6 +162,13 @@ fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
                         w.create_element("BaseUnit")
                             .with_attributes(exps.iter().map(|(n, e)| (*n, e.as_str())))
                             .write_empty()?;
+                        if name == "rad" {
+                            // Angles are read in degrees by people: tools may show them so.
+                            w.create_element("DisplayUnit")
+                                .with_attribute(("name", "deg"))
+                                .with_attribute(("factor", "57.29577951308232"))
+                                .write_empty()?;
+                        }
                         Ok(())
                     })?;
             }

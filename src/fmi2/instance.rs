@@ -806,6 +806,7 @@ impl Instance {
                     GapStatus::Slip => 2,
                 }),
                 Binding::Reaction { group, axis } => Value::Real(results.reactions[group][axis]),
+                Binding::HingeMoment(group) => Value::Real(results.moments[group]),
                 Binding::Iterations => count(report.map_or(0, StepReport::total_iterations)),
                 Binding::Cutbacks => count(report.map_or(0, |r| r.cutbacks)),
                 Binding::Residual => Value::Real(report.map_or(0.0, |r| r.residual)),
@@ -869,6 +870,7 @@ impl Instance {
         }
         let table = &self.description.variables;
         let mut targets = vec![[0.0; 3]; self.description.model.groups.len()];
+        let mut angles = vec![0.0; self.description.model.groups.len()];
         let mut loads = LoadLevels::zero(&self.description.model);
         let mut mu = None;
         for (v, x) in table.iter().zip(&self.values) {
@@ -876,6 +878,7 @@ impl Instance {
                 (Binding::GroupDisplacement { group, axis }, &Value::Real(x)) => {
                     targets[group][axis] = x
                 }
+                (Binding::GroupAngle(group), &Value::Real(x)) => angles[group] = x,
                 (Binding::Pressure(set), &Value::Real(x)) => loads.pressure[set] = x,
                 (Binding::NodalForce { set, axis }, &Value::Real(x)) => loads.force[set][axis] = x,
                 (Binding::Friction, &Value::Real(x)) if self.mu_set => mu = Some(x),
@@ -897,7 +900,7 @@ impl Instance {
             }
             _ => None,
         };
-        match checked_step(built, &targets, &loads, &self.logger) {
+        match checked_step(built, &targets, &angles, &loads, &self.logger) {
             Ok(report) => {
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
@@ -1272,19 +1275,20 @@ impl Instance {
     }
 }
 
-/// `Analysis::step_to_with_loads`, then a check that every output of the new state is finite; a state
+/// `Analysis::step_to_motion`, then a check that every output of the new state is finite; a state
 /// that is not is replaced by the one before the step and the step refused like a step that
 /// does not converge (fmi2Discard: the master may retry with a smaller change). Defence in
 /// depth: the solver itself rejects non-finite increments.
 fn checked_step(
     built: &mut Built,
     targets: &[[f64; 3]],
+    angles: &[f64],
     loads: &LoadLevels,
     logger: &Logger,
 ) -> Result<StepReport, StepError> {
     let analysis = &mut built.analysis;
     let before = analysis.state().clone();
-    let report = analysis.step_to_with_loads(targets, loads, built.increments)?;
+    let report = analysis.step_to_motion(targets, angles, loads, built.increments)?;
     let results = analysis.results();
     match check_results(analysis.model(), &results, Some(report.residual)) {
         Ok(()) => {

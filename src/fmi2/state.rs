@@ -6,8 +6,8 @@
 //! output written so far (step count and the states written, so the `.pvd` files continue from
 //! the state).
 //!
-//! Serialized form (little endian), version 4 (version 3 had either no load levels or VTK file
-//! names instead of state numbers, version 2 neither, version 1 no String values and no VTK
+//! Serialized form (little endian), version 5 (version 4 had no group angles, version 3 either no
+//! load levels or VTK file names instead of state numbers, version 2 neither, version 1 no String values and no VTK
 //! output; older states are refused, as they came from an FMU with another GUID anyway):
 //!
 //! | bytes | content |
@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 
 use super::instance::Phase;
 use super::variables::Value;
-use crate::mech::model::{GapSupport, MAX_FRICTION};
+use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::{AnalysisState, GapStatus, Model};
 
 /// Everything needed to continue an instance exactly.
@@ -55,7 +55,7 @@ pub struct Snapshot {
 }
 
 const MAGIC: &[u8; 8] = b"MCFMI2ST";
-const VERSION: u32 = 4;
+const VERSION: u32 = 5;
 
 /// The serialized bytes of `snapshot` for the FMU with `guid`.
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
@@ -149,6 +149,7 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
         ("displacements", state.displacement.len(), n),
         ("slip histories", state.plastic_slip.len(), gaps),
         ("group displacements", state.boundary.len(), groups),
+        ("group angles", state.angles.len(), groups),
         ("friction coefficients", state.friction.len(), gaps),
         ("gap statuses", state.status.len(), gaps),
     ];
@@ -208,6 +209,14 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
         &mut state.boundary.iter().flatten().copied(),
         reach,
     )?;
+    for ((g, &angle), group) in state.angles.iter().enumerate().zip(&model.groups) {
+        if !(angle.abs() <= Hinge::MAX_ANGLE) || (group.hinge.is_none() && angle != 0.0) {
+            return Err(format!(
+                "the state's angle of group [{g}] '{}' is {angle} rad: not finite, beyond two turns, or the group has no hinge",
+                group.name
+            ));
+        }
+    }
     bounded(
         "slip history",
         &mut state.plastic_slip.iter().flatten().copied(),

@@ -10,8 +10,9 @@
 //! | name | type | causality | unit | meaning |
 //! |---|---|---|---|---|
 //! | `time` | Real | independent | | pseudo-time of the load path |
-//! | `mu` | Real | input | 1 | friction coefficient of every gap (applied once set) |
+//! | `mu` | Real | input | 1 | friction coefficient of every gap (applied once set; models with gaps only) |
 //! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step (prescribed components only) |
+//! | `<group>.angle` | Real | input | rad | angle of a hinged group about its axis reached at the end of a step |
 //! | `<pressureSet>.pressure` | Real | input | Pa | follower pressure of the set reached at the end of a step (start: the model's) |
 //! | `<forceSet>.Fx/.Fy/.Fz` | Real | input | N | force on each node of the set reached at the end of a step (start: the model's) |
 //! | `archHeight` | Real | parameter | m | ParallelArch only: the model is regenerated from it |
@@ -28,6 +29,7 @@
 //! | `<gap>.frictionX/.frictionY` | Real | output | N | friction force on the film, local x, y (signed) |
 //! | `<gap>.status` | Integer | output | | 0 open, 1 stick, 2 slip |
 //! | `<group>.Rx/.Ry/.Rz` | Real | output | N | total reaction of the group (prescribed components only) |
+//! | `<group>.moment` | Real | output | N.m | moment of a hinged group's reaction about its axis |
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
 //! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
 //! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
@@ -155,6 +157,8 @@ pub enum Binding {
         group: usize,
         axis: usize,
     },
+    /// Input angle of a hinged group about its axis.
+    GroupAngle(usize),
     /// Input pressure of a pressure set.
     Pressure(usize),
     /// Input force per node of a force set along axis 0, 1, 2.
@@ -207,6 +211,8 @@ pub enum Binding {
         group: usize,
         axis: usize,
     },
+    /// Moment of a hinged group's reaction about its axis.
+    HingeMoment(usize),
     Iterations,
     Cutbacks,
     Residual,
@@ -330,15 +336,17 @@ impl Variable {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 3]); 8] = [
-    ("m", [0, 1, 0]),
-    ("m2", [0, 2, 0]),
-    ("m/s2", [0, 1, -2]),
-    ("kg/m3", [1, -3, 0]),
-    ("N", [1, 1, -2]),
-    ("Pa", [1, -1, -2]),
-    ("N/m", [1, 0, -2]),
-    ("1", [0, 0, 0]),
+pub const UNITS: [(&str, [i32; 4]); 10] = [
+    ("m", [0, 1, 0, 0]),
+    ("m2", [0, 2, 0, 0]),
+    ("m/s2", [0, 1, -2, 0]),
+    ("kg/m3", [1, -3, 0, 0]),
+    ("N", [1, 1, -2, 0]),
+    ("N.m", [1, 2, -2, 0]),
+    ("Pa", [1, -1, -2, 0]),
+    ("N/m", [1, 0, -2, 0]),
+    ("rad", [0, 0, 0, 1]),
+    ("1", [0, 0, 0, 0]),
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
@@ -417,13 +425,16 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "pseudo-time of the load path",
         Binding::Time,
     );
-    table.input(
-        "mu",
-        mu,
-        "1",
-        "friction coefficient of every gap; the model's own values apply until it is set",
-        Binding::Friction,
-    );
+    // A model without gaps has no friction to set: no `mu` input an importer must feed.
+    if !model.gaps.is_empty() {
+        table.input(
+            "mu",
+            mu,
+            "1",
+            "friction coefficient of every gap; the model's own values apply until it is set",
+            Binding::Friction,
+        );
+    }
     for (group, g) in model.groups.iter().enumerate() {
         let prescribed = g.prescribes();
         for (axis, a) in axes.iter().enumerate().filter(|(c, _)| prescribed[*c]) {
@@ -436,6 +447,18 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                     g.name
                 ),
                 Binding::GroupDisplacement { group, axis },
+            );
+        }
+        if g.hinge.is_some() {
+            table.input(
+                &format!("{}.angle", g.name),
+                0.0,
+                "rad",
+                &format!(
+                    "angle of boundary group '{}' about its hinge axis (right-hand rule), reached at the end of a step",
+                    g.name
+                ),
+                Binding::GroupAngle(group),
             );
         }
     }
@@ -715,6 +738,17 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                     g.name, axes[axis]
                 ),
                 Binding::Reaction { group, axis },
+            );
+        }
+        if g.hinge.is_some() {
+            table.output(
+                &format!("{}.moment", g.name),
+                "N.m",
+                &format!(
+                    "moment of the reaction of boundary group '{}' about its hinge axis (the drive's torque on the film)",
+                    g.name
+                ),
+                Binding::HingeMoment(group),
             );
         }
     }

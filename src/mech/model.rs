@@ -125,6 +125,43 @@ pub struct BoundaryGroup {
     /// three. Its free components are ordinary film DOFs; their targets are ignored.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub components: Option<Vec<Axis>>,
+    /// A hinge: the group also turns as a rigid body about it (a rotating frame side is one
+    /// group); omitted: the group only translates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hinge: Option<Hinge>,
+}
+
+/// The axis a boundary group turns about: a node at `X` moves by
+/// `t + (R(θ) − I)(X − p)`, with `R(θ)` the rotation by `θ` about `axis` (right-hand rule)
+/// and `p` the hinge `point`; the hinge itself moves with the group's translation `t`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Hinge {
+    /// A point of the axis in the initial configuration (m).
+    pub point: [f64; 3],
+    /// Direction of the axis (any length but zero).
+    pub axis: [f64; 3],
+    /// Angle of a standard run (rad); the CLI turns the group to it. The FMU starts at 0 and
+    /// follows its input `<group>.angle`.
+    #[serde(default)]
+    pub target_angle: f64,
+}
+
+impl Hinge {
+    /// Largest angle accepted (rad): two full turns either way.
+    pub const MAX_ANGLE: f64 = 4.0 * std::f64::consts::PI;
+
+    /// The displacement `(R(θ) − I)(X − p)` of a node at `x` turned by `angle` (Rodrigues).
+    pub fn displacement(&self, x: [f64; 3], angle: f64) -> [f64; 3] {
+        let a = Vector3::from(self.axis).normalize();
+        let r = Vector3::from(x) - Vector3::from(self.point);
+        let s = angle.sin();
+        // R r − r = sin θ (a × r) + (1 − cos θ) a × (a × r); 1 − cos θ = 2 sin²(θ/2) keeps
+        // small angles exact.
+        let ar = a.cross(&r);
+        let one_minus_cos = 2.0 * (0.5 * angle).sin().powi(2);
+        (s * ar + one_minus_cos * a.cross(&ar)).into()
+    }
 }
 
 impl BoundaryGroup {
@@ -572,6 +609,30 @@ impl Model {
                         item: format!("boundary group '{}'", g.name),
                         message: "components must list each of \"x\", \"y\", \"z\" at most once, and at least one"
                             .into(),
+                    });
+                }
+            }
+            if let Some(h) = &g.hinge {
+                let item = || format!("boundary group '{}' hinge", g.name);
+                if h.point.iter().chain(&h.axis).any(|v| !v.is_finite())
+                    || !h.target_angle.is_finite()
+                {
+                    return Err(ModelError::NotFinite { item: item() });
+                }
+                if Vector3::from(h.axis).norm() == 0.0 {
+                    return Err(ModelError::Name {
+                        item: item(),
+                        message: "axis is the zero vector".into(),
+                    });
+                }
+                if h.target_angle.abs() > Hinge::MAX_ANGLE {
+                    return Err(ModelError::Name {
+                        item: item(),
+                        message: format!(
+                            "target_angle {} rad is beyond two full turns ({:.4} rad)",
+                            h.target_angle,
+                            Hinge::MAX_ANGLE
+                        ),
                     });
                 }
             }

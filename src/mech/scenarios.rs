@@ -670,6 +670,7 @@ impl ArchPanel {
                 nodes: vec![id(nx, j)],
                 target,
                 components: None,
+                hinge: None,
             })
             .collect();
         validated(Model {
@@ -840,6 +841,7 @@ impl CylinderStrip {
             nodes: vec![id(s, 0), id(s, 1)],
             target: [sign * self.out, 0.0, -self.down],
             components: None,
+            hinge: None,
         };
         validated(Model {
             loads: Default::default(),
@@ -1007,6 +1009,7 @@ impl ArchEdge {
                 nodes: frame,
                 target: [0.0, 0.0, -h / 2.0],
                 components: None,
+                hinge: None,
             }],
         })
     }
@@ -1232,6 +1235,7 @@ impl CircularMembrane {
                 nodes: self.ring(self.rings).collect(),
                 target: [0.0; 3],
                 components: None,
+                hinge: None,
             }],
             loads: LoadSpec {
                 pressures: vec![PressureSet {

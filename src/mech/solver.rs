@@ -19,7 +19,7 @@ use super::element::{ElementStress, ElementVector, MembraneTriangle};
 use super::linear::LinearSolver;
 use super::load::{ExternalLoad, LoadLevels, Loads};
 use super::material::Wrinkling;
-use super::model::{Model, ModelError};
+use super::model::{Hinge, Model, ModelError};
 use super::summary::{FieldSummary, summarize};
 
 /// Newton and increment-control settings.
@@ -85,6 +85,13 @@ impl SolverSettings {
     }
 }
 
+/// Where the boundary groups are at one point of a step: translation and hinge angle of each.
+#[derive(Clone, Debug)]
+struct GroupMotion {
+    translation: Vec<[f64; 3]>,
+    angles: Vec<f64>,
+}
+
 /// The converged state of an analysis: everything needed to continue it exactly.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct AnalysisState {
@@ -94,6 +101,9 @@ pub struct AnalysisState {
     pub plastic_slip: Vec<[f64; 2]>,
     /// Current imposed displacement of each boundary group (m).
     pub boundary: Vec<[f64; 3]>,
+    /// Current hinge angle of each boundary group (rad; 0 for a group without a hinge).
+    #[serde(default)]
+    pub angles: Vec<f64>,
     /// Current level of each load (pressures, nodal forces, gravity).
     pub loads: LoadLevels,
     /// Friction coefficient of each gap.
@@ -113,6 +123,7 @@ impl AnalysisState {
             .iter()
             .chain(self.plastic_slip.iter().flatten())
             .chain(self.boundary.iter().flatten())
+            .chain(&self.angles)
             .chain(&self.friction)
             .chain(&self.last_increment)
             .all(|v| v.is_finite())
@@ -381,6 +392,10 @@ pub struct Results {
     /// Total reaction of each boundary group (N), global axes: the force the group applies to the
     /// film, `Σ (f_int − f_ext)` over its DOFs (it balances the loads on its nodes too).
     pub reactions: Vec<[f64; 3]>,
+    /// Moment of each boundary group's reaction about its hinge axis, through the hinge's
+    /// current position (N·m, right-hand rule about the axis): the torque the drive of a
+    /// rotating frame side applies to the film; 0 for a group without a hinge.
+    pub moments: Vec<f64>,
     /// Largest axial force and slack segments of each cable.
     pub cables: Vec<CableResult>,
     /// Total reaction of each named support set (N), global axes, over its fixed components.
@@ -462,6 +477,7 @@ impl Analysis {
             displacement: vec![0.0; model.dof_count()],
             plastic_slip: vec![[0.0; 2]; model.gaps.len()],
             boundary: vec![[0.0; 3]; model.groups.len()],
+            angles: vec![0.0; model.groups.len()],
             loads: LoadLevels::zero(&model),
             friction: laws.iter().map(|l| l.friction).collect(),
             status: laws
@@ -542,6 +558,7 @@ impl Analysis {
         if state.displacement.len() != s.displacement.len()
             || state.plastic_slip.len() != s.plastic_slip.len()
             || state.boundary.len() != s.boundary.len()
+            || state.angles.len() != s.angles.len()
             || state.friction.len() != s.friction.len()
             || state.status.len() != s.status.len()
             || !(state.last_increment.is_empty()
@@ -555,6 +572,7 @@ impl Analysis {
             .iter()
             .chain(state.plastic_slip.iter().flatten())
             .chain(state.boundary.iter().flatten())
+            .chain(&state.angles)
             .chain(&state.friction)
             .all(|v| v.is_finite())
             && state.loads.is_finite();
@@ -610,7 +628,23 @@ impl Analysis {
         loads: &LoadLevels,
         increments: usize,
     ) -> Result<StepReport, StepError> {
+        let angles = self.state.angles.clone();
+        self.step_to_motion(target, &angles, loads, increments)
+    }
+
+    /// Moves every boundary group to the translation `target` (m) and the hinge angle
+    /// `angles` (rad, one per group: 0 for a group without a hinge), and the loads to `loads`;
+    /// see [`Self::step_to_with_loads`]. The angles are interpolated linearly like the
+    /// translations, so a group turns about its hinge along the arc, not along the chord.
+    pub fn step_to_motion(
+        &mut self,
+        target: &[[f64; 3]],
+        angles: &[f64],
+        loads: &LoadLevels,
+        increments: usize,
+    ) -> Result<StepReport, StepError> {
         self.check_targets(target)?;
+        self.check_angles(angles)?;
         self.check_loads(loads)?;
         if increments == 0 {
             return Err(StepError::InvalidInput {
@@ -618,6 +652,7 @@ impl Analysis {
             });
         }
         let base = self.state.boundary.clone();
+        let base_angles = self.state.angles.clone();
         let base_loads = self.state.loads.clone();
         let mut current = self.state.clone();
         let mut report = StepReport::default();
@@ -631,12 +666,20 @@ impl Analysis {
             }
             IterationMatrix::JuRowlands => usize::MAX,
         };
-        // The group displacements at the fraction `f` of the step.
-        let at = |f: f64| -> Vec<[f64; 3]> {
-            base.iter()
-                .zip(target)
-                .map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * f))
-                .collect()
+        // The group translations and angles at the fraction `f` of the step.
+        let at = |f: f64| -> GroupMotion {
+            GroupMotion {
+                translation: base
+                    .iter()
+                    .zip(target)
+                    .map(|(b, t)| std::array::from_fn(|c| b[c] + (t[c] - b[c]) * f))
+                    .collect(),
+                angles: base_angles
+                    .iter()
+                    .zip(angles)
+                    .map(|(b, t)| b + (t - b) * f)
+                    .collect(),
+            }
         };
         while done < 1.0 {
             let next = if done + size > 1.0 - 1e-12 {
@@ -736,6 +779,49 @@ impl Analysis {
         Ok(())
     }
 
+    /// Refuses angles of the wrong length, not finite, beyond [`Hinge::MAX_ANGLE`] or given to
+    /// a group without a hinge.
+    fn check_angles(&self, angles: &[f64]) -> Result<(), StepError> {
+        let invalid = |message| Err(StepError::InvalidInput { message });
+        if angles.len() != self.model.groups.len() {
+            return invalid(format!(
+                "{} group angles given, the model has {} groups",
+                angles.len(),
+                self.model.groups.len()
+            ));
+        }
+        for (g, &a) in self.model.groups.iter().zip(angles) {
+            if !(a.abs() <= Hinge::MAX_ANGLE) {
+                return invalid(format!(
+                    "the angle of group '{}' ({a} rad) is not finite or beyond two full turns",
+                    g.name
+                ));
+            }
+            if g.hinge.is_none() && a != 0.0 {
+                return invalid(format!(
+                    "group '{}' has no hinge and cannot turn ({a} rad asked)",
+                    g.name
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The prescribed value of global DOF `i` (node `i / 3`, component `component`) of group
+    /// `group` under `motion`: its translation plus the turn about its hinge.
+    fn prescribed_value(
+        &self,
+        i: usize,
+        group: usize,
+        component: usize,
+        motion: &GroupMotion,
+    ) -> f64 {
+        let turn = self.model.groups[group].hinge.as_ref().map_or(0.0, |h| {
+            h.displacement(self.model.nodes[i / 3], motion.angles[group])[component]
+        });
+        motion.translation[group][component] + turn
+    }
+
     /// Refuses load targets of the wrong sizes or not finite.
     fn check_loads(&self, loads: &LoadLevels) -> Result<(), StepError> {
         let invalid = |message| Err(StepError::InvalidInput { message });
@@ -770,12 +856,12 @@ impl Analysis {
         Ok(())
     }
 
-    /// Newton–Raphson for one increment from the converged `start` to the boundary `boundary`
-    /// and the load levels `levels`.
+    /// Newton–Raphson for one increment from the converged `start` to the group motion
+    /// `motion` and the load levels `levels`.
     fn solve_increment(
         &mut self,
         start: &AnalysisState,
-        boundary: &[[f64; 3]],
+        motion: &GroupMotion,
         levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
         let mut u = start.displacement.clone();
@@ -784,10 +870,11 @@ impl Analysis {
         let (mut dot, mut old, mut new) = (0.0, 0.0, 0.0);
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { group, component } = d {
-                let step = boundary[*group][*component] - start.displacement[i];
+                let value = self.prescribed_value(i, *group, *component, motion);
+                let step = value - start.displacement[i];
                 let last = start.last_increment.get(i).copied().unwrap_or(0.0);
                 (dot, old, new) = (dot + step * last, old + last * last, new + step * step);
-                u[i] = boundary[*group][*component];
+                u[i] = value;
             }
         }
         if old > 0.0 && dot > 0.99 * (old * new).sqrt() {
@@ -847,7 +934,8 @@ impl Analysis {
                         .iter()
                         .map(|r| r.plastic_slip.into())
                         .collect(),
-                    boundary: boundary.to_vec(),
+                    boundary: motion.translation.clone(),
+                    angles: motion.angles.clone(),
                     loads: levels.clone(),
                     friction: start.friction.clone(),
                     status: self.work.responses.iter().map(|r| r.status).collect(),
@@ -1065,6 +1153,27 @@ impl Analysis {
     /// iteration from convergence.
     const SMALLEST_FALLBACK: f64 = 0.125;
 
+    /// The moment of each group's reaction about its hinge axis (see [`Results::moments`]).
+    fn hinge_moments(&self) -> Vec<f64> {
+        let u = &self.state.displacement;
+        let mut moments = vec![0.0; self.model.groups.len()];
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            let Dof::Prescribed { group, component } = *d else {
+                continue;
+            };
+            let Some(h) = &self.model.groups[group].hinge else {
+                continue;
+            };
+            let node = i / 3;
+            let hinge = Vector3::from(h.point) + Vector3::from(self.state.boundary[group]);
+            let arm = Vector3::from(self.model.nodes[node]) + node_vector(u, node) - hinge;
+            let mut force = Vector3::zeros();
+            force[component] = self.work.internal[i];
+            moments[group] += arm.cross(&force).dot(&Vector3::from(h.axis).normalize());
+        }
+        moments
+    }
+
     /// `‖R_free‖∞` of the last assembly.
     fn free_norm_inf(&self) -> f64 {
         max_abs(
@@ -1202,6 +1311,7 @@ impl Analysis {
                 total_reaction[i % 3] += self.work.internal[i];
             }
         }
+        let moments = self.hinge_moments();
         let sets = self.model.support_sets();
         let mut support_reactions = vec![[0.0; 3]; sets.len()];
         for s in &self.model.supports {
@@ -1255,6 +1365,7 @@ impl Analysis {
         Results {
             gaps,
             reactions,
+            moments,
             cables,
             support_reactions,
             total_reaction,

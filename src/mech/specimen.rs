@@ -242,6 +242,7 @@ impl ParallelArch {
                 nodes: frame,
                 target: self.target(),
                 components: None,
+                hinge: None,
             }],
         };
         model.validate().map_err(|e| e.to_string())?;

@@ -29,6 +29,16 @@ def cargo(*args, check=True):
     return subprocess.run(["cargo", *args], cwd=ROOT, capture_output=True, text=True, check=check)
 
 
+def pack(model_file, out_dir) -> Path:
+    """Packs the FMU of ``model_file`` into ``out_dir`` with ``fmu-pack`` and returns its path
+    (``<model name>.fmu``)."""
+    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(model_file), "--out", str(out_dir))
+    name = json.loads(Path(model_file).read_text())["name"]
+    path = Path(out_dir) / f"{name}.fmu"
+    assert path.exists(), path
+    return path
+
+
 @pytest.fixture(scope="session")
 def fmu_path() -> Path:
     if not PARALLEL_ARCH_FMU.exists():
@@ -89,8 +99,4 @@ def custom_model(cli, tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="session")
 def custom_fmu(custom_model, tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("custom-fmu")
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(custom_model), "--out", str(out))
-    path = out / "CustomArch.fmu"
-    assert path.exists()
-    return path
+    return pack(custom_model, tmp_path_factory.mktemp("custom-fmu"))

@@ -130,6 +130,32 @@ class Slave:
             status = self.step(t_end * k / steps, t_end / steps)
             assert status == OK, f"step {k}: status {status}: {self.messages[-3:]}"
 
+    def assert_states_keep_input_and_nan_is_refused(self, name, first, second):
+        """Steps ``name`` to ``first`` over [0, 0.5], saves the FMU state, steps to ``second``;
+        restoring the state gives the saved outputs back and the same second step repeats the
+        first run exactly; a NaN for ``name`` is then fmi2Error with a message and changes
+        nothing. The instance must be initialized."""
+        self.set({name: first})
+        assert self.step(0.0, 0.5) == OK
+        state = self.fmu.getFMUstate()
+        at_save = self.snapshot()
+        self.set({name: second})
+        assert self.step(0.5, 0.5) == OK
+        reference = self.snapshot()
+
+        self.fmu.setFMUstate(state)
+        assert self.snapshot() == at_save
+        self.set({name: second})
+        assert self.step(0.5, 0.5) == OK
+        assert self.snapshot() == reference
+        self.fmu.freeFMUstate(state)
+
+        vr = (c_uint * 1)(self.vr(name))
+        status = self.call("fmi2SetReal", self.c, vr, 1, (c_double * 1)(float("nan")))
+        assert status == ERROR
+        assert self.logged(ERROR, f"{name} = NaN")
+        assert self.snapshot() == reference
+
     def logged(self, status, text):
         return any(s == status and text in m for s, _, m in self.messages)
 

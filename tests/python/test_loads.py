@@ -16,15 +16,15 @@ load applied in the first step.
 
 from __future__ import annotations
 
+import csv
 import math
 import re
 import subprocess
-from ctypes import c_double, c_uint
 
 import pytest
-from conftest import CLI, ROOT, cargo
+from conftest import CLI, ROOT, pack
 from fmpy.validation import validate_fmu
-from fmu_helpers import ERROR, OK, Slave
+from fmu_helpers import OK, Slave
 
 EXAMPLE = ROOT / "examples" / "circular_membrane.json"
 PRESSURE, LAMP, DENSITY, THICKNESS, G = 200.0, -5.0, 1750.0, 250e-6, 9.81
@@ -35,11 +35,7 @@ STEPS = 4
 
 @pytest.fixture(scope="module")
 def membrane_fmu(tmp_path_factory):
-    out = tmp_path_factory.mktemp("membrane-fmu")
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(EXAMPLE), "--out", str(out))
-    path = out / "CircularMembrane.fmu"
-    assert path.exists()
-    return path
+    return pack(EXAMPLE, tmp_path_factory.mktemp("membrane-fmu"))
 
 
 def rim_balance(pressure):
@@ -82,25 +78,7 @@ def test_pressure_ramp_balances_the_rim_reaction_and_matches_the_cli(membrane_fm
 def test_nan_pressure_is_an_error_and_states_keep_the_load_level(membrane_fmu):
     with Slave(membrane_fmu) as s:
         s.initialize(inputs={"top.pressure": 100.0})
-        assert s.step(0.0, 0.5) == OK
-        state = s.fmu.getFMUstate()
-        at_save = s.snapshot()
-        s.set({"top.pressure": 200.0})
-        assert s.step(0.5, 0.5) == OK
-        reference = s.snapshot()
-
-        s.fmu.setFMUstate(state)
-        assert s.snapshot() == at_save
-        s.set({"top.pressure": 200.0})
-        assert s.step(0.5, 0.5) == OK
-        assert s.snapshot() == reference
-        s.fmu.freeFMUstate(state)
-
-        vr = (c_uint * 1)(s.vr("top.pressure"))
-        status = s.call("fmi2SetReal", s.c, vr, 1, (c_double * 1)(float("nan")))
-        assert status == ERROR
-        assert s.logged(ERROR, "top.pressure = NaN")
-        assert s.snapshot() == reference
+        s.assert_states_keep_input_and_nan_is_refused("top.pressure", 100.0, 200.0)
 
 
 def test_libcosim_drives_the_pressure_to_the_same_results_as_fmpy(membrane_fmu):
@@ -138,3 +116,30 @@ def test_line_search_parameter_reaches_the_same_state_in_fewer_iterations(membra
             results[line_search] = (s.get("film.maxEquivalentStress"), iterations)
     assert results[False][0] == pytest.approx(results[True][0], rel=1e-6)
     assert results[False][1] < results[True][1]
+
+
+def test_cushion_example_inflates_through_simulate_fmu_to_the_cli_answer(tmp_path):
+    """README's cushion: ``examples/inflate_cushion.py`` drives ``Cushion.fmu`` through fmpy's
+    ``simulate_fmu`` to 300 Pa and ends where the CLI's run of ``examples/cushion.json`` ends
+    (an elastic film: the answer does not depend on the path)."""
+    import sys
+
+    example = ROOT / "examples" / "cushion.json"
+    fmu = pack(example, tmp_path)
+    out_csv = tmp_path / "cushion.csv"
+    run = subprocess.run([sys.executable, str(ROOT / "examples" / "inflate_cushion.py"), "--steps", "5",
+                          "--fmu", str(fmu), "--out", str(out_csv)],
+                         capture_output=True, text=True, check=True)
+    assert "Warning" not in run.stdout + run.stderr
+    with open(out_csv) as f:
+        rows = list(csv.DictReader(f))
+    assert [float(r["time"]) for r in rows] == pytest.approx([0.0, 0.2, 0.4, 0.6, 0.8, 1.0])
+    crowns = [float(r["crownTop.uz"]) for r in rows]
+    assert all(b > a for a, b in zip(crowns, crowns[1:])), crowns
+
+    cli = subprocess.run([str(CLI), "model", str(example), "--steps", "5", "--quiet"],
+                         check=True, capture_output=True, text=True).stdout
+    top = float(re.search(r"output point crownTop \(node 0\): displacement \(\S+, \S+, (\S+)\) m", cli).group(1))
+    rz = float(re.search(r"reaction of group rim: \(\S+, \S+, (\S+)\) N", cli).group(1))
+    assert crowns[-1] == pytest.approx(top, abs=2e-6)
+    assert float(rows[-1]["rim.Rz"]) == pytest.approx(rz, abs=2e-3)
