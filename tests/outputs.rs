@@ -170,7 +170,8 @@ fn the_specimen_gives_no_model_warning() {
 fn a_modulus_in_mpa_and_an_inconsistent_initial_gap_warn_naming_the_item() {
     let mut model = ParallelArch::default().model().unwrap();
     model.material.youngs_modulus = 800.0;
-    model.gaps[3].initial_gap += 0.01;
+    // 50 µm: within what validation accepts (1e-4 of the 2.9 m model), beyond what is exact.
+    model.gaps[3].initial_gap += 5e-5;
     let warnings = summary::model_warnings(&model);
     assert_eq!(warnings.len(), 2, "{warnings:#?}");
     assert!(warnings[0].contains("looks like a value in MPa"));
@@ -179,6 +180,25 @@ fn a_modulus_in_mpa_and_an_inconsistent_initial_gap_warn_naming_the_item() {
     let mut model = ParallelArch::default().model().unwrap();
     model.gaps[3].initial_gap += 1e-9;
     assert!(summary::model_warnings(&model).is_empty());
+}
+
+#[test]
+fn initial_gap_that_contradicts_the_geometry_is_refused_naming_the_gap() {
+    let mut model = ParallelArch::default().model().unwrap();
+    model.validate().unwrap();
+    model.gaps[3].initial_gap += 0.01;
+    let e = model.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("gap 'G4'") && e.contains("contradicts the geometry"),
+        "{e}"
+    );
+    // A film node below a point support (inside the support) with any initial_gap ≥ 0.
+    let mut model = ParallelArch::default().model().unwrap();
+    let g = &model.gaps[0];
+    let z = g.frame.z;
+    model.nodes[g.film_node] = std::array::from_fn(|c| model.nodes[g.film_node][c] - 0.05 * z[c]);
+    let e = model.validate().unwrap_err().to_string();
+    assert!(e.contains("starts inside the support"), "{e}");
 }
 
 #[test]

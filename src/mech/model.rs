@@ -97,7 +97,26 @@ pub struct GapSpec {
     pub friction_law: FrictionLaw,
 }
 
+/// Largest difference between a gap's `initial_gap` and the distance its geometry gives, as a
+/// fraction of the model's size (bounding-box diagonal), that validation accepts: 0.2 mm on a
+/// 2 m model, above the rounding of hand-written coordinates; beyond it the two contradict each
+/// other and the model is refused. Smaller differences (above 1e-6 of the size) are warned
+/// about ([`super::summary::model_warnings`]).
+pub const GAP_GEOMETRY_TOLERANCE: f64 = 1e-4;
+
 impl GapSpec {
+    /// The gap its geometry gives (m): the distance along the frame's z from the support (point
+    /// or node B) to the film node A, `z · (X_A − X_B)` (§4.3; the gap closes when
+    /// `g0 + z · (u_A − u_B) < 0`, so `g0` should equal it). Node indices must exist.
+    pub fn geometric_gap(&self, nodes: &[[f64; 3]]) -> f64 {
+        let support = match self.support {
+            GapSupport::Point(p) => p,
+            GapSupport::Node(b) => nodes[b],
+        };
+        let a = nodes[self.film_node];
+        (0..3).map(|c| (a[c] - support[c]) * self.frame.z[c]).sum()
+    }
+
     /// The constitutive constants of this gap.
     pub fn law(&self) -> GapLaw {
         GapLaw {
@@ -486,6 +505,7 @@ impl Model {
     /// Checks every item; the first problem found is returned.
     pub fn validate(&self) -> Result<(), ModelError> {
         let n = self.nodes.len();
+        let size = super::solver::bounding_diagonal(&self.nodes);
         if n == 0 || self.triangles.is_empty() {
             return Err(ModelError::Empty {
                 message: "needs at least one node and one triangle".into(),
@@ -709,6 +729,22 @@ impl Model {
                 return Err(bad(format!(
                     "initial_gap = {} must be ≥ 0",
                     gap.initial_gap
+                )));
+            }
+            let distance = gap.geometric_gap(&self.nodes);
+            let tolerance = GAP_GEOMETRY_TOLERANCE * size;
+            if (distance - gap.initial_gap).abs() > tolerance {
+                return Err(bad(format!(
+                    "initial_gap = {} m contradicts the geometry: the film node lies {distance:.6} m \
+                     from the support along the gap's z (the difference is beyond {tolerance:.2e} m, \
+                     {GAP_GEOMETRY_TOLERANCE} of the model's size{}); correct initial_gap, the \
+                     support or the frame",
+                    gap.initial_gap,
+                    if distance < 0.0 {
+                        ", and the node starts inside the support"
+                    } else {
+                        ""
+                    }
                 )));
             }
         }

@@ -269,9 +269,11 @@ mod tests {
     }
 
     fn gap_to_point(name: &str, node: usize, point: [f64; 3]) -> String {
+        // The patch lies in z = 0: the gap is the support point's depth.
+        let gap = -point[2];
         format!(
             r#"{{ "name": "{name}", "film_node": {node}, "support": {{ "point": {point:?} }},
-                 "frame": {{ "x": [1,0,0], "y": [0,1,0], "z": [0,0,1] }}, "initial_gap": 0.001,
+                 "frame": {{ "x": [1,0,0], "y": [0,1,0], "z": [0,0,1] }}, "initial_gap": {gap},
                  "normal_stiffness": 2.5e8, "tangential_stiffness": 2.5e7, "friction": 0.2 }}"#
         )
     }
@@ -337,7 +339,11 @@ mod tests {
     fn node_held_only_by_a_gap_is_refused() {
         let mut model = ParallelArch::default().model().unwrap();
         let v = model.nodes.len();
-        model.nodes.push([0.4, 0.0, 0.5]);
+        // Beside the first gap's film node along its sliding direction: the same initial gap.
+        let (a, x) = (model.nodes[model.gaps[0].film_node], model.gaps[0].frame.x);
+        model
+            .nodes
+            .push(std::array::from_fn(|c| a[c] + 0.01 * x[c]));
         let mut gap = model.gaps[0].clone();
         gap.name = "Lonely".into();
         gap.film_node = v;

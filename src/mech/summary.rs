@@ -20,9 +20,10 @@ pub const SMALL_STRAIN_LIMIT: f64 = 0.05;
 pub const SUSPICIOUS_MODULUS: f64 = 1e5;
 
 /// Warnings about a model that validates but looks wrong (checked once, before any step): a
-/// Young's modulus that looks like MPa, and point-supported gaps whose `initial_gap` differs
-/// from the distance along the gap's local z between film node and support point (§4.3:
-/// `g0 = z · (X_A − P)`).
+/// Young's modulus that looks like MPa, and gaps whose `initial_gap` differs slightly (up to
+/// [`super::model::GAP_GEOMETRY_TOLERANCE`] of the size; beyond, validation refuses the model)
+/// from the distance along the gap's local z between film node and support (§4.3:
+/// `g0 = z · (X_A − X_B)`).
 pub fn model_warnings(model: &Model) -> Vec<String> {
     let mut warnings = vec![];
     let e = model.material.youngs_modulus;
@@ -34,13 +35,15 @@ pub fn model_warnings(model: &Model) -> Vec<String> {
     }
     let size = super::solver::bounding_diagonal(&model.nodes);
     for gap in &model.gaps {
-        let GapSupport::Point(p) = gap.support else {
-            continue;
+        let n = model.nodes.len();
+        let support_exists = match gap.support {
+            GapSupport::Point(_) => true,
+            GapSupport::Node(b) => b < n,
         };
-        let Some(a) = model.nodes.get(gap.film_node) else {
+        if gap.film_node >= n || !support_exists {
             continue;
-        };
-        let distance: f64 = (0..3).map(|c| (a[c] - p[c]) * gap.frame.z[c]).sum();
+        }
+        let distance = gap.geometric_gap(&model.nodes);
         if (distance - gap.initial_gap).abs() > 1e-6 * size {
             warnings.push(format!(
                 "gap '{}': initial_gap = {} m, but its film node lies {distance} m from the support \
