@@ -22,7 +22,9 @@ left unmapped) are reported as :class:`MeshImportWarning`.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import copy
+import io
 import json
 import math
 import re
@@ -197,12 +199,20 @@ class _Importer:
 
         self.path = Path(path)
         self.map = load_mapping(mapping)
-        try:
-            self.mesh = meshio.read(str(self.path))
-        except FileNotFoundError:
+        if not self.path.is_file():
             _fail(f"mesh file {self.path}: no such file")
-        except Exception as e:  # meshio raises ReadError, KeyError, ValueError … on bad files
-            _fail(f"mesh file {self.path}: meshio cannot read it: {type(e).__name__}: {e}")
+        # meshio 5.3.5 tries every format of the extension (".msh": ansys, then gmsh), prints each
+        # failure on stdout and calls sys.exit(1) when none reads: name gmsh for .msh, keep
+        # stdout clean (the model may go there) and turn the exit into an error
+        file_format = "gmsh" if self.path.suffix.lower() == ".msh" else None
+        chatter = io.StringIO()
+        try:
+            with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
+                self.mesh = meshio.read(str(self.path), file_format=file_format)
+        except (Exception, SystemExit) as e:  # ReadError, KeyError, ValueError … on bad files
+            said = " ".join(chatter.getvalue().split())
+            reason = f"{type(e).__name__}: {e}" if not isinstance(e, SystemExit) else said
+            _fail(f"mesh file {self.path}: meshio cannot read it ({reason or 'no reason given'})")
         self.groups = mesh_groups(self.mesh)
 
     # --------------------------------------------------------------- helpers
@@ -236,6 +246,13 @@ class _Importer:
             _fail("mapping: 'material' must be an object (the model's material, docs/model-format.md)")
         if not isinstance(m["physical_groups"], dict):
             _fail("mapping: 'physical_groups' must be an object: physical group name → role")
+        defaults = m.get("gap_defaults", {})
+        if not isinstance(defaults, dict):
+            _fail("mapping: 'gap_defaults' must be an object")
+        extra = sorted(set(defaults) - (GAP_KEYS - {"curve"}))
+        if extra:
+            _fail(f"mapping 'gap_defaults': unknown key(s) {', '.join(map(repr, extra))} "
+                  f"(allowed: {', '.join(sorted(GAP_KEYS - {'curve'}))})")
         if m.get("quads", "refuse") not in ("refuse", "split"):
             _fail(f"mapping: 'quads' = {m['quads']!r} must be \"refuse\" or \"split\"")
         self.entries: list[tuple[str, dict]] = []

@@ -326,6 +326,22 @@ def test_meshio_written_gmsh41_binary_with_a_cable_and_supports_runs(tmp_path):
     assert "cable edge" in run.stdout and "held" in run.stdout
 
 
+def test_other_formats_map_cell_sets_and_point_sets(tmp_path):
+    """An Abaqus .inp (meshio writes element and node sets): groups from cell_sets/point_sets."""
+    pts, blocks, _ = square()
+    triangles = np.array(blocks[0][1])
+    left = [j * 5 for j in range(5)]
+    mesh = meshio.Mesh(np.array(pts), [("triangle", triangles)], cell_sets={"skin": [np.arange(8)]},
+                       point_sets={"left": np.array(left), "corner": np.array([24])})
+    path = tmp_path / "square.inp"
+    meshio.write(str(path), mesh)
+    model = import_mesh(path, small_mapping(skin={"role": "pressure", "pressure": 5.0}, left={"role": "support"},
+                                            corner={"role": "output_point"}))
+    assert model["loads"]["pressures"] == [{"name": "skin", "elements": list(range(8)), "pressure": 5.0}]
+    assert [s["node"] for s in model["supports"]] == left
+    assert model["outputs"]["points"] == [{"name": "corner", "node": 24}]
+
+
 def test_a_closed_line_loop_becomes_a_closed_cable(tmp_path):
     pts, blocks, names = square()
     n, nid = 4, lambda i, j: j * 5 + i
@@ -397,6 +413,7 @@ def error_cases():
         ("unknown group", edit({"arch_west": {"role": "ignore"}}), r"physical group 'arch_west', which the mesh"),
         ("unknown role", edit({"frame": {"role": "clamp"}}), r"physical group 'frame'.*unknown role 'clamp'"),
         ("unknown key", edit({"frame": {"role": "boundary", "traget": [0, 0, 1]}}), r"'frame'.*unknown key\(s\) 'traget'"),
+        ("unknown default", edit(top={"gap_defaults": {"friciton": 0.2}}), r"'gap_defaults': unknown key\(s\) 'friciton'"),
         ("unknown top key", edit(top={"materail": {}}), r"mapping: unknown key\(s\) 'materail'"),
         ("point of many nodes", edit({"frame": {"role": "output_point"}}), r"physical group 'frame'.*has 50 nodes"),
         ("reserved name", edit({"film": {"role": "element_set"}}), r"element set 'film': the name is reserved"),
@@ -449,6 +466,16 @@ def test_reserved_names_are_those_of_the_rust_side():
     assert tuple(re.findall(r'"(\w+)"', block)) == RESERVED_NAMES
 
 
+def test_an_unreadable_mesh_is_an_error_not_an_exit(tmp_path, capsys):
+    bad = tmp_path / "broken.msh"
+    bad.write_bytes(MSH22.read_bytes()[:3000])  # cut inside $Nodes
+    with pytest.raises(MeshImportError, match=r"mesh file .*broken\.msh: meshio cannot read it"):
+        import_mesh(bad, MAPPING)
+    with pytest.raises(MeshImportError, match=r"mesh file .*nowhere\.msh: no such file"):
+        import_mesh(tmp_path / "nowhere.msh", MAPPING)
+    assert capsys.readouterr().out == ""
+
+
 def test_command_line(tmp_path):
     out = tmp_path / "model.json"
     env_path = str(ROOT / "python")
@@ -457,6 +484,9 @@ def test_command_line(tmp_path):
     assert run.returncode == 0, run.stderr
     assert "26 gaps (S1 … N13)" in run.stderr
     assert json.loads(out.read_text())["name"] == "FilmOverTwoArches"
+    to_stdout = subprocess.run([sys.executable, "-m", "membrane_contact.mesh", str(MSH41), str(MAPPING), "-q"],
+                               capture_output=True, text=True, cwd=env_path)
+    assert to_stdout.stdout.startswith("{") and json.loads(to_stdout.stdout) == json.loads(out.read_text())
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({**mapping(), "physical_groups": {"arch_west": {"role": "ignore"}}}))
     run = subprocess.run([sys.executable, "-m", "membrane_contact.mesh", str(MSH22), str(bad)],
