@@ -212,7 +212,8 @@ class _Importer:
         except (Exception, SystemExit) as e:  # ReadError, KeyError, ValueError … on bad files
             said = " ".join(chatter.getvalue().split())
             reason = f"{type(e).__name__}: {e}" if not isinstance(e, SystemExit) else said
-            _fail(f"mesh file {self.path}: meshio cannot read it ({reason or 'no reason given'})")
+            raise MeshImportError(
+                f"mesh file {self.path}: meshio cannot read it ({reason or 'no reason given'})") from None
         self.groups = mesh_groups(self.mesh)
 
     # --------------------------------------------------------------- helpers
@@ -227,6 +228,20 @@ class _Importer:
         if g.points is not None:
             parts.append(g.points)
         return np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=int)
+
+    def unnamed_hint(self) -> str:
+        """Physical tags without a name (gmsh `Physical Surface(1) = …`): the mapping cannot name them."""
+        physical = self.mesh.cell_data.get("gmsh:physical")
+        if physical is None:
+            return ""
+        named = {(int(np.ravel(v)[0]), int(np.ravel(v)[1])) for v in self.mesh.field_data.values() if np.size(v) >= 2}
+        unnamed = sorted({(cell_dim(b.type), int(t)) for b, tags in zip(self.mesh.cells, physical)
+                          for t in np.unique(tags)} - {(d, t) for t, d in named})
+        if not unnamed:
+            return ""
+        listing = ", ".join(f"tag {t} (dimension {d})" for d, t in unnamed)
+        return (f"; the mesh has physical groups without a name: {listing}: name them in gmsh, "
+                "e.g. Physical Surface(\"film\") = {1};")
 
     def where(self, name: str, role: str) -> str:
         return f"physical group '{name}' (role {role})"
@@ -279,7 +294,7 @@ class _Importer:
                 if name not in self.groups:
                     known = ", ".join(f"'{g}'" for g in self.groups) or "none"
                     _fail(f"mapping names physical group '{name}', which the mesh {self.path.name} does not "
-                          f"have (its groups: {known})")
+                          f"have (its groups: {known}){self.unnamed_hint()}")
                 self.entries.append((name, entry))
         for name in self.groups:
             if name not in m["physical_groups"] and name not in (m.get("film") or []):

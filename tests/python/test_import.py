@@ -453,6 +453,10 @@ def test_errors_on_small_meshes_name_the_bad_item(tmp_path, small_mesh):
     path = write_msh(tmp_path / "ghost.msh", pts, blocks, names)
     with pytest.raises(MeshImportError, match=r"physical group 'ghost' \(role support\): the group has no nodes"):
         import_mesh(path, small_mapping(**{**base, "left": {"role": "boundary"}, "ghost": {"role": "support"}}))
+    # physical groups with tags only: the mapping cannot name them, and the message says why
+    path = write_msh(tmp_path / "unnamed.msh", pts, blocks, {})
+    with pytest.raises(MeshImportError, match=r"'left', which the mesh .*its groups: none.*tag 2 \(dimension 1\)"):
+        import_mesh(path, small_mapping(left={"role": "boundary"}))
     # an unmapped group is reported, not dropped silently
     with pytest.warns(MeshImportWarning, match="physical group 'left' is not in the mapping"):
         import_mesh(small_mesh, small_mapping(**base))
