@@ -179,6 +179,9 @@ pub enum IncrementFailure {
         best: f64,
         /// The residual tolerance (N).
         tolerance: f64,
+        /// Smallest correction `‖Δu‖∞` reached (m) and the tolerance it had to meet (m): a
+        /// residual within its tolerance still needs the corrections to settle.
+        correction: (f64, f64),
         /// Gaps whose status changed in the last iterations.
         chattering: Vec<String>,
         /// Film elements whose tension-field state differs between the last two iterates.
@@ -236,6 +239,12 @@ impl IncrementFailure {
                  solver.incrementsPerStep; more prestress keeps a film taut",
                 flipping.len()
             ),
+            Self::Stalled {
+                best, tolerance, ..
+            } if best <= tolerance => "the forces balance but the film keeps moving along a direction with almost no \
+                stiffness (a part held by too little, a flat film without prestress across): hold it by supports or \
+                prestress, or loosen solver.displacementTolerance"
+                .into(),
             Self::Stalled { .. } => "Newton stopped making progress: move the inputs by less per step, or loosen \
                 solver.residualTolerance if the residual reached is acceptable for your model"
                 .into(),
@@ -282,13 +291,23 @@ impl fmt::Display for IncrementFailure {
                 iteration,
                 best,
                 tolerance,
+                correction: (correction, correction_tolerance),
                 chattering,
                 flipping,
             } => {
-                write!(
-                    f,
-                    "residual stalled at {best:.3e} N (tolerance {tolerance:.3e} N) by iteration {iteration}"
-                )?;
+                if best <= tolerance {
+                    write!(
+                        f,
+                        "corrections stalled at {correction:.3e} m (tolerance {correction_tolerance:.3e} m) \
+                         by iteration {iteration}, with the residual {best:.3e} N within its tolerance \
+                         {tolerance:.3e} N: the film moves along a direction with almost no stiffness"
+                    )?;
+                } else {
+                    write!(
+                        f,
+                        "residual stalled at {best:.3e} N (tolerance {tolerance:.3e} N) by iteration {iteration}"
+                    )?;
+                }
                 chatter(f, chattering, flipping)
             }
             Self::Diverged { iteration } => {
@@ -989,6 +1008,10 @@ impl Analysis {
                     iteration,
                     best,
                     tolerance,
+                    correction: (
+                        best_correction,
+                        s.displacement_tolerance * displacement_scale,
+                    ),
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
                 });
@@ -1439,6 +1462,36 @@ pub fn bounding_diagonal(nodes: &[[f64; 3]]) -> f64 {
 #[cfg(test)]
 mod advice_tests {
     use super::*;
+
+    #[test]
+    fn a_stall_within_the_residual_tolerance_names_the_corrections_not_the_residual() {
+        let stall = |best: f64| IncrementFailure::Stalled {
+            iteration: 12,
+            best,
+            tolerance: 1.374e-4,
+            correction: (3.2e-6, 1.0e-8),
+            chattering: vec![],
+            flipping: vec![],
+        };
+        let within = stall(6.996e-5);
+        let text = within.to_string();
+        assert!(
+            text.starts_with("corrections stalled at 3.200e-6 m (tolerance 1.000e-8 m)"),
+            "{text}"
+        );
+        assert!(
+            text.contains("residual 6.996e-5 N within its tolerance"),
+            "{text}"
+        );
+        assert!(within.advice().contains("solver.displacementTolerance"));
+        let above = stall(2.0e-4);
+        assert!(
+            above
+                .to_string()
+                .starts_with("residual stalled at 2.000e-4 N")
+        );
+        assert!(above.advice().contains("solver.residualTolerance"));
+    }
 
     fn out_of_iterations(first: f64, last: f64, matrix: IterationMatrix) -> String {
         IncrementFailure::MaxIterations {
