@@ -44,17 +44,8 @@ fn full_output_still_arrives_when_the_reader_reads_everything() {
 
 /// Runs `membrane-contact specimen --steps 2` with `args` added; (success, stdout, stderr).
 fn specimen(args: &[&str]) -> (bool, String, String) {
-    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
-        .args(["specimen", "--height", "200", "--steps", "2", "--quiet"])
-        .args(args)
-        .output()
-        .unwrap();
-    let text = |b: Vec<u8>| String::from_utf8(b).unwrap();
-    (
-        output.status.success(),
-        text(output.stdout),
-        text(output.stderr),
-    )
+    let base = ["specimen", "--height", "200", "--steps", "2", "--quiet"];
+    cli(&[base.as_slice(), args].concat())
 }
 
 #[test]
@@ -100,7 +91,7 @@ fn vtk_writes_film_and_gaps_per_state_from_0000_in_the_chosen_encoding() {
     let _ = std::fs::remove_dir_all(&root);
     let (ok, _, err) = specimen(&["--vtk-format", "xml"]);
     assert!(
-        !ok && err.contains("--vtk-format: unknown VTK format 'xml'"),
+        !ok && err.contains("invalid value 'xml' for '--vtk-format <F>': unknown VTK format 'xml'"),
         "{err}"
     );
 }
@@ -250,7 +241,174 @@ fn solver_settings_of_the_fmu_are_cli_options() {
     assert!(!ok && err.contains("solver settings: tolerances"), "{err}");
     let (ok, _, err) = specimen(&["--increments", "0"]);
     assert!(
-        !ok && err.contains("--increments needs a positive integer"),
+        !ok && err.contains("invalid value '0' for '--increments <N>': 0 is not in 1.."),
         "{err}"
     );
+}
+
+/// Runs `membrane-contact` with `args`; (success, stdout, stderr).
+fn cli(args: &[&str]) -> (bool, String, String) {
+    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(args)
+        .output()
+        .unwrap();
+    let text = |b: Vec<u8>| String::from_utf8(b).unwrap();
+    (
+        output.status.success(),
+        text(output.stdout),
+        text(output.stderr),
+    )
+}
+
+/// The printed results without the Newton statistics, a printed negative zero (`-0.000`) read
+/// as zero.
+fn results_text(out: &str) -> String {
+    let zero = |word: &str| {
+        let digits = word.trim_start_matches('-');
+        if word.starts_with('-') && digits.chars().all(|c| c == '0' || c == '.') {
+            digits.to_string()
+        } else {
+            word.to_string()
+        }
+    };
+    out.lines()
+        .filter(|l| !l.starts_with("Newton:"))
+        .map(|l| {
+            l.split_inclusive([' ', ',', '(', ')'])
+                .map(|w| {
+                    let cut = w.len() - w.ends_with([' ', ',', '(', ')']) as usize;
+                    zero(&w[..cut]) + &w[cut..]
+                })
+                .collect::<String>()
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+const HINGED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hinged_panel.json");
+
+/// TEST GOAL (issue 9 item 4): a staged table of FMU inputs drives the CLI: the table of the
+/// linear ramp gives the ramp's results to print precision (gravity, having no column, is
+/// reached in the first step as by the FMU, so the iterations differ); a table that turns the rail out and back and
+/// releases the snow ends where an unloaded, unturned panel is (the film is elastic); a bad
+/// table is refused naming line and column; `--path` and `--steps` exclude each other.
+#[test]
+fn staged_table_of_fmu_inputs_drives_the_steps() {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-path-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = |name: &str, text: &str| {
+        let file = dir.join(name);
+        std::fs::write(&file, text).unwrap();
+        file.to_str().unwrap().to_string()
+    };
+    let ramp = table(
+        "ramp.csv",
+        "time, rail.angle, snow.pressure\n0.25, 0.025, -25\n0.5, 0.05, -50\n0.75, 0.075, -75\n1.0, 0.1, -100\n",
+    );
+    let (ok, staged, err) = cli(&["model", HINGED, "--path", &ramp, "--quiet"]);
+    assert!(ok, "{err}");
+    let (ok, linear, err) = cli(&["model", HINGED, "--steps", "4", "--quiet"]);
+    assert!(ok, "{err}");
+    assert_eq!(results_text(&staged), results_text(&linear));
+    assert!(staged.contains("Newton: 4 steps"), "{staged}");
+
+    let back = table(
+        "back.csv",
+        "# out, back, and the snow gone\nrail.angle, snow.pressure\n0.1, -100\n0.05, -50\n0, 0\n",
+    );
+    let (ok, out, err) = cli(&["model", HINGED, "--path", &back, "--quiet"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("Newton: 3 steps"), "{out}");
+    let rest = table("rest.csv", "rail.angle, snow.pressure\n0, 0\n");
+    let (ok, at_rest, err) = cli(&["model", HINGED, "--path", &rest, "--quiet"]);
+    assert!(ok, "{err}");
+    assert!(at_rest.contains("at 0.000000 rad"), "{at_rest}");
+    assert_eq!(results_text(&out), results_text(&at_rest));
+
+    let bad = table("bad.csv", "rail.angle, snow.pressure\n0.1, lots\n");
+    let (ok, _, err) = cli(&["model", HINGED, "--path", &bad]);
+    assert!(
+        !ok && err.contains("bad.csv line 2, column 'snow.pressure': 'lots' is not a number"),
+        "{err}"
+    );
+    let (ok, _, err) = cli(&["model", HINGED, "--path", &ramp, "--steps", "3"]);
+    assert!(!ok && err.contains("cannot be used with"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 9 item 4): `--elements-csv` writes every triangle of every step with its
+/// stresses and strains; the last step's largest von Mises stress is the printed range's top.
+#[test]
+fn element_results_are_written_as_csv() {
+    let file = std::env::temp_dir().join(format!("membrane-contact-el-{}.csv", std::process::id()));
+    let (ok, out, err) = cli(&[
+        "model",
+        HINGED,
+        "--steps",
+        "2",
+        "--quiet",
+        "--elements-csv",
+        file.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(
+        header[..7],
+        [
+            "step", "time", "element", "node1", "node2", "node3", "state"
+        ]
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2 * 120);
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let top = rows
+        .iter()
+        .filter(|r| r[0] == "2")
+        .map(|r| r[col("von_mises_Pa")].parse::<f64>().unwrap())
+        .fold(0.0, f64::max);
+    let printed = out
+        .lines()
+        .find(|l| l.starts_with("equivalent (von Mises) stress"))
+        .unwrap();
+    assert!(
+        printed.ends_with(&format!("{:.3} MPa", top / 1e6)),
+        "{printed} vs {top}"
+    );
+    assert!(
+        rows.iter().all(|r| r.len() == header.len()
+            && r[7..].iter().all(|v| v.parse::<f64>().unwrap().is_finite()))
+    );
+    let _ = std::fs::remove_file(&file);
+}
+
+#[test]
+fn help_lists_every_command_and_the_solver_options() {
+    let (ok, out, _) = cli(&["--help"]);
+    assert!(ok);
+    for command in ["specimen", "model", "export-specimen"] {
+        assert!(out.contains(command), "{out}");
+    }
+    let (ok, out, _) = cli(&["model", "--help"]);
+    assert!(ok);
+    for option in [
+        "--path",
+        "--steps",
+        "--increments",
+        "--max-iterations",
+        "--max-cutbacks",
+        "--displacement-tolerance",
+        "--residual-tolerance",
+        "--no-line-search",
+        "--matrix",
+        "--friction-law",
+        "--mu",
+        "--csv",
+        "--elements-csv",
+        "--vtk",
+        "--vtk-format",
+    ] {
+        assert!(out.contains(option), "{option} missing:\n{out}");
+    }
 }

@@ -61,7 +61,7 @@ use super::state::{self, Snapshot};
 use super::types::{
     FMI2_CO_SIMULATION, FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status,
 };
-use super::variables::{Binding, Causality, Value, VarType, Variable};
+use super::variables::{Binding, Causality, StepInputs, Value, VarType, Variable, step_inputs};
 use crate::mech::element::state_counts;
 use crate::mech::material::Wrinkling;
 use crate::mech::{
@@ -868,23 +868,17 @@ impl Instance {
                 t + h
             )));
         }
-        let table = &self.description.variables;
-        let mut targets = vec![[0.0; 3]; self.description.model.groups.len()];
-        let mut angles = vec![0.0; self.description.model.groups.len()];
-        let mut loads = LoadLevels::zero(&self.description.model);
-        let mut mu = None;
-        for (v, x) in table.iter().zip(&self.values) {
-            match (v.binding, x) {
-                (Binding::GroupDisplacement { group, axis }, &Value::Real(x)) => {
-                    targets[group][axis] = x
-                }
-                (Binding::GroupAngle(group), &Value::Real(x)) => angles[group] = x,
-                (Binding::Pressure(set), &Value::Real(x)) => loads.pressure[set] = x,
-                (Binding::NodalForce { set, axis }, &Value::Real(x)) => loads.force[set][axis] = x,
-                (Binding::Friction, &Value::Real(x)) if self.mu_set => mu = Some(x),
-                _ => {}
-            }
-        }
+        let StepInputs {
+            targets,
+            angles,
+            mut loads,
+            mu,
+        } = step_inputs(
+            &self.description.model,
+            &self.description.variables,
+            &self.values,
+            self.mu_set,
+        );
         let built = self
             .analysis
             .as_mut()

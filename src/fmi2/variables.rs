@@ -41,7 +41,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::mech::{Model, SolverSettings};
+use crate::mech::{LoadLevels, Model, SolverSettings};
 
 /// What the FMU is built from, as far as the variable table is concerned.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -407,6 +407,51 @@ pub fn check_names(model: &Model) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// What the inputs ask of the next step: where the groups go (translations and hinge angles),
+/// the load levels, and `μ` (only once it has been set).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepInputs {
+    pub targets: Vec<[f64; 3]>,
+    pub angles: Vec<f64>,
+    /// Pressures and nodal forces from the inputs; gravity from the model (a parameter).
+    pub loads: LoadLevels,
+    pub mu: Option<f64>,
+}
+
+/// Reads the step's targets from the input values of `table` (`values[i]` belongs to
+/// `table[i]`): the one place that says which input moves what, for the FMU and the CLI's
+/// staged load tables alike. `mu_set`: whether `mu` was given (until then each gap keeps its
+/// own friction coefficient).
+pub fn step_inputs(
+    model: &Model,
+    table: &[Variable],
+    values: &[Value],
+    mu_set: bool,
+) -> StepInputs {
+    let mut inputs = StepInputs {
+        targets: vec![[0.0; 3]; model.groups.len()],
+        angles: vec![0.0; model.groups.len()],
+        loads: LoadLevels::zero(model),
+        mu: None,
+    };
+    inputs.loads.gravity = model.loads.gravity;
+    for (v, x) in table.iter().zip(values) {
+        match (v.binding, x) {
+            (Binding::GroupDisplacement { group, axis }, &Value::Real(x)) => {
+                inputs.targets[group][axis] = x
+            }
+            (Binding::GroupAngle(group), &Value::Real(x)) => inputs.angles[group] = x,
+            (Binding::Pressure(set), &Value::Real(x)) => inputs.loads.pressure[set] = x,
+            (Binding::NodalForce { set, axis }, &Value::Real(x)) => {
+                inputs.loads.force[set][axis] = x
+            }
+            (Binding::Friction, &Value::Real(x)) if mu_set => inputs.mu = Some(x),
+            _ => {}
+        }
+    }
+    inputs
 }
 
 /// The variable table of an FMU of `model`. Order: `time`, inputs, parameters, outputs.

@@ -129,7 +129,7 @@ pub fn film_grid(
     let tris = model.triangles.len();
     let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..tris).map(f).collect());
     let cell3 = |f: &dyn Fn(usize) -> [f64; 3]| Values::F64((0..tris).flat_map(f).collect());
-    let principal_strains: Vec<[f64; 2]> = el.iter().map(|e| principal(e.strain)).collect();
+    let principal_strains: Vec<[f64; 2]> = el.iter().map(|e| principal_strain(e.strain)).collect();
     let piece = Piece {
         points: deformed(model, displacement),
         connectivity: model
@@ -231,7 +231,7 @@ pub fn collection(entries: &[(f64, String)]) -> String {
 }
 
 /// Principal values `[e1 ≥ e2]` of a Voigt strain `[εx, εy, γxy]` (engineering shear).
-fn principal(strain: [f64; 3]) -> [f64; 2] {
+pub fn principal_strain(strain: [f64; 3]) -> [f64; 2] {
     let centre = 0.5 * (strain[0] + strain[1]);
     let radius = (0.5 * (strain[0] - strain[1])).hypot(0.5 * strain[2]);
     [centre + radius, centre - radius]
@@ -411,11 +411,11 @@ mod tests {
 
     #[test]
     fn principal_strains_are_the_mohr_circle_extremes() {
-        let [e1, e2] = principal([0.03, 0.01, 0.02]);
+        let [e1, e2] = principal_strain([0.03, 0.01, 0.02]);
         // centre 0.02, radius √(0.01² + 0.01²)
         assert!((e1 - (0.02 + 0.01 * 2f64.sqrt())).abs() < 1e-15);
         assert!((e1 + e2 - 0.04).abs() < 1e-15);
-        assert_eq!(principal([0.0, 0.0, 0.0]), [0.0, 0.0]);
+        assert_eq!(principal_strain([0.0, 0.0, 0.0]), [0.0, 0.0]);
     }
 
     #[test]

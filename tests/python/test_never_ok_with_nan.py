@@ -61,7 +61,10 @@ def test_singular_models_are_refused_by_fmu_pack_and_the_cli(custom_model, tmp_p
     floating = json.loads(json.dumps(model))
     floating["groups"] = []  # the frame held the film
     lonely = json.loads(json.dumps(model))
-    lonely["nodes"].append([0.4, 0.0, 0.5])
+    # Beside the first gap's film node along its sliding direction: the same initial gap.
+    first = lonely["gaps"][0]
+    a, x = lonely["nodes"][first["film_node"]], first["frame"]["x"]
+    lonely["nodes"].append([a[c] + 0.01 * x[c] for c in range(3)])
     extra = dict(lonely["gaps"][0], name="Lonely", film_node=len(lonely["nodes"]) - 1)
     lonely["gaps"].append(extra)
     cases = [

@@ -1,6 +1,7 @@
 //! `membrane-contact`: runs a parallel-arch specimen or a model file through the core solver,
-//! stepping the forced displacement to its target, and prints the slip at every gap beside the
-//! paper's Table 1, the equivalent-stress range and the Newton statistics.
+//! stepping the boundary groups and loads to their targets (a linear ramp, or a staged table of
+//! FMU inputs, [`path`]), and prints the slip at every gap (beside the paper's Table 1 for a
+//! specimen), reactions, stresses and the Newton statistics; options in [`args`].
 
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
@@ -10,9 +11,16 @@ use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
 use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
-    Analysis, FrictionLaw, IterationMatrix, LoadLevels, Model, ParallelArch, Results,
-    SolverSettings,
+    Analysis, FrictionLaw, LoadLevels, Model, ParallelArch, Results, SolverSettings,
 };
+
+mod args;
+mod path;
+
+use args::{Cli, Command, RunArgs, SpecimenArgs};
+use clap::Parser;
+use membrane_contact::fmi2::variables::StepInputs;
+use path::StagedPath;
 
 /// `println!` for the results on standard output, through [`print_line`]: a reader that closes
 /// the pipe early (`… | head`) ends the program quietly instead of a panic.
@@ -38,240 +46,93 @@ fn print_line(args: std::fmt::Arguments<'_>) {
     }
 }
 
-const USAGE: &str = "\
-usage: membrane-contact specimen [--height MM] [options]
-       membrane-contact model FILE.json [options]
-       membrane-contact export-specimen [--height MM] [--refine N] [--friction-law L]   (prints the model JSON)
-
-Runs the analysis: every boundary group is moved to its target displacement, and every load
-(pressures, nodal forces, self-weight) raised from zero to its model-file value, in --steps steps.
-
-options:
-  --height MM        arch height of the specimen in mm (200, 300, 400; default 300)
-  --refine N         mesh refinement factor of the specimen (default 1: 200 triangles)
-  --mu X             friction coefficient of every gap (default: the model's, 0.2 for specimens)
-  --friction-law L   isotropic (Coulomb cone) or sliding-direction (the paper's §2.2: slides
-                     along the gap's local x only) for every gap (default: the model's,
-                     isotropic for specimens)
-  --steps N          load steps to the target (default 20)
-  --matrix M         consistent (default) or ju-rowlands (the paper's; converges linearly:
-                     give it --max-iterations 3000)
-  --max-iterations N Newton iterations per increment before it is halved (default 100)
-  --increments N     largest increment = 1/N of a step (default 1; the FMU's
-                     solver.incrementsPerStep); increments halve on failure and grow back
-  --max-cutbacks N   halvings of an increment before a step fails (default 12)
-  --displacement-tolerance X, --residual-tolerance X
-                     relative Newton tolerances (default 1e-5 each; docs/mechanics.md)
-  --no-line-search   plain Newton steps: about half the iterations when each step starts near
-                     its answer (a prestressed film under a gradually raised pressure), but no
-                     safeguard for a first step from a slack flat film or gaps opening/closing
-  --csv FILE         write the gap results of every step as CSV
-  --vtk DIR          write every step as VTK: DIR/<model>_film_NNNN.vtu (film) and
-                     DIR/<model>_gaps_NNNN.vtu (gap lines), and a .pvd of each for ParaView
-  --vtk-format F     binary (default: raw appended data, about half the size) or ascii
-  --quiet            no progress indicator
-  -h, --help         this text";
-
-struct Options {
-    command: String,
-    file: Option<String>,
-    height_mm: f64,
-    refine: usize,
-    mu: Option<f64>,
-    friction_law: Option<FrictionLaw>,
-    steps: usize,
-    matrix: IterationMatrix,
-    max_iterations: Option<usize>,
-    max_cutbacks: Option<usize>,
-    displacement_tolerance: Option<f64>,
-    residual_tolerance: Option<f64>,
-    increments: usize,
-    line_search: bool,
-    csv: Option<String>,
-    vtk: Option<String>,
-    vtk_format: vtk::Encoding,
-    quiet: bool,
+/// Where the model comes from, and what the run compares with.
+enum Source<'a> {
+    /// A parallel-arch specimen of height `height_mm` (compared with Table 1).
+    Specimen { spec: ParallelArch, height_mm: f64 },
+    /// A model file.
+    File(&'a std::path::Path),
 }
 
-fn parse(args: &[String]) -> Result<Options, String> {
-    let mut o = Options {
-        command: String::new(),
-        file: None,
-        height_mm: 300.0,
-        refine: 1,
-        mu: None,
-        friction_law: None,
-        steps: 20,
-        matrix: IterationMatrix::Consistent,
-        max_iterations: None,
-        max_cutbacks: None,
-        displacement_tolerance: None,
-        residual_tolerance: None,
-        increments: 1,
-        line_search: true,
-        csv: None,
-        vtk: None,
-        vtk_format: vtk::Encoding::default(),
-        quiet: false,
-    };
-    let mut it = args.iter();
-    while let Some(a) = it.next() {
-        let mut value = |name: &str| {
-            it.next()
-                .cloned()
-                .ok_or_else(|| format!("{name} needs a value"))
-        };
-        let number = |name: &str, v: String| {
-            v.parse::<f64>()
-                .map_err(|_| format!("{name}: '{v}' is not a number"))
-        };
-        match a.as_str() {
-            "-h" | "--help" => return Err(String::new()),
-            "--height" => o.height_mm = number("--height", value("--height")?)?,
-            "--refine" => {
-                o.refine = value("--refine")?
-                    .parse()
-                    .map_err(|_| "--refine needs a positive integer".to_string())?
-            }
-            "--mu" => o.mu = Some(number("--mu", value("--mu")?)?),
-            "--friction-law" => {
-                let law = value("--friction-law")?;
-                o.friction_law = Some(law.parse().map_err(|e| format!("--friction-law: {e}"))?);
-            }
-            "--steps" => {
-                o.steps = value("--steps")?
-                    .parse()
-                    .map_err(|_| "--steps needs a positive integer".to_string())?;
-                if o.steps == 0 {
-                    return Err("--steps must be at least 1".into());
-                }
-            }
-            "--matrix" => {
-                o.matrix = match value("--matrix")?.as_str() {
-                    "consistent" => IterationMatrix::Consistent,
-                    "ju-rowlands" | "jr" => IterationMatrix::JuRowlands,
-                    other => {
-                        return Err(format!(
-                            "--matrix: unknown '{other}' (consistent or ju-rowlands)"
-                        ));
-                    }
-                }
-            }
-            "--max-iterations" => {
-                let n = value("--max-iterations")?
-                    .parse()
-                    .map_err(|_| "--max-iterations needs a positive integer".to_string())?;
-                o.max_iterations = Some(n);
-            }
-            "--max-cutbacks" => {
-                let n = value("--max-cutbacks")?
-                    .parse()
-                    .map_err(|_| "--max-cutbacks needs a non-negative integer".to_string())?;
-                o.max_cutbacks = Some(n);
-            }
-            "--increments" => {
-                o.increments = value("--increments")?
-                    .parse()
-                    .ok()
-                    .filter(|&n| n >= 1)
-                    .ok_or("--increments needs a positive integer")?;
-            }
-            "--displacement-tolerance" => {
-                let v = value("--displacement-tolerance")?;
-                o.displacement_tolerance = Some(number("--displacement-tolerance", v)?);
-            }
-            "--residual-tolerance" => {
-                let v = value("--residual-tolerance")?;
-                o.residual_tolerance = Some(number("--residual-tolerance", v)?);
-            }
-            "--no-line-search" => o.line_search = false,
-            "--csv" => o.csv = Some(value("--csv")?),
-            "--vtk" => o.vtk = Some(value("--vtk")?),
-            "--vtk-format" => {
-                o.vtk_format = value("--vtk-format")?
-                    .parse()
-                    .map_err(|e| format!("--vtk-format: {e}"))?
-            }
-            "--quiet" => o.quiet = true,
-            s if s.starts_with('-') => return Err(format!("unknown option {s}")),
-            s if o.command.is_empty() => o.command = s.to_string(),
-            s if o.command == "model" && o.file.is_none() => o.file = Some(s.to_string()),
-            s => return Err(format!("unexpected argument '{s}'")),
-        }
-    }
-    Ok(o)
-}
-
-fn specimen(o: &Options) -> Result<ParallelArch, String> {
+fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArch, String> {
     let spec = ParallelArch {
-        refinement: o.refine,
-        friction_law: o.friction_law.unwrap_or_default(),
-        ..ParallelArch::with_height(o.height_mm / 1000.0)
+        refinement: args.refine as usize,
+        friction_law: law.unwrap_or_default(),
+        ..ParallelArch::with_height(args.height / 1000.0)
     };
     spec.check()?;
     Ok(spec)
 }
 
-fn run(o: &Options) -> Result<(), String> {
-    let mut model = match o.command.as_str() {
-        "specimen" => specimen(o)?.model()?,
-        "export-specimen" => {
-            out!("{}", specimen(o)?.model()?.to_json());
-            return Ok(());
+/// The targets of each step: the staged table's rows, or the model file's targets and loads
+/// reached linearly in `--steps` steps.
+fn load_path(model: &Model, o: &RunArgs) -> Result<StagedPath, String> {
+    if let Some(file) = &o.path {
+        let source = file.display().to_string();
+        let text = std::fs::read_to_string(file).map_err(|e| format!("{source}: {e}"))?;
+        return path::read(&text, model, &source);
+    }
+    let steps = o.steps.unwrap_or(20) as usize;
+    let loads = LoadLevels::of_model(model);
+    let times = (1..=steps)
+        .map(|k| k as f64 / steps as f64)
+        .collect::<Vec<_>>();
+    let rows = times
+        .iter()
+        .map(|&f| StepInputs {
+            targets: model
+                .groups
+                .iter()
+                .map(|g| g.target.map(|v| v * f))
+                .collect(),
+            angles: model
+                .groups
+                .iter()
+                .map(|g| g.hinge.as_ref().map_or(0.0, |h| h.target_angle * f))
+                .collect(),
+            loads: loads.scaled(f),
+            mu: None,
+        })
+        .collect();
+    Ok(StagedPath { times, steps: rows })
+}
+
+fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
+    let mut model = match &source {
+        Source::Specimen { spec, .. } => spec.model()?,
+        Source::File(file) => {
+            let name = file.display();
+            let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
+            Model::from_json(&text).map_err(|e| format!("{name}: {e}"))?
         }
-        "model" => {
-            let file = o.file.as_deref().ok_or("model: give the model file")?;
-            let text = std::fs::read_to_string(file).map_err(|e| format!("{file}: {e}"))?;
-            Model::from_json(&text).map_err(|e| format!("{file}: {e}"))?
-        }
-        "" => return Err(String::new()),
-        other => return Err(format!("unknown command '{other}'")),
     };
     if let Some(law) = o.friction_law {
         model.set_friction_law(law);
     }
     let defaults = SolverSettings::default();
     let settings = SolverSettings {
-        iteration_matrix: o.matrix,
+        iteration_matrix: o.matrix.into(),
         max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
         max_cutbacks: o.max_cutbacks.unwrap_or(defaults.max_cutbacks),
         displacement_tolerance: o
             .displacement_tolerance
             .unwrap_or(defaults.displacement_tolerance),
         residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
-        line_search: o.line_search,
+        line_search: !o.no_line_search,
         ..defaults
     };
     for w in membrane_contact::mech::summary::model_warnings(&model) {
         eprintln!("warning: {w}");
     }
+    let path = load_path(&model, o)?;
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
     }
-    let targets: Vec<[f64; 3]> = analysis.model().groups.iter().map(|g| g.target).collect();
-    let angles: Vec<f64> = analysis
-        .model()
-        .groups
-        .iter()
-        .map(|g| g.hinge.as_ref().map_or(0.0, |h| h.target_angle))
-        .collect();
-    let loads = LoadLevels::of_model(analysis.model());
-    let mut csv = match &o.csv {
-        Some(path) => {
-            let mut f = std::fs::File::create(path).map_err(|e| format!("{path}: {e}"))?;
-            writeln!(
-                f,
-                "step,fraction,gap,slip_x_mm,slip_y_mm,normal_force_N,friction_force_N,status"
-            )
-            .map_err(|e| e.to_string())?;
-            Some((f, path.clone()))
-        }
-        None => None,
-    };
+    let mut csv = CsvFiles::create(o)?;
     let (mut vtk_steps, mut vtk_written) = (Vec::new(), VtkWritten::default());
     if let Some(dir) = &o.vtk {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{dir}: {e}"))?;
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
         // State 0000: the undeformed, prestressed film (as the FMU writes at initialization).
         vtk_steps.push((0.0, 0));
         let results = analysis.results();
@@ -284,23 +145,32 @@ fn run(o: &Options) -> Result<(), String> {
             &mut vtk_written,
         )?;
     }
-    let progress = !o.quiet && std::io::stderr().is_terminal();
-    let started = std::time::Instant::now();
+    let mut progress = Progress::new(
+        !o.quiet && std::io::stderr().is_terminal(),
+        path.steps.len(),
+    );
     let (mut iterations, mut cutbacks, mut enlarged, mut increments) = (Vec::new(), 0, 0, 0);
-    for step in 1..=o.steps {
-        let fraction = step as f64 / o.steps as f64;
-        let target: Vec<[f64; 3]> = targets.iter().map(|t| t.map(|v| v * fraction)).collect();
-        let angle: Vec<f64> = angles.iter().map(|a| a * fraction).collect();
+    let count = path.steps.len();
+    for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
+        let step = k + 1;
+        if let Some(mu) = inputs.mu {
+            analysis.set_friction(mu)?;
+        }
         let report = analysis
-            .step_to_motion(&target, &angle, &loads.scaled(fraction), o.increments)
-            .map_err(|e| format!("step {step}/{}: {e}", o.steps))?;
+            .step_to_motion(
+                &inputs.targets,
+                &inputs.angles,
+                &inputs.loads,
+                o.increments as usize,
+            )
+            .map_err(|e| format!("step {step}/{count}: {e}"))?;
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;
         increments += report.iterations.len();
         iterations.push(report.total_iterations());
-        let results = (o.csv.is_some() || o.vtk.is_some()).then(|| analysis.results());
+        let results = (csv.any() || o.vtk.is_some()).then(|| analysis.results());
         if let (Some(dir), Some(results)) = (&o.vtk, &results) {
-            vtk_steps.push((fraction, step));
+            vtk_steps.push((time, step));
             write_vtk(
                 dir,
                 &analysis,
@@ -310,41 +180,28 @@ fn run(o: &Options) -> Result<(), String> {
                 &mut vtk_written,
             )?;
         }
-        if progress {
-            eprint!("\rstep {step}/{} ({:.0}%)", o.steps, 100.0 * fraction);
+        if let Some(results) = &results {
+            csv.write_step(step, time, analysis.model(), results)?;
         }
-        if let (Some((f, path)), Some(results)) = (csv.as_mut(), &results) {
-            for (g, r) in analysis.model().gaps.iter().zip(&results.gaps) {
-                writeln!(
-                    f,
-                    "{step},{fraction},{},{:.6},{:.6},{:.6},{:.6},{:?}",
-                    g.name,
-                    r.slip_x * 1e3,
-                    r.slip_y * 1e3,
-                    r.normal_force,
-                    r.friction_force,
-                    r.status
-                )
-                .map_err(|e| format!("{path}: {e}"))?;
-            }
-        }
+        progress.step(step);
     }
-    if progress {
-        eprintln!();
-    }
-    let elapsed = started.elapsed();
+    progress.finish();
+    let elapsed = progress.started.elapsed();
     let results = analysis.results();
     membrane_contact::mech::check_results(analysis.model(), &results, None)
         .map_err(|e| format!("the results are not finite ({e}): refused"))?;
-    report(o, &analysis, &results);
+    let height_mm = match source {
+        Source::Specimen { height_mm, .. } => Some(height_mm),
+        Source::File(_) => None,
+    };
+    report(height_mm, &analysis, &results);
     for w in membrane_contact::mech::summary::result_warnings(analysis.model(), &results) {
         eprintln!("warning: {w}");
     }
     let total: usize = iterations.iter().sum();
     out!(
-        "\nNewton: {} steps, {increments} increments, {cutbacks} cut-backs, {enlarged} enlarged, \
+        "\nNewton: {count} steps, {increments} increments, {cutbacks} cut-backs, {enlarged} enlarged, \
          {total} iterations ({:.1} per increment), iterations per step {:?}; {:.1} ms",
-        o.steps,
         total as f64 / increments.max(1) as f64,
         iterations,
         elapsed.as_secs_f64() * 1e3
@@ -361,6 +218,129 @@ fn run(o: &Options) -> Result<(), String> {
     Ok(())
 }
 
+/// A progress line on the terminal (only there: a pipe or a file gets none): the step, its
+/// share and, after the first step, the time left at the pace so far.
+struct Progress {
+    shown: bool,
+    steps: usize,
+    started: std::time::Instant,
+}
+
+impl Progress {
+    fn new(shown: bool, steps: usize) -> Self {
+        Self {
+            shown,
+            steps,
+            started: std::time::Instant::now(),
+        }
+    }
+
+    fn step(&mut self, step: usize) {
+        if !self.shown {
+            return;
+        }
+        let elapsed = self.started.elapsed().as_secs_f64();
+        let left = elapsed / step as f64 * (self.steps - step) as f64;
+        eprint!(
+            "\rstep {step}/{} ({:.0}%), {elapsed:.1} s, about {left:.1} s left   ",
+            self.steps,
+            100.0 * step as f64 / self.steps as f64
+        );
+    }
+
+    fn finish(&self) {
+        if self.shown {
+            eprintln!();
+        }
+    }
+}
+
+/// The CSV outputs of a run: gap results and element results of every step.
+struct CsvFiles {
+    gaps: Option<(std::fs::File, String)>,
+    elements: Option<(std::fs::File, String)>,
+}
+
+impl CsvFiles {
+    fn create(o: &RunArgs) -> Result<Self, String> {
+        let open = |path: &Option<std::path::PathBuf>, header: &str| -> Result<_, String> {
+            let Some(path) = path else {
+                return Ok(None);
+            };
+            let name = path.display().to_string();
+            let mut f = std::fs::File::create(path).map_err(|e| format!("{name}: {e}"))?;
+            writeln!(f, "{header}").map_err(|e| format!("{name}: {e}"))?;
+            Ok(Some((f, name)))
+        };
+        Ok(Self {
+            gaps: open(
+                &o.csv,
+                "step,fraction,gap,slip_x_mm,slip_y_mm,normal_force_N,friction_force_N,status",
+            )?,
+            elements: open(
+                &o.elements_csv,
+                "step,time,element,node1,node2,node3,state,stress_x_Pa,stress_y_Pa,stress_xy_Pa,\
+                 principal_1_Pa,principal_2_Pa,von_mises_Pa,strain_x,strain_y,strain_xy,\
+                 principal_strain_1,principal_strain_2",
+            )?,
+        })
+    }
+
+    fn any(&self) -> bool {
+        self.gaps.is_some() || self.elements.is_some()
+    }
+
+    fn write_step(
+        &mut self,
+        step: usize,
+        time: f64,
+        model: &Model,
+        results: &Results,
+    ) -> Result<(), String> {
+        if let Some((f, name)) = self.gaps.as_mut() {
+            for (g, r) in model.gaps.iter().zip(&results.gaps) {
+                writeln!(
+                    f,
+                    "{step},{time},{},{:.6},{:.6},{:.6},{:.6},{:?}",
+                    g.name,
+                    r.slip_x * 1e3,
+                    r.slip_y * 1e3,
+                    r.normal_force,
+                    r.friction_force,
+                    r.status
+                )
+                .map_err(|e| format!("{name}: {e}"))?;
+            }
+        }
+        if let Some((f, name)) = self.elements.as_mut() {
+            for (i, (t, e)) in model.triangles.iter().zip(&results.elements).enumerate() {
+                let [e1, e2] = vtk::principal_strain(e.strain);
+                writeln!(
+                    f,
+                    "{step},{time},{i},{},{},{},{:?},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
+                    t[0],
+                    t[1],
+                    t[2],
+                    e.state,
+                    e.stress[0],
+                    e.stress[1],
+                    e.stress[2],
+                    e.principal[0],
+                    e.principal[1],
+                    e.von_mises,
+                    e.strain[0],
+                    e.strain[1],
+                    e.strain[2],
+                    e1,
+                    e2
+                )
+                .map_err(|e| format!("{name}: {e}"))?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// What the VTK output of a run wrote: `.vtu` files, their bytes, and the time spent encoding
 /// and writing them (`.pvd` files included).
 #[derive(Default)]
@@ -373,7 +353,7 @@ struct VtkWritten {
 /// Writes the last state of `steps` (`(fraction, step)` pairs) as the film and gaps `.vtu` files
 /// in `dir` and rewrites both `.pvd` collections.
 fn write_vtk(
-    dir: &str,
+    dir: &std::path::Path,
     analysis: &Analysis,
     results: &Results,
     steps: &[(f64, usize)],
@@ -381,7 +361,7 @@ fn write_vtk(
     written: &mut VtkWritten,
 ) -> Result<(), String> {
     let started = std::time::Instant::now();
-    let (model, dir) = (analysis.model(), std::path::Path::new(dir));
+    let model = analysis.model();
     let step = steps.last().map_or(0, |&(_, k)| k);
     let u = &analysis.state().displacement;
     for &block in vtk::Block::of(model) {
@@ -442,7 +422,9 @@ fn report_loads(analysis: &Analysis) {
     }
 }
 
-fn report(o: &Options, analysis: &Analysis, results: &Results) {
+/// Prints the results; `height_mm`: the specimen's, whose observed points are compared with
+/// Table 1.
+fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     let model = analysis.model();
     out!(
         "{}: {} nodes, {} triangles, {} gaps",
@@ -545,10 +527,10 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
         let [taut, wrinkled, slack] = state_counts(&results.elements);
         println!("tension-field film: {taut} taut, {wrinkled} wrinkled, {slack} slack elements");
     }
-    if o.command == "specimen" {
+    if let Some(height_mm) = height_mm {
         let measured = table1()
             .into_iter()
-            .find(|m| (m.arch_height_mm - o.height_mm).abs() < 1e-9);
+            .find(|m| (m.arch_height_mm - height_mm).abs() < 1e-9);
         out!("\nobserved points (paper §4.4: points 2–5 = G2, G4, G6, G8):");
         out!(
             "{:<6} {:<5} {:>14} {:>14} {:>10}",
@@ -589,17 +571,30 @@ fn report(o: &Options, analysis: &Analysis, results: &Results) {
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    match parse(&args).and_then(|o| run(&o)) {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Specimen {
+            specimen: args,
+            run: o,
+        } => specimen(args, o.friction_law).and_then(|spec| {
+            run(
+                Source::Specimen {
+                    spec,
+                    height_mm: args.height,
+                },
+                o,
+            )
+        }),
+        Command::Model { file, run: o } => run(Source::File(file), o),
+        Command::ExportSpecimen {
+            specimen: args,
+            friction_law,
+        } => specimen(args, *friction_law)
+            .and_then(|spec| spec.model())
+            .map(|model| out!("{}", model.to_json())),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(message) if message.is_empty() => {
-            out!("{USAGE}");
-            if args.iter().any(|a| a == "-h" || a == "--help") {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(2)
-            }
-        }
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::FAILURE

@@ -1,0 +1,161 @@
+//! The command line (clap): commands, their options, and the checks clap can make on them
+//! (numbers, ranges, names). What a value means is checked where it is used (the solver
+//! settings by `SolverSettings::validate`, the model by `Model::validate`).
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use membrane_contact::mech::vtk::Encoding;
+use membrane_contact::mech::{FrictionLaw, IterationMatrix};
+
+/// Geometrically nonlinear ETFE membrane analysis with friction gap elements (Bui & Kawabata's
+/// method): runs a parallel-arch specimen or a model file, stepping every boundary group to its
+/// target and every load to its value, and prints slips, reactions, stresses and Newton
+/// statistics.
+#[derive(Debug, Parser)]
+#[command(name = "membrane-contact", version, max_term_width = 100)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Runs a parallel-arch specimen of the paper (§4) and compares it with Table 1.
+    Specimen {
+        #[command(flatten)]
+        specimen: SpecimenArgs,
+        #[command(flatten)]
+        run: RunArgs,
+    },
+    /// Runs a model file (docs/model-format.md).
+    Model {
+        /// The model file (JSON).
+        file: PathBuf,
+        #[command(flatten)]
+        run: RunArgs,
+    },
+    /// Prints a specimen as a model file (JSON) on standard output.
+    ExportSpecimen {
+        #[command(flatten)]
+        specimen: SpecimenArgs,
+        /// Friction law of every gap.
+        #[arg(long, value_name = "LAW", value_parser = parse_friction_law)]
+        friction_law: Option<FrictionLaw>,
+    },
+}
+
+/// Which specimen.
+#[derive(Debug, Args)]
+pub struct SpecimenArgs {
+    /// Arch height in mm (Table 1 has 200, 300 and 400).
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "MM",
+        default_value_t = 300.0
+    )]
+    pub height: f64,
+    /// Mesh refinement factor (1: 200 triangles).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub refine: u32,
+}
+
+/// Newton iteration matrix.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Matrix {
+    /// The consistent tangent (quadratic convergence).
+    Consistent,
+    /// The paper's symmetric Ju–Rowlands matrix (converges linearly: give it
+    /// --max-iterations 3000).
+    #[value(name = "ju-rowlands", alias = "jr")]
+    JuRowlands,
+}
+
+impl From<Matrix> for IterationMatrix {
+    fn from(m: Matrix) -> Self {
+        match m {
+            Matrix::Consistent => IterationMatrix::Consistent,
+            Matrix::JuRowlands => IterationMatrix::JuRowlands,
+        }
+    }
+}
+
+/// How to run an analysis and what to write.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Friction coefficient of every gap (default: the model's; 0.2 for specimens).
+    #[arg(allow_negative_numbers = true, long, value_name = "X")]
+    pub mu: Option<f64>,
+    /// Friction law of every gap: isotropic (Coulomb cone) or sliding-direction (the paper's
+    /// §2.2: slides along the gap's local x only). Default: the model's.
+    #[arg(long, value_name = "LAW", value_parser = parse_friction_law)]
+    pub friction_law: Option<FrictionLaw>,
+    /// Load steps from the start to the targets of the model file (default 20).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..), conflicts_with = "path")]
+    pub steps: Option<u32>,
+    /// A staged load path instead of the linear ramp: a CSV table, one row per step, whose
+    /// columns are FMU input names (<group>.dx/dy/dz/angle, <set>.pressure, <set>.Fx/Fy/Fz,
+    /// mu) and an optional first column time; inputs without a column keep their FMU start
+    /// values.
+    #[arg(long, value_name = "TABLE.csv")]
+    pub path: Option<PathBuf>,
+    /// Iteration matrix.
+    #[arg(long, value_enum, default_value_t = Matrix::Consistent)]
+    pub matrix: Matrix,
+    /// Newton iterations per increment before it is halved (default 100).
+    #[arg(long, value_name = "N")]
+    pub max_iterations: Option<usize>,
+    /// The largest increment is 1/N of a step (the FMU's solver.incrementsPerStep);
+    /// increments halve on failure and grow back.
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub increments: u32,
+    /// Halvings of an increment before a step fails (default 12).
+    #[arg(long, value_name = "N")]
+    pub max_cutbacks: Option<usize>,
+    /// Relative Newton tolerance on the corrections (default 1e-5; docs/mechanics.md).
+    #[arg(allow_negative_numbers = true, long, value_name = "X")]
+    pub displacement_tolerance: Option<f64>,
+    /// Relative Newton tolerance on the residual (default 1e-5).
+    #[arg(allow_negative_numbers = true, long, value_name = "X")]
+    pub residual_tolerance: Option<f64>,
+    /// Plain Newton steps: about half the iterations when each step starts near its answer,
+    /// no safeguard for a first step from a slack flat film.
+    #[arg(long)]
+    pub no_line_search: bool,
+    /// Write the gap results of every step as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
+    /// Write the element results (stresses, strains, wrinkling state) of every step as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub elements_csv: Option<PathBuf>,
+    /// Write every step as VTK: DIR/<model>_film_NNNN.vtu, DIR/<model>_gaps_NNNN.vtu and a
+    /// .pvd of each for ParaView (the FMU's numbering: 0000 is the initial state).
+    #[arg(long, value_name = "DIR")]
+    pub vtk: Option<PathBuf>,
+    /// VTK encoding: binary (raw appended data) or ascii.
+    #[arg(long, value_name = "F", default_value = "binary", value_parser = parse_encoding)]
+    pub vtk_format: Encoding,
+    /// No progress line on the terminal.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {
+    s.parse()
+}
+
+fn parse_encoding(s: &str) -> Result<Encoding, String> {
+    s.parse()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+}

@@ -1,0 +1,189 @@
+//! Staged load paths for the command line: a CSV table whose rows are steps and whose columns
+//! are the FMU's input names, read through the FMU's variable table (the one place that says
+//! which input moves what), so a table drives the CLI exactly as a master drives the FMU.
+//!
+//! ```csv
+//! time, frame.dz, rail.angle, snow.pressure
+//! 0.5,  -0.05,    0.02,       0
+//! 1.0,  -0.10,    0.05,      -100
+//! ```
+//!
+//! Blank lines and lines starting with `#` are skipped; cells are trimmed. An input without a
+//! column keeps its FMU start value (a group's displacement and angle 0, a load the model
+//! file's, reached in the first step as by the FMU); `mu` applies from the first row when it has
+//! a column. The optional first column `time` (increasing) is the pseudo-time of the VTK
+//! collection; without it, row k of N is at k/N.
+
+use membrane_contact::fmi2::variables::{
+    Causality, Kind, StepInputs, Value, Variable, step_inputs, variables,
+};
+use membrane_contact::mech::Model;
+
+/// The steps of a staged load path.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StagedPath {
+    /// Pseudo-time at the end of each step.
+    pub times: Vec<f64>,
+    /// What each step asks for.
+    pub steps: Vec<StepInputs>,
+}
+
+/// Reads a staged path for `model` from the CSV `text` (`source` names it in errors).
+pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, String> {
+    let table = variables(model, Kind::Model);
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let (header_line, header) = lines
+        .next()
+        .ok_or_else(|| format!("{source}: no header line (the FMU's input names)"))?;
+    let names: Vec<&str> = header.split(',').map(str::trim).collect();
+    let has_time = names.first() == Some(&"time");
+    let columns: Vec<usize> = names[usize::from(has_time)..]
+        .iter()
+        .map(|name| column(&table, name, names.as_slice()))
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{source} line {header_line}: {e}"))?;
+    let mu_given = columns.iter().any(|&c| table[c].name == "mu");
+    let mut values: Vec<Value> = table
+        .iter()
+        .map(|v| v.start.clone().unwrap_or(Value::Real(0.0)))
+        .collect();
+    let (mut times, mut rows) = (Vec::new(), Vec::new());
+    for (line, row) in lines {
+        let cells: Vec<&str> = row.split(',').map(str::trim).collect();
+        if cells.len() != names.len() {
+            return Err(format!(
+                "{source} line {line}: {} cells, the header has {} columns",
+                cells.len(),
+                names.len()
+            ));
+        }
+        let number = |k: usize| -> Result<f64, String> {
+            let v: f64 = cells[k].parse().map_err(|_| {
+                format!(
+                    "{source} line {line}, column '{}': '{}' is not a number",
+                    names[k], cells[k]
+                )
+            })?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(format!(
+                    "{source} line {line}, column '{}': {v} is not finite",
+                    names[k]
+                ))
+            }
+        };
+        if has_time {
+            let t = number(0)?;
+            if let Some(&last) = times.last()
+                && t <= last
+            {
+                return Err(format!(
+                    "{source} line {line}: time {t} does not increase (the row before is at {last})"
+                ));
+            }
+            times.push(t);
+        }
+        for (k, &c) in columns.iter().enumerate() {
+            values[c] = Value::Real(number(k + usize::from(has_time))?);
+        }
+        rows.push(step_inputs(model, &table, &values, mu_given));
+    }
+    if rows.is_empty() {
+        return Err(format!("{source}: no steps (only a header)"));
+    }
+    if !has_time {
+        let n = rows.len() as f64;
+        times = (1..=rows.len()).map(|k| k as f64 / n).collect();
+    }
+    Ok(StagedPath { times, steps: rows })
+}
+
+/// The table row of the input `name`, or an error that says what the name is instead.
+fn column(table: &[Variable], name: &str, header: &[&str]) -> Result<usize, String> {
+    if header.iter().filter(|&&n| n == name).count() > 1 {
+        return Err(format!("column '{name}' appears twice"));
+    }
+    match table.iter().position(|v| v.name == name) {
+        Some(i) if table[i].causality == Causality::Input => Ok(i),
+        Some(i) => Err(format!(
+            "column '{name}' is {} of the FMU, not an input: set it in the model file",
+            match table[i].causality {
+                Causality::Parameter => "a parameter",
+                Causality::Output => "an output",
+                _ => "not an input",
+            }
+        )),
+        None => {
+            let inputs: Vec<&str> = table
+                .iter()
+                .filter(|v| v.causality == Causality::Input)
+                .map(|v| v.name.as_str())
+                .collect();
+            Err(format!(
+                "unknown column '{name}'; the model's inputs are: time (first column), {}",
+                inputs.join(", ")
+            ))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use membrane_contact::mech::ParallelArch;
+
+    fn specimen() -> Model {
+        ParallelArch::default().model().unwrap()
+    }
+
+    #[test]
+    fn rows_become_steps_and_missing_inputs_keep_their_start_values() {
+        let path = read(
+            "# lower the frame, then raise mu\ntime, frame.dz, mu\n0.5, -0.05, 0.2\n\n1.0, -0.15, 0.4\n",
+            &specimen(),
+            "t.csv",
+        )
+        .unwrap();
+        assert_eq!(path.times, vec![0.5, 1.0]);
+        assert_eq!(path.steps[1].targets[0], [0.0, 0.0, -0.15]);
+        assert_eq!(path.steps[0].mu, Some(0.2));
+        assert_eq!(path.steps[1].mu, Some(0.4));
+        let without_time = read("frame.dx\n0.01\n0.02\n", &specimen(), "t.csv").unwrap();
+        assert_eq!(without_time.times, vec![0.5, 1.0]);
+        assert_eq!(without_time.steps[0].mu, None);
+    }
+
+    #[test]
+    fn bad_tables_are_refused_naming_line_and_column() {
+        let cases = [
+            ("", "no header line"),
+            ("frame.dz\n", "no steps"),
+            (
+                "frame.dq\n1\n",
+                "unknown column 'frame.dq'; the model's inputs are: time",
+            ),
+            ("film.E\n1\n", "column 'film.E' is a parameter of the FMU"),
+            ("G1.slip\n1\n", "column 'G1.slip' is an output of the FMU"),
+            ("frame.dz, frame.dz\n1, 2\n", "appears twice"),
+            (
+                "frame.dz\nabc\n",
+                "t.csv line 2, column 'frame.dz': 'abc' is not a number",
+            ),
+            ("frame.dz\nNaN\n", "NaN is not finite"),
+            (
+                "frame.dz, mu\n1\n",
+                "line 2: 1 cells, the header has 2 columns",
+            ),
+            ("time, frame.dz\n1, 0\n1, 0\n", "time 1 does not increase"),
+        ];
+        for (text, expected) in cases {
+            let e = read(text, &specimen(), "t.csv").unwrap_err();
+            assert!(e.contains(expected), "'{e}' lacks '{expected}'");
+        }
+    }
+}
