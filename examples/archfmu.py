@@ -6,8 +6,8 @@ The examples (``fig7_mu_sweep.py``, ``fig8_vs_experiment.py``, ``fig6_stress.py`
 Units: everything returned here is SI (m, N, Pa); the scripts convert slips to mm for the
 figures and CSV files.
 
-* :class:`ArchFMU` wraps one FMI 2.0 Co-Simulation instance (fmpy's low-level ``FMU2Slave``,
-  see ``tests/python/FMPY_NOTES.md``): parameters at initialisation, inputs per step,
+* :class:`ArchFMU` wraps one FMI 2.0 Co-Simulation instance through the package's
+  :class:`membrane_contact.Film` (``python/``): parameters at initialisation, inputs per step,
   ``fmi2Discard`` returned as ``False`` (the FMU keeps its last converged state, time and
   outputs), and :meth:`ArchFMU.step_to` which retries a refused step in halves.
 * :func:`ramp` lowers the frame of a specimen to its target ``dz = -H/2`` in ``steps``
@@ -20,13 +20,19 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import shutil
 import subprocess
 import tempfile
-from ctypes import byref
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+try:
+    from membrane_contact import Film, StepRefused
+    from membrane_contact.film import DISCARD
+except ImportError:  # run from a checkout without the package installed (pip install ./python)
+    sys.path.insert(0, str(ROOT / "python"))
+    from membrane_contact import Film, StepRefused
+    from membrane_contact.film import DISCARD
 DEFAULT_FMU = ROOT / "target" / "fmu" / "ParallelArch.fmu"
 CLI = ROOT / "target" / "release" / "membrane-contact"
 TABLE1 = ROOT / "data" / "table1_sliding.csv"
@@ -36,7 +42,6 @@ GAPS = [f"G{i}" for i in range(1, 10)]
 # Paper §4.4: observed points 1..5 are G1 (crown) and G2, G4, G6, G8.
 OBSERVED = {1: "G1", 2: "G2", 3: "G4", 4: "G6", 5: "G8"}
 STATUS = {0: "open", 1: "stick", 2: "slip"}
-FMI2_DISCARD = 2
 # String parameter of the FMU: write the film and the gaps as VTK (.vtu per step + .pvd) into this
 # directory (encoding: results.vtkFormat, binary by default).
 RESULTS_DIRECTORY = "results.directory"
@@ -118,7 +123,8 @@ def read_table1() -> dict[int, dict[int, float]]:
 
 
 class ArchFMU:
-    """One instance of the ParallelArch FMU (FMI 2.0 Co-Simulation) through fmpy.
+    """One instance of the ParallelArch FMU (FMI 2.0 Co-Simulation) over the package's
+    :class:`membrane_contact.Film`, with the specimen's vocabulary (gaps G1…G9, the frame).
 
     ``parameters`` (name -> value) are set in initialization mode, as are the initial
     ``inputs`` (``mu``, ``frame.dz``, ...). Time is the FMU's pseudo-time: any positive step
@@ -126,65 +132,28 @@ class ArchFMU:
     """
 
     def __init__(self, fmu_path=None, parameters=None, inputs=None, name="arch"):
-        from fmpy import extract, read_model_description
-        from fmpy.fmi2 import FMU2Slave
-
         path = Path(fmu_path or DEFAULT_FMU)
         if not path.is_file():
             raise FileNotFoundError(f"{path} not found; build it with: {BUILD_HINT}")
         self.path = path
-        self.md = read_model_description(str(path))
-        self.variables = {v.name: v for v in self.md.modelVariables}
-        self.messages: list[tuple[int, str, str]] = []
-        self.unzipdir = extract(str(path))
-        self.slave = None
-        try:
-            self._start(FMU2Slave, name, parameters, inputs)
-        except Exception as e:
-            log = self.log_tail()
-            self.close()
-            if type(e).__name__ == "FMICallException":
-                raise RuntimeError(f"{e}; FMU log: {log}") from e
-            raise
-
-    def _start(self, FMU2Slave, name, parameters, inputs):
-        self.slave = FMU2Slave(guid=self.md.guid, unzipDirectory=self.unzipdir,
-                               modelIdentifier=self.md.coSimulation.modelIdentifier,
-                               instanceName=name)
-        self.slave.instantiate(visible=False, callbacks=self._callbacks(), loggingOn=False)
-        self.time = 0.0
+        self.film = Film(path, name=name, logging=False)
+        self.md, self.variables, self.messages = self.film.md, self.film.variables, self.film.messages
         self.inputs = {v.name: float(v.start) for v in self.md.modelVariables
                        if v.causality == "input" and v.type == "Real" and v.start is not None}
+        self.inputs.update(inputs or {})
         # Inputs at the last converged point (inputs set in initialization mode are only
         # reached by the first step): the start of a step that is split after a Discard.
         self.reached = dict(self.inputs)
         self.discards = 0
-        self.slave.setupExperiment(startTime=0.0)
-        self.slave.enterInitializationMode()
-        for k, v in (parameters or {}).items():
-            if v is not None:
-                self.set(k, v)
-        for k, v in (inputs or {}).items():
-            self.set(k, v)
-        self.slave.exitInitializationMode()
+        try:
+            self.film.initialize({k: v for k, v in (parameters or {}).items() if v is not None}, inputs)
+        except Exception:
+            self.close()
+            raise
 
-    def _callbacks(self):
-        """Collect the FMU's log messages in ``self.messages`` (status, category, text)."""
-        from fmpy import calloc, free
-        from fmpy.fmi2 import (fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
-                               fmi2CallbackFunctions, fmi2CallbackLoggerTYPE)
-        from fmpy.logging import addLoggerProxy
-
-        def logger(env, instance, status, category, message):
-            self.messages.append((status, category.decode(errors="replace"),
-                                  message.decode(errors="replace")))
-
-        cb = fmi2CallbackFunctions()
-        cb.logger = fmi2CallbackLoggerTYPE(logger)
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        addLoggerProxy(byref(cb))
-        return cb
+    @property
+    def time(self) -> float:
+        return self.film.time
 
     # -- values
 
@@ -192,37 +161,13 @@ class ArchFMU:
         return name in self.variables
 
     def set(self, name: str, value):
-        v = self.variables.get(name)
-        if v is None:
-            raise KeyError(f"the FMU has no variable '{name}'")
-        vr = [v.valueReference]
-        if v.type == "Real":
-            self.slave.setReal(vr, [float(value)])
-            if v.causality == "input":
-                self.inputs[name] = float(value)
-        elif v.type == "Integer":
-            self.slave.setInteger(vr, [int(value)])
-        elif v.type == "Boolean":
-            self.slave.setBoolean(vr, [bool(value)])
-        elif v.type == "String":
-            self.slave.setString(vr, [str(value)])
-        else:
-            raise TypeError(f"{name}: unsupported type {v.type}")
+        self.film.set({name: value})
+        if self.variables[name].causality == "input":
+            self.inputs[name] = float(value)
 
     def get(self, names: list[str]) -> dict:
-        """Values of ``names`` (batched per type)."""
-        by_type: dict[str, list[str]] = {}
-        for n in names:
-            if n not in self.variables:
-                raise KeyError(f"the FMU has no variable '{n}'")
-            by_type.setdefault(self.variables[n].type, []).append(n)
-        out = {}
-        getter = {"Real": self.slave.getReal, "Integer": self.slave.getInteger,
-                  "Boolean": self.slave.getBoolean, "String": self.slave.getString}
-        for t, ns in by_type.items():
-            vals = getter[t]([self.variables[n].valueReference for n in ns])
-            out.update(zip(ns, vals))
-        return out
+        """Values of ``names``."""
+        return {n: self.film.get(n) for n in names}
 
     def snapshot(self, **extra) -> dict:
         """Gap results, frame reaction and solver statistics now (SI units)."""
@@ -257,33 +202,28 @@ class ArchFMU:
         After a Discard the FMU stays at its last converged point (time, state, outputs), so
         the caller may set other inputs and step again from the same time.
         """
-        from fmpy.fmi1 import FMICallException
-
         for k, v in (inputs or {}).items():
             self.set(k, v)
-        try:
-            self.slave.doStep(self.time, h)
-        except FMICallException as e:
-            if e.status == FMI2_DISCARD:
-                self.discards += 1
-                return False
-            raise RuntimeError(f"{e}; FMU log: {self.log_tail()}") from e
-        self.time += h
+        if self.film.step(h) == DISCARD:
+            self.discards += 1
+            return False
         self.reached = dict(self.inputs)
         return True
 
     def step_to(self, h: float, inputs: dict, max_halvings: int = 8) -> int:
         """Reach ``inputs`` at ``time + h``; a refused step is split in two halves (inputs
-        interpolated linearly), recursively. Returns the number of accepted sub-steps."""
-        start = {k: self.reached.get(k, 0.0) for k in inputs}
-        if self.step(h, inputs):
-            return 1
-        if max_halvings == 0:
-            raise RuntimeError(f"step from t = {self.time} refused even after halving; "
-                               f"FMU log: {self.log_tail()}")
-        mid = {k: 0.5 * (start[k] + v) for k, v in inputs.items()}
-        return (self.step_to(0.5 * h, mid, max_halvings - 1)
-                + self.step_to(0.5 * h, inputs, max_halvings - 1))
+        interpolated linearly), recursively (:meth:`membrane_contact.Film.run`). Returns the
+        number of accepted sub-steps."""
+        before = self.film.time
+        table = {"time": [before + h], **{k: [v] for k, v in inputs.items()}}
+        try:
+            results = self.film.run(table, outputs=[], max_halvings=max_halvings)
+        except StepRefused as e:
+            raise RuntimeError(str(e)) from e
+        self.discards += results.halvings
+        self.inputs.update(inputs)
+        self.reached = dict(self.inputs)
+        return results.steps
 
     def log_tail(self, n: int = 3) -> str:
         return " | ".join(m for _, _, m in self.messages[-n:]) or "(no messages)"
@@ -291,34 +231,23 @@ class ArchFMU:
     # -- FMU state (rollback)
 
     def save(self):
-        """The FMU state at the last converged point (with its time and inputs), for
-        :meth:`restore`."""
-        return (self.slave.getFMUstate(), self.time, dict(self.reached))
+        """The FMU state at the last converged point (with its inputs), for :meth:`restore`."""
+        return (self.film.save(), dict(self.reached))
 
     def restore(self, saved):
         """Back to a saved point (fmi2SetFMUstate); set the inputs again before stepping."""
-        state, t, reached = saved
-        self.slave.setFMUstate(state)
-        self.time = t
+        state, reached = saved
+        self.film.restore(state)
         self.reached = dict(reached)
         self.inputs.update(reached)
 
     def free(self, saved):
-        self.slave.freeFMUstate(saved[0])
+        self.film.free(saved[0])
 
     # -- end
 
     def close(self):
-        slave, self.slave = self.slave, None
-        try:
-            if slave is not None and getattr(slave, "component", None) is not None:
-                try:
-                    slave.terminate()
-                except Exception:
-                    pass  # e.g. still in initialization mode after a failed start
-                slave.freeInstance()
-        finally:
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
+        self.film.close()
 
     def __enter__(self):
         return self

@@ -10,13 +10,14 @@ the slip of every gap beside the paper's Table 1 (observed points 1-5 = G1, G2, 
 import argparse
 import csv
 import pathlib
-import shutil
 import sys
 
-from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
-
 ROOT = pathlib.Path(__file__).resolve().parent.parent
+try:
+    from membrane_contact import Film
+except ImportError:  # run from a checkout without the package installed (pip install ./python)
+    sys.path.insert(0, str(ROOT / "python"))
+    from membrane_contact import Film
 OBSERVED = ["G1", "G2", "G4", "G6", "G8"]
 STATUS = {0: "open", 1: "stick", 2: "slip"}
 
@@ -32,33 +33,15 @@ def table1(height_mm):
 
 def run(fmu, height_mm, mu, steps):
     """Steps frame.dz to -H/2 in `steps` communication steps; returns {gap: (slip mm, status)}."""
-    md = read_model_description(str(fmu))
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    gaps = sorted({n.split(".")[0] for n in vr if n.endswith(".slip")}, key=lambda g: int(g[1:]))
-    unzipdir = extract(str(fmu))
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="specimen")
-    try:
-        slave.instantiate()
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        slave.setReal([vr["archHeight"]], [height_mm / 1000.0])
-        slave.exitInitializationMode()
-        slave.setReal([vr["mu"]], [mu])
-        target = -0.5 * height_mm / 1000.0
-        t, h = 0.0, 1.0 / steps
-        for k in range(1, steps + 1):
-            slave.setReal([vr["frame.dz"]], [target * k / steps])
-            slave.doStep(t, h)
-            t += h
-        slips = slave.getReal([vr[f"{g}.slip"] for g in gaps])
-        status = slave.getInteger([vr[f"{g}.status"] for g in gaps])
-        reaction = slave.getReal([vr["frame.Rz"]])[0]
-        stress = slave.getReal([vr["film.maxEquivalentStress"]])[0]
-        slave.terminate()
-    finally:
-        slave.freeInstance()
-        shutil.rmtree(unzipdir, ignore_errors=True)
+    target = -0.5 * height_mm / 1000.0
+    with Film(fmu, name="specimen") as film:
+        film.initialize(parameters={"archHeight": height_mm / 1000.0}, inputs={"mu": mu})
+        times = [k / steps for k in range(1, steps + 1)]
+        results = film.run({"time": times, "frame.dz": [target * t for t in times]})
+        gaps = film.gaps
+        slips = [results[f"{g}.slip"][-1] for g in gaps]
+        status = [int(results[f"{g}.status"][-1]) for g in gaps]
+        reaction, stress = results["frame.Rz"][-1], results["film.maxEquivalentStress"][-1]
     return {g: (1000.0 * s, STATUS.get(st, st)) for g, s, st in zip(gaps, slips, status)}, reaction, stress
 
 

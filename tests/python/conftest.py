@@ -15,11 +15,15 @@ from __future__ import annotations
 import csv
 import json
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
+# The tests use the package of this checkout (python/), installed or not; test_package.py checks
+# the installed copy separately.
+sys.path.insert(0, str(ROOT / "python"))
 TARGET = ROOT / "target"
 PARALLEL_ARCH_FMU = TARGET / "fmu" / "ParallelArch.fmu"
 CLI = TARGET / "release" / "membrane-contact"

@@ -12,18 +12,11 @@ API verified on this machine in FMPY_NOTES.md. Two additions for tests:
 from __future__ import annotations
 
 import shutil
-from ctypes import byref, c_double, c_int, c_uint
+from ctypes import c_double, c_int, c_uint
 
-from fmpy import calloc, extract, free, read_model_description
+from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import (
-    FMU2Slave,
-    fmi2CallbackAllocateMemoryTYPE,
-    fmi2CallbackFreeMemoryTYPE,
-    fmi2CallbackFunctions,
-    fmi2CallbackLoggerTYPE,
-)
-from fmpy.logging import addLoggerProxy
+from fmpy.fmi2 import FMU2Slave
 
 OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
 _COUNT = 0
@@ -160,34 +153,9 @@ class Slave:
         return any(s == status and text in m for s, _, m in self.messages)
 
 
-# fmpy's native logger proxy (fmpy/logging/<platform>/logging.so) keeps ONE Python logger for
-# the whole process: the last one passed to addLoggerProxy receives the messages of every
-# instance. So there is one module-level logger that routes by instance name, and it is never
-# garbage collected (the proxy may call it after the Slave that registered it is gone).
-_ROUTES: dict[str, list] = {}
-_UNROUTED: list = []
-
-
-def _route(env, instance_name, status, category, message):
-    name = instance_name.decode() if instance_name else ""
-    _ROUTES.get(name, _UNROUTED).append((status, category.decode() if category else "", message.decode()))
-
-
-_LOGGER = fmi2CallbackLoggerTYPE(_route)
-_ALLOCATE = fmi2CallbackAllocateMemoryTYPE(calloc)
-_FREE = fmi2CallbackFreeMemoryTYPE(free)
-
-
-def callbacks_for(messages, instance_name):
-    """fmi2CallbackFunctions whose logger appends (status, category, message) of the instance
-    named ``instance_name`` to ``messages``."""
-    _ROUTES[instance_name] = messages
-    callbacks = fmi2CallbackFunctions()
-    callbacks.logger = _LOGGER
-    callbacks.allocateMemory = _ALLOCATE
-    callbacks.freeMemory = _FREE
-    addLoggerProxy(byref(callbacks))
-    return callbacks
+# fmpy's native logger proxy keeps one Python logger per process: the package routes the
+# messages by instance name (membrane_contact.film.callbacks_for), as these tests need too.
+from membrane_contact.film import callbacks_for  # noqa: E402
 
 
 def vr_array(*vrs):

@@ -214,3 +214,16 @@ def test_discard_is_retried_in_halves(fmu_path, archfmu):
     for g in archfmu.GAPS:
         assert gaps[g]["slip"] == pytest.approx(reference[g]["slip"], abs=5e-5), g
         assert gaps[g]["status"] == reference[g]["status"], g
+
+
+def test_the_readme_own_model_block_runs_as_written():
+    """README's "Your own model" commands, run by bash in the repository as a user would."""
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("## Your own model", 1)[1]
+    block = section.split("```sh\n", 1)[1].split("```", 1)[0]
+    r = subprocess.run(["bash", "-euo", "pipefail", "-c", block], cwd=ROOT, capture_output=True, text=True,
+                       timeout=600)
+    assert r.returncode == 0, f"{r.stdout}\n{r.stderr}"
+    assert "frame reaction Rz" in r.stdout and "FilmOverTwoArches_film.pvd" in r.stdout
+    assert (ROOT / "out" / "own_model" / "vtk" / "FilmOverTwoArches_film_0006.vtu").is_file()
+    assert (ROOT / "out" / "own_model" / "slip.png").stat().st_size > 1000

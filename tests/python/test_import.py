@@ -573,3 +573,30 @@ def test_an_fmu_of_the_imported_model_steps_like_the_cli(model, fmu, cli_run):
         assert s.get("reactions.Rz") == pytest.approx(reaction[2], rel=1e-12)
         status = s.step(1.0, 0.2)  # one more step at the same target: nothing moves
         assert status == OK
+
+
+def test_mesh_to_fmu_to_the_python_package_with_a_staged_path_and_a_rollback(model, fmu, cli_run):
+    """Issue 9's end-to-end path: the gmsh mesh imported with its arch gaps (``model``), packed
+    (``fmu``), driven by ``membrane_contact.Film`` through a staged table (down, a pause, the
+    friction raised) with a rollback to the mid-point that replays the second half exactly; the
+    first half lands on the CLI's steps."""
+    from membrane_contact import Film
+
+    _, rows, _ = cli_run
+    times = [(k + 1) / STEPS for k in range(STEPS)]
+    with Film(fmu) as film:
+        film.initialize(parameters={"solver.incrementsPerStep": 1})
+        first = film.run({"time": times, "frame.dz": [TARGET_DZ * t for t in times]})
+        for k in range(STEPS):
+            row = next(r for r in rows if int(r["step"]) == k + 1 and r["gap"] == "S5")
+            assert first["S5.slip"][k + 1] * 1e3 == pytest.approx(float(row["slip_x_mm"]), abs=2e-6)
+        state = film.save()
+        second_table = {"time": [1.5, 2.0], "frame.dz": [TARGET_DZ, TARGET_DZ * 1.2], "mu": [0.4, 0.4]}
+        second = film.run(second_table)
+        film.restore(state)
+        assert film.time == 1.0 and film["S5.slip"] == first["S5.slip"][-1]
+        replay = film.run(second_table)
+        for name in ("S5.slip", "N7.normalForce", "frame.Rz", "centre.uz"):
+            np.testing.assert_array_equal(replay[name], second[name])
+        names, slips = replay.slips()
+        assert names[:13] == [f"S{i}" for i in range(1, 14)] and slips.shape == (3, 26)

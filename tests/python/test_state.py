@@ -11,6 +11,8 @@ history matters), 2 increments per step.
 
 from __future__ import annotations
 
+import re
+
 from ctypes import byref, c_size_t, c_void_p, create_string_buffer
 
 import pytest
@@ -115,3 +117,30 @@ def test_bad_buffers_and_handles_are_refused(fmu_path, custom_fmu):
         s.fmu.freeFMUstate(state)
         assert s.call("fmi2SetFMUstate", s.c, c_void_p(0x1234)) == ERROR
         s.ramp(RAMP, STEPS, first=2, last=3)
+
+
+def test_models_differing_in_one_number_have_two_guids_and_refuse_each_others_states(tmp_path):
+    """Issue 9 item 5: the GUID covers the model, not only the interface: two FMUs of the hinged
+    panel whose models differ in one node's height (same variables, same XML but the GUID)
+    carry different GUIDs, and a state serialized by one is refused by the other, named."""
+    import json
+
+    from conftest import ROOT, pack
+    from membrane_contact import Film, FmuError
+
+    model = json.loads((ROOT / "examples" / "hinged_panel.json").read_text())
+    paths = []
+    for k, dz in enumerate((0.0, 1e-3)):
+        m = json.loads(json.dumps(model))
+        m["nodes"][40][2] += dz
+        (tmp_path / f"m{k}").mkdir()
+        (tmp_path / f"m{k}" / "model.json").write_text(json.dumps(m))
+        paths.append(pack(tmp_path / f"m{k}" / "model.json", tmp_path / f"m{k}"))
+    with Film(paths[0]) as a, Film(paths[1]) as b:
+        assert a.md.guid != b.md.guid
+        assert [v.name for v in a.md.modelVariables] == [v.name for v in b.md.modelVariables]
+        a.run({"time": [1.0], "rail.angle": [0.05]})
+        data = a.serialize(a.save())
+        b.initialize()
+        with pytest.raises(FmuError, match=re.escape(f"serialized by another FMU (GUID {a.md.guid}); this one is")):
+            b.deserialize(data, time=1.0)

@@ -1,0 +1,173 @@
+"""The Python package ``membrane_contact`` (issue 9 item 3) over the FMUs of this checkout.
+
+TEST GOAL: the package is installed in the venv (``pip install ./python``) and importable from
+anywhere; ``Film`` sets and reads variables by name, and refuses unknown names and bad values
+with the FMU's message; ``Film.run`` steps a staged table to the same outputs as stepping by
+hand with the same inputs; a step the FMU refuses (fmi2Discard) is halved until it passes, and
+the result equals a hand-stepped run over the same sub-steps, bit for bit; when even the
+smallest step is refused, ``StepRefused`` names the time and the FMU's reason and the film
+stays at its last converged state; ``save``/``restore`` and ``serialize``/``deserialize`` roll
+back exactly; results are numpy arrays (slips along the support, reactions); the plotting
+helpers draw slip, reactions and a stress map from the VTK the FMU writes.
+
+MODELS: the ParallelArch FMU (300 mm, frame lowered to −H/2) and the hinged panel example.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from conftest import ROOT, pack
+
+from membrane_contact import Film, FmuError, Results, StepRefused, find_fmu
+from membrane_contact.film import DISCARD, OK
+
+TARGET = -0.15
+
+
+def test_the_package_is_installed_in_the_venv_and_importable_from_anywhere(tmp_path):
+    r = subprocess.run([sys.executable, "-c", "import membrane_contact, sys; print(membrane_contact.__file__, "
+                        "membrane_contact.__version__)"], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    path, version = r.stdout.split()
+    assert "site-packages" in path and version == "0.1.0"
+    r = subprocess.run([sys.executable, "-c", "import membrane_contact.mesh, membrane_contact.arches, "
+                        "membrane_contact.plot"], cwd=tmp_path, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_names_in_and_out_and_bad_values_refused_with_the_fmus_message(fmu_path):
+    with Film(fmu_path) as film:
+        assert "frame.dz" in film.inputs and "G4.slip" in film.outputs and "film.E" in film.parameters
+        assert film.gaps == [f"G{i}" for i in range(1, 10)]
+        film.initialize(parameters={"archHeight": 0.3}, inputs={"mu": 0.3})
+        assert film["mu"] == 0.3 and film.get("archHeight", "mu") == [0.3, 0.3]
+        with pytest.raises(KeyError, match="'frame.dq' is not a variable of ParallelArch"):
+            film.set({"frame.dq": 1.0})
+        with pytest.raises(FmuError, match=r"fmi2SetReal returned fmi2Error: .*frame\.dz = NaN"):
+            film.set({"frame.dz": float("nan")})
+        assert film.step(0.5) == OK and film.time == 0.5
+
+
+def by_hand(fmu_path, times, dz, parameters=None):
+    with Film(fmu_path) as film:
+        film.initialize(parameters=parameters)
+        t = 0.0
+        for ti, zi in zip(times, dz):
+            film.set({"frame.dz": zi})
+            assert film.step(ti - t) == OK
+            t = ti
+        return film.values()
+
+
+def test_staged_table_reaches_what_stepping_by_hand_reaches(fmu_path):
+    times, dz = [0.25, 0.5, 0.75, 1.0], [TARGET * f for f in (0.25, 0.5, 0.75, 1.0)]
+    with Film(fmu_path) as film:
+        # Rows at or before the current time are where the film is: skipped.
+        results = film.run({"time": [0.0, *times], "frame.dz": [0.0, *dz]})
+        assert isinstance(results, Results) and results.steps == 4 and results.halvings == 0
+        np.testing.assert_array_equal(results.time, [0.0, *times])
+        final = film.values()
+    assert final == by_hand(fmu_path, times, dz)
+    # Other table shapes give the same steps.
+    for table in ([{"time": t, "frame.dz": z} for t, z in zip(times, dz)],
+                  np.array(list(zip(times, dz)), dtype=[("time", float), ("frame.dz", float)])):
+        with Film(fmu_path) as film:
+            film.run(table)
+            assert film.values() == final
+    names, slips = results.slips()
+    assert names == [f"G{i}" for i in range(1, 10)] and slips.shape == (5, 9)
+    assert slips[-1, 3] == final["G4.slip"]
+    assert results.reaction("frame")[-1, 2] == final["frame.Rz"]
+    with Film(fmu_path) as film:
+        with pytest.raises(KeyError, match="column 'G1.slip' is an output, not an input"):
+            film.run({"time": [1.0], "G1.slip": [0.0]})
+        with pytest.raises(ValueError, match="times must increase"):
+            film.run({"time": [1.0, 0.5], "frame.dz": [0.0, 0.0]})
+
+
+# One increment per step, no cut-backs inside the FMU, few iterations: lowering the frame to its
+# target in one step is refused, and so are its halves down to 1/32 of it.
+HARD = {"solver.incrementsPerStep": 1, "solver.maxCutbacks": 0, "solver.maxIterations": 10}
+
+
+def test_a_refused_step_is_halved_until_it_passes_and_equals_those_steps_by_hand(fmu_path):
+    with Film(fmu_path) as film:
+        film.initialize(parameters=HARD)
+        results = film.run({"time": [1.0], "frame.dz": [TARGET]})
+        assert results.halvings == 5 and results.steps == 6
+        assert sum(1 for s, _, m in film.messages if s == DISCARD) == 5
+        np.testing.assert_allclose(results.time, [0, 1 / 32, 1 / 16, 1 / 8, 1 / 4, 1 / 2, 1])
+        assert film.time == 1.0
+        final = film.values()
+    times = list(results.time[1:])
+    assert final == by_hand(fmu_path, times, [TARGET * t for t in times], HARD)
+
+
+def test_a_step_refused_after_every_halving_raises_and_keeps_the_last_state(fmu_path):
+    with Film(fmu_path) as film:
+        film.initialize(parameters={**HARD, "solver.maxIterations": 3})
+        before = film.values()
+        with pytest.raises(StepRefused, match=r"from t = 0 toward t = 0.125 even after 3 halvings .*did not converge"):
+            film.run({"time": [1.0], "frame.dz": [TARGET]}, max_halvings=3)
+        assert film.time == 0.0 and film.values() == before
+
+
+def test_save_restore_and_serialized_states_roll_back_exactly(fmu_path):
+    with Film(fmu_path) as film:
+        film.run({"time": [0.5], "frame.dz": [TARGET / 2]})
+        state = film.save()
+        at_save = film.values()
+        data = film.serialize(state)
+        film.run({"time": [1.0], "frame.dz": [TARGET]})
+        reference = film.values()
+        film.restore(state)
+        assert film.time == 0.5 and film.values() == at_save
+        film.run({"time": [1.0], "frame.dz": [TARGET]})
+        assert film.values() == reference
+        again = film.deserialize(data, time=0.5)
+        film.restore(again)
+        assert film.values() == at_save
+        film.free(state)
+        with pytest.raises(ValueError, match="not a state saved by this film"):
+            film.restore(state)
+
+
+def test_plots_draw_slip_reactions_and_a_stress_map(fmu_path, tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from membrane_contact import plot
+
+    vtk = tmp_path / "vtk"
+    with Film(fmu_path) as film:
+        film.initialize(parameters={"results.directory": str(vtk)})
+        results = film.run({"time": [0.5, 1.0], "frame.dz": [TARGET / 2, TARGET]})
+    ax = plot.slip_along_support(results, times=[0.5, 1.0])
+    assert len(ax.lines) == 2 and list(ax.lines[1].get_ydata()) == list(results.slips()[1][-1] * 1e3)
+    ax = plot.reactions_vs_load(results, "time", "frame", components="z")
+    assert list(ax.lines[0].get_ydata()) == list(results["frame.Rz"])
+    ax = plot.stress_map(vtk / "ParallelArch_film_0002.vtu")
+    assert len(ax.collections) == 1 and ax.collections[0].get_array().max() > 1.0  # MPa
+    ax.figure.savefig(tmp_path / "map.png")
+    assert (tmp_path / "map.png").stat().st_size > 1000
+
+
+def test_results_as_pandas_and_other_models(tmp_path):
+    pd = pytest.importorskip("pandas")
+    fmu = pack(ROOT / "examples" / "hinged_panel.json", tmp_path)
+    with Film(fmu) as film:
+        results = film.run({"time": [0.5, 1.0], "rail.angle": [0.05, 0.1], "snow.pressure": [-50, -100]},
+                           outputs=["rail.moment", "mid.uz"])
+    frame = results.to_pandas()
+    assert list(frame.columns) == ["rail.moment", "mid.uz"] and isinstance(frame, pd.DataFrame)
+
+
+def test_find_fmu_says_how_to_make_one_when_there_is_none(monkeypatch):
+    monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
+    assert find_fmu().name == "ParallelArch.fmu"
+    with pytest.raises(FileNotFoundError, match="pack it with"):
+        find_fmu(model="NoSuchModel")
