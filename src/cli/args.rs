@@ -35,6 +35,22 @@ pub enum Command {
         #[command(flatten)]
         run: RunArgs,
     },
+    /// Imports a mesh (gmsh 2.2/4.1 ASCII or binary, or any format meshio reads) with a mapping
+    /// file into a model file, gaps generated along arches (python/README-import.md). Runs the
+    /// Python importer `membrane_contact.mesh` (meshio) of this checkout.
+    Import {
+        /// The mesh file (.msh, or another format meshio reads).
+        mesh: PathBuf,
+        /// The mapping file (JSON): physical groups → element sets, supports, groups, gaps, …
+        mapping: PathBuf,
+        /// The model file to write (default: standard output).
+        #[arg(short, long, value_name = "FILE")]
+        output: Option<PathBuf>,
+        /// The Python interpreter with the package and meshio (default: $MEMBRANE_CONTACT_PYTHON,
+        /// else the checkout's .venv/bin/python, else python3).
+        #[arg(long, value_name = "PATH")]
+        python: Option<PathBuf>,
+    },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {
         #[command(flatten)]

@@ -570,6 +570,53 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     }
 }
 
+/// Runs the Python mesh importer (`python -m membrane_contact.mesh`): one implementation of
+/// the import, on meshio, which reads gmsh 2.2 and 4.1 (the Rust crate mshio reads 4.1 only).
+/// The package is taken from this checkout's `python/` directory when the interpreter lacks it.
+fn import(
+    mesh: &std::path::Path,
+    mapping: &std::path::Path,
+    output: Option<&std::path::Path>,
+    python: Option<&std::path::Path>,
+) -> Result<(), String> {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let python = python
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("MEMBRANE_CONTACT_PYTHON").map(Into::into))
+        .or_else(|| {
+            let venv = root.join(".venv/bin/python");
+            venv.is_file().then_some(venv)
+        })
+        .unwrap_or_else(|| "python3".into());
+    let mut command = std::process::Command::new(&python);
+    command
+        .args(["-m", "membrane_contact.mesh"])
+        .arg(mesh)
+        .arg(mapping);
+    if let Some(output) = output {
+        command.arg("-o").arg(output);
+    }
+    let pythonpath = std::env::var_os("PYTHONPATH").unwrap_or_default();
+    let mut paths = vec![root.join("python")];
+    paths.extend(std::env::split_paths(&pythonpath));
+    command.env(
+        "PYTHONPATH",
+        std::env::join_paths(paths).map_err(|e| e.to_string())?,
+    );
+    let status = command.status().map_err(|e| {
+        format!(
+            "cannot run {} ({e}): give --python, or create the environment with bash fmu/prepare.sh",
+            python.display()
+        )
+    })?;
+    if status.success() {
+        Ok(())
+    } else {
+        // The importer printed its error (naming the bad item) on stderr.
+        Err(format!("the import failed ({status})"))
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -586,6 +633,12 @@ fn main() -> ExitCode {
             )
         }),
         Command::Model { file, run: o } => run(Source::File(file), o),
+        Command::Import {
+            mesh,
+            mapping,
+            output,
+            python,
+        } => import(mesh, mapping, output.as_deref(), python.as_deref()),
         Command::ExportSpecimen {
             specimen: args,
             friction_law,

@@ -600,3 +600,16 @@ def test_mesh_to_fmu_to_the_python_package_with_a_staged_path_and_a_rollback(mod
             np.testing.assert_array_equal(replay[name], second[name])
         names, slips = replay.slips()
         assert names[:13] == [f"S{i}" for i in range(1, 14)] and slips.shape == (3, 26)
+
+
+def test_the_cli_import_command_runs_the_same_importer(model, tmp_path):
+    """``membrane-contact import MESH MAPPING -o FILE`` writes the model import_mesh gives; a bad
+    mapping fails with the importer's message naming it."""
+    out = tmp_path / "model.json"
+    run = subprocess.run([str(CLI), "import", str(MSH22), str(MAPPING), "-o", str(out), "--python", sys.executable],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    assert json.loads(out.read_text()) == json.loads(json.dumps(model))
+    run = subprocess.run([str(CLI), "import", str(MSH22), str(tmp_path / "none.json"), "--python", sys.executable],
+                         capture_output=True, text=True)
+    assert run.returncode == 1 and "none.json" in run.stderr and "the import failed" in run.stderr
