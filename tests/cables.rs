@@ -77,6 +77,7 @@ fn strip(cables: bool, n0: f64) -> Model {
         } else {
             vec![]
         },
+        curved_supports: vec![],
     }
 }
 

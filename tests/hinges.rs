@@ -36,6 +36,7 @@ fn model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model 
         loads: Default::default(),
         outputs: Default::default(),
         cables: vec![],
+        curved_supports: vec![],
     }
 }
 

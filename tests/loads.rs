@@ -65,6 +65,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         loads: LoadSpec::default(),
         outputs: Default::default(),
         cables: vec![],
+        curved_supports: vec![],
     }
 }
 

@@ -57,6 +57,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         loads: Default::default(),
         outputs: Default::default(),
         cables: vec![],
+        curved_supports: vec![],
         name: "Patch".into(),
         description: String::new(),
         nodes,

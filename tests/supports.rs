@@ -64,6 +64,7 @@ fn strip() -> Model {
         loads: Default::default(),
         outputs: Default::default(),
         cables: vec![],
+        curved_supports: vec![],
     }
 }
 

@@ -818,6 +818,16 @@ impl Instance {
                 }
                 Binding::TotalReaction(axis) => Value::Real(results.total_reaction[axis]),
                 Binding::CableForce(c) => Value::Real(results.cables[c].max_force),
+                Binding::SurfaceSlip(c) => Value::Real(results.surface_contacts[c].slip),
+                Binding::SurfaceNormalForce(c) => {
+                    Value::Real(results.surface_contacts[c].normal_force)
+                }
+                Binding::SurfaceFrictionForce(c) => {
+                    Value::Real(results.surface_contacts[c].friction_force)
+                }
+                Binding::SurfaceStatus(c) => {
+                    Value::Integer(results.surface_contacts[c].status as i32)
+                }
                 Binding::PointDisplacement { point, axis } => {
                     Value::Real(results.points[point][axis])
                 }

@@ -6,7 +6,8 @@
 //! output written so far (step count and the states written, so the `.pvd` files continue from
 //! the state).
 //!
-//! Serialized form (little endian), version 5 (version 4 had no group angles, version 3 either no
+//! Serialized form (little endian), version 6 (version 5 had no curved-support contacts, version
+//! 4 no group angles, version 3 either no
 //! load levels or VTK file names instead of state numbers, version 2 neither, version 1 no String values and no VTK
 //! output; older states are refused, as they came from an FMU with another GUID anyway):
 //!
@@ -55,7 +56,7 @@ pub struct Snapshot {
 }
 
 const MAGIC: &[u8; 8] = b"MCFMI2ST";
-const VERSION: u32 = 5;
+const VERSION: u32 = 6;
 
 /// The serialized bytes of `snapshot` for the FMU with `guid`.
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
@@ -150,6 +151,11 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
         ("slip histories", state.plastic_slip.len(), gaps),
         ("group displacements", state.boundary.len(), groups),
         ("group angles", state.angles.len(), groups),
+        (
+            "curved-support contacts",
+            state.contacts.len(),
+            model.curved_supports.iter().map(|s| s.nodes.len()).sum(),
+        ),
         ("friction coefficients", state.friction.len(), gaps),
         ("gap statuses", state.status.len(), gaps),
     ];
@@ -214,6 +220,20 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             return Err(format!(
                 "the state's angle of group [{g}] '{}' is {angle} rad: not finite, beyond two turns, or the group has no hinge",
                 group.name
+            ));
+        }
+    }
+    for (k, c) in state.contacts.iter().enumerate() {
+        let values = [c.anchor[0], c.anchor[1], c.angle, c.origin];
+        if values
+            .iter()
+            .any(|v| !v.is_finite() || v.abs() > 1e3 * reach.max(1.0))
+            || !(c.friction >= 0.0 && c.friction <= MAX_FRICTION)
+        {
+            return Err(format!(
+                "the state's curved-support contact [{k}] holds {values:?} with μ = {}: not finite, \
+                 beyond the model's reach, or μ outside [0, {MAX_FRICTION}]",
+                c.friction
             ));
         }
     }

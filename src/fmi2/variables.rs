@@ -36,6 +36,7 @@
 //! | `<support set>.Rx/.Ry/.Rz` | Real | output | N | total reaction of a named support set |
 //! | `reactions.Rx/.Ry/.Rz` | Real | output | N | sum of all restraint forces (supports, symmetry, groups) |
 //! | `<cable>.maxForce` | Real | output | N | largest axial force of a tension-only cable |
+//! | `<support>.node<v>.slip/.normalForce/.frictionForce/.status` | Real, Integer | output | m, N | node-to-surface contact on a curved support: arc length slid along it, forces, status |
 //! | `<point>.ux/.uy/.uz` | Real | output | m | displacement of a named output point |
 //! | `<set>.maxPrincipalStress/.minPrincipalStress/.maxEquivalentStress/.maxStrain/.compressedArea` | Real | output | Pa, 1, m2 | field summary of a named element set |
 
@@ -228,6 +229,12 @@ pub enum Binding {
     TotalReaction(usize),
     /// Largest axial force of a cable.
     CableForce(usize),
+    /// Slip along the support, normal force, friction force and status of a curved-support
+    /// contact (model order).
+    SurfaceSlip(usize),
+    SurfaceNormalForce(usize),
+    SurfaceFrictionForce(usize),
+    SurfaceStatus(usize),
     /// Displacement of an output point along axis 0, 1, 2.
     PointDisplacement {
         point: usize,
@@ -397,7 +404,13 @@ pub fn check_names(model: &Model) -> Result<(), String> {
     let support_sets = model.support_sets();
     let names = names
         .chain(support_sets.iter().map(|n| ("support set", n)))
-        .chain(model.cables.iter().map(|c| ("cable", &c.name)));
+        .chain(model.cables.iter().map(|c| ("cable", &c.name)))
+        .chain(
+            model
+                .curved_supports
+                .iter()
+                .map(|c| ("curved support", &c.name)),
+        );
     for (kind, name) in names {
         if RESERVED_NAMES.contains(&name.as_str()) {
             return Err(format!(
@@ -820,6 +833,57 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             ),
             Binding::TotalReaction(axis),
         );
+    }
+    let mut contact = 0;
+    for s in &model.curved_supports {
+        for &v in &s.nodes {
+            let prefix = format!("{}.node{v}", s.name);
+            let outputs: [(&str, &'static str, String, Binding); 3] = [
+                (
+                    "slip",
+                    "m",
+                    format!(
+                        "arc length node {v} has slid along curved support '{}' since the start",
+                        s.name
+                    ),
+                    Binding::SurfaceSlip(contact),
+                ),
+                (
+                    "normalForce",
+                    "N",
+                    format!(
+                        "contact force between node {v} and curved support '{}'",
+                        s.name
+                    ),
+                    Binding::SurfaceNormalForce(contact),
+                ),
+                (
+                    "frictionForce",
+                    "N",
+                    format!(
+                        "friction force on node {v} from curved support '{}'",
+                        s.name
+                    ),
+                    Binding::SurfaceFrictionForce(contact),
+                ),
+            ];
+            for (what, unit, description, binding) in outputs {
+                table.output(&format!("{prefix}.{what}"), unit, &description, binding);
+            }
+            table.push(
+                &format!("{prefix}.status"),
+                VarType::Integer,
+                Causality::Output,
+                None,
+                None,
+                &format!(
+                    "status of node {v} on curved support '{}': 0 open, 1 stick, 2 slip",
+                    s.name
+                ),
+                Binding::SurfaceStatus(contact),
+            );
+            contact += 1;
+        }
     }
     for (cable, c) in model.cables.iter().enumerate() {
         table.output(

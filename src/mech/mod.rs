@@ -33,6 +33,7 @@ pub mod scenarios;
 pub mod solver;
 pub mod specimen;
 pub mod summary;
+pub mod surface;
 pub mod vtk;
 
 pub use contact::{FrictionLaw, GapStatus, IterationMatrix};

@@ -15,6 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::contact::{FrictionLaw, GapFrame, GapLaw};
 use super::element::{Material, MembraneTriangle};
+use super::surface::{Centreline, CurvedSupport};
 
 /// A global axis, used for supports and symmetry planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -367,6 +368,10 @@ pub struct Model {
     /// Tension-only edge cables.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub cables: Vec<CableSpec>,
+    /// Rigid curved supports (cylinders, pipe arches) with node-to-surface friction contact
+    /// whose frames follow the contact point ([`super::surface`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub curved_supports: Vec<CurvedSupport>,
 }
 
 /// Why a model is rejected. Every variant names the offending item.
@@ -751,6 +756,7 @@ impl Model {
         self.validate_loads(&mut names)?;
         self.validate_outputs(&mut names)?;
         self.validate_cables(&mut names)?;
+        self.validate_curved_supports(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -822,6 +828,107 @@ impl Model {
     }
 
     /// Checks the `cables` section; cable names join the namespace.
+    fn validate_curved_supports(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        let mut in_triangle = vec![false; self.nodes.len()];
+        for t in &self.triangles {
+            for &v in t {
+                if let Some(x) = in_triangle.get_mut(v) {
+                    *x = true;
+                }
+            }
+        }
+        for s in &self.curved_supports {
+            check_name(names, "curved support", &s.name)?;
+            let bad = |message: String| ModelError::Gap {
+                gap: format!("curved support '{}'", s.name),
+                message,
+            };
+            let (point, axis, ring) = match &s.centreline {
+                Centreline::Line { point, axis } => (*point, *axis, None),
+                Centreline::Circle {
+                    centre,
+                    axis,
+                    radius,
+                    angles,
+                    start_direction,
+                } => {
+                    if !(*radius > 0.0 && radius.is_finite()) {
+                        return Err(bad(format!("centreline radius = {radius} must be > 0")));
+                    }
+                    let finite = angles
+                        .iter()
+                        .flatten()
+                        .chain(start_direction.iter().flatten());
+                    if finite.clone().any(|v| !v.is_finite()) {
+                        return Err(bad("angles or start_direction not finite".into()));
+                    }
+                    if let Some([lo, hi]) = angles
+                        && !(lo < hi)
+                    {
+                        return Err(bad(format!("angles [{lo}, {hi}] must increase")));
+                    }
+                    if let Some(d) = start_direction {
+                        let (d, a) = (Vector3::from(*d), Vector3::from(*axis));
+                        if (d - a * (a.dot(&d) / a.norm_squared())).norm()
+                            < 1e-9 * d.norm().max(1.0)
+                        {
+                            return Err(bad("start_direction is parallel to the axis".into()));
+                        }
+                    }
+                    (*centre, *axis, Some(*radius))
+                }
+            };
+            if point.iter().chain(&axis).any(|v| !v.is_finite()) {
+                return Err(bad("centreline point or axis not finite".into()));
+            }
+            let a = Vector3::from(axis);
+            if a.norm() == 0.0 {
+                return Err(bad("centreline axis is the zero vector".into()));
+            }
+            let positive = |v: f64| v > 0.0 && v.is_finite();
+            for (what, v) in [
+                ("tube_radius", s.tube_radius),
+                ("normal_stiffness", s.normal_stiffness),
+                ("tangential_stiffness", s.tangential_stiffness),
+            ] {
+                if !positive(v) {
+                    return Err(bad(format!("{what} = {v} must be > 0")));
+                }
+            }
+            if !(s.friction >= 0.0 && s.friction <= MAX_FRICTION) {
+                return Err(bad(format!(
+                    "friction μ = {} must lie in [0, {MAX_FRICTION}]",
+                    s.friction
+                )));
+            }
+            if s.nodes.is_empty() {
+                return Err(bad("lists no nodes".into()));
+            }
+            let a = a.normalize();
+            for &v in &s.nodes {
+                let Some(x) = self.nodes.get(v) else {
+                    return Err(ModelError::UnknownNode {
+                        item: format!("curved support '{}'", s.name),
+                        node: v,
+                        node_count: self.nodes.len(),
+                    });
+                };
+                if !in_triangle[v] {
+                    return Err(bad(format!("node {v} belongs to no triangle")));
+                }
+                let rel = Vector3::from(*x) - Vector3::from(point);
+                let rho = (rel - a * a.dot(&rel)).norm();
+                let scale = ring.unwrap_or(s.tube_radius);
+                if rho < 1e-9 * scale {
+                    return Err(bad(format!(
+                        "node {v} lies on the centreline's axis: its closest point is undefined"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn validate_cables(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
         if self.cables.is_empty() {
             return Ok(());

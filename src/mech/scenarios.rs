@@ -677,6 +677,7 @@ impl ArchPanel {
             loads: Default::default(),
             outputs: Default::default(),
             cables: vec![],
+            curved_supports: vec![],
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",
@@ -847,6 +848,7 @@ impl CylinderStrip {
             loads: Default::default(),
             outputs: Default::default(),
             cables: vec![],
+            curved_supports: vec![],
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,
@@ -989,6 +991,7 @@ impl ArchEdge {
             loads: Default::default(),
             outputs: Default::default(),
             cables: vec![],
+            curved_supports: vec![],
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",
@@ -1257,6 +1260,7 @@ impl CircularMembrane {
                 }],
             },
             cables: vec![],
+            curved_supports: vec![],
         })
     }
 }

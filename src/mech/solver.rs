@@ -21,6 +21,7 @@ use super::load::{ExternalLoad, LoadLevels, Loads};
 use super::material::Wrinkling;
 use super::model::{Hinge, Model, ModelError};
 use super::summary::{FieldSummary, summarize};
+use super::surface::{ContactHistory, ContactResponse, SurfaceContactResult, SurfaceContacts};
 
 /// Newton and increment-control settings.
 ///
@@ -110,6 +111,9 @@ pub struct AnalysisState {
     pub friction: Vec<f64>,
     /// Status of each gap at convergence.
     pub status: Vec<GapStatus>,
+    /// History of each curved-support contact ([`super::surface`]): anchor, angle, status, μ.
+    #[serde(default)]
+    pub contacts: Vec<ContactHistory>,
     /// Displacement change of the last converged increment (empty before the first): the
     /// predictor of the next increment when the boundary keeps moving the same way.
     #[serde(default)]
@@ -127,6 +131,11 @@ impl AnalysisState {
             .chain(&self.friction)
             .chain(&self.last_increment)
             .all(|v| v.is_finite())
+            && self.contacts.iter().all(|c| {
+                [c.anchor[0], c.anchor[1], c.angle, c.origin, c.friction]
+                    .iter()
+                    .all(|v| v.is_finite())
+            })
             && self.loads.is_finite()
     }
 }
@@ -417,6 +426,9 @@ pub struct Results {
     pub moments: Vec<f64>,
     /// Largest axial force and slack segments of each cable.
     pub cables: Vec<CableResult>,
+    /// Slip along the support, forces and status of each curved-support contact (model order:
+    /// supports, then their nodes).
+    pub surface_contacts: Vec<SurfaceContactResult>,
     /// Total reaction of each named support set (N), global axes, over its fixed components.
     pub support_reactions: Vec<[f64; 3]>,
     /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the
@@ -456,6 +468,8 @@ pub struct Analysis {
     loads: Loads,
     /// Tension-only edge cables.
     cables: Cables,
+    /// Node-to-surface contacts on curved supports.
+    surfaces: SurfaceContacts,
     state: AnalysisState,
     work: Workspace,
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
@@ -478,6 +492,10 @@ struct Workspace {
     closed: Vec<bool>,
     /// Slot of each free DOF's diagonal entry in `values` (for the Levenberg–Marquardt shift).
     diagonal: Vec<usize>,
+    /// Curved-support contact histories at the start of the increment, and the responses at
+    /// the last assembled iterate.
+    contact_start: Vec<ContactHistory>,
+    contact_responses: Vec<ContactResponse>,
 }
 
 impl Analysis {
@@ -504,7 +522,11 @@ impl Analysis {
                 .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
                 .collect(),
             last_increment: Vec::new(),
+            contacts: Vec::new(),
         };
+        let surfaces = SurfaceContacts::new(&model);
+        let mut state = state;
+        state.contacts = surfaces.initial_histories(&model);
         let idle = laws
             .first()
             .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()));
@@ -516,6 +538,8 @@ impl Analysis {
             latched: vec![None; laws.len()],
             closed: vec![false; laws.len()],
             diagonal: diagonal_slots(&system),
+            contact_start: state.contacts.clone(),
+            contact_responses: Vec::new(),
         };
         let loads = Loads::new(&model, &system);
         let cables = Cables::new(&model);
@@ -529,6 +553,7 @@ impl Analysis {
             linear,
             loads,
             cables,
+            surfaces,
             state,
             work,
             length_scale,
@@ -578,6 +603,7 @@ impl Analysis {
             || state.plastic_slip.len() != s.plastic_slip.len()
             || state.boundary.len() != s.boundary.len()
             || state.angles.len() != s.angles.len()
+            || state.contacts.len() != s.contacts.len()
             || state.friction.len() != s.friction.len()
             || state.status.len() != s.status.len()
             || !(state.last_increment.is_empty()
@@ -608,6 +634,7 @@ impl Analysis {
             return Err(format!("friction coefficient {mu} must be finite and ≥ 0"));
         }
         self.state.friction.iter_mut().for_each(|m| *m = mu);
+        self.state.contacts.iter_mut().for_each(|c| c.friction = mu);
         Ok(())
     }
 
@@ -908,6 +935,7 @@ impl Analysis {
             }
         }
         let (laws, history) = self.laws_and_history(start);
+        self.work.contact_start.clone_from(&start.contacts);
         self.work.latched.iter_mut().for_each(|l| *l = None);
         self.work.closed.iter_mut().for_each(|c| *c = false);
         let mut correction_norm = f64::INFINITY;
@@ -953,6 +981,10 @@ impl Analysis {
                         .iter()
                         .map(|r| r.plastic_slip.into())
                         .collect(),
+                    contacts: SurfaceContacts::commit(
+                        &self.work.contact_responses,
+                        &start.contacts,
+                    ),
                     boundary: motion.translation.clone(),
                     angles: motion.angles.clone(),
                     loads: levels.clone(),
@@ -1239,6 +1271,8 @@ impl Analysis {
             responses,
             latched,
             closed,
+            contact_start,
+            contact_responses,
             ..
         } = &mut self.work;
         let mut values = iteration.map(|_| values.as_mut_slice());
@@ -1281,7 +1315,15 @@ impl Analysis {
         self.loads
             .add_to(&self.system, levels, u, internal, values.as_deref_mut());
         self.cables
-            .add_to(&self.system, levels, u, internal, values);
+            .add_to(&self.system, levels, u, internal, values.as_deref_mut());
+        self.surfaces.add_to(
+            &self.system,
+            u,
+            contact_start,
+            internal,
+            values,
+            contact_responses,
+        );
         self.free_norm_inf()
     }
 
@@ -1390,6 +1432,7 @@ impl Analysis {
             reactions,
             moments,
             cables,
+            surface_contacts: self.surfaces.results(u, &self.state.contacts),
             support_reactions,
             total_reaction,
             elements,

@@ -225,6 +225,7 @@ impl ParallelArch {
             loads: Default::default(),
             outputs: Default::default(),
             cables: vec![],
+            curved_supports: vec![],
             name: "ParallelArch".into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

@@ -1,0 +1,408 @@
+//! Node-to-surface contact on curved supports (issue 10): `mech::surface` through the solver.
+//!
+//! TEST GOAL: (1) a film node pressed onto a rigid cylinder and dragged a full quarter-turn
+//! around it (its film patch turned about the cylinder's axis by a hinged group) stays at one
+//! radius, `r − λN/k_n`, and reports as slip the arc length `r Δφ` of its own position; without
+//! friction it follows the turn exactly, with friction it lags and slides at `|T| = μN`; the
+//! (2) a strip wrapped half-way round a cylinder and pulled at one end until it slides
+//! over every station reaches the capstan ratio of its polygon of stations (within 1 %; the
+//! continuous `e^{μθ}` differs from it by the polygon's coarseness), closer than the paper's
+//! fixed-frame gaps at the same stations.
+//!
+//! MODELS: (1) a 3 × 3-node patch (8 triangles, 20 mm) tangent to a cylinder of radius 0.1 m
+//! (axis y), its 8 rim nodes one hinged group lowered 2 mm so the film presses the centre node
+//! onto the cylinder; (2) a 20 mm wide strip (ν = 0) over a cylinder of radius 0.1 m, `n`
+//! stations on the half circle, vertical legs of 0.1 m, the left end held, the right end
+//! pulled down.
+
+use membrane_contact::mech::contact::GapFrame;
+use membrane_contact::mech::contact::{FrictionLaw, GapStatus};
+use membrane_contact::mech::model::{BoundaryGroup, GapSpec, GapSupport, Hinge, Model};
+use membrane_contact::mech::surface::{Centreline, CurvedSupport};
+use membrane_contact::mech::{Analysis, LoadLevels, ParallelArch, SolverSettings};
+use nalgebra::Vector3;
+
+const R: f64 = 0.1;
+
+fn cylinder(name: &str, nodes: Vec<usize>, mu: f64, kn: f64) -> CurvedSupport {
+    CurvedSupport {
+        name: name.into(),
+        centreline: Centreline::Line {
+            point: [0.0, 0.0, 0.0],
+            axis: [0.0, 1.0, 0.0],
+        },
+        tube_radius: R,
+        nodes,
+        normal_stiffness: kn,
+        tangential_stiffness: 0.2 * kn,
+        friction: mu,
+        friction_law: FrictionLaw::Isotropic,
+    }
+}
+
+fn empty_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model {
+    Model {
+        name: name.into(),
+        description: String::new(),
+        nodes,
+        triangles,
+        material: ParallelArch::default().material,
+        supports: vec![],
+        symmetry: vec![],
+        gaps: vec![],
+        groups: vec![],
+        loads: Default::default(),
+        outputs: Default::default(),
+        cables: vec![],
+        curved_supports: vec![],
+    }
+}
+
+/// The patch: centre node 0 on top of the cylinder, rim nodes 1..=8 around it lowered by `dip`,
+/// all rim nodes one group turning about the cylinder's axis.
+fn patch(mu: f64) -> Model {
+    let (h, dip) = (0.01, 0.002);
+    let mut nodes = vec![[0.0, 0.0, R]];
+    let ring = [
+        (1, 0),
+        (1, 1),
+        (0, 1),
+        (-1, 1),
+        (-1, 0),
+        (-1, -1),
+        (0, -1),
+        (1, -1),
+    ];
+    for (i, j) in ring {
+        nodes.push([i as f64 * h, j as f64 * h, R - dip]);
+    }
+    let triangles = (0..8).map(|k| [0, 1 + k, 1 + (k + 1) % 8]).collect();
+    let mut m = empty_model("Patch", nodes, triangles);
+    m.groups.push(BoundaryGroup {
+        name: "rim".into(),
+        nodes: (1..=8).collect(),
+        target: [0.0; 3],
+        components: None,
+        hinge: Some(Hinge {
+            point: [0.0, 0.0, 0.0],
+            axis: [0.0, 1.0, 0.0],
+            target_angle: 0.0,
+        }),
+    });
+    m.curved_supports.push(cylinder("drum", vec![0], mu, 1.0e6));
+    m
+}
+
+#[test]
+fn node_dragged_a_quarter_turn_round_a_cylinder_keeps_its_radius_and_reports_the_arc_length() {
+    for mu in [0.0, 0.3] {
+        let m = patch(mu);
+        let mut analysis = Analysis::new(m.clone(), SolverSettings::default()).unwrap();
+        let loads = LoadLevels::zero(&m);
+        let steps = 18;
+        let mut radius_seen: Option<f64> = None;
+        for k in 1..=steps {
+            // The rim turns about +y: a point on top (+z) moves toward +x.
+            let theta = std::f64::consts::FRAC_PI_2 * k as f64 / steps as f64;
+            analysis
+                .step_to_motion(&[[0.0; 3]], &[theta], &loads, 2)
+                .unwrap_or_else(|e| panic!("μ = {mu}, step {k}: {e}"));
+            let x = Vector3::from(m.nodes[0]) + analysis.node_displacement(0);
+            let radius = x.x.hypot(x.z);
+            let contact = analysis.results().surface_contacts[0];
+            assert!(contact.normal_force > 0.0, "μ = {mu}, step {k}: no contact");
+            // The penalty's depth, the same at every step.
+            let expected = R - contact.normal_force / 1.0e6;
+            assert!(
+                (radius - expected).abs() < 1e-12,
+                "μ = {mu}, step {k}: {radius} vs {expected}"
+            );
+            if let Some(first) = radius_seen {
+                assert!(
+                    (radius - first).abs() < 1e-3 * (R - first),
+                    "μ = {mu}: radius drifts"
+                );
+            }
+            radius_seen.get_or_insert(radius);
+            // Slip = r × the angle the node has travelled (from +z toward +x about +y).
+            let travelled = x.x.atan2(x.z);
+            assert!(
+                (contact.slip - R * travelled).abs() < 1e-12,
+                "μ = {mu}, step {k}: slip {} vs arc {}",
+                contact.slip,
+                R * travelled
+            );
+            if mu == 0.0 {
+                assert!(
+                    (travelled - theta).abs() < 1e-9,
+                    "frictionless: follows the turn"
+                );
+                assert_eq!(contact.friction_force, 0.0);
+            } else if k > 2 {
+                assert_eq!(contact.status, GapStatus::Slip, "step {k}");
+                assert!(
+                    (contact.friction_force - mu * contact.normal_force).abs()
+                        < 1e-9 * contact.normal_force,
+                    "step {k}"
+                );
+                assert!(travelled < theta, "friction makes the node lag");
+            }
+        }
+        let slip = analysis.results().surface_contacts[0].slip;
+        println!(
+            "μ = {mu}: slip after a quarter turn {slip:.6} m (r π/2 = {:.6} m)",
+            R * std::f64::consts::FRAC_PI_2
+        );
+        assert!(slip > 0.9 * R * std::f64::consts::FRAC_PI_2);
+    }
+}
+
+/// The strip: `n` segments on the half circle (stations at θ = 0…π in the x–z plane, 0 at
+/// +x), legs of `LEG` down from both ends in `legs` segments; two nodes across (y = 0, W).
+const W: f64 = 0.02;
+const LEG: f64 = 0.1;
+
+fn strip(n: usize, mu: f64) -> (Model, Vec<usize>) {
+    let legs = 4;
+    let mut line = vec![];
+    // Right leg from the bottom up, the arc from θ = 0 to π, the left leg down.
+    for k in 0..legs {
+        line.push([R, -LEG * (legs - k) as f64 / legs as f64]);
+    }
+    for i in 0..=n {
+        let th = std::f64::consts::PI * i as f64 / n as f64;
+        line.push([R * th.cos(), R * th.sin()]);
+    }
+    for k in 1..=legs {
+        line.push([-R, -LEG * k as f64 / legs as f64]);
+    }
+    let mut nodes = vec![];
+    for p in &line {
+        nodes.push([p[0], 0.0, p[1]]);
+        nodes.push([p[0], W, p[1]]);
+    }
+    let mut triangles = vec![];
+    for k in 0..line.len() - 1 {
+        let (a, b, c, d) = (2 * k, 2 * k + 1, 2 * k + 2, 2 * k + 3);
+        triangles.push([a, c, d]);
+        triangles.push([a, d, b]);
+    }
+    let mut m = empty_model("Capstan", nodes, triangles);
+    m.material.poisson_ratio = 0.0;
+    m.material.prestress = [1.0e6, 1.0e6, 0.0];
+    let last = line.len() - 1;
+    for (name, k) in [("pulled", 0), ("held", last)] {
+        m.groups.push(BoundaryGroup {
+            name: name.into(),
+            nodes: vec![2 * k, 2 * k + 1],
+            target: [0.0; 3],
+            components: None,
+            hinge: None,
+        });
+    }
+    let stations: Vec<usize> = (legs..=legs + n).flat_map(|k| [2 * k, 2 * k + 1]).collect();
+    m.curved_supports
+        .push(cylinder("drum", stations.clone(), mu, 1.0e7));
+    (m, stations)
+}
+
+/// Tension ratio of a polygon of stations: the end stations turn the strip by Δθ/2, the others
+/// by Δθ; at each, `(T_out − T_in) cos(α/2) = μ (T_in + T_out) sin(α/2)`.
+fn polygon_ratio(n: usize, mu: f64) -> f64 {
+    let q = |alpha: f64| (1.0 + mu * (alpha / 2.0).tan()) / (1.0 - mu * (alpha / 2.0).tan());
+    let dt = std::f64::consts::PI / n as f64;
+    q(dt).powi(n as i32 - 1) * q(dt / 2.0).powi(2)
+}
+
+/// The same strip on the paper's fixed-frame gaps: at each station a gap to the cylinder's
+/// surface point, `z` radial and `x` along the circle, fixed at the start (§4.3).
+fn strip_on_gaps(n: usize, mu: f64) -> Model {
+    let (mut m, stations) = strip(n, mu);
+    let drum = m.curved_supports.remove(0);
+    for v in stations {
+        let p = m.nodes[v];
+        let z = Vector3::new(p[0], 0.0, p[2]) / R;
+        let x = Vector3::new(-z.z, 0.0, z.x);
+        m.gaps.push(GapSpec {
+            name: format!("G{v}"),
+            film_node: v,
+            support: GapSupport::Point(p),
+            frame: GapFrame {
+                x: x.into(),
+                y: z.cross(&x).into(),
+                z: z.into(),
+            },
+            initial_gap: 0.0,
+            normal_stiffness: drum.normal_stiffness,
+            tangential_stiffness: drum.tangential_stiffness,
+            friction: mu,
+            friction_law: FrictionLaw::Isotropic,
+        });
+    }
+    m
+}
+
+/// Pulls the strip's right end down in steps of 0.5 mm until every station slides (or 20
+/// steps); the tension ratio `T2/T1` from the two ends' reactions.
+fn pull_until_sliding(m: &Model) -> f64 {
+    let mut analysis = Analysis::new(m.clone(), SolverSettings::default()).unwrap();
+    let mut ratio = 0.0;
+    for k in 1..=20 {
+        let pull = -0.0005 * k as f64;
+        analysis
+            .step_to(&[[0.0, 0.0, pull], [0.0; 3]], 4)
+            .unwrap_or_else(|e| panic!("{}, step {k}: {e}", m.name));
+        let r = analysis.results();
+        let (t2, t1) = (-r.reactions[0][2], -r.reactions[1][2]);
+        ratio = t2 / t1;
+        let sliding = |s: GapStatus| s == GapStatus::Slip;
+        if r.surface_contacts.iter().all(|c| sliding(c.status))
+            && r.gaps.iter().all(|g| sliding(g.status))
+        {
+            break;
+        }
+    }
+    ratio
+}
+
+#[test]
+fn strip_pulled_over_a_cylinder_reaches_the_capstan_ratio_of_its_stations() {
+    let mu = 0.3;
+    for n in [6, 12] {
+        let (m, _) = strip(n, mu);
+        let ratio = pull_until_sliding(&m);
+        let gaps = pull_until_sliding(&strip_on_gaps(n, mu));
+        let target = polygon_ratio(n, mu);
+        let continuous = (mu * std::f64::consts::PI).exp();
+        println!(
+            "n = {n}: T2/T1 = {ratio:.5} curved support, {gaps:.5} fixed-frame gaps; polygon {target:.5}, e^(μπ) = {continuous:.5}"
+        );
+        assert!(
+            (ratio / target - 1.0).abs() < 0.01,
+            "n = {n}: {ratio} vs {target}"
+        );
+        // The gaps' normals stay where the stations started while the strip stretches and
+        // slides along the circle: their ratio is further from the polygon's.
+        assert!(
+            (ratio - target).abs() < (gaps - target).abs(),
+            "n = {n}: curved {ratio}, gaps {gaps}, polygon {target}"
+        );
+    }
+}
+
+#[test]
+fn curved_supports_read_from_model_files_and_bad_ones_are_refused_by_name() {
+    let m = patch(0.2);
+    let text = m.to_json();
+    assert!(
+        text.contains("\"curved_supports\"") && text.contains("\"line\""),
+        "{text}"
+    );
+    assert_eq!(Model::from_json(&text).unwrap(), m);
+    let ring = r#"{"name": "pipe", "centreline": {"circle": {"centre": [0, 0, -2], "axis": [0, 1, 0],
+        "radius": 2.1, "angles": [0.5, 2.6]}}, "tube_radius": 0.02, "nodes": [0],
+        "normal_stiffness": 1e7, "tangential_stiffness": 1e6, "friction": 0.2,
+        "friction_law": "sliding-direction"}"#;
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    value["curved_supports"]
+        .as_array_mut()
+        .unwrap()
+        .insert(0, serde_json::from_str(ring).unwrap());
+    let parsed = Model::from_json(&value.to_string()).unwrap();
+    assert_eq!(parsed.curved_supports.len(), 2);
+    assert_eq!(
+        parsed.curved_supports[0].friction_law,
+        FrictionLaw::SlidingDirection
+    );
+    let cases: Vec<(Box<dyn Fn(&mut CurvedSupport)>, &str)> = vec![
+        (
+            Box::new(|s| s.tube_radius = 0.0),
+            "tube_radius = 0 must be > 0",
+        ),
+        (Box::new(|s| s.nodes = vec![99]), "node 99"),
+        (Box::new(|s| s.nodes.clear()), "lists no nodes"),
+        (Box::new(|s| s.friction = -1.0), "friction μ = -1"),
+        (
+            Box::new(|s| {
+                s.centreline = Centreline::Line {
+                    point: [0.0; 3],
+                    axis: [0.0; 3],
+                }
+            }),
+            "axis is the zero vector",
+        ),
+        (
+            Box::new(|s| {
+                s.centreline = Centreline::Line {
+                    point: [0.0, 0.0, R],
+                    axis: [0.0, 1.0, 0.0],
+                }
+            }),
+            "node 0 lies on the centreline's axis",
+        ),
+        (
+            Box::new(|s| {
+                s.centreline = Centreline::Circle {
+                    centre: [0.0; 3],
+                    axis: [0.0, 1.0, 0.0],
+                    radius: 0.1,
+                    angles: Some([1.0, 0.5]),
+                    start_direction: None,
+                }
+            }),
+            "angles [1, 0.5] must increase",
+        ),
+    ];
+    for (change, expected) in cases {
+        let mut bad = patch(0.2);
+        change(&mut bad.curved_supports[0]);
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("curved support 'drum'") && e.contains(expected),
+            "{e}"
+        );
+    }
+    let typo = text.replace("\"tube_radius\"", "\"tube_radios\"");
+    assert!(
+        Model::from_json(&typo)
+            .unwrap_err()
+            .to_string()
+            .contains("tube_radios")
+    );
+}
+
+#[test]
+fn fmu_reports_each_contact_node_and_states_carry_the_contact_history() {
+    use membrane_contact::fmi2::description::describe;
+    use membrane_contact::fmi2::resources::Source;
+    let m = patch(0.3);
+    let d = describe(&Source::Model(m.clone())).unwrap();
+    let names: Vec<&str> = d.variables.iter().map(|v| v.name.as_str()).collect();
+    for suffix in ["slip", "normalForce", "frictionForce", "status"] {
+        assert!(
+            names.contains(&format!("drum.node0.{suffix}").as_str()),
+            "{suffix}"
+        );
+    }
+    let mut analysis = Analysis::new(m.clone(), SolverSettings::default()).unwrap();
+    analysis
+        .step_to_motion(&[[0.0; 3]], &[0.3], &LoadLevels::zero(&m), 4)
+        .unwrap();
+    let saved = analysis.state().clone();
+    assert_eq!(saved.contacts[0].status, GapStatus::Slip);
+    membrane_contact::fmi2::state::check_analysis_state(&m, &saved).unwrap();
+    let mut broken = saved.clone();
+    broken.contacts.clear();
+    let e = membrane_contact::fmi2::state::check_analysis_state(&m, &broken).unwrap_err();
+    assert!(e.contains("curved-support contacts"), "{e}");
+    // Continuing from a restored state repeats the original exactly.
+    analysis
+        .step_to_motion(&[[0.0; 3]], &[0.6], &LoadLevels::zero(&m), 4)
+        .unwrap();
+    let reference = analysis.results().surface_contacts;
+    analysis.set_state(saved).unwrap();
+    analysis
+        .step_to_motion(&[[0.0; 3]], &[0.6], &LoadLevels::zero(&m), 4)
+        .unwrap();
+    assert_eq!(analysis.results().surface_contacts, reference);
+}
