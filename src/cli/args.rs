@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use membrane_contact::mech::specimen::SpecimenContact;
 use membrane_contact::mech::vtk::Encoding;
 use membrane_contact::mech::{FrictionLaw, IterationMatrix};
 
@@ -75,6 +76,13 @@ pub struct SpecimenArgs {
     /// Mesh refinement factor (1: 200 triangles).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub refine: u32,
+    /// Contact between film and arch: gaps (the paper's fixed-frame gap elements) or
+    /// curved-support (node-to-surface contact with the arch pipe; slip along the arch).
+    #[arg(long, value_name = "MODEL", default_value = "gaps", value_parser = parse_contact)]
+    pub contact: SpecimenContact,
+    /// Frame target dz as a multiple of the arch height (default -0.5: lowered by H/2).
+    #[arg(allow_negative_numbers = true, long, value_name = "X")]
+    pub target_dz_per_height: Option<f64>,
 }
 
 /// Newton iteration matrix.
@@ -158,6 +166,10 @@ pub struct RunArgs {
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {
+    s.parse()
+}
+
+fn parse_contact(s: &str) -> Result<SpecimenContact, String> {
     s.parse()
 }
 

@@ -55,9 +55,14 @@ enum Source<'a> {
 }
 
 fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArch, String> {
+    let defaults = ParallelArch::default();
     let spec = ParallelArch {
         refinement: args.refine as usize,
         friction_law: law.unwrap_or_default(),
+        contact: args.contact,
+        target_dz_per_height: args
+            .target_dz_per_height
+            .unwrap_or(defaults.target_dz_per_height),
         ..ParallelArch::with_height(args.height / 1000.0)
     };
     spec.check()?;
@@ -455,6 +460,30 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             r.status
         );
     }
+    if !model.curved_supports.is_empty() {
+        out!(
+            "\n{:<14} {:>11} {:>11} {:>10} {:>10}  status   (curved supports: slip = arc length along the support)",
+            "contact",
+            "slip mm",
+            "across mm",
+            "N (N)",
+            "|T| (N)"
+        );
+    }
+    let contacts = model
+        .curved_supports
+        .iter()
+        .flat_map(|s| s.nodes.iter().map(move |v| format!("{}.node{v}", s.name)));
+    for (name, c) in contacts.zip(&results.surface_contacts) {
+        out!(
+            "{name:<14} {:>11.3} {:>11.3} {:>10.3} {:>10.3}  {:?}",
+            c.slip * 1e3,
+            c.slip_across * 1e3,
+            c.normal_force,
+            c.friction_force,
+            c.status
+        );
+    }
     for (i, (g, r)) in model.groups.iter().zip(&results.reactions).enumerate() {
         out!(
             "reaction of group {}: ({:.3}, {:.3}, {:.3}) N",
@@ -541,10 +570,17 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             "diff mm"
         );
         for (p, name) in OBSERVED_GAPS.iter().enumerate() {
-            let Some(i) = model.gap_index(name) else {
-                continue;
-            };
-            let slip = results.gaps[i].slip_x * 1e3;
+            // G<k> is the k-th film node on the arch: its gap, or its curved-support contact.
+            let slip = match model.gap_index(name) {
+                Some(i) => results.gaps[i].slip_x,
+                None => {
+                    let k: usize = name[1..].parse().unwrap_or(0);
+                    match results.surface_contacts.get(k.wrapping_sub(1)) {
+                        Some(c) => c.slip,
+                        None => continue,
+                    }
+                }
+            } * 1e3;
             match &measured {
                 Some(m) => out!(
                     "{:<6} {:<5} {:>14.2} {:>14.1} {:>10.2}",

@@ -26,6 +26,8 @@
 //! | gaps `G1…G9` | film nodes on the arch line `x = 0.4`, `y = 0, 0.1, …, 0.8` (crown to foot); support = the fixed arch point on the radius through the node; `g0` = the initial distance | §4.2, §4.3 |
 //! | gap frame | `z` from the arch centre to the contact point, `x` = arch tangent towards the foot, `y = z × x` | §4.3 |
 //! | observed points 1–5 | `G1` (crown) and `G2, G4, G6, G8` | §4.4 maps points 2–5 to `G2, G4, G6, G8`; point 1 reads 0 at the crown |
+//! | contact model | the paper's fixed-frame gaps (default); `contact: curved-support` puts the same nine film nodes in node-to-surface contact with the arch itself (`surface.rs`): a ring of radius `R − r_p` about the arch's axis with a tube of radius `r_p`, so that its outer surface is the arch line the gaps use; slip is then the arc length along the arch | §4.3–4.4 and the conclusions name the fixed frames as the model's limit; issue 10 |
+//! | pipe radius `r_p` | 24.3 mm | the arches are steel pipes of unknown size; 48.6 mm is the common Japanese structural/scaffold tube (JIS G 3444 STK400 φ48.6); only the curved-support model uses it (the gaps see the arch line) |
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -33,6 +35,7 @@ use serde::{Deserialize, Serialize};
 use super::contact::{FrictionLaw, GapFrame};
 use super::material::{DEFAULT_WRINKLING_REGULARISATION, Material, Wrinkling};
 use super::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Symmetry};
+use super::surface::{Centreline, CurvedSupport};
 
 /// Measured sliding along the arch at the final step (mm), the paper's Table 1 (points 1–5).
 pub const TABLE1_CSV: &str = include_str!("../../data/table1_sliding.csv");
@@ -68,6 +71,34 @@ pub struct ParallelArch {
     pub target_dz_per_height: f64,
     /// Mesh refinement factor (1 gives the paper's 200 triangles).
     pub refinement: usize,
+    /// Contact model between film and arch.
+    pub contact: SpecimenContact,
+    /// Radius of the arch pipes (m), for [`SpecimenContact::CurvedSupport`].
+    pub pipe_radius: f64,
+}
+
+/// How the film touches the arch in a specimen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpecimenContact {
+    /// The paper's nine node-to-point gap elements with fixed frames (§4.2–4.3).
+    #[default]
+    Gaps,
+    /// The same nine film nodes in node-to-surface contact with the arch pipe (`surface.rs`).
+    CurvedSupport,
+}
+
+impl std::str::FromStr for SpecimenContact {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "gaps" => Ok(Self::Gaps),
+            "curved-support" | "curved" => Ok(Self::CurvedSupport),
+            other => Err(format!(
+                "unknown contact model '{other}' (gaps or curved-support)"
+            )),
+        }
+    }
 }
 
 impl Default for ParallelArch {
@@ -94,6 +125,8 @@ impl Default for ParallelArch {
             friction_law: FrictionLaw::Isotropic,
             target_dz_per_height: -0.5,
             refinement: 1,
+            contact: SpecimenContact::Gaps,
+            pipe_radius: 0.0243,
         }
     }
 }
@@ -152,6 +185,18 @@ impl ParallelArch {
         if !(self.friction >= 0.0 && self.friction.is_finite()) {
             return Err(format!("friction {} must be ≥ 0", self.friction));
         }
+        if !(self.pipe_radius > 0.0 && self.pipe_radius < self.arch_radius()) {
+            return Err(format!(
+                "pipe radius {} must be > 0 and below the arch radius",
+                self.pipe_radius
+            ));
+        }
+        if !(self.target_dz_per_height.is_finite() && self.target_dz_per_height.abs() <= 5.0) {
+            return Err(format!(
+                "target_dz_per_height {} must be finite and within ±5",
+                self.target_dz_per_height
+            ));
+        }
         Ok(())
     }
 
@@ -200,7 +245,7 @@ impl ParallelArch {
         let radius = self.arch_radius();
         let column = (self.arch_offset / dx).round() as usize;
         let kn = self.normal_penalty_factor * self.material.membrane_stiffness();
-        let gaps = (0..GAP_COUNT)
+        let gaps: Vec<GapSpec> = (0..GAP_COUNT)
             .map(|k| {
                 let node = id(column, k * r);
                 let a = Vector3::from(nodes[node]);
@@ -221,11 +266,36 @@ impl ParallelArch {
                 }
             })
             .collect();
+        let (gaps, curved_supports) = match self.contact {
+            SpecimenContact::Gaps => (gaps, vec![]),
+            SpecimenContact::CurvedSupport => {
+                let rp = self.pipe_radius;
+                let foot = (self.arch_half_span / radius).asin();
+                let support = CurvedSupport {
+                    name: "arch".into(),
+                    centreline: Centreline::Circle {
+                        centre: [column as f64 * dx, 0.0, h - radius],
+                        // About −x, from +z: the angle grows from the crown toward the foot (+y).
+                        axis: [-1.0, 0.0, 0.0],
+                        radius: radius - rp,
+                        angles: Some([-0.1, foot + 0.1]),
+                        start_direction: Some([0.0, 0.0, 1.0]),
+                    },
+                    tube_radius: rp,
+                    nodes: gaps.iter().map(|g| g.film_node).collect(),
+                    normal_stiffness: kn,
+                    tangential_stiffness: self.tangential_penalty_ratio * kn,
+                    friction: self.friction,
+                    friction_law: self.friction_law,
+                };
+                (vec![], vec![support])
+            }
+        };
         let model = Model {
             loads: Default::default(),
             outputs: Default::default(),
             cables: vec![],
-            curved_supports: vec![],
+            curved_supports,
             name: "ParallelArch".into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",
