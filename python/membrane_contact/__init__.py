@@ -7,7 +7,9 @@ mesh into a model file.
 * :func:`find_fmu` / :func:`build_fmu` — locate or pack an FMU (``fmu-pack``);
 * :func:`membrane_contact.mesh.import_mesh` — a gmsh (or any meshio) mesh and a mapping file
   to a model file, gaps along arches from :mod:`membrane_contact.arches`;
-* :mod:`membrane_contact.plot` — slip along a support, reactions against a load, stress maps.
+* :mod:`membrane_contact.plot` — slip along a support, reactions against a load, stress maps;
+* :mod:`membrane_contact.inverse` — fit μ, parameters or boundary-movement scales to measured
+  outputs through the FMU.
 """
 
 from .film import Film, Results, StepRefused, FmuError

@@ -1,0 +1,210 @@
+"""Which unknowns explain what was measured: least-squares fit through the FMU (issue 10 item 4).
+
+Given measured outputs at the end of a load path (slips at observed points, a reaction, a sag),
+:func:`fit` finds the unknowns a user names — the friction coefficient ``mu``, any FMU parameter
+(``film.E``, ``archHeight``, …), or a scale on a column of the load path (``scale:frame.dz``: the
+measured boundary movement known up to a factor) — by Levenberg–Marquardt on the residuals
+``model − measured``, each model evaluation a fresh run of the FMU through
+:class:`membrane_contact.Film`. The Jacobian is taken by central differences of those runs.
+
+It reports the fitted values, their sensitivities (the Jacobian ``∂output/∂unknown`` at the
+fit), standard errors from the residual scatter (``s²(JᵀJ)⁻¹``, when there are more
+measurements than unknowns) and the remaining misfit per measurement.
+
+    python -m membrane_contact.inverse --fmu target/fmu/ParallelArch.fmu \\
+        --measured table1_300.csv --unknown mu=0.2:0:1 --path path.csv --parameter archHeight=0.3
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .film import Film
+
+
+@dataclass
+class Unknown:
+    """A quantity to fit: ``name`` (an input such as ``mu``, a parameter, or ``scale:<column>``),
+    its start value and bounds."""
+
+    name: str
+    start: float
+    lower: float = -np.inf
+    upper: float = np.inf
+
+    @classmethod
+    def parse(cls, text: str) -> "Unknown":
+        """``name=start[:lower:upper]``."""
+        name, _, rest = text.partition("=")
+        parts = [float(p) for p in rest.split(":")] if rest else []
+        if not name or len(parts) not in (1, 3):
+            raise ValueError(f"unknown '{text}': write name=start or name=start:lower:upper")
+        return cls(name, *parts)
+
+
+@dataclass
+class FitResult:
+    names: list[str]
+    values: np.ndarray
+    #: ∂output/∂unknown at the fit: one row per measurement, one column per unknown.
+    sensitivities: np.ndarray
+    standard_errors: np.ndarray
+    measured: dict[str, float]
+    fitted: dict[str, float]
+    evaluations: int
+    iterations: int
+    converged: bool
+    history: list[tuple[list[float], float]] = field(default_factory=list)
+
+    @property
+    def misfit(self) -> dict[str, float]:
+        """``model − measured`` per measurement."""
+        return {k: self.fitted[k] - v for k, v in self.measured.items()}
+
+    @property
+    def rms(self) -> float:
+        return float(np.sqrt(np.mean([m * m for m in self.misfit.values()])))
+
+    def report(self) -> str:
+        lines = ["unknown          value      std. error"]
+        for n, v, e in zip(self.names, self.values, self.standard_errors):
+            lines.append(f"{n:<14} {v:>10.5g}   {e:>10.3g}")
+        lines.append("\nmeasurement            measured       fitted      misfit   " +
+                     "   ".join(f"d/d{n}" for n in self.names))
+        for i, (k, v) in enumerate(self.measured.items()):
+            sens = "   ".join(f"{s:>10.4g}" for s in self.sensitivities[i])
+            lines.append(f"{k:<20} {v:>11.5g} {self.fitted[k]:>12.5g} {self.fitted[k] - v:>11.4g}   {sens}")
+        lines.append(f"\nRMS misfit {self.rms:.4g} after {self.iterations} iterations, "
+                     f"{self.evaluations} FMU runs{'' if self.converged else ' (not converged)'}")
+        return "\n".join(lines)
+
+
+def read_measurements(path) -> dict[str, float]:
+    """A CSV with columns ``output,value`` (the FMU output name and the measured value, SI)."""
+    with open(path, newline="") as f:
+        rows = [r for r in csv.DictReader(line for line in f if not line.startswith("#"))]
+    if not rows or not {"output", "value"} <= set(rows[0]):
+        raise ValueError(f"{path}: needs the columns output,value")
+    return {r["output"].strip(): float(r["value"]) for r in rows}
+
+
+def read_path(path) -> dict[str, list[float]]:
+    """A load path table (CSV with a ``time`` column and input columns)."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    return {k.strip(): [float(r[k]) for r in rows] for k in rows[0]}
+
+
+def _run(fmu, path, parameters, unknowns, values, outputs):
+    """The outputs at the end of ``path`` with the unknowns at ``values``."""
+    params = dict(parameters or {})
+    table = {k: np.asarray(v, dtype=float).copy() for k, v in path.items()}
+    with Film(fmu, logging=False) as film:
+        for u, x in zip(unknowns, values):
+            if u.name.startswith("scale:"):
+                column = u.name[len("scale:"):]
+                if column not in table:
+                    raise KeyError(f"'{u.name}': the path has no column '{column}'")
+                table[column] = table[column] * x
+            elif u.name in film.inputs:
+                table[u.name] = np.full(len(table["time"]), x)
+            elif u.name in film.parameters:
+                params[u.name] = x
+            else:
+                raise KeyError(f"unknown '{u.name}' is neither an input, a parameter nor scale:<column>")
+        film.initialize(parameters=params)
+        film.run(table, outputs=[])
+        return np.array([film[o] for o in outputs], dtype=float)
+
+
+def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, parameters: dict | None = None,
+        max_iterations: int = 30, tolerance: float = 1e-8, relative_step: float = 1e-4) -> FitResult:
+    """Levenberg–Marquardt on ``model(unknowns) − measured`` over the outputs named in
+    ``measured`` at the end of the staged ``path`` (a table for :meth:`Film.run`)."""
+    outputs = list(measured)
+    y = np.array([measured[o] for o in outputs], dtype=float)
+    x = np.array([u.start for u in unknowns], dtype=float)
+    lo = np.array([u.lower for u in unknowns])
+    hi = np.array([u.upper for u in unknowns])
+    evaluations = 0
+
+    def model(v):
+        nonlocal evaluations
+        evaluations += 1
+        return _run(fmu, path, parameters, unknowns, v, outputs)
+
+    def jacobian(v):
+        cols = []
+        for j in range(len(v)):
+            h = relative_step * max(abs(v[j]), 1e-3)
+            plus, minus = v.copy(), v.copy()
+            plus[j] = min(v[j] + h, hi[j])
+            minus[j] = max(v[j] - h, lo[j])
+            cols.append((model(plus) - model(minus)) / (plus[j] - minus[j]))
+        return np.stack(cols, axis=1)
+
+    f = model(x) - y
+    cost = float(f @ f)
+    damping = 1e-3
+    history = [(x.tolist(), cost)]
+    converged = False
+    iterations = 0
+    for iterations in range(1, max_iterations + 1):
+        jac = jacobian(x)
+        g = jac.T @ f
+        a = jac.T @ jac
+        while True:
+            step = np.linalg.solve(a + damping * np.diag(np.diag(a) + 1e-30), -g)
+            trial = np.clip(x + step, lo, hi)
+            ft = model(trial) - y
+            trial_cost = float(ft @ ft)
+            if trial_cost < cost or damping > 1e8:
+                break
+            damping *= 10.0
+        if trial_cost >= cost:
+            converged = True  # no descent left: a minimum within the bounds
+            break
+        moved = np.max(np.abs(trial - x) / np.maximum(np.abs(x), 1e-12))
+        x, f, cost = trial, ft, trial_cost
+        history.append((x.tolist(), cost))
+        damping = max(damping / 10.0, 1e-12)
+        if moved < tolerance or cost < 1e-30:
+            converged = True
+            break
+    jac = jacobian(x)
+    m, n = jac.shape
+    try:
+        cov = np.linalg.inv(jac.T @ jac) * (cost / (m - n) if m > n else np.nan)
+        errors = np.sqrt(np.abs(np.diag(cov)))
+    except np.linalg.LinAlgError:
+        errors = np.full(n, np.inf)
+    fitted = dict(zip(outputs, (f + y).tolist()))
+    return FitResult([u.name for u in unknowns], x, jac, errors, dict(measured), fitted, evaluations,
+                     iterations, converged, history)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--fmu", required=True)
+    p.add_argument("--measured", required=True, help="CSV with columns output,value (SI units)")
+    p.add_argument("--path", required=True, help="load path CSV: time and input columns")
+    p.add_argument("--unknown", action="append", required=True, help="name=start[:lower:upper], repeatable")
+    p.add_argument("--parameter", action="append", default=[], help="name=value, set at initialization")
+    a = p.parse_args(argv)
+    params = {}
+    for text in a.parameter:
+        k, _, v = text.partition("=")
+        params[k] = float(v)
+    result = fit(a.fmu, read_measurements(a.measured), [Unknown.parse(u) for u in a.unknown],
+                 read_path(a.path), params)
+    print(result.report())
+    return 0 if result.converged else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
