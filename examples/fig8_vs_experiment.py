@@ -6,6 +6,11 @@ paper §4.4) are plotted beside Table 1: experiment dashed, analysis solid, one 
 specimen. A gap whose status is *open* at the end is not in contact: its "slip" is the film's
 movement relative to the arch point below it, not sliding on the arch; it is drawn hollow.
 
+The same specimens with the nine arch nodes in node-to-surface contact with the arch pipe
+(``export-specimen --contact curved-support``, packed as an FMU of its own; issue 10) are drawn
+beside them (dash-dot): their slip is the arc length along the arch, the quantity the experiment
+measured, where the gaps give the displacement along the arch's starting tangent.
+
 Writes fig8_vs_experiment.png and fig8_vs_experiment.csv into --out and prints the table of
 differences (analysis - experiment, mm) for points 1-5.
 
@@ -25,17 +30,42 @@ MU = 0.2
 PLOTTED_POINTS = [2, 3, 4, 5]
 
 
-def rows_of(final, table1):
+def rows_of(final, table1, curved):
     """One row per specimen and observed point 1..5."""
     rows = []
     for h, snap in final.items():
         for p, g in archfmu.OBSERVED.items():
             r = snap["gaps"][g]
             a, e = r["slip"] * 1e3, table1[h][p]
+            c_slip, c_status = curved[h][g]
             rows.append({"specimen": f"{h}_Spec", "arch_height_mm": h, "point": p, "gap": g,
                          "analysis_mm": a, "experiment_mm": e, "difference_mm": a - e,
-                         "status": archfmu.STATUS[r["status"]]})
+                         "status": archfmu.STATUS[r["status"]],
+                         "curved_support_mm": c_slip * 1e3, "curved_support_difference_mm": c_slip * 1e3 - e,
+                         "curved_support_status": archfmu.STATUS[c_status]})
     return rows
+
+
+def curved_support_run(height_mm, steps, out):
+    """The specimen with curved-support contact, exported by the CLI, packed and stepped through
+    its own FMU: {G<k>: (slip along the arch (m), status)} at dz = -H/2."""
+    import json
+    import subprocess
+
+    from membrane_contact import Film, build_fmu
+
+    text = subprocess.run([str(archfmu.CLI), "export-specimen", "--height", str(height_mm),
+                           "--contact", "curved-support"], check=True, capture_output=True, text=True).stdout
+    model = json.loads(text)
+    model["name"] = f"ParallelArchCurved{height_mm}"
+    fmu = build_fmu(model, out_dir=Path(out) / "curved-fmu")
+    nodes = model["curved_supports"][0]["nodes"]
+    times = [k / steps for k in range(1, steps + 1)]
+    with Film(fmu, logging=False) as film:
+        film.initialize(inputs={"mu": MU})
+        film.run({"time": times, "frame.dz": [-0.5 * height_mm / 1e3 * t for t in times]}, outputs=[])
+        return {f"G{k + 1}": (film[f"arch.node{v}.slip"], int(film[f"arch.node{v}.status"]))
+                for k, v in enumerate(nodes)}
 
 
 def plot(rows, steps, path):
@@ -49,7 +79,9 @@ def plot(rows, steps, path):
         ax.plot(pts, [r["experiment_mm"] for r in rs], "s--", color="tab:red",
                 label="experiment (Table 1)")
         ax.plot(pts, [r["analysis_mm"] for r in rs], "-", color="tab:blue",
-                label=f"analysis, μ = {MU:g}")
+                label=f"analysis, gaps (paper), μ = {MU:g}")
+        ax.plot(pts, [r["curved_support_mm"] for r in rs], "-.", color="tab:green", marker="^",
+                label="analysis, curved support (slip along the arch)")
         for r in rs:
             is_open = r["status"] == "open"
             ax.plot(r["point"], r["analysis_mm"], "o", color="tab:blue",
@@ -76,10 +108,11 @@ def plot(rows, steps, path):
 def print_table(rows):
     print("slip along the arch at the observed points (mm); difference = analysis - experiment")
     print(f"{'specimen':<10}{'point':>6}{'gap':>5}{'analysis':>10}{'Table 1':>9}"
-          f"{'diff':>8}  status")
+          f"{'diff':>8}  status   {'curved':>8}{'diff':>8}  status")
     for r in rows:
         print(f"{r['specimen']:<10}{r['point']:>6}{r['gap']:>5}{r['analysis_mm']:>10.2f}"
-              f"{r['experiment_mm']:>9.1f}{r['difference_mm']:>8.2f}  {r['status']}")
+              f"{r['experiment_mm']:>9.1f}{r['difference_mm']:>8.2f}  {r['status']:<7}"
+              f"{r['curved_support_mm']:>9.2f}{r['curved_support_difference_mm']:>8.2f}  {r['curved_support_status']}")
 
 
 def main(argv=None):
@@ -92,7 +125,8 @@ def main(argv=None):
     table1 = archfmu.read_table1()
     final = {h: archfmu.ramp(h / 1e3, MU, a.steps, backend=a.backend, fmu_path=a.fmu)[-1]
              for h in HEIGHTS_MM}
-    rows = rows_of(final, table1)
+    curved = {h: curved_support_run(h, a.steps, out) for h in HEIGHTS_MM}
+    rows = rows_of(final, table1, curved)
     header = list(rows[0])
     csv_path = archfmu.write_csv(out / "fig8_vs_experiment.csv", header,
                                  [[r[k] for k in header] for r in rows])

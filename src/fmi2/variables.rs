@@ -471,7 +471,10 @@ pub fn step_inputs(
 pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     let mut table = TableBuilder::default();
     let solver = SolverSettings::default();
-    let mu = model.gaps.first().map_or(0.0, |g| g.friction);
+    let mu = model.gaps.first().map_or_else(
+        || model.curved_supports.first().map_or(0.0, |s| s.friction),
+        |g| g.friction,
+    );
     let axes = ["x", "y", "z"];
 
     table.push(
@@ -483,13 +486,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "pseudo-time of the load path",
         Binding::Time,
     );
-    // A model without gaps has no friction to set: no `mu` input an importer must feed.
-    if !model.gaps.is_empty() {
+    // A model without gaps or curved supports has no friction to set: no `mu` input an
+    // importer must feed.
+    if !model.gaps.is_empty() || !model.curved_supports.is_empty() {
         table.input(
             "mu",
             mu,
             "1",
-            "friction coefficient of every gap; the model's own values apply until it is set",
+            "friction coefficient of every gap and curved-support contact; the model's own values apply until it is set",
             Binding::Friction,
         );
     }
