@@ -134,7 +134,7 @@ fn iteration_at(refinement: usize, matrix: IterationMatrix) {
     // Ours: pattern, slots, elements, the value array and the vectors an iteration uses.
     let ours =
         system.memory_bytes() + 8 * (values.len() + internal.len() + rhs.len() + 2 * u.len());
-    let mut linear = LinearSolver::new(&system).unwrap();
+    let mut linear = LinearSolver::new(&system, false).unwrap();
     let assemble = |internal: &mut Vec<f64>, values: &mut Vec<f64>| {
         system.assemble(&u, internal, Some(values), |g, d| {
             let r = laws[g].evaluate(d, history[g]);

@@ -2,7 +2,13 @@
 //!
 //! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer` supernodal/simplicial Cholesky structure,
 //!   AMD ordering), which also handles the indefinite matrices of compressed films;
-//! * unsymmetric consistent tangent: LU with partial pivoting (`faer` `SymbolicLu`).
+//! * unsymmetric consistent tangent: LU with partial pivoting (`faer` `SymbolicLu`);
+//! * the consistent tangent when it happens to be symmetric (no slipping gap, no follower
+//!   pressure, no slipping curved contact: checked on the assembled values, entry by entry
+//!   against its transpose to 1e-12 of the largest): LDLᵀ of its lower triangle, with both
+//!   symbolic analyses done once (issue 11 item 1). Without pivoting, LDLᵀ can lose accuracy on
+//!   an indefinite matrix: its solution is accepted only if `‖A x − b‖∞ ≤ 1e-9 (‖A‖∞‖x‖∞ +
+//!   ‖b‖∞)`, else the LU solves the same system (counted, [`LinearSolver::counts`]).
 //!
 //! Buffers (factor values, scratch) are allocated once and reused every iteration.
 
@@ -30,7 +36,59 @@ enum Kind {
     Lu {
         symbolic: Arc<SymbolicLu<usize>>,
         numeric: NumericLu<usize, f64>,
+        /// The LDLᵀ of the same pattern's lower triangle, for symmetric matrices.
+        symmetric: Option<SymmetricPart>,
     },
+}
+
+/// LDLᵀ of the lower triangle of a full-pattern matrix, and the slot of each entry's
+/// transpose (to see whether the values are symmetric).
+struct SymmetricPart {
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    /// Allocated at the first symmetric factorization.
+    factor: Vec<f64>,
+    transpose: Arc<[usize]>,
+    /// The right-hand side kept for the accuracy check and the LU fallback.
+    rhs: Vec<f64>,
+}
+
+impl SymmetricPart {
+    fn new(
+        pattern: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+    ) -> Result<Self, faer::sparse::FaerError> {
+        let symbolic = factorize_symbolic_cholesky(
+            pattern,
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )?;
+        let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
+        let mut transpose = Vec::with_capacity(rows.len());
+        for j in 0..pattern.ncols() {
+            for &i in &rows[ptr[j]..ptr[j + 1]] {
+                let column = &rows[ptr[i]..ptr[i + 1]];
+                // A structurally symmetric pattern (element blocks are square): (j, i) exists.
+                let k = column.binary_search(&j).map_or(usize::MAX, |k| ptr[i] + k);
+                transpose.push(k);
+            }
+        }
+        Ok(Self {
+            symbolic: Arc::new(symbolic),
+            factor: Vec::new(),
+            transpose: transpose.into(),
+            rhs: Vec::new(),
+        })
+    }
+
+    /// Whether `values` equal their transpose to `1e-12` of the largest entry.
+    fn is_symmetric(&self, values: &[f64]) -> bool {
+        let scale = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let tolerance = 1e-12 * scale;
+        values
+            .iter()
+            .zip(self.transpose.iter())
+            .all(|(&v, &t)| t != usize::MAX && (v - values[t]).abs() <= tolerance)
+    }
 }
 
 /// Factorization of the free–free Newton matrix with a reusable symbolic analysis.
@@ -39,6 +97,8 @@ pub struct LinearSolver {
     scratch: MemBuffer,
     /// Global DOF (`3 × node + axis`) of each equation, to name nodes in errors.
     equation_dofs: Arc<[u32]>,
+    /// Factorizations: LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ rejected and redone by LU.
+    counts: [usize; 3],
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -58,9 +118,19 @@ impl Clone for LinearSolver {
                 symbolic: symbolic.clone(),
                 factor: vec![0.0; factor.len()],
             },
-            Kind::Lu { symbolic, .. } => Kind::Lu {
+            Kind::Lu {
+                symbolic,
+                symmetric,
+                ..
+            } => Kind::Lu {
                 symbolic: symbolic.clone(),
                 numeric: NumericLu::new(),
+                symmetric: symmetric.as_ref().map(|p| SymmetricPart {
+                    symbolic: p.symbolic.clone(),
+                    factor: Vec::new(),
+                    transpose: p.transpose.clone(),
+                    rhs: Vec::new(),
+                }),
             },
         };
         let scratch = MemBuffer::new(Self::scratch_req(&kind_ref(&kind)));
@@ -68,25 +138,31 @@ impl Clone for LinearSolver {
             kind,
             scratch,
             equation_dofs: self.equation_dofs.clone(),
+            counts: [0; 3],
         }
     }
 }
 
 enum KindRef<'a> {
     Ldlt(&'a SymbolicCholesky<usize>),
-    Lu(&'a SymbolicLu<usize>),
+    Lu(&'a SymbolicLu<usize>, Option<&'a SymbolicCholesky<usize>>),
 }
 
 fn kind_ref(k: &Kind) -> KindRef<'_> {
     match k {
         Kind::Ldlt { symbolic, .. } => KindRef::Ldlt(symbolic),
-        Kind::Lu { symbolic, .. } => KindRef::Lu(symbolic),
+        Kind::Lu {
+            symbolic,
+            symmetric,
+            ..
+        } => KindRef::Lu(symbolic, symmetric.as_ref().map(|p| &*p.symbolic)),
     }
 }
 
 impl LinearSolver {
-    /// Symbolic analysis of the system's pattern: LDLᵀ if it stores the lower triangle, else LU.
-    pub fn new(system: &System) -> Result<Self, FactorizationError> {
+    /// Symbolic analysis of the system's pattern: LDLᵀ if it stores the lower triangle, else LU
+    /// and, with `symmetric_when_possible`, LDLᵀ of its lower triangle for symmetric values.
+    pub fn new(system: &System, symmetric_when_possible: bool) -> Result<Self, FactorizationError> {
         let err =
             |e: faer::sparse::FaerError| FactorizationError(format!("symbolic analysis: {e:?}"));
         let kind = if system.is_lower_only() {
@@ -110,9 +186,15 @@ impl LinearSolver {
                 ..Default::default()
             };
             let symbolic = factorize_symbolic_lu(system.pattern(), params).map_err(err)?;
+            let symmetric = if symmetric_when_possible {
+                Some(SymmetricPart::new(system.pattern()).map_err(err)?)
+            } else {
+                None
+            };
             Kind::Lu {
                 symbolic: Arc::new(symbolic),
                 numeric: NumericLu::new(),
+                symmetric,
             }
         };
         let scratch = MemBuffer::new(Self::scratch_req(&kind_ref(&kind)));
@@ -128,6 +210,7 @@ impl LinearSolver {
             kind,
             scratch,
             equation_dofs,
+            counts: [0; 3],
         })
     }
 
@@ -137,11 +220,23 @@ impl LinearSolver {
                 s.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
                 s.solve_in_place_scratch::<f64>(1, Par::Seq),
             ]),
-            KindRef::Lu(s) => faer::dyn_stack::StackReq::any_of(&[
+            KindRef::Lu(s, c) => faer::dyn_stack::StackReq::any_of(&[
                 s.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
                 s.solve_in_place_scratch::<f64>(1, Par::Seq),
+                c.map_or(faer::dyn_stack::StackReq::EMPTY, |c| {
+                    faer::dyn_stack::StackReq::any_of(&[
+                        c.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+                        c.solve_in_place_scratch::<f64>(1, Par::Seq),
+                    ])
+                }),
             ]),
         }
+    }
+
+    /// Factorizations so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ rejected by the
+    /// accuracy check and redone by LU]`.
+    pub fn counts(&self) -> [usize; 3] {
+        self.counts
     }
 
     /// Number of stored values of the factor (LDLᵀ) or 0 when unknown before factorization (LU).
@@ -241,7 +336,6 @@ impl LinearSolver {
     ) -> Result<(), FactorizationError> {
         let n = rhs.len();
         let stack = MemStack::new(&mut self.scratch);
-        let rhs = MatMut::from_column_major_slice_mut(rhs, n, 1);
         match &mut self.kind {
             Kind::Ldlt { symbolic, factor } => {
                 let ldlt = symbolic
@@ -255,17 +349,70 @@ impl LinearSolver {
                         Default::default(),
                     )
                     .map_err(|e| FactorizationError(format!("LDLᵀ: {e:?}")))?;
-                ldlt.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
             }
-            Kind::Lu { symbolic, numeric } => {
+            Kind::Lu {
+                symbolic,
+                numeric,
+                symmetric,
+            } => {
+                if let Some(part) = symmetric.as_mut()
+                    && part.is_symmetric(matrix.val())
+                {
+                    if part.factor.is_empty() {
+                        part.factor = vec![0.0; part.symbolic.len_val()];
+                    }
+                    part.rhs.clear();
+                    part.rhs.extend_from_slice(rhs);
+                    let factored = part.symbolic.factorize_numeric_ldlt(
+                        &mut part.factor,
+                        matrix,
+                        Side::Lower,
+                        LdltRegularization::default(),
+                        Par::Seq,
+                        &mut *stack,
+                        Default::default(),
+                    );
+                    if let Ok(ldlt) = factored {
+                        let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                        ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
+                        if accurate(matrix, rhs, &part.rhs) {
+                            self.counts[1] += 1;
+                            return Ok(());
+                        }
+                    }
+                    self.counts[2] += 1;
+                    rhs.copy_from_slice(&part.rhs);
+                }
+                self.counts[0] += 1;
                 let lu = symbolic
                     .factorize_numeric_lu(numeric, matrix, Par::Seq, stack, Default::default())
                     .map_err(|e| FactorizationError(format!("LU: {e:?}")))?;
-                lu.solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack);
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                lu.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
             }
         }
         Ok(())
     }
+}
+
+/// Whether `x` solves `matrix · x = b` to `1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row.
+fn accurate(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], b: &[f64]) -> bool {
+    let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
+    let mut norm_a = vec![0.0_f64; b.len()];
+    let (ptr, rows, values) = (matrix.col_ptr(), matrix.row_idx(), matrix.val());
+    for j in 0..matrix.ncols() {
+        for k in ptr[j]..ptr[j + 1] {
+            r[rows[k]] += values[k] * x[j];
+            norm_a[rows[k]] += values[k].abs();
+        }
+    }
+    let a = norm_a.iter().fold(0.0_f64, |m, &v| m.max(v));
+    let xm = x.iter().fold(0.0_f64, |m, &v| m.max(v.abs()));
+    let bm = b.iter().fold(0.0_f64, |m, &v| m.max(v.abs()));
+    let limit = 1e-9 * (a * xm + bm);
+    r.iter().all(|v| v.abs() <= limit)
 }
 
 #[cfg(test)]
@@ -305,7 +452,7 @@ mod tests {
 
     fn solve(lower_only: bool, entries: &[(usize, usize, f64)]) -> Result<Vec<f64>, String> {
         let system = system(lower_only);
-        let mut solver = LinearSolver::new(&system).unwrap();
+        let mut solver = LinearSolver::new(&system, true).unwrap();
         let v = values(&system, entries);
         let mut rhs = vec![1.0; system.free_count];
         solver
@@ -348,6 +495,48 @@ mod tests {
             err.contains("zero pivot") && err.contains("node 3"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn symmetric_values_take_the_ldlt_and_others_the_lu() {
+        let system = system(false);
+        let mut solver = LinearSolver::new(&system, true).unwrap();
+        let mut entries = diagonal_except(&[]);
+        entries.extend([(4, 5, 0.5), (5, 4, 0.5)]);
+        let mut rhs = vec![1.0; system.free_count];
+        let v = values(&system, &entries);
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut rhs)
+            .unwrap();
+        assert_eq!(solver.counts(), [0, 1, 0]);
+        assert!(
+            (rhs[4] - 0.4).abs() < 1e-14 && (rhs[0] - 0.5).abs() < 1e-14,
+            "{rhs:?}"
+        );
+        entries.push((4, 5, 0.25)); // unsymmetric now
+        let v = values(&system, &entries);
+        let mut rhs = vec![1.0; system.free_count];
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut rhs)
+            .unwrap();
+        assert_eq!(solver.counts(), [1, 1, 0]);
+    }
+
+    #[test]
+    fn symmetric_matrix_the_ldlt_cannot_pivot_is_solved_by_the_lu() {
+        // Node 3's x and y: [[0, 1], [1, 0]] (symmetric, indefinite, zero diagonal).
+        let system = system(false);
+        let mut solver = LinearSolver::new(&system, true).unwrap();
+        let mut entries = diagonal_except(&[4, 5]);
+        entries.extend([(4, 5, 1.0), (5, 4, 1.0)]);
+        let v = values(&system, &entries);
+        let mut rhs = vec![1.0; system.free_count];
+        rhs[5] = 3.0;
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut rhs)
+            .unwrap();
+        assert_eq!(solver.counts(), [1, 0, 1]);
+        assert_eq!((rhs[4], rhs[5]), (3.0, 1.0));
     }
 
     #[test]

@@ -51,6 +51,9 @@ pub struct SolverSettings {
     pub max_cutbacks: usize,
     /// Backtracking on `‖R‖₂` along each Newton correction (see `Analysis::line_search`).
     pub line_search: bool,
+    /// Factorize a consistent tangent that is symmetric (no slipping gap, no follower pressure)
+    /// by LDLᵀ instead of LU (`linear.rs`); false: always LU.
+    pub symmetric_factorization: bool,
 }
 
 impl Default for SolverSettings {
@@ -62,6 +65,7 @@ impl Default for SolverSettings {
             max_iterations: 100,
             max_cutbacks: 12,
             line_search: true,
+            symmetric_factorization: true,
         }
     }
 }
@@ -508,7 +512,8 @@ impl Analysis {
         if system.free_count == 0 {
             return Err(SetupError::System("the model has no free DOF".into()));
         }
-        let linear = LinearSolver::new(&system).map_err(|e| SetupError::System(e.0))?;
+        let linear = LinearSolver::new(&system, settings.symmetric_factorization)
+            .map_err(|e| SetupError::System(e.0))?;
         let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
         let state = AnalysisState {
             displacement: vec![0.0; model.dof_count()],
@@ -559,6 +564,12 @@ impl Analysis {
             length_scale,
             force_floor,
         })
+    }
+
+    /// Factorizations so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ redone by
+    /// LU]` (the Ju–Rowlands matrix's LDLᵀ is not counted).
+    pub fn factorization_counts(&self) -> [usize; 3] {
+        self.linear.counts()
     }
 
     /// The model.

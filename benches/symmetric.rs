@@ -1,0 +1,139 @@
+//! LDLᵀ for symmetric consistent tangents against LU (issue 11 item 1):
+//! `cargo bench --bench symmetric` (`-- --max-n N` to cap the mesh).
+//!
+//! The sheet of issue 11's side-by-side benchmark: 1 m × 1 m, t = 1 mm, E = 1 GPa, ν = 0.3,
+//! prestress 1 MPa, edges pinned, n × n nodes with each cell split into two triangles; the centre
+//! node pushed 50 mm out of plane in 5 steps (a prescribed displacement: the tangent stays
+//! symmetric). Each size runs with `symmetric_factorization` on (LDLᵀ whenever symmetric) and
+//! off (LU always), alternately, three times; medians and their ratio, measured in one run.
+
+use std::time::{Duration, Instant};
+
+use membrane_contact::mech::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
+use membrane_contact::mech::model::{Axis, BoundaryGroup, Support};
+use membrane_contact::mech::{Analysis, Material, Model, SolverSettings};
+
+fn sheet(n: usize) -> Model {
+    let id = |i: usize, j: usize| j * n + i;
+    let h = 1.0 / (n - 1) as f64;
+    let mut nodes = vec![];
+    for j in 0..n {
+        for i in 0..n {
+            nodes.push([i as f64 * h, j as f64 * h, 0.0]);
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    let edge = (0..n * n).filter(|&v| {
+        let (i, j) = (v % n, v / n);
+        i == 0 || j == 0 || i == n - 1 || j == n - 1
+    });
+    Model {
+        name: "Sheet".into(),
+        description: String::new(),
+        nodes,
+        triangles,
+        material: Material {
+            youngs_modulus: 1.0e9,
+            poisson_ratio: 0.3,
+            thickness: 1.0e-3,
+            prestress: [1.0e6, 1.0e6, 0.0],
+            density: 0.0,
+            wrinkling: Wrinkling::None,
+            wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+            yield_stress: None,
+        },
+        supports: edge
+            .map(|node| Support {
+                node,
+                fixed: vec![Axis::X, Axis::Y, Axis::Z],
+                name: None,
+            })
+            .collect(),
+        symmetry: vec![],
+        gaps: vec![],
+        groups: vec![BoundaryGroup {
+            name: "centre".into(),
+            nodes: vec![id(n / 2, n / 2)],
+            target: [0.0, 0.0, 0.05],
+            components: Some(vec![Axis::Z]),
+            hinge: None,
+        }],
+        loads: Default::default(),
+        outputs: Default::default(),
+        cables: vec![],
+        curved_supports: vec![],
+    }
+}
+
+fn solve(model: &Model, symmetric: bool) -> (Duration, usize, [usize; 3], f64) {
+    let settings = SolverSettings {
+        symmetric_factorization: symmetric,
+        ..SolverSettings::default()
+    };
+    let started = Instant::now();
+    let mut analysis = Analysis::new(model.clone(), settings).unwrap();
+    let mut iterations = 0;
+    for k in 1..=5 {
+        let report = analysis.step_to(&[[0.0, 0.0, 0.01 * k as f64]], 1).unwrap();
+        iterations += report.total_iterations();
+    }
+    let reaction = analysis.results().reactions[0][2];
+    (
+        started.elapsed(),
+        iterations,
+        analysis.factorization_counts(),
+        reaction,
+    )
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let max_n: usize = args
+        .iter()
+        .position(|a| a == "--max-n")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(161);
+    println!(
+        "## symmetric consistent tangent: LDLᵀ against LU (sheet, centre pushed 50 mm in 5 steps)\n"
+    );
+    println!(
+        "| n × n | free DOF | iterations | LDLᵀ / LU factorizations | median LDLᵀ run | median LU run | LDLᵀ / LU | centre reaction |"
+    );
+    println!("|---|---|---|---|---|---|---|---|");
+    for n in [41, 101, 161].into_iter().filter(|&n| n <= max_n) {
+        let model = sheet(n);
+        let (mut on, mut off) = (vec![], vec![]);
+        let mut summary = None;
+        for _ in 0..3 {
+            let a = solve(&model, true);
+            let b = solve(&model, false);
+            assert!((a.3 - b.3).abs() <= 1e-6 * b.3.abs(), "{} vs {}", a.3, b.3);
+            on.push(a.0);
+            off.push(b.0);
+            summary = Some((a.1, a.2, a.3));
+        }
+        let (iterations, counts, reaction) = summary.unwrap();
+        let (t_on, t_off) = (median(on), median(off));
+        println!(
+            "| {n} × {n} | {} | {iterations} | {} / {} | {:.1} ms | {:.1} ms | {:.2} | {reaction:.3} N |",
+            3 * (n - 2) * (n - 2) - 1,
+            counts[1],
+            counts[0] + counts[2],
+            t_on.as_secs_f64() * 1e3,
+            t_off.as_secs_f64() * 1e3,
+            t_on.as_secs_f64() / t_off.as_secs_f64()
+        );
+    }
+}
