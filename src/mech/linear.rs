@@ -2,13 +2,19 @@
 //!
 //! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer` supernodal/simplicial Cholesky structure,
 //!   AMD ordering), which also handles the indefinite matrices of compressed films;
-//! * unsymmetric consistent tangent: LU with partial pivoting (`faer` `SymbolicLu`);
 //! * the consistent tangent when it happens to be symmetric (no slipping gap, no follower
 //!   pressure, no slipping curved contact: checked on the assembled values, entry by entry
 //!   against its transpose to 1e-12 of the largest): LDLᵀ of its lower triangle, with both
-//!   symbolic analyses done once (issue 11 item 1). Without pivoting, LDLᵀ can lose accuracy on
-//!   an indefinite matrix: its solution is accepted only if `‖A x − b‖∞ ≤ 1e-9 (‖A‖∞‖x‖∞ +
-//!   ‖b‖∞)`, else the LU solves the same system (counted, [`LinearSolver::counts`]).
+//!   symbolic analyses done once (issue 11 item 1);
+//! * an unsymmetric consistent tangent `A`: GMRES (no restart, at most [`KRYLOV_DIMENSION`]
+//!   vectors, to `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`) right-preconditioned by the LDLᵀ of its symmetric
+//!   part `(A + Aᵀ)/2` (issue 11 item 2): the unsymmetric part comes from the slipping gaps and
+//!   loaded triangles only, a local perturbation that GMRES resolves in a few iterations, so a
+//!   Newton iteration costs one LDLᵀ and a few solves and keeps its quadratic convergence;
+//! * every other case, and every LDLᵀ or GMRES solution that fails the accuracy check
+//!   `‖A x − b‖∞ ≤ 1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` (an indefinite matrix the unpivoted LDLᵀ cannot
+//!   take, a Krylov space too small): LU with partial pivoting (`faer` `SymbolicLu`) on the
+//!   same system (counted, [`LinearSolver::counts`]).
 //!
 //! Buffers (factor values, scratch) are allocated once and reused every iteration.
 
@@ -50,6 +56,8 @@ struct SymmetricPart {
     transpose: Arc<[usize]>,
     /// The right-hand side kept for the accuracy check and the LU fallback.
     rhs: Vec<f64>,
+    /// Values of the symmetric part `(A + Aᵀ)/2` of an unsymmetric matrix.
+    symmetric_values: Vec<f64>,
 }
 
 impl SymmetricPart {
@@ -77,6 +85,7 @@ impl SymmetricPart {
             factor: Vec::new(),
             transpose: transpose.into(),
             rhs: Vec::new(),
+            symmetric_values: Vec::new(),
         })
     }
 
@@ -97,8 +106,123 @@ pub struct LinearSolver {
     scratch: MemBuffer,
     /// Global DOF (`3 × node + axis`) of each equation, to name nodes in errors.
     equation_dofs: Arc<[u32]>,
-    /// Factorizations: LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ rejected and redone by LU.
-    counts: [usize; 3],
+    /// Solves: LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or Krylov rejected and redone
+    /// by LU, GMRES preconditioned by the symmetric part's LDLᵀ.
+    counts: [usize; 4],
+    /// Krylov work space (basis vectors, Hessenberg matrix), reused.
+    krylov: Krylov,
+}
+
+/// Buffers of [`gmres`].
+#[derive(Clone, Debug, Default)]
+struct Krylov {
+    basis: Vec<Vec<f64>>,
+    work: Vec<f64>,
+    /// Iterations of the last solve.
+    last_iterations: usize,
+}
+
+/// Largest Krylov dimension before GMRES gives up (then LU solves): the unsymmetric part of a
+/// Newton matrix is a few slipping gaps or loaded triangles, a perturbation of low rank that a
+/// preconditioned GMRES resolves in about as many iterations.
+const KRYLOV_DIMENSION: usize = 40;
+
+/// Right-preconditioned GMRES (no restart) for `A x = b` from `x = 0`, to `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`;
+/// `x` receives the solution. False when it does not get there within [`KRYLOV_DIMENSION`].
+fn gmres(
+    a: SparseColMatRef<'_, usize, f64>,
+    b: &[f64],
+    x: &mut [f64],
+    precondition: &mut dyn FnMut(&mut [f64]),
+    k: &mut Krylov,
+) -> bool {
+    let n = b.len();
+    let m = KRYLOV_DIMENSION;
+    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let beta = norm(b);
+    x.iter_mut().for_each(|v| *v = 0.0);
+    if beta == 0.0 {
+        return true;
+    }
+    if k.basis.len() < m + 1 {
+        k.basis.resize_with(m + 1, Vec::new);
+    }
+    k.basis[0].clear();
+    k.basis[0].extend(b.iter().map(|v| v / beta));
+    let mut h = vec![0.0; (m + 1) * m];
+    let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
+    g[0] = beta;
+    let (ptr, rows, values) = (a.col_ptr(), a.row_idx(), a.val());
+    let mut used = 0;
+    let mut converged = false;
+    for j in 0..m {
+        // w = A M⁻¹ v_j
+        k.work.clear();
+        k.work.extend_from_slice(&k.basis[j]);
+        precondition(&mut k.work);
+        let mut w = vec![0.0; n];
+        for c in 0..n {
+            let z = k.work[c];
+            if z != 0.0 {
+                for p in ptr[c]..ptr[c + 1] {
+                    w[rows[p]] += values[p] * z;
+                }
+            }
+        }
+        for i in 0..=j {
+            let hij: f64 = w.iter().zip(&k.basis[i]).map(|(a, b)| a * b).sum();
+            h[i * m + j] = hij;
+            w.iter_mut()
+                .zip(&k.basis[i])
+                .for_each(|(a, b)| *a -= hij * b);
+        }
+        let hn = norm(&w);
+        h[(j + 1) * m + j] = hn;
+        for i in 0..j {
+            let (a, b) = (h[i * m + j], h[(i + 1) * m + j]);
+            h[i * m + j] = cs[i] * a + sn[i] * b;
+            h[(i + 1) * m + j] = -sn[i] * a + cs[i] * b;
+        }
+        let (a, b) = (h[j * m + j], h[(j + 1) * m + j]);
+        let r = a.hypot(b);
+        if r == 0.0 || !r.is_finite() {
+            break;
+        }
+        cs[j] = a / r;
+        sn[j] = b / r;
+        h[j * m + j] = r;
+        h[(j + 1) * m + j] = 0.0;
+        g[j + 1] = -sn[j] * g[j];
+        g[j] *= cs[j];
+        used = j + 1;
+        if g[j + 1].abs() <= 1e-12 * beta {
+            converged = true;
+            break;
+        }
+        if hn == 0.0 {
+            converged = true;
+            break;
+        }
+        k.basis[j + 1].clear();
+        k.basis[j + 1].extend(w.iter().map(|v| v / hn));
+    }
+    k.last_iterations = used;
+    if !converged || used == 0 {
+        return false;
+    }
+    // y = H⁻¹ g (upper triangular), x = M⁻¹ V y.
+    let mut y = vec![0.0; used];
+    for i in (0..used).rev() {
+        let s: f64 = (i + 1..used).map(|l| h[i * m + l] * y[l]).sum();
+        y[i] = (g[i] - s) / h[i * m + i];
+    }
+    for (i, yi) in y.iter().enumerate() {
+        x.iter_mut()
+            .zip(&k.basis[i])
+            .for_each(|(a, b)| *a += yi * b);
+    }
+    precondition(x);
+    x.iter().all(|v| v.is_finite())
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -130,6 +254,7 @@ impl Clone for LinearSolver {
                     factor: Vec::new(),
                     transpose: p.transpose.clone(),
                     rhs: Vec::new(),
+                    symmetric_values: Vec::new(),
                 }),
             },
         };
@@ -138,7 +263,8 @@ impl Clone for LinearSolver {
             kind,
             scratch,
             equation_dofs: self.equation_dofs.clone(),
-            counts: [0; 3],
+            counts: [0; 4],
+            krylov: Krylov::default(),
         }
     }
 }
@@ -210,7 +336,8 @@ impl LinearSolver {
             kind,
             scratch,
             equation_dofs,
-            counts: [0; 3],
+            counts: [0; 4],
+            krylov: Krylov::default(),
         })
     }
 
@@ -233,9 +360,9 @@ impl LinearSolver {
         }
     }
 
-    /// Factorizations so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ rejected by the
-    /// accuracy check and redone by LU]`.
-    pub fn counts(&self) -> [usize; 3] {
+    /// Solves so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or GMRES rejected and
+    /// redone by LU, GMRES preconditioned by the symmetric part's LDLᵀ]`.
+    pub fn counts(&self) -> [usize; 4] {
         self.counts
     }
 
@@ -384,6 +511,48 @@ impl LinearSolver {
                     }
                     self.counts[2] += 1;
                     rhs.copy_from_slice(&part.rhs);
+                } else if let Some(part) = symmetric.as_mut()
+                    && part.transpose.iter().all(|&t| t != usize::MAX)
+                {
+                    // Unsymmetric: GMRES preconditioned by the LDLᵀ of the symmetric part.
+                    if part.factor.is_empty() {
+                        part.factor = vec![0.0; part.symbolic.len_val()];
+                    }
+                    let values = matrix.val();
+                    part.symmetric_values.clear();
+                    part.symmetric_values.extend(
+                        values
+                            .iter()
+                            .zip(part.transpose.iter())
+                            .map(|(&v, &t)| 0.5 * (v + values[t])),
+                    );
+                    part.rhs.clear();
+                    part.rhs.extend_from_slice(rhs);
+                    let symmetric_matrix =
+                        SparseColMatRef::new(matrix.symbolic(), &part.symmetric_values);
+                    let factored = part.symbolic.factorize_numeric_ldlt(
+                        &mut part.factor,
+                        symmetric_matrix,
+                        Side::Lower,
+                        LdltRegularization::default(),
+                        Par::Seq,
+                        &mut *stack,
+                        Default::default(),
+                    );
+                    if let Ok(ldlt) = factored {
+                        let mut precondition = |v: &mut [f64]| {
+                            let x = MatMut::from_column_major_slice_mut(v, n, 1);
+                            ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
+                        };
+                        let solved =
+                            gmres(matrix, &part.rhs, rhs, &mut precondition, &mut self.krylov);
+                        if solved && accurate(matrix, rhs, &part.rhs) {
+                            self.counts[3] += 1;
+                            return Ok(());
+                        }
+                    }
+                    self.counts[2] += 1;
+                    rhs.copy_from_slice(&part.rhs);
                 }
                 self.counts[0] += 1;
                 let lu = symbolic
@@ -508,7 +677,7 @@ mod tests {
         solver
             .factorize_and_solve(system.matrix(&v), &mut rhs)
             .unwrap();
-        assert_eq!(solver.counts(), [0, 1, 0]);
+        assert_eq!(solver.counts(), [0, 1, 0, 0]);
         assert!(
             (rhs[4] - 0.4).abs() < 1e-14 && (rhs[0] - 0.5).abs() < 1e-14,
             "{rhs:?}"
@@ -519,7 +688,11 @@ mod tests {
         solver
             .factorize_and_solve(system.matrix(&v), &mut rhs)
             .unwrap();
-        assert_eq!(solver.counts(), [1, 1, 0]);
+        assert_eq!(
+            solver.counts(),
+            [0, 1, 0, 1],
+            "GMRES on the unsymmetric one"
+        );
     }
 
     #[test]
@@ -535,7 +708,7 @@ mod tests {
         solver
             .factorize_and_solve(system.matrix(&v), &mut rhs)
             .unwrap();
-        assert_eq!(solver.counts(), [1, 0, 1]);
+        assert_eq!(solver.counts(), [1, 0, 1, 0]);
         assert_eq!((rhs[4], rhs[5]), (3.0, 1.0));
     }
 

@@ -566,9 +566,10 @@ impl Analysis {
         })
     }
 
-    /// Factorizations so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ redone by
-    /// LU]` (the Ju–Rowlands matrix's LDLᵀ is not counted).
-    pub fn factorization_counts(&self) -> [usize; 3] {
+    /// Solves so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or GMRES redone by
+    /// LU, GMRES preconditioned by the symmetric part's LDLᵀ]` (the Ju–Rowlands matrix's LDLᵀ is
+    /// not counted).
+    pub fn factorization_counts(&self) -> [usize; 4] {
         self.linear.counts()
     }
 
