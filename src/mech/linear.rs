@@ -111,6 +111,8 @@ pub struct LinearSolver {
     counts: [usize; 4],
     /// Krylov work space (basis vectors, Hessenberg matrix), reused.
     krylov: Krylov,
+    /// Whether the LDLᵀ and Krylov paths may be taken (else LU for full patterns).
+    fast: bool,
 }
 
 /// Buffers of [`gmres`].
@@ -265,6 +267,7 @@ impl Clone for LinearSolver {
             equation_dofs: self.equation_dofs.clone(),
             counts: [0; 4],
             krylov: Krylov::default(),
+            fast: true,
         }
     }
 }
@@ -338,6 +341,7 @@ impl LinearSolver {
             equation_dofs,
             counts: [0; 4],
             krylov: Krylov::default(),
+            fast: true,
         })
     }
 
@@ -358,6 +362,11 @@ impl LinearSolver {
                 }),
             ]),
         }
+    }
+
+    /// Allows (true, the default) or forbids the LDLᵀ and Krylov paths for full patterns.
+    pub fn set_fast(&mut self, fast: bool) {
+        self.fast = fast;
     }
 
     /// Solves so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or GMRES rejected and
@@ -484,6 +493,7 @@ impl LinearSolver {
                 numeric,
                 symmetric,
             } => {
+                let symmetric = if self.fast { symmetric } else { &mut None };
                 if let Some(part) = symmetric.as_mut()
                     && part.is_symmetric(matrix.val())
                 {

@@ -746,6 +746,11 @@ impl Analysis {
                 done + size
             };
             let levels = base_loads.interpolate(loads, next);
+            // Once an increment of this step has been cut back, the rest of the step is solved
+            // by LU: the unpivoted LDLᵀ and the Krylov solve are fast on ordinary iterations, but
+            // on the edge of a mechanism (a film slack across, gaps opening) LU's pivoting was
+            // measured to converge where they stall (robustness bench, arch-edge family).
+            self.linear.set_fast(report.cutbacks == 0);
             match self.solve_increment(&current, &at(next), &levels) {
                 Ok((state, history)) => {
                     current = state;
@@ -774,6 +779,7 @@ impl Analysis {
                     while reached.is_none() && larger < 2.0 * (1.0 - done) {
                         let next = (done + larger).min(1.0);
                         let levels = base_loads.interpolate(loads, next);
+                        self.linear.set_fast(false);
                         if let Ok(converged) = self.solve_increment(&current, &at(next), &levels) {
                             reached = Some((next, converged));
                         }
@@ -797,6 +803,7 @@ impl Analysis {
             }
         }
         self.state = current;
+        self.linear.set_fast(true);
         Ok(report)
     }
 
