@@ -16,29 +16,11 @@ use membrane_contact::fmi2::description::describe;
 use membrane_contact::fmi2::resources::Source;
 use membrane_contact::mech::model::Axis;
 use membrane_contact::mech::model::{BoundaryGroup, Hinge, Model, Support};
-use membrane_contact::mech::{Analysis, LoadLevels, ParallelArch, SolverSettings, StepError};
+use membrane_contact::mech::{Analysis, LoadLevels, SolverSettings, StepError};
 use nalgebra::{Rotation3, Unit, Vector3};
 
 mod common;
-use common::{assert_example_file, flat_grid};
-
-fn model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model {
-    Model {
-        name: name.into(),
-        description: String::new(),
-        nodes,
-        triangles,
-        material: ParallelArch::default().material,
-        supports: vec![],
-        symmetry: vec![],
-        gaps: vec![],
-        groups: vec![],
-        loads: Default::default(),
-        outputs: Default::default(),
-        cables: vec![],
-        curved_supports: vec![],
-    }
-}
+use common::{assert_example_file, film_model, flat_grid};
 
 const N: usize = 6;
 const SIDE: f64 = 0.5;
@@ -48,7 +30,7 @@ const POINT: [f64; 3] = [0.1, -0.2, 0.3];
 /// The square panel whose rim is the hinged group `rim`.
 fn panel() -> Model {
     let (nodes, triangles) = flat_grid(N, N, SIDE, SIDE);
-    let mut m = model("Panel", nodes, triangles);
+    let mut m = film_model("Panel", nodes, triangles);
     m.material.prestress = [2.0e6, 2.0e6, 0.0];
     let rim: Vec<usize> = (0..m.nodes.len())
         .filter(|&v| {
@@ -141,7 +123,7 @@ const SIGMA0: f64 = 1.0e6;
 fn strip() -> Model {
     let (nx, ny) = (8, 2);
     let (nodes, triangles) = flat_grid(nx, ny, L, B);
-    let mut m = model("Strip", nodes, triangles);
+    let mut m = film_model("Strip", nodes, triangles);
     m.material.poisson_ratio = 0.0;
     m.material.prestress = [SIGMA0, 0.0, 0.0];
     let edge = |i: usize| (0..=ny).map(|j| j * (nx + 1) + i).collect::<Vec<_>>();
@@ -321,7 +303,7 @@ fn hinged_panel() -> Model {
     };
     let (nx, ny) = (10, 6);
     let (nodes, triangles) = flat_grid(nx, ny, 1.0, 0.6);
-    let mut m = model("HingedPanel", nodes, triangles);
+    let mut m = film_model("HingedPanel", nodes, triangles);
     m.description = "ETFE panel carried by a hinged rail (examples/hinged_panel.json)".into();
     m.material.prestress = [0.5e6, 0.0, 0.0];
     m.material.density = 1750.0;

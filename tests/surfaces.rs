@@ -22,6 +22,9 @@ use membrane_contact::mech::surface::{Centreline, CurvedSupport};
 use membrane_contact::mech::{Analysis, LoadLevels, ParallelArch, SolverSettings};
 use nalgebra::Vector3;
 
+mod common;
+use common::film_model;
+
 const R: f64 = 0.1;
 
 fn cylinder(name: &str, nodes: Vec<usize>, mu: f64, kn: f64) -> CurvedSupport {
@@ -37,24 +40,6 @@ fn cylinder(name: &str, nodes: Vec<usize>, mu: f64, kn: f64) -> CurvedSupport {
         tangential_stiffness: 0.2 * kn,
         friction: mu,
         friction_law: FrictionLaw::Isotropic,
-    }
-}
-
-fn empty_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model {
-    Model {
-        name: name.into(),
-        description: String::new(),
-        nodes,
-        triangles,
-        material: ParallelArch::default().material,
-        supports: vec![],
-        symmetry: vec![],
-        gaps: vec![],
-        groups: vec![],
-        loads: Default::default(),
-        outputs: Default::default(),
-        cables: vec![],
-        curved_supports: vec![],
     }
 }
 
@@ -77,7 +62,7 @@ fn patch(mu: f64) -> Model {
         nodes.push([i as f64 * h, j as f64 * h, R - dip]);
     }
     let triangles = (0..8).map(|k| [0, 1 + k, 1 + (k + 1) % 8]).collect();
-    let mut m = empty_model("Patch", nodes, triangles);
+    let mut m = film_model("Patch", nodes, triangles);
     m.groups.push(BoundaryGroup {
         name: "rim".into(),
         nodes: (1..=8).collect(),
@@ -187,7 +172,7 @@ fn strip(n: usize, mu: f64) -> (Model, Vec<usize>) {
         triangles.push([a, c, d]);
         triangles.push([a, d, b]);
     }
-    let mut m = empty_model("Capstan", nodes, triangles);
+    let mut m = film_model("Capstan", nodes, triangles);
     m.material.poisson_ratio = 0.0;
     m.material.prestress = [1.0e6, 1.0e6, 0.0];
     let last = line.len() - 1;

@@ -1,7 +1,26 @@
 //! Helpers shared by the integration tests (each test crate uses some of them).
 #![allow(dead_code)]
 
-use membrane_contact::mech::Model;
+use membrane_contact::mech::{Model, ParallelArch};
+
+/// A model of just a film (the specimen's ETFE, no supports, groups, gaps or loads).
+pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model {
+    Model {
+        name: name.into(),
+        description: String::new(),
+        nodes,
+        triangles,
+        material: ParallelArch::default().material,
+        supports: vec![],
+        symmetry: vec![],
+        gaps: vec![],
+        groups: vec![],
+        loads: Default::default(),
+        outputs: Default::default(),
+        cables: vec![],
+        curved_supports: vec![],
+    }
+}
 
 /// A flat `lx × ly` grid of `nx × ny` cells in the xy-plane, each cell split into two triangles
 /// with normals +Z; node `(i, j)` is `j (nx + 1) + i`.
