@@ -369,7 +369,7 @@ fn write_vtk(
     let model = analysis.model();
     let step = steps.last().map_or(0, |&(_, k)| k);
     let u = &analysis.state().displacement;
-    for &block in vtk::Block::of(model) {
+    for block in vtk::Block::of(model) {
         let file = dir.join(vtk::state_file_name(&model.name, block, step));
         let bytes = vtk::grid(block, model, u, results, encoding);
         std::fs::write(&file, &bytes).map_err(|e| format!("{}: {e}", file.display()))?;

@@ -45,6 +45,29 @@ pub fn check_results(
             results.elements[e].von_mises
         ));
     }
+    let contacts = model
+        .curved_supports
+        .iter()
+        .flat_map(|s| s.nodes.iter().map(move |v| (s, v)));
+    for (r, (s, v)) in results.surface_contacts.iter().zip(contacts) {
+        let values = [
+            r.slip,
+            r.slip_across,
+            r.gap,
+            r.normal_force,
+            r.friction_force,
+        ];
+        if let Some(x) = values
+            .iter()
+            .chain(&r.contact_point)
+            .find(|x| !x.is_finite())
+        {
+            return Err(format!(
+                "contact of node {v} on curved support {} = {x}",
+                s.name
+            ));
+        }
+    }
     for (r, c) in results.cables.iter().zip(&model.cables) {
         if !r.max_force.is_finite() {
             return Err(format!("axial force of cable {} = {}", c.name, r.max_force));

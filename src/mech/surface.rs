@@ -356,6 +356,8 @@ pub struct SurfaceContactResult {
     pub slip_across: f64,
     /// Gap `d − r` (m; negative: penetration).
     pub gap: f64,
+    /// Closest point on the support's surface (m, current).
+    pub contact_point: [f64; 3],
     /// Normal force (N).
     pub normal_force: f64,
     /// Friction force magnitude (N).
@@ -488,6 +490,7 @@ impl SurfaceContacts {
                 let x0 = c.project(&self.reference[c.node], 0.0);
                 let r = c.respond(&x, h);
                 SurfaceContactResult {
+                    contact_point: (x - p.normal * p.gap).into(),
                     slip: p.xi.x - h.origin,
                     slip_across: p.xi.y - x0.xi.y,
                     gap: p.gap,

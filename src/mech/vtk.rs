@@ -17,6 +17,12 @@
 //!   node in the film grid), `gap_slip_x`, `gap_slip_y` (m), `gap_normal_force`,
 //!   `gap_friction_force` (N) and `gap_status` (0 open, 1 stick, 2 slip). Written only when the
 //!   model has gaps ([`Block::of`]).
+//! * **contacts** ([`Block::Contacts`]): for the curved supports, points are the deformed
+//!   contact nodes (point `k`) followed by their closest points on the support surface (point
+//!   `C + k`), one line per contact; cell data `film_node`, `contact_slip` (arc length along the
+//!   support), `contact_slip_across`, `contact_gap` (m), `contact_normal_force`,
+//!   `contact_friction_force` (N), `contact_status`. Written only when the model has curved
+//!   supports.
 //!
 //! [`Encoding::Ascii`] writes the values as text in the `DataArray` elements;
 //! [`Encoding::Binary`] writes them after the XML as `<AppendedData encoding="raw">`: a `_`, then
@@ -62,34 +68,41 @@ impl FromStr for Encoding {
     }
 }
 
-/// The two grids of a state, each in its own files.
+/// The grids of a state, each in its own files.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Block {
     /// The film triangles.
     Film,
     /// The gap lines.
     Gaps,
+    /// The curved-support contacts: a line from each contact node to its closest point on the
+    /// support.
+    Contacts,
 }
 
 impl Block {
-    /// Both blocks, in file order.
-    pub const ALL: [Block; 2] = [Block::Film, Block::Gaps];
+    /// Every block, in file order.
+    pub const ALL: [Block; 3] = [Block::Film, Block::Gaps, Block::Contacts];
 
-    /// The blocks written for `model`: the film, and the gaps if it has any (a grid without
-    /// cells is valid VTK, but meshio 5.3 cannot read it).
-    pub fn of(model: &Model) -> &'static [Block] {
-        if model.gaps.is_empty() {
-            &Self::ALL[..1]
-        } else {
-            &Self::ALL
+    /// The blocks written for `model`: the film, the gaps if it has any, the curved-support
+    /// contacts if it has any (a grid without cells is valid VTK, but meshio 5.3 cannot read it).
+    pub fn of(model: &Model) -> Vec<Block> {
+        let mut blocks = vec![Self::Film];
+        if !model.gaps.is_empty() {
+            blocks.push(Self::Gaps);
         }
+        if !model.curved_supports.is_empty() {
+            blocks.push(Self::Contacts);
+        }
+        blocks
     }
 
-    /// The block's part of the file names (`film`, `gaps`).
+    /// The block's part of the file names (`film`, `gaps`, `contacts`).
     pub fn name(self) -> &'static str {
         match self {
             Self::Film => "film",
             Self::Gaps => "gaps",
+            Self::Contacts => "contacts",
         }
     }
 }
@@ -115,7 +128,61 @@ pub fn grid(
     match block {
         Block::Film => film_grid(model, displacement, results, encoding),
         Block::Gaps => gap_grid(model, displacement, results, encoding),
+        Block::Contacts => contact_grid(model, displacement, results, encoding),
     }
+}
+
+/// The contacts `.vtu` of one state: a line per curved-support contact from its (deformed)
+/// film node to its closest point on the support's surface, with the contact results.
+pub fn contact_grid(
+    model: &Model,
+    displacement: &[f64],
+    results: &Results,
+    encoding: Encoding,
+) -> Vec<u8> {
+    let film = deformed(model, displacement);
+    let nodes: Vec<usize> = model
+        .curved_supports
+        .iter()
+        .flat_map(|s| s.nodes.iter().copied())
+        .collect();
+    let count = nodes.len();
+    let cr = &results.surface_contacts;
+    let mut points: Vec<f64> = nodes
+        .iter()
+        .flat_map(|&n| [film[3 * n], film[3 * n + 1], film[3 * n + 2]])
+        .collect();
+    points.extend(cr.iter().flat_map(|c| c.contact_point));
+    let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..count).map(f).collect());
+    let piece = Piece {
+        points,
+        connectivity: (0..count as i64)
+            .flat_map(|k| [k, count as i64 + k])
+            .collect(),
+        offsets: (1..=count as i64).map(|k| 2 * k).collect(),
+        types: vec![3; count],
+        point_data: Vec::new(),
+        cell_data: vec![
+            (
+                "film_node",
+                1,
+                Values::I64(nodes.iter().map(|&n| n as i64).collect()),
+            ),
+            ("contact_slip", 1, cell(&|k| cr[k].slip)),
+            ("contact_slip_across", 1, cell(&|k| cr[k].slip_across)),
+            ("contact_gap", 1, cell(&|k| cr[k].gap)),
+            ("contact_normal_force", 1, cell(&|k| cr[k].normal_force)),
+            ("contact_friction_force", 1, cell(&|k| cr[k].friction_force)),
+            (
+                "contact_status",
+                1,
+                Values::I32(cr.iter().map(|c| c.status as i32).collect()),
+            ),
+        ],
+        point_vectors: None,
+        cell_scalars: Some("contact_normal_force"),
+    };
+    piece.encode(encoding)
 }
 
 /// The film `.vtu` of one state: triangles, displacement, stresses, strains, wrinkling.

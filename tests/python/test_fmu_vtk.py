@@ -187,3 +187,30 @@ def test_an_unknown_vtk_format_is_an_error(fmu_path):
             s.fmu.setString([vr], ["xml"])
         assert any("unknown VTK format 'xml'" in m for _, _, m in s.messages), s.messages
         assert s.fmu.getString([vr]) == [b"binary"]
+
+
+def test_curved_support_contacts_are_written_as_their_own_lines(tmp_path):
+    """The CLI's VTK of a specimen on curved supports has a contacts file per state that meshio
+    reads: one line per arch node from the film to its closest point on the pipe, with the slip
+    along the arch and the forces (issue 10)."""
+    import subprocess
+
+    from conftest import CLI
+
+    out = tmp_path / "vtk"
+    run = subprocess.run([str(CLI), "specimen", "--contact", "curved-support", "--steps", "2", "--quiet",
+                          "--vtk", str(out), "--vtk-format", "ascii"], capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    mesh = meshio.read(out / "ParallelArch_contacts_0002.vtu")
+    lines = next(c.data for c in mesh.cells if c.type == "line")
+    assert lines.shape == (9, 2)
+    slip = mesh.cell_data["contact_slip"][0]
+    status = mesh.cell_data["contact_status"][0]
+    assert slip[0] == pytest.approx(0.0, abs=1e-9) and np.all(np.diff(slip) > 0)  # crown to foot
+    touching = status > 0
+    gap = mesh.cell_data["contact_gap"][0]
+    assert np.all(gap[touching] < 0) and np.all(gap[~touching] >= 0)
+    # The contact points lie on the pipe: the line lengths are the gaps.
+    length = np.linalg.norm(mesh.points[lines[:, 0]] - mesh.points[lines[:, 1]], axis=1)
+    np.testing.assert_allclose(length, np.abs(gap), rtol=1e-5, atol=1e-9)
+    assert (out / "ParallelArch_contacts.pvd").is_file() and not (out / "ParallelArch_gaps.pvd").exists()
