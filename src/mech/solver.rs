@@ -1465,6 +1465,22 @@ impl Analysis {
         &self.loads
     }
 
+    /// The out-of-balance force of every DOF at displacements `u` (three per node; prescribed
+    /// ones as given) and the Newton matrix there (column-major values of the system's
+    /// pattern), iterating from the converged state with the load levels `levels`: what one
+    /// Newton iteration assembles. For checking the assembled tangent against finite
+    /// differences of the assembled residual.
+    #[doc(hidden)]
+    pub fn residual_and_matrix(&mut self, u: &[f64], levels: &LoadLevels) -> (Vec<f64>, Vec<f64>) {
+        let start = self.state.clone();
+        let (laws, history) = self.laws_and_history(&start);
+        self.work.contact_start.clone_from(&start.contacts);
+        self.work.latched.iter_mut().for_each(|l| *l = None);
+        self.work.closed.iter_mut().for_each(|c| *c = false);
+        self.assemble_at(u, &laws, &history, levels, Some(1));
+        (self.work.internal.clone(), self.work.values.clone())
+    }
+
     /// Displacement of node `v` (m).
     pub fn node_displacement(&self, v: usize) -> Vector3<f64> {
         node_vector(&self.state.displacement, v)
