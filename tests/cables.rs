@@ -197,3 +197,46 @@ fn the_fmu_reports_the_largest_cable_force() {
         .unwrap();
     assert_eq!(v.unit, Some("N"));
 }
+
+/// TEST GOAL: the cables' VTK block draws every segment with its axial force; the largest is
+/// the one the results report, and a strip without cables writes no cables block.
+#[test]
+fn cable_segments_are_written_to_vtk_with_their_axial_forces() {
+    use membrane_contact::mech::vtk::{self, Block, Encoding};
+    let model = strip(true, 200.0);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    analysis.step_to(&[[0.0; 3], [0.002, 0.0, 0.0]], 4).unwrap();
+    let results = analysis.results();
+    assert!(Block::of(&model).contains(&Block::Cables));
+    assert!(!Block::of(&strip(false, 0.0)).contains(&Block::Cables));
+    let text = String::from_utf8(vtk::grid(
+        Block::Cables,
+        &model,
+        &analysis.state().displacement,
+        &results,
+        Encoding::Ascii,
+    ))
+    .unwrap();
+    let segments: usize = model.cables.iter().map(|c| c.nodes.len() - 1).sum();
+    assert!(
+        text.contains(&format!("NumberOfCells=\"{segments}\"")),
+        "{text}"
+    );
+    let at = text.find("Name=\"cable_axial_force\"").unwrap();
+    let body = &text[at..];
+    let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+    let forces: Vec<f64> = body
+        .split_whitespace()
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(forces.len(), segments);
+    let largest = forces.iter().fold(0.0_f64, |m, &f| m.max(f));
+    let reported = results
+        .cables
+        .iter()
+        .fold(0.0_f64, |m, c| m.max(c.max_force));
+    assert!(
+        (largest - reported).abs() <= 1e-6 * reported,
+        "{largest} vs {reported}"
+    );
+}

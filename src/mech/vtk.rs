@@ -23,6 +23,9 @@
 //!   support), `contact_slip_across`, `contact_gap` (m), `contact_normal_force`,
 //!   `contact_friction_force` (N), `contact_status`. Written only when the model has curved
 //!   supports.
+//! * **cables** ([`Block::Cables`]): one line per cable segment between its deformed nodes (two
+//!   points each); cell data `cable` (index in the model), `cable_strain` (Green),
+//!   `cable_axial_force` (N, tension only). Written only when the model has cables.
 //!
 //! [`Encoding::Ascii`] writes the values as text in the `DataArray` elements;
 //! [`Encoding::Binary`] writes them after the XML as `<AppendedData encoding="raw">`: a `_`, then
@@ -78,11 +81,13 @@ pub enum Block {
     /// The curved-support contacts: a line from each contact node to its closest point on the
     /// support.
     Contacts,
+    /// The edge cables' segments.
+    Cables,
 }
 
 impl Block {
     /// Every block, in file order.
-    pub const ALL: [Block; 3] = [Block::Film, Block::Gaps, Block::Contacts];
+    pub const ALL: [Block; 4] = [Block::Film, Block::Gaps, Block::Contacts, Block::Cables];
 
     /// The blocks written for `model`: the film, the gaps if it has any, the curved-support
     /// contacts if it has any (a grid without cells is valid VTK, but meshio 5.3 cannot read it).
@@ -94,6 +99,9 @@ impl Block {
         if !model.curved_supports.is_empty() {
             blocks.push(Self::Contacts);
         }
+        if !model.cables.is_empty() {
+            blocks.push(Self::Cables);
+        }
         blocks
     }
 
@@ -103,6 +111,7 @@ impl Block {
             Self::Film => "film",
             Self::Gaps => "gaps",
             Self::Contacts => "contacts",
+            Self::Cables => "cables",
         }
     }
 }
@@ -129,7 +138,51 @@ pub fn grid(
         Block::Film => film_grid(model, displacement, results, encoding),
         Block::Gaps => gap_grid(model, displacement, results, encoding),
         Block::Contacts => contact_grid(model, displacement, results, encoding),
+        Block::Cables => cable_grid(model, displacement, encoding),
     }
+}
+
+/// The cables `.vtu` of one state: a line per segment between its deformed nodes, with the
+/// cable's index, the segment's Green strain and axial force (tension only, `cable.rs`).
+pub fn cable_grid(model: &Model, displacement: &[f64], encoding: Encoding) -> Vec<u8> {
+    use nalgebra::Vector3;
+    let film = deformed(model, displacement);
+    let at = |n: usize| Vector3::new(film[3 * n], film[3 * n + 1], film[3 * n + 2]);
+    let mut points = vec![];
+    let (mut cable, mut strain, mut force) = (vec![], vec![], vec![]);
+    for (c, spec) in model.cables.iter().enumerate() {
+        for pair in spec.nodes.windows(2) {
+            let (a, b) = (at(pair[0]), at(pair[1]));
+            let l0 =
+                (Vector3::from(model.nodes[pair[0]]) - Vector3::from(model.nodes[pair[1]])).norm();
+            points.extend(a.iter().chain(b.iter()));
+            cable.push(c as i64);
+            strain.push(((a - b).norm_squared() - l0 * l0) / (2.0 * l0 * l0));
+            force.push(super::cable::axial_force(
+                &a,
+                &b,
+                l0,
+                spec.youngs_modulus * spec.area,
+                spec.prestress_force,
+            ));
+        }
+    }
+    let count = cable.len();
+    let piece = Piece {
+        points,
+        connectivity: (0..2 * count as i64).collect(),
+        offsets: (1..=count as i64).map(|k| 2 * k).collect(),
+        types: vec![3; count],
+        point_data: Vec::new(),
+        cell_data: vec![
+            ("cable", 1, Values::I64(cable)),
+            ("cable_strain", 1, Values::F64(strain)),
+            ("cable_axial_force", 1, Values::F64(force)),
+        ],
+        point_vectors: None,
+        cell_scalars: Some("cable_axial_force"),
+    };
+    piece.encode(encoding)
 }
 
 /// The contacts `.vtu` of one state: a line per curved-support contact from its (deformed)
