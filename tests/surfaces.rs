@@ -524,3 +524,29 @@ fn assembled_tangent_with_sliding_curved_contacts_matches_finite_differences() {
     println!("largest relative difference {worst:e}");
     assert!(worst < 1e-4, "largest relative difference {worst:e}");
 }
+
+#[test]
+fn the_friction_law_setting_reaches_curved_supports_too() {
+    let mut m = patch(0.3);
+    assert_eq!(m.uniform_friction_law(), Some(FrictionLaw::Isotropic));
+    m.set_friction_law(FrictionLaw::SlidingDirection);
+    assert_eq!(
+        m.curved_supports[0].friction_law,
+        FrictionLaw::SlidingDirection
+    );
+    assert_eq!(
+        m.uniform_friction_law(),
+        Some(FrictionLaw::SlidingDirection)
+    );
+    use membrane_contact::fmi2::description::describe;
+    use membrane_contact::fmi2::resources::Source;
+    use membrane_contact::fmi2::variables::Value;
+    let d = describe(&Source::Model(m)).unwrap();
+    let law = d
+        .variables
+        .iter()
+        .find(|v| v.name == "frictionLaw")
+        .unwrap();
+    assert_eq!(law.start, Some(Value::String("sliding-direction".into())));
+    assert!(d.variables.iter().any(|v| v.name == "mu"));
+}

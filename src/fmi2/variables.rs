@@ -21,7 +21,7 @@
 //! | `film.density` | Real | parameter | kg/m3 | film density for self-weight (start: the model's) |
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
-//! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap; start: the model's when uniform, else "" (each gap keeps its own) |
+//! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch` | | parameter | | Newton settings |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
@@ -663,8 +663,8 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 .map_or(String::new(), |l| l.name().to_string()),
         ),
         None,
-        "friction law of every gap: isotropic (Coulomb cone) or sliding-direction (the paper's: \
-         slides along the gap's local x only); empty: each gap keeps the model file's",
+        "friction law of every gap and curved support: isotropic (Coulomb cone) or sliding-direction \
+         (the paper's: slides along the gap's local x, or along the support, only); empty: each keeps the model file's",
         Binding::FrictionLaw,
     );
     let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 7] = [

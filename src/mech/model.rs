@@ -1056,19 +1056,25 @@ impl Model {
         self.gaps.iter().position(|g| g.name == name)
     }
 
-    /// The friction law of every gap when they all have the same one (`None`: mixed, or no gaps).
+    /// The friction law of every gap and curved support when they all have the same one
+    /// (`None`: mixed, or none of either).
     pub fn uniform_friction_law(&self) -> Option<FrictionLaw> {
-        let first = self.gaps.first()?.friction_law;
-        self.gaps
+        let mut laws = self
+            .gaps
             .iter()
-            .all(|g| g.friction_law == first)
-            .then_some(first)
+            .map(|g| g.friction_law)
+            .chain(self.curved_supports.iter().map(|s| s.friction_law));
+        let first = laws.next()?;
+        laws.all(|l| l == first).then_some(first)
     }
 
-    /// Gives every gap the friction law `law`.
+    /// Gives every gap and curved support the friction law `law`.
     pub fn set_friction_law(&mut self, law: FrictionLaw) {
         for g in &mut self.gaps {
             g.friction_law = law;
+        }
+        for s in &mut self.curved_supports {
+            s.friction_law = law;
         }
     }
 
