@@ -299,7 +299,8 @@ fn curved_supports_read_from_model_files_and_bad_ones_are_refused_by_name() {
         parsed.curved_supports[0].friction_law,
         FrictionLaw::SlidingDirection
     );
-    let cases: Vec<(Box<dyn Fn(&mut CurvedSupport)>, &str)> = vec![
+    type Change = Box<dyn Fn(&mut CurvedSupport)>;
+    let cases: Vec<(Change, &str)> = vec![
         (
             Box::new(|s| s.tube_radius = 0.0),
             "tube_radius = 0 must be > 0",

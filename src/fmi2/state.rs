@@ -216,7 +216,10 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
         reach,
     )?;
     for ((g, &angle), group) in state.angles.iter().enumerate().zip(&model.groups) {
-        if !(angle.abs() <= Hinge::MAX_ANGLE) || (group.hinge.is_none() && angle != 0.0) {
+        if !angle.is_finite()
+            || angle.abs() > Hinge::MAX_ANGLE
+            || (group.hinge.is_none() && angle != 0.0)
+        {
             return Err(format!(
                 "the state's angle of group [{g}] '{}' is {angle} rad: not finite, beyond two turns, or the group has no hinge",
                 group.name

@@ -43,7 +43,7 @@ enum Kind {
         symbolic: Arc<SymbolicLu<usize>>,
         numeric: NumericLu<usize, f64>,
         /// The LDLᵀ of the same pattern's lower triangle, for symmetric matrices.
-        symmetric: Option<SymmetricPart>,
+        symmetric: Option<Box<SymmetricPart>>,
     },
 }
 
@@ -251,12 +251,14 @@ impl Clone for LinearSolver {
             } => Kind::Lu {
                 symbolic: symbolic.clone(),
                 numeric: NumericLu::new(),
-                symmetric: symmetric.as_ref().map(|p| SymmetricPart {
-                    symbolic: p.symbolic.clone(),
-                    factor: Vec::new(),
-                    transpose: p.transpose.clone(),
-                    rhs: Vec::new(),
-                    symmetric_values: Vec::new(),
+                symmetric: symmetric.as_ref().map(|p| {
+                    Box::new(SymmetricPart {
+                        symbolic: p.symbolic.clone(),
+                        factor: Vec::new(),
+                        transpose: p.transpose.clone(),
+                        rhs: Vec::new(),
+                        symmetric_values: Vec::new(),
+                    })
                 }),
             },
         };
@@ -316,7 +318,7 @@ impl LinearSolver {
             };
             let symbolic = factorize_symbolic_lu(system.pattern(), params).map_err(err)?;
             let symmetric = if symmetric_when_possible {
-                Some(SymmetricPart::new(system.pattern()).map_err(err)?)
+                Some(Box::new(SymmetricPart::new(system.pattern()).map_err(err)?))
             } else {
                 None
             };

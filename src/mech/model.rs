@@ -863,7 +863,7 @@ impl Model {
                         return Err(bad("angles or start_direction not finite".into()));
                     }
                     if let Some([lo, hi]) = angles
-                        && !(lo < hi)
+                        && lo >= hi
                     {
                         return Err(bad(format!("angles [{lo}, {hi}] must increase")));
                     }

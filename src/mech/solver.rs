@@ -856,7 +856,7 @@ impl Analysis {
             ));
         }
         for (g, &a) in self.model.groups.iter().zip(angles) {
-            if !(a.abs() <= Hinge::MAX_ANGLE) {
+            if !a.is_finite() || a.abs() > Hinge::MAX_ANGLE {
                 return invalid(format!(
                     "the angle of group '{}' ({a} rad) is not finite or beyond two full turns",
                     g.name
