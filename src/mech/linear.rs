@@ -115,11 +115,16 @@ pub struct LinearSolver {
     fast: bool,
 }
 
-/// Buffers of [`gmres`].
+/// Buffers of [`gmres`] and [`accurate`], allocated once.
 #[derive(Clone, Debug, Default)]
 struct Krylov {
     basis: Vec<Vec<f64>>,
     work: Vec<f64>,
+    product: Vec<f64>,
+    hessenberg: Vec<f64>,
+    rotations: Vec<f64>,
+    residual: Vec<f64>,
+    row_norms: Vec<f64>,
     /// Iterations of the last solve.
     last_iterations: usize,
 }
@@ -151,8 +156,14 @@ fn gmres(
     }
     k.basis[0].clear();
     k.basis[0].extend(b.iter().map(|v| v / beta));
-    let mut h = vec![0.0; (m + 1) * m];
-    let (mut cs, mut sn, mut g) = (vec![0.0; m], vec![0.0; m], vec![0.0; m + 1]);
+    k.hessenberg.clear();
+    k.hessenberg.resize((m + 1) * m, 0.0);
+    k.rotations.clear();
+    k.rotations.resize(4 * m + 1, 0.0);
+    let h = &mut k.hessenberg;
+    let (cs, rest) = k.rotations.split_at_mut(m);
+    let (sn, rest) = rest.split_at_mut(m);
+    let (g, y) = rest.split_at_mut(m + 1);
     g[0] = beta;
     let (ptr, rows, values) = (a.col_ptr(), a.row_idx(), a.val());
     let mut used = 0;
@@ -162,7 +173,9 @@ fn gmres(
         k.work.clear();
         k.work.extend_from_slice(&k.basis[j]);
         precondition(&mut k.work);
-        let mut w = vec![0.0; n];
+        k.product.clear();
+        k.product.resize(n, 0.0);
+        let w = &mut k.product;
         for c in 0..n {
             let z = k.work[c];
             if z != 0.0 {
@@ -178,7 +191,7 @@ fn gmres(
                 .zip(&k.basis[i])
                 .for_each(|(a, b)| *a -= hij * b);
         }
-        let hn = norm(&w);
+        let hn = norm(w);
         h[(j + 1) * m + j] = hn;
         for i in 0..j {
             let (a, b) = (h[i * m + j], h[(i + 1) * m + j]);
@@ -213,7 +226,7 @@ fn gmres(
         return false;
     }
     // y = H⁻¹ g (upper triangular), x = M⁻¹ V y.
-    let mut y = vec![0.0; used];
+    let y = &mut y[..used];
     for i in (0..used).rev() {
         let s: f64 = (i + 1..used).map(|l| h[i * m + l] * y[l]).sum();
         y[i] = (g[i] - s) / h[i * m + i];
@@ -516,7 +529,7 @@ impl LinearSolver {
                     if let Ok(ldlt) = factored {
                         let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                         ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
-                        if accurate(matrix, rhs, &part.rhs) {
+                        if accurate(matrix, rhs, &part.rhs, &mut self.krylov) {
                             self.counts[1] += 1;
                             return Ok(());
                         }
@@ -558,7 +571,7 @@ impl LinearSolver {
                         };
                         let solved =
                             gmres(matrix, &part.rhs, rhs, &mut precondition, &mut self.krylov);
-                        if solved && accurate(matrix, rhs, &part.rhs) {
+                        if solved && accurate(matrix, rhs, &part.rhs, &mut self.krylov) {
                             self.counts[3] += 1;
                             return Ok(());
                         }
@@ -578,10 +591,13 @@ impl LinearSolver {
     }
 }
 
-/// Whether `x` solves `matrix · x = b` to `1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row.
-fn accurate(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], b: &[f64]) -> bool {
-    let mut r: Vec<f64> = b.iter().map(|v| -v).collect();
-    let mut norm_a = vec![0.0_f64; b.len()];
+/// Whether `x` solves `matrix · x = b` to `1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row (`k`: buffers).
+fn accurate(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], b: &[f64], k: &mut Krylov) -> bool {
+    k.residual.clear();
+    k.residual.extend(b.iter().map(|v| -v));
+    k.row_norms.clear();
+    k.row_norms.resize(b.len(), 0.0);
+    let (r, norm_a) = (&mut k.residual, &mut k.row_norms);
     let (ptr, rows, values) = (matrix.col_ptr(), matrix.row_idx(), matrix.val());
     for j in 0..matrix.ncols() {
         for k in ptr[j]..ptr[j + 1] {
