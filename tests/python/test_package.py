@@ -13,7 +13,8 @@ FMU writes. Named values round-trip for every variable type, keyword form includ
 step is rolled back with fmi2SetFMUstate to the state saved before it (the FMI 2.0 way; the
 same answer as trusting this FMU to keep its state); split steps keep ``mu`` at the row's value
 (the FMU applies it unramped); ``dt`` splits rows into steps with the inputs interpolated
-linearly, and the inputs reached are recorded beside the outputs.
+linearly, and the inputs reached are recorded beside the outputs. README.md's package block
+runs as written.
 
 MODELS: the ParallelArch FMU (300 mm, frame lowered to −H/2) and the hinged panel example.
 """
@@ -250,3 +251,18 @@ def test_find_fmu_says_how_to_make_one_when_there_is_none(monkeypatch):
     assert find_fmu().name == "ParallelArch.fmu"
     with pytest.raises(FileNotFoundError, match="pack it with"):
         find_fmu(model="NoSuchModel")
+
+
+def test_the_readme_python_package_block_runs_as_written(fmu_path, monkeypatch):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Python package"):]
+    block = section[section.index("```python") + len("```python"):section.index("```\n\n")]
+    monkeypatch.chdir(ROOT)
+    monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
+    scope = {}
+    exec(compile(block, "README.md", "exec"), scope)
+    assert scope["names"] == [f"G{i}" for i in range(1, 10)] and scope["slips"].shape == (21, 9)
+    np.testing.assert_allclose(scope["results"]["frame.dz"], -0.15 * scope["results"].time, rtol=1e-14)
