@@ -28,7 +28,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, pack
 
-from membrane_contact import Film, FmuError, Results, StepRefused, find_fmu
+from membrane_contact import Film, FmuError, Results, StepRefused, build_fmu, find_fmu
 from membrane_contact.film import DISCARD, OK
 
 TARGET = -0.15
@@ -246,11 +246,41 @@ def test_results_as_pandas_and_other_models(tmp_path):
     assert list(both["rail.angle"]) == [0.0, 0.05, 0.1] and list(both.index) == [0.0, 0.5, 1.0]
 
 
+def test_build_fmu_packs_a_model_file_or_dict_and_reports_a_refused_model(tmp_path):
+    import json
+
+    fmu = build_fmu(ROOT / "examples" / "hinged_panel.json", out_dir=tmp_path / "a")
+    assert fmu == tmp_path / "a" / "HingedPanel.fmu" and fmu.is_file()
+    model = json.loads((ROOT / "examples" / "hinged_panel.json").read_text())
+    model["name"] = "PanelFromDict"
+    fmu = build_fmu(model, out_dir=tmp_path / "b")
+    with Film(fmu) as film:
+        assert film.md.coSimulation.modelIdentifier == "PanelFromDict" and "rail.angle" in film.inputs
+    model["material"]["youngs_modulus"] = -1.0
+    with pytest.raises(RuntimeError, match=r"fmu-pack failed: .*must be > 0"):
+        build_fmu(model, out_dir=tmp_path / "c")
+    assert not (tmp_path / "c" / "PanelFromDict.fmu").exists()
+
+
 def test_find_fmu_says_how_to_make_one_when_there_is_none(monkeypatch):
     monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
     assert find_fmu().name == "ParallelArch.fmu"
     with pytest.raises(FileNotFoundError, match="pack it with"):
         find_fmu(model="NoSuchModel")
+
+
+def test_find_fmu_takes_a_path_then_the_environment_then_the_repository(fmu_path, tmp_path, monkeypatch):
+    copy = tmp_path / "Copy.fmu"
+    copy.write_bytes(fmu_path.read_bytes())
+    monkeypatch.setenv("MEMBRANE_CONTACT_FMU", str(copy))
+    assert find_fmu() == copy and find_fmu(fmu_path) == fmu_path
+    with Film() as film:
+        assert film.path == copy
+    monkeypatch.setenv("MEMBRANE_CONTACT_FMU", str(tmp_path / "gone.fmu"))
+    with pytest.raises(FileNotFoundError, match="gone.fmu: no such FMU"):
+        find_fmu()
+    monkeypatch.delenv("MEMBRANE_CONTACT_FMU")
+    assert find_fmu() == ROOT / "target" / "fmu" / "ParallelArch.fmu"
 
 
 def test_the_readme_python_package_block_runs_as_written(fmu_path, monkeypatch):
