@@ -126,6 +126,20 @@ def test_staged_table_reaches_what_stepping_by_hand_reaches(fmu_path):
 HARD = {"solver.incrementsPerStep": 1, "solver.maxCutbacks": 0, "solver.maxIterations": 10}
 
 
+def test_a_refused_step_raises_nothing_but_returns_discard_and_is_logged(fmu_path, capsys):
+    with Film(fmu_path, echo=True) as film:
+        film.initialize(parameters=HARD)
+        before = film.values()
+        film.set({"frame.dz": TARGET})
+        assert film.step(1.0) == DISCARD
+        assert film.time == 0.0 and film.values() == before
+        (refusal,) = [m for s, _, m in film.messages if s == DISCARD]
+        assert "did not converge" in refusal
+        assert f"fmi2Discard: {refusal}" in capsys.readouterr().out
+        film.set({"frame.dz": TARGET / 32})
+        assert film.step(1 / 32) == OK and film.time == 1 / 32
+
+
 def test_a_refused_step_is_halved_until_it_passes_and_equals_those_steps_by_hand(fmu_path):
     with Film(fmu_path) as film:
         film.initialize(parameters=HARD)
