@@ -15,8 +15,9 @@ Exchange (explicit, Gauss-Seidel): the jack reads |Rz| at time t, moves the fram
 Step control by the master (the FMU is asked not to cut back internally,
 ``solver.maxCutbacks = 0``):
 
-* ``fmi2Discard`` (Newton did not converge): the FMU keeps its last converged state, so the
-  master halves h and steps again from the same time;
+* ``fmi2Discard`` (Newton did not converge): the master restores the state saved before the
+  step (fmi2SetFMUstate; this FMU keeps its last converged state anyway), halves h and steps
+  again from the same time;
 * a step whose reaction changed by more than ``--max-force-change`` (the coupling would
   overshoot the valve's band) is rolled back with fmi2SetFMUstate and repeated with h / 2;
 * after an accepted step h grows again (x 1.5, at most the nominal duration / --steps).
@@ -99,7 +100,9 @@ def simulate(jack: HydraulicJack, duration: float, steps: int, fmu_path=None,
             saved = fmu.save()
             try:
                 if not fmu.step(h, {"frame.dz": dz_new}):
-                    # fmi2Discard: the FMU is still at its last converged point; shorter step.
+                    # fmi2Discard: back to the state before the step (FMI 2.0; this FMU has
+                    # kept it anyway), then a shorter step.
+                    fmu.restore(saved)
                     if h / 2 < min_step:
                         raise RuntimeError(f"step refused at t = {fmu.time} s even with h = {h} s: "
                                            + fmu.log_tail(1))

@@ -6,10 +6,12 @@
   process (the last one registered receives every instance's messages), so one module-level
   logger routes the messages by instance name; instance names are made unique.
 * :meth:`Film.run` steps a staged load path (a table of input values over pseudo-time): each
-  row's inputs are reached at the row's time (the FMU moves its inputs linearly over a step). A
-  step the FMU refuses (fmi2Discard: it keeps its last converged state) is split into two halves
-  with the inputs interpolated, recursively, up to ``max_halvings`` times; then
-  :class:`StepRefused` says where and why (the FMU's last messages).
+  row's inputs are reached at the row's time (the FMU moves its inputs linearly over a step;
+  ``dt`` splits the rows into shorter steps with the inputs interpolated linearly). Before each
+  step the FMU state is saved (fmi2GetFMUstate, into one reused buffer); a step the FMU refuses
+  (fmi2Discard) is rolled back to it (fmi2SetFMUstate) and split into two halves with the inputs
+  interpolated, recursively, up to ``max_halvings`` times; then :class:`StepRefused` says where
+  and why (the FMU's last messages), the film at its last converged state.
 * :meth:`Film.save` / :meth:`Film.restore` roll the instance back (fmi2Get/SetFMUstate);
   :meth:`Film.serialize` / :meth:`Film.deserialize` give bytes to keep a state on disk.
 """
@@ -24,6 +26,7 @@ import numpy as np
 from fmpy import calloc, extract, free, read_model_description
 from fmpy.fmi2 import (
     FMU2Slave,
+    fmi2FMUstate,
     fmi2CallbackAllocateMemoryTYPE,
     fmi2CallbackFreeMemoryTYPE,
     fmi2CallbackFunctions,
@@ -35,6 +38,11 @@ from .fmu import find_fmu
 
 OK, WARNING, DISCARD, ERROR, FATAL, PENDING = range(6)
 STATUS_NAMES = ("fmi2OK", "fmi2Warning", "fmi2Discard", "fmi2Error", "fmi2Fatal", "fmi2Pending")
+
+#: Inputs the FMU applies as they are for the whole step (not ramped from their last value):
+#: split steps take the row's value, not an interpolated one. ``mu`` holds from the next step on
+#: (docs/fmu.md); every other input (displacements, angles, pressures, forces) is ramped.
+HELD_INPUTS = frozenset({"mu"})
 
 # ---------------------------------------------------------------------------- the FMU's log
 
@@ -103,45 +111,61 @@ class StepRefused(RuntimeError):
 
 class Results:
     """Outputs over the communication points reached: ``time`` and one numpy array per output
-    (``results["G2.slip"]``)."""
+    (``results["G2.slip"]``) and per input column of the table, as reached
+    (``results["frame.dz"]``)."""
 
-    def __init__(self, names: list[str], gap_names: list[str]):
+    def __init__(self, names: list[str], gap_names: list[str], input_names: list[str] = ()):
         self.names = list(names)
         self.gap_names = list(gap_names)
+        #: The table's input columns, recorded as reached at each point (``results["frame.dz"]``).
+        self.input_names = [n for n in input_names if n not in self.names]
         self._time: list[float] = []
         self._rows: list[list[float]] = []
-        #: Steps split in halves after a refusal, and steps taken in all.
+        self._inputs: list[list[float]] = []
+        #: Steps split in halves after a refusal, steps taken in all, and refused steps rolled
+        #: back to the state saved before them (fmi2SetFMUstate).
         self.halvings = 0
         self.steps = 0
+        self.rollbacks = 0
 
-    def _append(self, time: float, row: list[float]):
+    def _append(self, time: float, row: list[float], inputs: list[float] = ()):
         self._time.append(time)
         self._rows.append(row)
+        self._inputs.append(list(inputs))
 
     @property
     def time(self) -> np.ndarray:
         return np.asarray(self._time, dtype=float)
 
     def __getitem__(self, name: str) -> np.ndarray:
-        try:
+        if name == "time":
+            return self.time
+        if name in self.names:
             k = self.names.index(name)
-        except ValueError:
-            raise KeyError(f"'{name}' is not a recorded output; recorded: {', '.join(self.names)}") from None
-        return np.asarray([r[k] for r in self._rows], dtype=float)
+            return np.asarray([r[k] for r in self._rows], dtype=float)
+        if name in self.input_names:
+            k = self.input_names.index(name)
+            return np.asarray([r[k] for r in self._inputs], dtype=float)
+        raise KeyError(f"'{name}' is not recorded; recorded: {', '.join(self.names + self.input_names)}")
 
     def __len__(self):
         return len(self._time)
 
-    def as_dict(self) -> dict[str, np.ndarray]:
-        """``{"time": …, name: …}`` as numpy arrays."""
+    def as_dict(self, inputs: bool = False) -> dict[str, np.ndarray]:
+        """``{"time": …, name: …}`` as numpy arrays: the outputs, and with ``inputs`` the
+        table's input columns as reached."""
         table = np.asarray(self._rows, dtype=float).reshape(len(self._rows), len(self.names))
-        return {"time": self.time, **{n: table[:, k] for k, n in enumerate(self.names)}}
+        data = {"time": self.time, **{n: table[:, k] for k, n in enumerate(self.names)}}
+        if inputs:
+            data.update({n: self[n] for n in self.input_names})
+        return data
 
-    def to_pandas(self):
-        """A pandas DataFrame indexed by time (needs pandas)."""
+    def to_pandas(self, inputs: bool = False):
+        """A pandas DataFrame indexed by time (needs pandas): the outputs, and with ``inputs``
+        the table's input columns as reached."""
         import pandas as pd
 
-        data = self.as_dict()
+        data = self.as_dict(inputs)
         return pd.DataFrame({n: v for n, v in data.items() if n != "time"}, index=pd.Index(data["time"], name="time"))
 
     def slips(self, gaps: list[str] | None = None, component: str = "slip") -> tuple[list[str], np.ndarray]:
@@ -325,7 +349,7 @@ class Film:
             v = self._variable(name)
             getter = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger,
                       "Boolean": self.fmu.getBoolean, "String": self.fmu.getString}[v.type]
-            value = getter([v.valueReference])[0]
+            value = self._guard(f"fmi2Get{v.type}", lambda: getter([v.valueReference])[0])
             out.append(value.decode() if isinstance(value, bytes) else value)
         return out[0] if len(names) == 1 else out
 
@@ -410,20 +434,31 @@ class Film:
         self._states.append((state, time, reached, dict(reached)))
         return state
 
-    def run(self, table, outputs: list[str] | None = None, max_halvings: int = 6) -> Results:
+    def run(self, table, outputs: list[str] | None = None, max_halvings: int = 6, dt: float | None = None,
+            rollback: bool | None = None) -> Results:
         """Steps a staged load path. ``table``: a dict of columns, a list of row dicts, a numpy
         structured array or a pandas DataFrame, with a ``time`` column and columns named after
         inputs; each row's inputs are reached at its time (rows up to the film's current time
-        are where it already is and are skipped). A refused step is retried in halves with the
-        inputs interpolated, at most ``max_halvings`` deep; then :class:`StepRefused`. Initializes
-        the film first (start time 0) if it is not. Returns the ``outputs`` (default: all) at the
-        start and after every step taken."""
+        are where it already is and are skipped; an input without a column keeps its value).
+        ``dt``: the longest step; a longer row interval is split into equal steps with the
+        inputs interpolated linearly over pseudo-time (default: one step per row).
+
+        A refused step (fmi2Discard) is rolled back to the state saved just before it
+        (fmi2GetFMUstate/fmi2SetFMUstate; ``rollback``: default when the FMU can get and set
+        its state, else the FMU is trusted to keep its last converged state, as this one does)
+        and retried as two halves with the inputs interpolated (:data:`HELD_INPUTS` keep the
+        row's value), at most ``max_halvings`` deep; then :class:`StepRefused` naming the time
+        and the FMU's log, the film at its last converged state. Initializes the film first
+        (start time 0) if it is not. Returns the ``outputs`` (default: all) and the table's
+        inputs at the start and after every step taken."""
         columns = _columns(table)
         if "time" not in columns:
             raise KeyError("the table needs a 'time' column")
         times = columns.pop("time")
         if np.any(np.diff(times) <= 0):
             raise ValueError("the table's times must increase")
+        if dt is not None and not dt > 0:
+            raise ValueError(f"dt = {dt} must be > 0")
         inputs = set(self.inputs)
         for name in columns:
             if name not in inputs:
@@ -434,33 +469,68 @@ class Film:
                 raise ValueError(f"column '{name}' holds values that are not finite")
         if self.time is None:
             self.initialize()
+        if rollback is None:
+            rollback = bool(self.md.coSimulation.canGetAndSetFMUstate)
         names = self.outputs if outputs is None else list(outputs)
-        results = Results(names, [g for g in self.gaps if f"{g}.slip" in names])
-        read = self._reader(names)
-        results._append(self.time, read())
+        results = Results(names, [g for g in self.gaps if f"{g}.slip" in names], list(columns))
+        read_outputs = self._reader(names)
+
+        def read():
+            return read_outputs(), [self._reached[n] for n in results.input_names]
+
+        results._append(self.time, *read())
         current = {n: self._reached[n] for n in columns}
-        for k, t in enumerate(times):
-            if t <= self.time + 1e-12 * max(1.0, abs(t)):
-                continue
-            target = {n: float(v[k]) for n, v in columns.items()}
-            self._advance(self.time, t, current, target, 0, max_halvings, results, read)
-            current = target
+        checkpoint = fmi2FMUstate() if rollback else None
+        try:
+            for k, t in enumerate(times):
+                if t <= self.time + 1e-12 * max(1.0, abs(t)):
+                    continue
+                target = {n: float(v[k]) for n, v in columns.items()}
+                t0, n = self.time, 1
+                if dt is not None:
+                    n = max(1, int(np.ceil((t - t0) / dt * (1 - 1e-12))))
+                start = current
+                for j in range(1, n + 1):
+                    f = j / n
+                    tj = t if j == n else t0 + (t - t0) * f
+                    vj = target if j == n else _between(start, target, f)
+                    self._advance(self.time, tj, current, vj, 0, max_halvings, results, read, checkpoint)
+                    current = vj
+        finally:
+            if checkpoint is not None and checkpoint.value:
+                self._raw("fmi2FreeFMUstate", byref(checkpoint))
         return results
 
-    def _advance(self, t0, t1, v0, v1, depth, max_halvings, results, read):
+    def _advance(self, t0, t1, v0, v1, depth, max_halvings, results, read, checkpoint):
+        """Reaches the inputs ``v1`` at ``t1`` from ``v0`` at ``t0`` (the film's time), halving
+        refused steps."""
+        if checkpoint is not None:
+            self._call("fmi2GetFMUstate", byref(checkpoint))
+            set_before = dict(self._set_inputs)
         self.set(v1)
         status = self.step(t1 - t0)
         if status != DISCARD:
             results.steps += 1
             # Land exactly on the row's time (no drift from summing step sizes).
             self.time = t1
-            results._append(t1, read())
+            results._append(t1, *read())
             return
+        if checkpoint is not None:
+            # FMI 2.0: after fmi2Discard the master restores a state before it steps again.
+            self._call("fmi2SetFMUstate", checkpoint)
+            self._set_inputs = set_before
+            results.rollbacks += 1
         if depth >= max_halvings:
             self.set(v0)
             raise StepRefused(t0, t1, depth, self.messages)
         results.halvings += 1
         tm = 0.5 * (t0 + t1)
-        vm = {n: 0.5 * (v0[n] + v1[n]) for n in v1}
-        self._advance(t0, tm, v0, vm, depth + 1, max_halvings, results, read)
-        self._advance(tm, t1, vm, v1, depth + 1, max_halvings, results, read)
+        vm = {n: v1[n] if n in HELD_INPUTS else 0.5 * (v0[n] + v1[n]) for n in v1}
+        self._advance(t0, tm, v0, vm, depth + 1, max_halvings, results, read, checkpoint)
+        self._advance(tm, t1, vm, v1, depth + 1, max_halvings, results, read, checkpoint)
+
+
+def _between(v0: dict, v1: dict, f: float) -> dict:
+    """Inputs a fraction ``f`` of the way from ``v0`` to ``v1``: linear, except the held inputs
+    (the FMU applies them as they are over a step), which take ``v1``'s value."""
+    return {n: v1[n] if n in HELD_INPUTS else v0[n] + f * (v1[n] - v0[n]) for n in v1}

@@ -1,65 +1,52 @@
-"""Drive one FMU instance by variable *name* through fmpy's low-level FMU2Slave.
+"""Drive one FMU instance by variable *name*: the package's :class:`membrane_contact.Film`
+(fmpy's low-level FMU2Slave with the logger routed per instance) plus what only tests need.
 
-API verified on this machine in FMPY_NOTES.md. Two additions for tests:
+API verified on this machine in FMPY_NOTES.md. What the tests use:
 
 * the FMU's log messages are captured in ``Slave.messages`` as ``(status, category, text)``
-  (through fmpy's logger proxy, which formats the variadic call first; the proxy holds one
-  logger per process, so messages are routed by instance name: keep names unique);
+  (the package's logger: fmpy's logger proxy holds one logger per process, so messages are
+  routed by instance name, made unique by the package);
+* ``Slave.fmu`` is fmpy's ``FMU2Slave`` (its wrappers raise ``FMICallException``) and
+  ``Slave.c`` the component;
 * ``Slave.call(name, *args)`` calls an ``fmi2*`` function raw and returns its status instead of
-  raising, so tests can check fmi2Discard / fmi2Error (and pass NULL pointers as ``None``).
+  raising, so tests can check fmi2Discard / fmi2Error (and pass NULL pointers as ``None``);
+* ``Slave.step(t, h)`` is a raw fmi2DoStep at an explicit time (the package's ``Film.step``
+  keeps the time itself).
 """
 
 from __future__ import annotations
 
-import shutil
 from ctypes import c_double, c_int, c_uint
 
-from fmpy import extract, read_model_description
 from fmpy.fmi1 import FMICallException
-from fmpy.fmi2 import FMU2Slave
 
-OK, WARNING, DISCARD, ERROR, FATAL = 0, 1, 2, 3, 4
+from membrane_contact import Film
+from membrane_contact.film import DISCARD, ERROR, FATAL, OK, WARNING, callbacks_for
+
 _COUNT = 0
 
 
 class Slave:
-    """One instance of an FMU, addressed by variable names."""
+    """One instance of an FMU, addressed by variable names (over the package's ``Film``)."""
 
-    def __init__(self, fmu_path, instance_name=None, logging_on=True, unzipdir=None):
+    def __init__(self, fmu_path, instance_name=None, logging_on=True):
         global _COUNT
         _COUNT += 1
-        instance_name = instance_name or f"inst{_COUNT}"
-        self.name = instance_name
-        self.md = read_model_description(str(fmu_path))
-        self.variables = {v.name: v for v in self.md.modelVariables}
-        self.own_dir = unzipdir is None
-        self.unzipdir = unzipdir or extract(str(fmu_path))
-        self.messages: list[tuple[int, str, str]] = []
-        self.fmu = FMU2Slave(
-            guid=self.md.guid,
-            unzipDirectory=self.unzipdir,
-            modelIdentifier=self.md.coSimulation.modelIdentifier,
-            instanceName=instance_name,
-        )
-        self.callbacks = callbacks_for(self.messages, instance_name)
-        self.fmu.instantiate(callbacks=self.callbacks, loggingOn=logging_on)
+        self.film = Film(fmu_path, name=instance_name or f"inst{_COUNT}", logging=logging_on)
+        self.name = self.film.name
+        self.md, self.variables, self.messages = self.film.md, self.film.variables, self.film.messages
+        self.fmu = self.film.fmu
         self.c = self.fmu.component
 
     # ------------------------------------------------------------------ lifecycle
 
     def initialize(self, parameters=None, inputs=None, start=0.0, stop=None):
-        self.fmu.setupExperiment(startTime=start, stopTime=stop)
-        self.fmu.enterInitializationMode()
-        self.set({**(parameters or {}), **(inputs or {})})
-        self.fmu.exitInitializationMode()
+        self.film.initialize(parameters, inputs, start_time=start, stop_time=stop)
         return self
 
     def close(self):
-        if self.fmu is not None:
-            self.fmu.freeInstance()
-            self.fmu = None
-        if self.own_dir:
-            shutil.rmtree(self.unzipdir, ignore_errors=True)
+        self.film.close()
+        self.fmu = None
 
     def __enter__(self):
         return self
@@ -73,28 +60,12 @@ class Slave:
         return self.variables[name].valueReference
 
     def set(self, values: dict):
-        """Sets values by name, each with the setter of its type."""
-        for name, value in values.items():
-            v = self.variables[name]
-            if v.type == "Real":
-                self.fmu.setReal([v.valueReference], [float(value)])
-            elif v.type == "Integer":
-                self.fmu.setInteger([v.valueReference], [int(value)])
-            elif v.type == "Boolean":
-                self.fmu.setBoolean([v.valueReference], [bool(value)])
-            elif v.type == "String":
-                self.fmu.setString([v.valueReference], [str(value)])
-            else:
-                raise TypeError(f"{name}: {v.type}")
+        """Sets values by name, each with the setter of its type (``Film.set``)."""
+        self.film.set(values)
 
     def get(self, *names):
         """Values by name (one name: the value, several: a list)."""
-        out = []
-        for name in names:
-            v = self.variables[name]
-            getter = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger, "Boolean": self.fmu.getBoolean}
-            out.append(getter[v.type]([v.valueReference])[0])
-        return out[0] if len(names) == 1 else out
+        return self.film.get(*names)
 
     def snapshot(self):
         """Every Real, Integer and Boolean variable by name (for exact comparisons)."""
@@ -151,11 +122,6 @@ class Slave:
 
     def logged(self, status, text):
         return any(s == status and text in m for s, _, m in self.messages)
-
-
-# fmpy's native logger proxy keeps one Python logger per process: the package routes the
-# messages by instance name (membrane_contact.film.callbacks_for), as these tests need too.
-from membrane_contact.film import callbacks_for  # noqa: E402
 
 
 def vr_array(*vrs):

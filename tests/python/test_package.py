@@ -8,7 +8,13 @@ the result equals a hand-stepped run over the same sub-steps, bit for bit; when 
 smallest step is refused, ``StepRefused`` names the time and the FMU's reason and the film
 stays at its last converged state; ``save``/``restore`` and ``serialize``/``deserialize`` roll
 back exactly; results are numpy arrays (slips along the support, reactions); the plotting
-helpers draw slip, reactions and a stress map from the VTK the FMU writes.
+helpers draw slip, reactions (against an input column too) and a stress map from the VTK the
+FMU writes. Named values round-trip for every variable type, keyword form included. A refused
+step is rolled back with fmi2SetFMUstate to the state saved before it (the FMI 2.0 way; the
+same answer as trusting this FMU to keep its state); split steps keep ``mu`` at the row's value
+(the FMU applies it unramped); ``dt`` splits rows into steps with the inputs interpolated
+linearly, and the inputs reached are recorded beside the outputs. README.md's package block
+runs as written.
 
 MODELS: the ParallelArch FMU (300 mm, frame lowered to −H/2) and the hinged panel example.
 """
@@ -22,7 +28,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, pack
 
-from membrane_contact import Film, FmuError, Results, StepRefused, find_fmu
+from membrane_contact import Film, FmuError, Results, StepRefused, build_fmu, find_fmu
 from membrane_contact.film import DISCARD, OK
 
 TARGET = -0.15
@@ -52,12 +58,30 @@ def test_names_in_and_out_and_bad_values_refused_with_the_fmus_message(fmu_path)
         assert film.step(0.5) == OK and film.time == 0.5
 
 
-def by_hand(fmu_path, times, dz, parameters=None):
+def test_named_values_round_trip_for_every_type_also_as_keywords(fmu_path):
+    with Film(fmu_path) as film:
+        # Keyword form with dotted names, one of each type: Real, Integer, Boolean, String.
+        film.set(**{"film.E": 1.1e9, "solver.maxIterations": 40, "film.wrinkling": True,
+                    "results.vtkFormat": "ascii"})
+        with pytest.raises(FmuError, match="fmi2GetReal must not be called in state Instantiated"):
+            film.get("film.E")
+        film.initialize(inputs={"mu": 0.25})
+        assert film.get("film.E", "solver.maxIterations", "film.wrinkling", "results.vtkFormat") == [
+            1.1e9, 40, True, "ascii"]
+        film.set(**{"frame.dz": -0.01}, mu=0.3)
+        assert film["frame.dz"] == -0.01 and film["mu"] == 0.3
+        assert film.step(0.5) == OK
+        outputs = film.values()
+        assert list(outputs) == film.outputs and outputs["frame.Rz"] == film["frame.Rz"] != 0.0
+        assert isinstance(outputs["G1.status"], int) and isinstance(outputs["G1.slip"], float)
+
+
+def by_hand(fmu_path, times, dz, parameters=None, mu=None):
     with Film(fmu_path) as film:
         film.initialize(parameters=parameters)
         t = 0.0
         for ti, zi in zip(times, dz):
-            film.set({"frame.dz": zi})
+            film.set({"frame.dz": zi, **({"mu": mu} if mu is not None else {})})
             assert film.step(ti - t) == OK
             t = ti
         return film.values()
@@ -73,8 +97,10 @@ def test_staged_table_reaches_what_stepping_by_hand_reaches(fmu_path):
         final = film.values()
     assert final == by_hand(fmu_path, times, dz)
     # Other table shapes give the same steps.
+    pd = pytest.importorskip("pandas")
     for table in ([{"time": t, "frame.dz": z} for t, z in zip(times, dz)],
-                  np.array(list(zip(times, dz)), dtype=[("time", float), ("frame.dz", float)])):
+                  np.array(list(zip(times, dz)), dtype=[("time", float), ("frame.dz", float)]),
+                  pd.DataFrame({"time": times, "frame.dz": dz})):
         with Film(fmu_path) as film:
             film.run(table)
             assert film.values() == final
@@ -82,6 +108,12 @@ def test_staged_table_reaches_what_stepping_by_hand_reaches(fmu_path):
     assert names == [f"G{i}" for i in range(1, 10)] and slips.shape == (5, 9)
     assert slips[-1, 3] == final["G4.slip"]
     assert results.reaction("frame")[-1, 2] == final["frame.Rz"]
+    # One array per output and per input column, one value per point (start + 4 steps).
+    assert results["G4.slip"].shape == results["frame.dz"].shape == results.time.shape == (5,)
+    assert results.reaction("frame").shape == (5, 3)
+    np.testing.assert_array_equal(results["frame.dz"], [0.0, *dz])
+    data = results.as_dict(inputs=True)
+    assert len(data) == 1 + len(film.outputs) + 1 and all(v.shape == (5,) for v in data.values())
     with Film(fmu_path) as film:
         with pytest.raises(KeyError, match="column 'G1.slip' is an output, not an input"):
             film.run({"time": [1.0], "G1.slip": [0.0]})
@@ -94,17 +126,64 @@ def test_staged_table_reaches_what_stepping_by_hand_reaches(fmu_path):
 HARD = {"solver.incrementsPerStep": 1, "solver.maxCutbacks": 0, "solver.maxIterations": 10}
 
 
+def test_a_refused_step_raises_nothing_but_returns_discard_and_is_logged(fmu_path, capsys):
+    with Film(fmu_path, echo=True) as film:
+        film.initialize(parameters=HARD)
+        before = film.values()
+        film.set({"frame.dz": TARGET})
+        assert film.step(1.0) == DISCARD
+        assert film.time == 0.0 and film.values() == before
+        (refusal,) = [m for s, _, m in film.messages if s == DISCARD]
+        assert "did not converge" in refusal
+        assert f"fmi2Discard: {refusal}" in capsys.readouterr().out
+        film.set({"frame.dz": TARGET / 32})
+        assert film.step(1 / 32) == OK and film.time == 1 / 32
+
+
 def test_a_refused_step_is_halved_until_it_passes_and_equals_those_steps_by_hand(fmu_path):
     with Film(fmu_path) as film:
         film.initialize(parameters=HARD)
+        # Count the rollbacks the FMU sees (fmpy's raw function table).
+        set_state = film.fmu._functions["fmi2SetFMUstate"]
+        calls = []
+        film.fmu._functions["fmi2SetFMUstate"] = lambda *a: calls.append(a) or set_state(*a)
         results = film.run({"time": [1.0], "frame.dz": [TARGET]})
         assert results.halvings == 5 and results.steps == 6
+        assert results.rollbacks == len(calls) == 5
         assert sum(1 for s, _, m in film.messages if s == DISCARD) == 5
         np.testing.assert_allclose(results.time, [0, 1 / 32, 1 / 16, 1 / 8, 1 / 4, 1 / 2, 1])
         assert film.time == 1.0
         final = film.values()
     times = list(results.time[1:])
     assert final == by_hand(fmu_path, times, [TARGET * t for t in times], HARD)
+    # Without the rollback (the FMU keeps its last converged state itself): the same answer.
+    with Film(fmu_path) as film:
+        film.initialize(parameters=HARD)
+        again = film.run({"time": [1.0], "frame.dz": [TARGET]}, rollback=False)
+        assert again.rollbacks == 0 and again.halvings == 5 and film.values() == final
+
+
+def test_split_steps_keep_mu_at_the_rows_value(fmu_path):
+    # mu is applied as it is over a step, not ramped: halving must not average it.
+    with Film(fmu_path) as film:
+        film.initialize(parameters=HARD, inputs={"mu": 0.2})
+        results = film.run({"time": [1.0], "frame.dz": [TARGET], "mu": [0.4]})
+        assert results.halvings > 0 and set(results["mu"][1:]) == {0.4}
+        final = film.values()
+    times = list(results.time[1:])
+    assert final == by_hand(fmu_path, times, [TARGET * t for t in times], HARD, mu=0.4)
+
+
+def test_dt_splits_rows_into_steps_with_inputs_interpolated_linearly(fmu_path):
+    with Film(fmu_path) as film:
+        results = film.run({"time": [0.5, 1.0], "frame.dz": [TARGET / 2, TARGET]}, dt=0.125)
+        assert results.steps == 8 and results.halvings == 0
+        np.testing.assert_array_equal(results.time, np.arange(9) / 8)
+        np.testing.assert_allclose(results["frame.dz"], TARGET * results.time, rtol=1e-15, atol=0)
+        final = film.values()
+    assert final == by_hand(fmu_path, list(results.time[1:]), list(results["frame.dz"][1:]))
+    with Film(fmu_path) as film, pytest.raises(ValueError, match="dt = 0 must be > 0"):
+        film.run({"time": [1.0], "frame.dz": [TARGET]}, dt=0)
 
 
 def test_a_step_refused_after_every_halving_raises_and_keeps_the_last_state(fmu_path):
@@ -114,6 +193,16 @@ def test_a_step_refused_after_every_halving_raises_and_keeps_the_last_state(fmu_
         with pytest.raises(StepRefused, match=r"from t = 0 toward t = 0.125 even after 3 halvings .*did not converge"):
             film.run({"time": [1.0], "frame.dz": [TARGET]}, max_halvings=3)
         assert film.time == 0.0 and film.values() == before
+    # Refused after some steps passed: the film stays at the last converged one, and the
+    # exception names its time and carries the FMU's log.
+    with Film(fmu_path) as film:
+        film.initialize(parameters=HARD)
+        film.run({"time": [0.25], "frame.dz": [TARGET / 4]})
+        at_quarter = film.values()
+        with pytest.raises(StepRefused, match=r"from t = 0.25 toward t = 0.625 even after 1 halvings") as refused:
+            film.run({"time": [1.0], "frame.dz": [4 * TARGET]}, max_halvings=1)
+        assert film.time == 0.25 and film.values() == at_quarter and film["frame.dz"] == TARGET / 4
+        assert refused.value.time == 0.25 and any(s == DISCARD for s, _, _ in refused.value.messages)
 
 
 def test_save_restore_and_serialized_states_roll_back_exactly(fmu_path):
@@ -150,6 +239,8 @@ def test_plots_draw_slip_reactions_and_a_stress_map(fmu_path, tmp_path):
     assert len(ax.lines) == 2 and list(ax.lines[1].get_ydata()) == list(results.slips()[1][-1] * 1e3)
     ax = plot.reactions_vs_load(results, "time", "frame", components="z")
     assert list(ax.lines[0].get_ydata()) == list(results["frame.Rz"])
+    ax = plot.reactions_vs_load(results, "frame.dz", "frame")
+    assert list(ax.lines[0].get_xdata()) == [0.0, TARGET / 2, TARGET] and len(ax.lines) == 3
     ax = plot.stress_map(vtk / "ParallelArch_film_0002.vtu")
     assert len(ax.collections) == 1 and ax.collections[0].get_array().max() > 1.0  # MPa
     ax.figure.savefig(tmp_path / "map.png")
@@ -164,6 +255,25 @@ def test_results_as_pandas_and_other_models(tmp_path):
                            outputs=["rail.moment", "mid.uz"])
     frame = results.to_pandas()
     assert list(frame.columns) == ["rail.moment", "mid.uz"] and isinstance(frame, pd.DataFrame)
+    both = results.to_pandas(inputs=True)
+    assert list(both.columns) == ["rail.moment", "mid.uz", "rail.angle", "snow.pressure"]
+    assert list(both["rail.angle"]) == [0.0, 0.05, 0.1] and list(both.index) == [0.0, 0.5, 1.0]
+
+
+def test_build_fmu_packs_a_model_file_or_dict_and_reports_a_refused_model(tmp_path):
+    import json
+
+    fmu = build_fmu(ROOT / "examples" / "hinged_panel.json", out_dir=tmp_path / "a")
+    assert fmu == tmp_path / "a" / "HingedPanel.fmu" and fmu.is_file()
+    model = json.loads((ROOT / "examples" / "hinged_panel.json").read_text())
+    model["name"] = "PanelFromDict"
+    fmu = build_fmu(model, out_dir=tmp_path / "b")
+    with Film(fmu) as film:
+        assert film.md.coSimulation.modelIdentifier == "PanelFromDict" and "rail.angle" in film.inputs
+    model["material"]["youngs_modulus"] = -1.0
+    with pytest.raises(RuntimeError, match=r"fmu-pack failed: .*must be > 0"):
+        build_fmu(model, out_dir=tmp_path / "c")
+    assert not (tmp_path / "c" / "PanelFromDict.fmu").exists()
 
 
 def test_find_fmu_says_how_to_make_one_when_there_is_none(monkeypatch):
@@ -171,3 +281,32 @@ def test_find_fmu_says_how_to_make_one_when_there_is_none(monkeypatch):
     assert find_fmu().name == "ParallelArch.fmu"
     with pytest.raises(FileNotFoundError, match="pack it with"):
         find_fmu(model="NoSuchModel")
+
+
+def test_find_fmu_takes_a_path_then_the_environment_then_the_repository(fmu_path, tmp_path, monkeypatch):
+    copy = tmp_path / "Copy.fmu"
+    copy.write_bytes(fmu_path.read_bytes())
+    monkeypatch.setenv("MEMBRANE_CONTACT_FMU", str(copy))
+    assert find_fmu() == copy and find_fmu(fmu_path) == fmu_path
+    with Film() as film:
+        assert film.path == copy
+    monkeypatch.setenv("MEMBRANE_CONTACT_FMU", str(tmp_path / "gone.fmu"))
+    with pytest.raises(FileNotFoundError, match="gone.fmu: no such FMU"):
+        find_fmu()
+    monkeypatch.delenv("MEMBRANE_CONTACT_FMU")
+    assert find_fmu() == ROOT / "target" / "fmu" / "ParallelArch.fmu"
+
+
+def test_the_readme_python_package_block_runs_as_written(fmu_path, monkeypatch):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    text = (ROOT / "README.md").read_text()
+    section = text[text.index("## Python package"):]
+    block = section[section.index("```python") + len("```python"):section.index("```\n\n")]
+    monkeypatch.chdir(ROOT)
+    monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
+    scope = {}
+    exec(compile(block, "README.md", "exec"), scope)
+    assert scope["names"] == [f"G{i}" for i in range(1, 10)] and scope["slips"].shape == (21, 9)
+    np.testing.assert_allclose(scope["results"]["frame.dz"], -0.15 * scope["results"].time, rtol=1e-14)
