@@ -148,14 +148,15 @@ pub fn cable_grid(model: &Model, displacement: &[f64], encoding: Encoding) -> Ve
     use nalgebra::Vector3;
     let film = deformed(model, displacement);
     let at = |n: usize| Vector3::new(film[3 * n], film[3 * n + 1], film[3 * n + 2]);
-    let mut points = vec![];
+    let (mut starts, mut ends): (Vec<f64>, Vec<f64>) = (vec![], vec![]);
     let (mut cable, mut strain, mut force) = (vec![], vec![], vec![]);
     for (c, spec) in model.cables.iter().enumerate() {
         for pair in spec.nodes.windows(2) {
             let (a, b) = (at(pair[0]), at(pair[1]));
             let l0 =
                 (Vector3::from(model.nodes[pair[0]]) - Vector3::from(model.nodes[pair[1]])).norm();
-            points.extend(a.iter().chain(b.iter()));
+            starts.extend(a.iter());
+            ends.extend(b.iter());
             cable.push(c as i64);
             strain.push(((a - b).norm_squared() - l0 * l0) / (2.0 * l0 * l0));
             force.push(super::cable::axial_force(
@@ -167,22 +168,17 @@ pub fn cable_grid(model: &Model, displacement: &[f64], encoding: Encoding) -> Ve
             ));
         }
     }
-    let count = cable.len();
-    let piece = Piece {
-        points,
-        connectivity: (0..2 * count as i64).collect(),
-        offsets: (1..=count as i64).map(|k| 2 * k).collect(),
-        types: vec![3; count],
-        point_data: Vec::new(),
-        cell_data: vec![
+    starts.extend(ends);
+    lines(
+        starts,
+        vec![
             ("cable", 1, Values::I64(cable)),
             ("cable_strain", 1, Values::F64(strain)),
             ("cable_axial_force", 1, Values::F64(force)),
         ],
-        point_vectors: None,
-        cell_scalars: Some("cable_axial_force"),
-    };
-    piece.encode(encoding)
+        Some("cable_axial_force"),
+    )
+    .encode(encoding)
 }
 
 /// The contacts `.vtu` of one state: a line per curved-support contact from its (deformed)
@@ -207,15 +203,9 @@ pub fn contact_grid(
         .collect();
     points.extend(cr.iter().flat_map(|c| c.contact_point));
     let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..count).map(f).collect());
-    let piece = Piece {
+    lines(
         points,
-        connectivity: (0..count as i64)
-            .flat_map(|k| [k, count as i64 + k])
-            .collect(),
-        offsets: (1..=count as i64).map(|k| 2 * k).collect(),
-        types: vec![3; count],
-        point_data: Vec::new(),
-        cell_data: vec![
+        vec![
             (
                 "film_node",
                 1,
@@ -232,10 +222,9 @@ pub fn contact_grid(
                 Values::I32(cr.iter().map(|c| c.status as i32).collect()),
             ),
         ],
-        point_vectors: None,
-        cell_scalars: Some("contact_normal_force"),
-    };
-    piece.encode(encoding)
+        Some("contact_normal_force"),
+    )
+    .encode(encoding)
 }
 
 /// The film `.vtu` of one state: triangles, displacement, stresses, strains, wrinkling.
@@ -304,15 +293,9 @@ pub fn gap_grid(
     }));
     let gp = &results.gaps;
     let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..gaps).map(f).collect());
-    let piece = Piece {
+    lines(
         points,
-        connectivity: (0..gaps as i64)
-            .flat_map(|k| [k, gaps as i64 + k])
-            .collect(),
-        offsets: (1..=gaps as i64).map(|k| 2 * k).collect(),
-        types: vec![3; gaps],
-        point_data: Vec::new(),
-        cell_data: vec![
+        vec![
             (
                 "film_node",
                 1,
@@ -328,10 +311,9 @@ pub fn gap_grid(
                 Values::I32(gp.iter().map(|g| g.status as i32).collect()),
             ),
         ],
-        point_vectors: None,
-        cell_scalars: Some("gap_normal_force"),
-    };
-    piece.encode(encoding)
+        Some("gap_normal_force"),
+    )
+    .encode(encoding)
 }
 
 /// The `.pvd` collection text listing `(time, file name)` pairs.
@@ -432,6 +414,26 @@ impl Values {
 }
 
 /// One unstructured grid: geometry, cells and named arrays `(name, components, values)`.
+/// A grid of line cells (VTK type 3): `points` holds the `n` start points followed by the `n`
+/// end points, cell `k` joins point `k` to point `n + k` (gaps, contacts, cable segments).
+fn lines(
+    points: Vec<f64>,
+    cell_data: Vec<(&'static str, usize, Values)>,
+    cell_scalars: Option<&'static str>,
+) -> Piece {
+    let n = (points.len() / 6) as i64;
+    Piece {
+        points,
+        connectivity: (0..n).flat_map(|k| [k, n + k]).collect(),
+        offsets: (1..=n).map(|k| 2 * k).collect(),
+        types: vec![3; n as usize],
+        point_data: Vec::new(),
+        cell_data,
+        point_vectors: None,
+        cell_scalars,
+    }
+}
+
 struct Piece {
     /// Three coordinates per point.
     points: Vec<f64>,
