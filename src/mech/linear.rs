@@ -2,31 +2,40 @@
 //!
 //! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer` supernodal/simplicial Cholesky structure,
 //!   AMD ordering), which also handles the indefinite matrices of compressed films;
-//! * the consistent tangent when it happens to be symmetric (no slipping gap, no follower
-//!   pressure, no slipping curved contact: checked on the assembled values, entry by entry
-//!   against its transpose to 1e-12 of the largest): LDLᵀ of its lower triangle, with both
-//!   symbolic analyses done once (issue 11 item 1);
-//! * an unsymmetric consistent tangent `A`: GMRES (no restart, at most [`KRYLOV_DIMENSION`]
-//!   vectors, to `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`) right-preconditioned by the LDLᵀ of its symmetric
-//!   part `(A + Aᵀ)/2` (issue 11 item 2): the unsymmetric part comes from the slipping gaps and
-//!   loaded triangles only, a local perturbation that GMRES resolves in a few iterations, so a
-//!   Newton iteration costs one LDLᵀ and a few solves and keeps its quadratic convergence;
-//! * every other case, and every LDLᵀ or GMRES solution that fails the accuracy check
-//!   `‖A x − b‖∞ ≤ 1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` (an indefinite matrix the unpivoted LDLᵀ cannot
-//!   take, a Krylov space too small): LU with partial pivoting (`faer` `SymbolicLu`) on the
-//!   same system (counted, [`LinearSolver::counts`]).
+//! * the consistent tangent `A` (full pattern): one pass over its lower triangle forms the
+//!   symmetric part `S = (A + Aᵀ)/2` through a transpose map built once, the row sums of `|A|`
+//!   and the entries of the skew part `K = (A − Aᵀ)/2` above `1e-12` of the largest entry; then
+//!   the LDLᵀ of `S` (issue 11 items 1 and 2):
+//!   - no skew entry (no slipping gap, no follower pressure, no slipping curved contact): that
+//!     LDLᵀ solves `A x = b`;
+//!   - skew entries on at most [`LinearSolver::woodbury_limit`] DOFs `C` (a few slipping gaps):
+//!     the Woodbury identity `A⁻¹b = y − W (I + K_CC W_C)⁻¹ K_CC y_C` with `[W y] = S⁻¹ [I_C b]`,
+//!     one solve with `|C| + 1` right-hand sides (the factor is read once for all of them);
+//!   - more (follower pressures, many slipping gaps), or a Woodbury solution that fails the
+//!     accuracy check: GMRES (no restart, at most [`KRYLOV_DIMENSION`] vectors, to
+//!     `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`) right-preconditioned by the same LDLᵀ;
 //!
-//! Buffers (factor values, scratch) are allocated once and reused every iteration.
+//!   so a Newton iteration costs one LDLᵀ and a block solve and keeps its quadratic convergence;
+//! * every solution is checked, `‖A x − b‖∞ ≤ 1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row; one that
+//!   fails (an indefinite matrix the unpivoted LDLᵀ cannot take, a Krylov space too small) is
+//!   redone by LU with partial pivoting (`faer` `SymbolicLu`, counted in
+//!   [`LinearSolver::counts`]). The LU's symbolic analysis is built at its first use: at 1 M DOF
+//!   it alone is larger than the LDLᵀ factor, and the fast paths usually never need it.
+//!
+//! Buffers (factor values, scratch) are allocated once and reused every iteration; where the
+//! time goes is summed in [`SolveProfile`].
 
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
-use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::cholesky::{SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
+use nalgebra::{DMatrix, DVector};
 
 use super::assembly::{Dof, System};
 
@@ -34,69 +43,314 @@ use super::assembly::{Dof, System};
 #[derive(Clone, Debug, PartialEq)]
 pub struct FactorizationError(pub String);
 
+/// How an unsymmetric consistent tangent is solved on the LDLᵀ of its symmetric part.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum UnsymmetricMethod {
+    /// Woodbury when the skew part touches at most [`LinearSolver::woodbury_limit`] DOFs, else
+    /// GMRES (the default).
+    #[default]
+    Auto,
+    /// GMRES preconditioned by the LDLᵀ always.
+    Gmres,
+    /// The Woodbury correction whenever the skew part is confined to few enough DOFs to be
+    /// stored (else GMRES).
+    Woodbury,
+}
+
+/// Wall-clock time and work of the solves so far, by part (see the module doc).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveProfile {
+    /// Symbolic analyses (LDLᵀ at creation, LU at its first use).
+    pub symbolic: Duration,
+    /// The pass forming the symmetric part, the row norms and the skew entries.
+    pub symmetric_part: Duration,
+    /// LDLᵀ numeric factorizations, and their number.
+    pub ldlt: Duration,
+    /// Number of LDLᵀ numeric factorizations.
+    pub ldlt_count: usize,
+    /// Single right-hand-side LDLᵀ solves of symmetric systems.
+    pub ldlt_solve: Duration,
+    /// Woodbury corrections (block solve and the small dense system).
+    pub woodbury: Duration,
+    /// Woodbury solves, and the right-hand sides of their block solves (`|C| + 1` each).
+    pub woodbury_count: usize,
+    /// Total right-hand sides of the Woodbury block solves.
+    pub woodbury_columns: usize,
+    /// GMRES solves (preconditioner solves, products, orthogonalization).
+    pub gmres: Duration,
+    /// GMRES solves started.
+    pub gmres_count: usize,
+    /// GMRES iterations in all, and the most in one solve.
+    pub gmres_iterations: usize,
+    /// Most GMRES iterations in one solve.
+    pub gmres_max: usize,
+    /// Accuracy checks of the fast paths' solutions.
+    pub accuracy: Duration,
+    /// LU numeric factorizations and solves (symbolic analysis in `symbolic`).
+    pub lu: Duration,
+    /// Number of LU factorizations.
+    pub lu_count: usize,
+}
+
+impl SolveProfile {
+    /// Time of every part together.
+    pub fn total(&self) -> Duration {
+        self.symbolic
+            + self.symmetric_part
+            + self.ldlt
+            + self.ldlt_solve
+            + self.woodbury
+            + self.gmres
+            + self.accuracy
+            + self.lu
+    }
+}
+
+/// Time `f` into `slot`.
+fn timed<T>(slot: &mut Duration, f: impl FnOnce() -> T) -> T {
+    let start = Instant::now();
+    let out = f();
+    *slot += start.elapsed();
+    out
+}
+
 enum Kind {
     Ldlt {
         symbolic: Arc<SymbolicCholesky<usize>>,
         factor: Vec<f64>,
     },
-    Lu {
-        symbolic: Arc<SymbolicLu<usize>>,
-        numeric: NumericLu<usize, f64>,
-        /// The LDLᵀ of the same pattern's lower triangle, for symmetric matrices.
+    Full {
+        /// Built at creation without a symmetric part, else at the first fallback.
+        lu: Option<LuPart>,
+        /// The LDLᵀ of the same pattern's symmetric part, when the fast paths are allowed.
         symmetric: Option<Box<SymmetricPart>>,
     },
 }
 
-/// LDLᵀ of the lower triangle of a full-pattern matrix, and the slot of each entry's
-/// transpose (to see whether the values are symmetric).
-struct SymmetricPart {
-    symbolic: Arc<SymbolicCholesky<usize>>,
-    /// Allocated at the first symmetric factorization.
-    factor: Vec<f64>,
-    transpose: Arc<[usize]>,
-    /// The right-hand side kept for the accuracy check and the LU fallback.
-    rhs: Vec<f64>,
-    /// Values of the symmetric part `(A + Aᵀ)/2` of an unsymmetric matrix.
-    symmetric_values: Vec<f64>,
+struct LuPart {
+    symbolic: Arc<SymbolicLu<usize>>,
+    numeric: NumericLu<usize, f64>,
+    scratch: MemBuffer,
 }
 
-impl SymmetricPart {
-    fn new(
+impl LuPart {
+    fn new(symbolic: Arc<SymbolicLu<usize>>) -> Self {
+        let scratch = MemBuffer::new(StackReq::any_of(&[
+            symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]));
+        Self {
+            symbolic,
+            numeric: NumericLu::new(),
+            scratch,
+        }
+    }
+
+    fn analyse(
         pattern: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
-    ) -> Result<Self, faer::sparse::FaerError> {
+    ) -> Result<Self, FactorizationError> {
+        // faer's simplicial LU (its pick for small systems) was 5× slower than the supernodal
+        // one on the 363-DOF specimen; the supernodal one is as fast on large systems.
+        let params = LuSymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let symbolic = factorize_symbolic_lu(pattern, params)
+            .map_err(|e| FactorizationError(format!("symbolic analysis: {e:?}")))?;
+        Ok(Self::new(Arc::new(symbolic)))
+    }
+}
+
+/// LDLᵀ of the symmetric part of a full-pattern matrix, stored on the pattern's lower triangle
+/// (what a symmetric matrix's LDLᵀ reads), the slot of each lower entry's transpose, and the
+/// buffers of the Woodbury correction.
+struct SymmetricPart {
+    /// The lower triangle of the pattern (the Ju–Rowlands matrix's pattern: same analysis).
+    lower: Arc<SymbolicSparseColMat<usize>>,
+    symbolic: Arc<SymbolicCholesky<usize>>,
+    /// Allocated at the first factorization.
+    factor: Vec<f64>,
+    /// Slot in the full pattern of the transpose of each lower entry (`u32::MAX`: none).
+    transpose: Arc<[u32]>,
+    /// Whether every entry's transpose is in the pattern (else no fast path).
+    structural: bool,
+    /// The right-hand side kept for the accuracy check and the fallbacks.
+    rhs: Vec<f64>,
+    /// `(A + Aᵀ)/2` on the lower pattern.
+    symmetric_values: Vec<f64>,
+    /// Row sums of `|A|`.
+    row_norms: Vec<f64>,
+    /// Skew entries below the diagonal: (row, column, `(a_ij − a_ji)/2`).
+    skew: Vec<(usize, usize, f64)>,
+    /// More skew entries than [`SKEW_ENTRIES`] (then none are kept).
+    skew_overflow: bool,
+    /// Woodbury: the DOFs `C`, the block `[W y]` (column-major, `n × (|C| + 1)`), its scratch.
+    dofs: Vec<usize>,
+    block: Vec<f64>,
+    block_scratch: MemBuffer,
+    block_columns: usize,
+    scratch: MemBuffer,
+}
+
+/// Skew entries kept for the Woodbury correction at most (beyond: GMRES).
+const SKEW_ENTRIES: usize = 1 << 14;
+
+impl SymmetricPart {
+    fn new(pattern: faer::sparse::SymbolicSparseColMatRef<'_, usize>) -> Result<Self, String> {
+        let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
+        let n = pattern.ncols();
+        if rows.len() >= u32::MAX as usize {
+            return Err(format!("{} nonzeros: more than 2^32", rows.len()));
+        }
+        let mut lower_ptr = Vec::with_capacity(n + 1);
+        let mut lower_rows = Vec::new();
+        let mut transpose = Vec::new();
+        lower_ptr.push(0);
+        for j in 0..n {
+            for &i in &rows[ptr[j]..ptr[j + 1]] {
+                if i < j {
+                    continue;
+                }
+                let column = &rows[ptr[i]..ptr[i + 1]];
+                // A structurally symmetric pattern (element blocks are square): (j, i) exists.
+                let k = column
+                    .binary_search(&j)
+                    .map_or(u32::MAX, |k| (ptr[i] + k) as u32);
+                lower_rows.push(i);
+                transpose.push(k);
+            }
+            lower_ptr.push(lower_rows.len());
+        }
+        // Upper entries without a lower twin make the pattern unsymmetric too.
+        let lower_count = lower_rows.len();
+        let structural =
+            transpose.iter().all(|&t| t != u32::MAX) && 2 * lower_count - n == rows.len();
+        let lower = SymbolicSparseColMat::new_checked(n, n, lower_ptr, None, lower_rows);
         let symbolic = factorize_symbolic_cholesky(
-            pattern,
+            lower.as_ref(),
             Side::Lower,
             Default::default(),
             Default::default(),
-        )?;
-        let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
-        let mut transpose = Vec::with_capacity(rows.len());
-        for j in 0..pattern.ncols() {
-            for &i in &rows[ptr[j]..ptr[j + 1]] {
-                let column = &rows[ptr[i]..ptr[i + 1]];
-                // A structurally symmetric pattern (element blocks are square): (j, i) exists.
-                let k = column.binary_search(&j).map_or(usize::MAX, |k| ptr[i] + k);
-                transpose.push(k);
-            }
-        }
-        Ok(Self {
+        )
+        .map_err(|e| format!("{e:?}"))?;
+        let mut part = Self {
+            lower: Arc::new(lower),
             symbolic: Arc::new(symbolic),
             factor: Vec::new(),
             transpose: transpose.into(),
+            structural,
             rhs: Vec::new(),
             symmetric_values: Vec::new(),
-        })
+            row_norms: Vec::new(),
+            skew: Vec::new(),
+            skew_overflow: false,
+            dofs: Vec::new(),
+            block: Vec::new(),
+            block_scratch: MemBuffer::new(StackReq::EMPTY),
+            block_columns: 0,
+            scratch: MemBuffer::new(StackReq::EMPTY),
+        };
+        part.scratch = MemBuffer::new(part.scratch_req());
+        Ok(part)
     }
 
-    /// Whether `values` equal their transpose to `1e-12` of the largest entry.
-    fn is_symmetric(&self, values: &[f64]) -> bool {
-        let scale = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    fn scratch_req(&self) -> StackReq {
+        StackReq::any_of(&[
+            self.symbolic
+                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+            self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ])
+    }
+
+    fn fresh_copy(&self) -> Self {
+        Self {
+            lower: self.lower.clone(),
+            symbolic: self.symbolic.clone(),
+            factor: Vec::new(),
+            transpose: self.transpose.clone(),
+            structural: self.structural,
+            rhs: Vec::new(),
+            symmetric_values: Vec::new(),
+            row_norms: Vec::new(),
+            skew: Vec::new(),
+            skew_overflow: false,
+            dofs: Vec::new(),
+            block: Vec::new(),
+            block_scratch: MemBuffer::new(StackReq::EMPTY),
+            block_columns: 0,
+            scratch: MemBuffer::new(self.scratch_req()),
+        }
+    }
+
+    /// One pass over the lower triangle of `a`: the symmetric part, the row sums of `|A|` and
+    /// the skew entries above `1e-12` of the largest entry. Returns whether there are none
+    /// (the values are symmetric).
+    fn split(&mut self, a: SparseColMatRef<'_, usize, f64>) -> bool {
+        let (ptr, v) = (a.col_ptr(), a.val());
+        let (lower_ptr, lower_rows) = (self.lower.col_ptr(), self.lower.row_idx());
+        let n = a.ncols();
+        self.symmetric_values.resize(lower_rows.len(), 0.0);
+        self.row_norms.clear();
+        self.row_norms.resize(n, 0.0);
+        self.skew.clear();
+        self.skew_overflow = false;
+        let mut scale = 0.0_f64;
+        for j in 0..n {
+            let (start, end) = (lower_ptr[j], lower_ptr[j + 1]);
+            // The lower entries end each column of the full pattern.
+            let first = ptr[j + 1] - (end - start);
+            for (k, p) in (start..end).zip(first..) {
+                let i = lower_rows[k];
+                let (x, y) = (v[p], v[self.transpose[k] as usize]);
+                self.symmetric_values[k] = 0.5 * (x + y);
+                self.row_norms[i] += x.abs();
+                if i != j {
+                    self.row_norms[j] += y.abs();
+                }
+                scale = scale.max(x.abs()).max(y.abs());
+                // Entries at or below the running tolerance are below the final one too.
+                let d = x - y;
+                if d.abs() > 1e-12 * scale {
+                    if self.skew.len() < SKEW_ENTRIES {
+                        self.skew.push((i, j, 0.5 * d));
+                    } else {
+                        self.skew_overflow = true;
+                    }
+                }
+            }
+        }
         let tolerance = 1e-12 * scale;
-        values
-            .iter()
-            .zip(self.transpose.iter())
-            .all(|(&v, &t)| t != usize::MAX && (v - values[t]).abs() <= tolerance)
+        self.skew.retain(|&(_, _, h)| 2.0 * h.abs() > tolerance);
+        if self.skew_overflow {
+            // Many entries passed the running tolerance: is any above the final one?
+            let any = (0..n).any(|j| {
+                let (start, end) = (lower_ptr[j], lower_ptr[j + 1]);
+                let first = ptr[j + 1] - (end - start);
+                (start..end)
+                    .zip(first..)
+                    .any(|(k, p)| (v[p] - v[self.transpose[k] as usize]).abs() > tolerance)
+            });
+            self.skew_overflow = any;
+            if !any {
+                self.skew.clear();
+            }
+        }
+        self.skew.is_empty() && !self.skew_overflow
+    }
+
+    /// The DOFs the skew part touches (sorted), or `None` when more than `limit`.
+    fn skew_dofs(&mut self, limit: usize) -> Option<usize> {
+        if self.skew_overflow {
+            return None;
+        }
+        self.dofs.clear();
+        for &(i, j, _) in &self.skew {
+            self.dofs.push(i);
+            self.dofs.push(j);
+        }
+        self.dofs.sort_unstable();
+        self.dofs.dedup();
+        (self.dofs.len() <= limit).then_some(self.dofs.len())
     }
 }
 
@@ -107,12 +361,14 @@ pub struct LinearSolver {
     /// Global DOF (`3 × node + axis`) of each equation, to name nodes in errors.
     equation_dofs: Arc<[u32]>,
     /// Solves: LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or Krylov rejected and redone
-    /// by LU, GMRES preconditioned by the symmetric part's LDLᵀ.
+    /// by LU, GMRES or Woodbury on the symmetric part's LDLᵀ.
     counts: [usize; 4],
     /// Krylov work space (basis vectors, Hessenberg matrix), reused.
     krylov: Krylov,
     /// Whether the LDLᵀ and Krylov paths may be taken (else LU for full patterns).
     fast: bool,
+    method: UnsymmetricMethod,
+    profile: SolveProfile,
 }
 
 /// Buffers of [`gmres`] and [`accurate`], allocated once.
@@ -124,7 +380,6 @@ struct Krylov {
     hessenberg: Vec<f64>,
     rotations: Vec<f64>,
     residual: Vec<f64>,
-    row_norms: Vec<f64>,
     /// Iterations of the last solve.
     last_iterations: usize,
 }
@@ -133,7 +388,6 @@ struct Krylov {
 /// Newton matrix is a few slipping gaps or loaded triangles, a perturbation of low rank that a
 /// preconditioned GMRES resolves in about as many iterations.
 const KRYLOV_DIMENSION: usize = 40;
-
 /// Right-preconditioned GMRES (no restart) for `A x = b` from `x = 0`, to `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`;
 /// `x` receives the solution. False when it does not get there within [`KRYLOV_DIMENSION`].
 fn gmres(
@@ -244,7 +498,7 @@ impl std::fmt::Debug for LinearSolver {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let name = match self.kind {
             Kind::Ldlt { .. } => "LDLt",
-            Kind::Lu { .. } => "LU",
+            Kind::Full { .. } => "LU",
         };
         write!(f, "LinearSolver({name})")
     }
@@ -257,58 +511,32 @@ impl Clone for LinearSolver {
                 symbolic: symbolic.clone(),
                 factor: vec![0.0; factor.len()],
             },
-            Kind::Lu {
-                symbolic,
-                symmetric,
-                ..
-            } => Kind::Lu {
-                symbolic: symbolic.clone(),
-                numeric: NumericLu::new(),
-                symmetric: symmetric.as_ref().map(|p| {
-                    Box::new(SymmetricPart {
-                        symbolic: p.symbolic.clone(),
-                        factor: Vec::new(),
-                        transpose: p.transpose.clone(),
-                        rhs: Vec::new(),
-                        symmetric_values: Vec::new(),
-                    })
-                }),
+            Kind::Full { lu, symmetric } => Kind::Full {
+                lu: lu.as_ref().map(|l| LuPart::new(l.symbolic.clone())),
+                symmetric: symmetric.as_ref().map(|p| Box::new(p.fresh_copy())),
             },
         };
-        let scratch = MemBuffer::new(Self::scratch_req(&kind_ref(&kind)));
         Self {
             kind,
-            scratch,
+            scratch: MemBuffer::new(self.scratch_req()),
             equation_dofs: self.equation_dofs.clone(),
             counts: [0; 4],
             krylov: Krylov::default(),
             fast: true,
+            method: self.method,
+            profile: SolveProfile::default(),
         }
     }
 }
 
-enum KindRef<'a> {
-    Ldlt(&'a SymbolicCholesky<usize>),
-    Lu(&'a SymbolicLu<usize>, Option<&'a SymbolicCholesky<usize>>),
-}
-
-fn kind_ref(k: &Kind) -> KindRef<'_> {
-    match k {
-        Kind::Ldlt { symbolic, .. } => KindRef::Ldlt(symbolic),
-        Kind::Lu {
-            symbolic,
-            symmetric,
-            ..
-        } => KindRef::Lu(symbolic, symmetric.as_ref().map(|p| &*p.symbolic)),
-    }
-}
-
 impl LinearSolver {
-    /// Symbolic analysis of the system's pattern: LDLᵀ if it stores the lower triangle, else LU
-    /// and, with `symmetric_when_possible`, LDLᵀ of its lower triangle for symmetric values.
+    /// Symbolic analysis of the system's pattern: LDLᵀ if it stores the lower triangle; else,
+    /// with `symmetric_when_possible`, LDLᵀ of its symmetric part (LU analysed when first
+    /// needed), without it LU.
     pub fn new(system: &System, symmetric_when_possible: bool) -> Result<Self, FactorizationError> {
         let err =
             |e: faer::sparse::FaerError| FactorizationError(format!("symbolic analysis: {e:?}"));
+        let started = Instant::now();
         let kind = if system.is_lower_only() {
             let symbolic = factorize_symbolic_cholesky(
                 system.pattern(),
@@ -322,26 +550,20 @@ impl LinearSolver {
                 symbolic: Arc::new(symbolic),
                 factor,
             }
+        } else if symmetric_when_possible {
+            Kind::Full {
+                lu: None,
+                symmetric: Some(Box::new(
+                    SymmetricPart::new(system.pattern())
+                        .map_err(|e| FactorizationError(format!("symbolic analysis: {e}")))?,
+                )),
+            }
         } else {
-            // faer's simplicial LU (its pick for small systems) was 5× slower than the supernodal
-            // one on the 363-DOF specimen; the supernodal one is as fast on large systems.
-            let params = LuSymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            };
-            let symbolic = factorize_symbolic_lu(system.pattern(), params).map_err(err)?;
-            let symmetric = if symmetric_when_possible {
-                Some(Box::new(SymmetricPart::new(system.pattern()).map_err(err)?))
-            } else {
-                None
-            };
-            Kind::Lu {
-                symbolic: Arc::new(symbolic),
-                numeric: NumericLu::new(),
-                symmetric,
+            Kind::Full {
+                lu: Some(LuPart::analyse(system.pattern())?),
+                symmetric: None,
             }
         };
-        let scratch = MemBuffer::new(Self::scratch_req(&kind_ref(&kind)));
         let equation_dofs = system
             .dofs
             .iter()
@@ -350,32 +572,29 @@ impl LinearSolver {
             .map(|(i, _)| u32::try_from(i))
             .collect::<Result<Arc<[u32]>, _>>()
             .map_err(|_| FactorizationError("more than 2^32 DOFs".into()))?;
-        Ok(Self {
+        let mut solver = Self {
             kind,
-            scratch,
+            scratch: MemBuffer::new(StackReq::EMPTY),
             equation_dofs,
             counts: [0; 4],
             krylov: Krylov::default(),
             fast: true,
-        })
+            method: UnsymmetricMethod::Auto,
+            profile: SolveProfile::default(),
+        };
+        solver.scratch = MemBuffer::new(solver.scratch_req());
+        solver.profile.symbolic = started.elapsed();
+        Ok(solver)
     }
 
-    fn scratch_req(kind: &KindRef<'_>) -> faer::dyn_stack::StackReq {
-        match kind {
-            KindRef::Ldlt(s) => faer::dyn_stack::StackReq::any_of(&[
-                s.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
-                s.solve_in_place_scratch::<f64>(1, Par::Seq),
+    fn scratch_req(&self) -> StackReq {
+        match &self.kind {
+            Kind::Ldlt { symbolic, .. } => StackReq::any_of(&[
+                symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+                symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
             ]),
-            KindRef::Lu(s, c) => faer::dyn_stack::StackReq::any_of(&[
-                s.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-                s.solve_in_place_scratch::<f64>(1, Par::Seq),
-                c.map_or(faer::dyn_stack::StackReq::EMPTY, |c| {
-                    faer::dyn_stack::StackReq::any_of(&[
-                        c.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
-                        c.solve_in_place_scratch::<f64>(1, Par::Seq),
-                    ])
-                }),
-            ]),
+            // The parts hold their own.
+            Kind::Full { .. } => StackReq::EMPTY,
         }
     }
 
@@ -384,18 +603,62 @@ impl LinearSolver {
         self.fast = fast;
     }
 
-    /// Solves so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or GMRES rejected and
-    /// redone by LU, GMRES preconditioned by the symmetric part's LDLᵀ]`.
+    /// Chooses how unsymmetric matrices are solved on the symmetric part's LDLᵀ.
+    pub fn set_method(&mut self, method: UnsymmetricMethod) {
+        self.method = method;
+    }
+
+    /// Solves so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ, Woodbury or GMRES
+    /// rejected and redone by LU, Woodbury or GMRES on the symmetric part's LDLᵀ]`.
     pub fn counts(&self) -> [usize; 4] {
         self.counts
     }
 
-    /// Number of stored values of the factor (LDLᵀ) or 0 when unknown before factorization (LU).
+    /// Where the solves' time went so far.
+    pub fn profile(&self) -> SolveProfile {
+        self.profile
+    }
+
+    /// Whether the LU's symbolic analysis has been built.
+    pub fn has_lu(&self) -> bool {
+        matches!(&self.kind, Kind::Full { lu: Some(_), .. })
+    }
+
+    /// Number of stored values of the LDLᵀ factor (0 for LU only).
     pub fn factor_len(&self) -> usize {
         match &self.kind {
             Kind::Ldlt { factor, .. } => factor.len(),
-            Kind::Lu { .. } => 0,
+            Kind::Full {
+                symmetric: Some(p), ..
+            } => p.symbolic.len_val(),
+            Kind::Full { .. } => 0,
         }
+    }
+
+    /// Largest number of DOFs the skew part may touch for the Woodbury correction under
+    /// [`UnsymmetricMethod::Auto`]: its block `[W y]` (`n × (|C| + 1)` values) stays within a
+    /// quarter of the LDLᵀ factor, so that its block solve costs a fraction of the
+    /// factorization; at least 16.
+    pub fn woodbury_limit(&self) -> usize {
+        let n = self.equation_dofs.len().max(1);
+        (self.factor_len() / (4 * n)).max(17) - 1
+    }
+
+    /// Bytes held for the solves beyond the symbolic analyses: factor values, the symmetric
+    /// part's values, the Woodbury block and the Krylov basis.
+    pub fn memory_bytes(&self) -> usize {
+        let f = std::mem::size_of::<f64>();
+        let krylov = self.krylov.basis.iter().map(Vec::len).sum::<usize>() * f;
+        krylov
+            + match &self.kind {
+                Kind::Ldlt { factor, .. } => factor.len() * f,
+                Kind::Full { symmetric, .. } => symmetric.as_ref().map_or(0, |p| {
+                    (p.factor.len() + p.symmetric_values.len() + p.block.len()) * f
+                        + p.transpose.len() * std::mem::size_of::<u32>()
+                        + (p.lower.col_ptr().len() + p.lower.row_idx().len())
+                            * std::mem::size_of::<usize>()
+                }),
+            }
     }
 
     /// Numeric factorization of `matrix` (same pattern as the symbolic analysis), then the
@@ -486,9 +749,15 @@ impl LinearSolver {
         rhs: &mut [f64],
     ) -> Result<(), FactorizationError> {
         let n = rhs.len();
-        let stack = MemStack::new(&mut self.scratch);
+        let limit = match self.method {
+            UnsymmetricMethod::Auto => self.woodbury_limit(),
+            UnsymmetricMethod::Gmres => 0,
+            UnsymmetricMethod::Woodbury => WOODBURY_MOST,
+        };
         match &mut self.kind {
             Kind::Ldlt { symbolic, factor } => {
+                let stack = MemStack::new(&mut self.scratch);
+                let start = Instant::now();
                 let ldlt = symbolic
                     .factorize_numeric_ldlt(
                         factor,
@@ -500,112 +769,228 @@ impl LinearSolver {
                         Default::default(),
                     )
                     .map_err(|e| FactorizationError(format!("LDLᵀ: {e:?}")))?;
+                self.profile.ldlt += start.elapsed();
+                self.profile.ldlt_count += 1;
                 let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
+                timed(&mut self.profile.ldlt_solve, || {
+                    ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack)
+                });
             }
-            Kind::Lu {
-                symbolic,
-                numeric,
-                symmetric,
-            } => {
-                let symmetric = if self.fast { symmetric } else { &mut None };
-                if let Some(part) = symmetric.as_mut()
-                    && part.is_symmetric(matrix.val())
+            Kind::Full { lu, symmetric } => {
+                if self.fast
+                    && let Some(part) = symmetric.as_mut()
+                    && part.structural
                 {
-                    if part.factor.is_empty() {
-                        part.factor = vec![0.0; part.symbolic.len_val()];
-                    }
-                    part.rhs.clear();
-                    part.rhs.extend_from_slice(rhs);
-                    let factored = part.symbolic.factorize_numeric_ldlt(
-                        &mut part.factor,
-                        matrix,
-                        Side::Lower,
-                        LdltRegularization::default(),
-                        Par::Seq,
-                        &mut *stack,
-                        Default::default(),
-                    );
-                    if let Ok(ldlt) = factored {
-                        let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                        ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
-                        if accurate(matrix, rhs, &part.rhs, &mut self.krylov) {
-                            self.counts[1] += 1;
-                            return Ok(());
-                        }
-                    }
-                    self.counts[2] += 1;
-                    rhs.copy_from_slice(&part.rhs);
-                } else if let Some(part) = symmetric.as_mut()
-                    && part.transpose.iter().all(|&t| t != usize::MAX)
-                {
-                    // Unsymmetric: GMRES preconditioned by the LDLᵀ of the symmetric part.
-                    if part.factor.is_empty() {
-                        part.factor = vec![0.0; part.symbolic.len_val()];
-                    }
-                    let values = matrix.val();
-                    part.symmetric_values.clear();
-                    part.symmetric_values.extend(
-                        values
-                            .iter()
-                            .zip(part.transpose.iter())
-                            .map(|(&v, &t)| 0.5 * (v + values[t])),
-                    );
-                    part.rhs.clear();
-                    part.rhs.extend_from_slice(rhs);
-                    let symmetric_matrix =
-                        SparseColMatRef::new(matrix.symbolic(), &part.symmetric_values);
-                    let factored = part.symbolic.factorize_numeric_ldlt(
-                        &mut part.factor,
-                        symmetric_matrix,
-                        Side::Lower,
-                        LdltRegularization::default(),
-                        Par::Seq,
-                        &mut *stack,
-                        Default::default(),
-                    );
-                    if let Ok(ldlt) = factored {
-                        let mut precondition = |v: &mut [f64]| {
-                            let x = MatMut::from_column_major_slice_mut(v, n, 1);
-                            ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
-                        };
-                        let solved =
-                            gmres(matrix, &part.rhs, rhs, &mut precondition, &mut self.krylov);
-                        if solved && accurate(matrix, rhs, &part.rhs, &mut self.krylov) {
-                            self.counts[3] += 1;
-                            return Ok(());
-                        }
+                    let mut ctx = Context {
+                        krylov: &mut self.krylov,
+                        profile: &mut self.profile,
+                        counts: &mut self.counts,
+                    };
+                    if part.solve(matrix, rhs, limit, &mut ctx) {
+                        return Ok(());
                     }
                     self.counts[2] += 1;
                     rhs.copy_from_slice(&part.rhs);
                 }
+                if lu.is_none() {
+                    let analysed = timed(&mut self.profile.symbolic, || {
+                        LuPart::analyse(matrix.symbolic())
+                    })?;
+                    *lu = Some(analysed);
+                }
+                let lu = lu.as_mut().expect("analysed above");
                 self.counts[0] += 1;
-                let lu = symbolic
-                    .factorize_numeric_lu(numeric, matrix, Par::Seq, stack, Default::default())
+                self.profile.lu_count += 1;
+                let start = Instant::now();
+                let stack = MemStack::new(&mut lu.scratch);
+                let factored = lu
+                    .symbolic
+                    .factorize_numeric_lu(
+                        &mut lu.numeric,
+                        matrix,
+                        Par::Seq,
+                        stack,
+                        Default::default(),
+                    )
                     .map_err(|e| FactorizationError(format!("LU: {e:?}")))?;
                 let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                lu.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
+                factored.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
+                self.profile.lu += start.elapsed();
             }
         }
         Ok(())
     }
 }
 
-/// Whether `x` solves `matrix · x = b` to `1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row (`k`: buffers).
-fn accurate(matrix: SparseColMatRef<'_, usize, f64>, x: &[f64], b: &[f64], k: &mut Krylov) -> bool {
-    k.residual.clear();
-    k.residual.extend(b.iter().map(|v| -v));
-    k.row_norms.clear();
-    k.row_norms.resize(b.len(), 0.0);
-    let (r, norm_a) = (&mut k.residual, &mut k.row_norms);
-    let (ptr, rows, values) = (matrix.col_ptr(), matrix.row_idx(), matrix.val());
-    for j in 0..matrix.ncols() {
-        for k in ptr[j]..ptr[j + 1] {
-            r[rows[k]] += values[k] * x[j];
-            norm_a[rows[k]] += values[k].abs();
+/// Most DOFs of the skew part under [`UnsymmetricMethod::Woodbury`].
+const WOODBURY_MOST: usize = 1024;
+
+/// The solver's counters, lent to a fast solve.
+struct Context<'a> {
+    krylov: &'a mut Krylov,
+    profile: &'a mut SolveProfile,
+    counts: &'a mut [usize; 4],
+}
+
+impl SymmetricPart {
+    /// Solves `a x = rhs` on the LDLᵀ of the symmetric part (directly, by Woodbury with at most
+    /// `limit` DOFs, or by GMRES). False when the factorization fails or no solution passes the
+    /// accuracy check; `self.rhs` then holds the right-hand side.
+    fn solve(
+        &mut self,
+        a: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+        limit: usize,
+        ctx: &mut Context<'_>,
+    ) -> bool {
+        let n = rhs.len();
+        let symmetric = timed(&mut ctx.profile.symmetric_part, || self.split(a));
+        let woodbury = !symmetric && self.skew_dofs(limit).is_some();
+        if self.factor.is_empty() {
+            self.factor = vec![0.0; self.symbolic.len_val()];
+        }
+        self.rhs.clear();
+        self.rhs.extend_from_slice(rhs);
+        let s = SparseColMatRef::new(self.lower.as_ref().as_ref(), &self.symmetric_values);
+        let stack = MemStack::new(&mut self.scratch);
+        let start = Instant::now();
+        let factored = self.symbolic.factorize_numeric_ldlt(
+            &mut self.factor,
+            s,
+            Side::Lower,
+            LdltRegularization::default(),
+            Par::Seq,
+            &mut *stack,
+            Default::default(),
+        );
+        ctx.profile.ldlt += start.elapsed();
+        ctx.profile.ldlt_count += 1;
+        let Ok(ldlt) = factored else {
+            return false;
+        };
+        let check = |x: &[f64], ctx: &mut Context<'_>| {
+            timed(&mut ctx.profile.accuracy, || {
+                accurate(a, x, &self.rhs, &self.row_norms, ctx.krylov)
+            })
+        };
+        if symmetric {
+            let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+            timed(&mut ctx.profile.ldlt_solve, || {
+                ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack)
+            });
+            if check(rhs, ctx) {
+                ctx.counts[1] += 1;
+                return true;
+            }
+            return false;
+        }
+        if woodbury {
+            let start = Instant::now();
+            let c = self.dofs.len();
+            let m = c + 1;
+            self.block.clear();
+            self.block.resize(n * m, 0.0);
+            for (k, &d) in self.dofs.iter().enumerate() {
+                self.block[k * n + d] = 1.0;
+            }
+            self.block[c * n..].copy_from_slice(&self.rhs);
+            if self.block_columns < m {
+                self.block_scratch =
+                    MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(m, Par::Seq));
+                self.block_columns = m;
+            }
+            ldlt.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(&mut self.block, n, m),
+                Par::Seq,
+                MemStack::new(&mut self.block_scratch),
+            );
+            let solved = woodbury_correction(&self.dofs, &self.skew, &self.block, rhs);
+            ctx.profile.woodbury += start.elapsed();
+            ctx.profile.woodbury_count += 1;
+            ctx.profile.woodbury_columns += m;
+            if solved && check(rhs, ctx) {
+                ctx.counts[3] += 1;
+                return true;
+            }
+        }
+        let start = Instant::now();
+        let mut precondition = |v: &mut [f64]| {
+            let x = MatMut::from_column_major_slice_mut(v, n, 1);
+            ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
+        };
+        let solved = gmres(a, &self.rhs, rhs, &mut precondition, ctx.krylov);
+        ctx.profile.gmres += start.elapsed();
+        ctx.profile.gmres_count += 1;
+        ctx.profile.gmres_iterations += ctx.krylov.last_iterations;
+        ctx.profile.gmres_max = ctx.profile.gmres_max.max(ctx.krylov.last_iterations);
+        if solved && check(rhs, ctx) {
+            ctx.counts[3] += 1;
+            return true;
+        }
+        false
+    }
+}
+
+/// `x = y − W (I + K_CC W_C)⁻¹ K_CC y_C` from the block `[W y] = S⁻¹ [I_C b]` (column-major,
+/// `n` rows) and the skew entries `(i, j, k_ij)` below the diagonal (`k_ji = −k_ij`): the
+/// solution of `(S + K) x = b` (Woodbury's identity with `K = I_C K_CC I_Cᵀ`). False when the
+/// small matrix is singular.
+fn woodbury_correction(
+    dofs: &[usize],
+    skew: &[(usize, usize, f64)],
+    block: &[f64],
+    x: &mut [f64],
+) -> bool {
+    let (c, n) = (dofs.len(), x.len());
+    let index = |d: usize| {
+        dofs.binary_search(&d)
+            .expect("skew DOFs collected from skew")
+    };
+    let mut k = DMatrix::<f64>::zeros(c, c);
+    for &(i, j, h) in skew {
+        let (a, b) = (index(i), index(j));
+        k[(a, b)] += h;
+        k[(b, a)] -= h;
+    }
+    let w_c = DMatrix::from_fn(c, c, |r, l| block[l * n + dofs[r]]);
+    let y = &block[c * n..];
+    let y_c = DVector::from_fn(c, |r, _| y[dofs[r]]);
+    let m = DMatrix::<f64>::identity(c, c) + &k * w_c;
+    let Some(z) = m.lu().solve(&(&k * y_c)) else {
+        return false;
+    };
+    x.copy_from_slice(y);
+    for (l, &zl) in z.iter().enumerate() {
+        if zl != 0.0 {
+            x.iter_mut()
+                .zip(&block[l * n..(l + 1) * n])
+                .for_each(|(a, w)| *a -= zl * w);
         }
     }
-    let a = norm_a.iter().fold(0.0_f64, |m, &v| m.max(v));
+    true
+}
+
+/// Whether `x` solves `matrix · x = b` to `1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row, with the row
+/// sums of `|A|` given (`k`: buffers).
+fn accurate(
+    matrix: SparseColMatRef<'_, usize, f64>,
+    x: &[f64],
+    b: &[f64],
+    row_norms: &[f64],
+    k: &mut Krylov,
+) -> bool {
+    k.residual.clear();
+    k.residual.extend(b.iter().map(|v| -v));
+    let r = &mut k.residual;
+    let (ptr, rows, values) = (matrix.col_ptr(), matrix.row_idx(), matrix.val());
+    for j in 0..matrix.ncols() {
+        let xj = x[j];
+        for k in ptr[j]..ptr[j + 1] {
+            r[rows[k]] += values[k] * xj;
+        }
+    }
+    let a = row_norms.iter().fold(0.0_f64, |m, &v| m.max(v));
     let xm = x.iter().fold(0.0_f64, |m, &v| m.max(v.abs()));
     let bm = b.iter().fold(0.0_f64, |m, &v| m.max(v.abs()));
     let limit = 1e-9 * (a * xm + bm);

@@ -16,7 +16,7 @@ use super::assembly::{Dof, PatternError, System, node_dofs, node_vector};
 use super::cable::{CableResult, Cables};
 use super::contact::{GapLaw, GapResponse, GapStatus, IterationMatrix};
 use super::element::{ElementStress, ElementVector, MembraneTriangle};
-use super::linear::LinearSolver;
+use super::linear::{LinearSolver, SolveProfile, UnsymmetricMethod};
 use super::load::{ExternalLoad, LoadLevels, Loads};
 use super::material::Wrinkling;
 use super::model::{Hinge, Model, ModelError};
@@ -571,6 +571,22 @@ impl Analysis {
     /// not counted).
     pub fn factorization_counts(&self) -> [usize; 4] {
         self.linear.counts()
+    }
+
+    /// Where the linear solves' time went so far (see [`SolveProfile`]).
+    pub fn solve_profile(&self) -> SolveProfile {
+        self.linear.profile()
+    }
+
+    /// The linear solver (its memory, limits and whether the LU was ever analysed).
+    pub fn linear_solver(&self) -> &LinearSolver {
+        &self.linear
+    }
+
+    /// Chooses how unsymmetric consistent tangents are solved (Woodbury or GMRES on the
+    /// symmetric part's LDLᵀ; [`UnsymmetricMethod::Auto`] by default).
+    pub fn set_unsymmetric_method(&mut self, method: UnsymmetricMethod) {
+        self.linear.set_method(method);
     }
 
     /// The model.

@@ -1,0 +1,240 @@
+//! One Newton iteration of the consistent tangent at scale against the bare LDLᵀ factorization
+//! (issue 11 item 2): `cargo bench --bench newton` (`-- --refine 4,16 --steps 20 --methods
+//! auto,gmres`).
+//!
+//! For each refinement `r` of the 300 mm specimen (`ParallelArch`, `3 (10 r + 1)²` DOF) and
+//! each way of solving the unsymmetric tangent, a fresh process runs the first `--steps` of the
+//! 20 steps to the target (one increment each, gaps sliding) with the default settings, and
+//! reports where the time went (`Analysis::solve_profile`): the symmetric-part pass, the LDLᵀ
+//! factorizations, the Woodbury block solves or GMRES iterations, the accuracy checks, LU
+//! fallbacks and the rest (assembly, line search). Then, in the same process, the bare LDLᵀ
+//! factorization of the same pattern's lower triangle (the Ju–Rowlands matrix at the final
+//! state, same AMD ordering, same cost) and the memory: ours (pattern, values, symmetric part,
+//! Woodbury block, Krylov basis, vectors) against the LDLᵀ factor.
+
+use std::time::{Duration, Instant};
+
+use membrane_contact::mech::assembly::System;
+use membrane_contact::mech::contact::GapLaw;
+use membrane_contact::mech::linear::{LinearSolver, UnsymmetricMethod};
+use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use nalgebra::Vector2;
+
+/// Peak resident set size (bytes) from /proc (0 where unavailable).
+fn peak_rss() -> usize {
+    let text = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    text.lines()
+        .find(|l| l.starts_with("VmHWM:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|v| v.parse::<usize>().ok())
+        .map_or(0, |kb| kb * 1024)
+}
+
+/// Resident set size now (bytes).
+fn current_rss() -> usize {
+    let text = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    text.lines()
+        .find(|l| l.starts_with("VmRSS:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|v| v.parse::<usize>().ok())
+        .map_or(0, |kb| kb * 1024)
+}
+
+fn mib(bytes: usize) -> f64 {
+    bytes as f64 / (1024.0 * 1024.0)
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn parse_method(name: &str) -> UnsymmetricMethod {
+    match name {
+        "gmres" => UnsymmetricMethod::Gmres,
+        "woodbury" => UnsymmetricMethod::Woodbury,
+        _ => UnsymmetricMethod::Auto,
+    }
+}
+
+fn system_free(analysis: &Analysis) -> usize {
+    analysis.system().free_count
+}
+
+/// One case in this process: prints one table row.
+fn case(r: usize, steps: usize, method: &str) {
+    let spec = ParallelArch {
+        refinement: r,
+        ..ParallelArch::with_height(0.3)
+    };
+    let model = spec.model().unwrap();
+    let started = Instant::now();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let setup = started.elapsed();
+    analysis.set_unsymmetric_method(parse_method(method));
+    // The bare LDLᵀ: the same pattern's lower triangle with the symmetric Ju–Rowlands matrix
+    // of the current state (the factorization's cost does not depend on the values), factorized
+    // before the run and after every step, so that its samples see the same machine load.
+    let lower = System::new(&model, true).unwrap();
+    let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
+    let mut internal = vec![0.0; model.dof_count()];
+    let mut values = vec![0.0; lower.nonzeros()];
+    let mut bare = LinearSolver::new(&lower, true).unwrap();
+    let mut rhs = vec![1.0; system_free(&analysis)];
+    let mut factorizations = vec![];
+    let mut bare_sample = |analysis: &Analysis| {
+        let u = &analysis.state().displacement;
+        let history: Vec<Vector2<f64>> = analysis
+            .state()
+            .plastic_slip
+            .iter()
+            .map(|s| Vector2::new(s[0], s[1]))
+            .collect();
+        lower.assemble(u, &mut internal, Some(&mut values), |g, d| {
+            let r = laws[g].evaluate(d, history[g]);
+            (r.force, laws[g].ju_rowlands_matrix(r.status, r.direction))
+        });
+        rhs.fill(1.0);
+        let before = bare.profile().ldlt;
+        bare.factorize_and_solve(lower.matrix(&values), &mut rhs)
+            .unwrap();
+        factorizations.push(bare.profile().ldlt - before);
+    };
+    bare_sample(&analysis);
+    let mut run = Duration::ZERO;
+    let (mut iterations, mut increments, mut cutbacks) = (0, 0, 0);
+    for step in 1..=steps {
+        let target = spec.target().map(|v| v * step as f64 / 20.0);
+        let started = Instant::now();
+        let report = analysis.step_to(&[target], 1).unwrap();
+        run += started.elapsed();
+        iterations += report.total_iterations();
+        increments += report.iterations.len();
+        cutbacks += report.cutbacks;
+        bare_sample(&analysis);
+    }
+    let p = analysis.solve_profile();
+    let counts = analysis.factorization_counts();
+    let linear = analysis.linear_solver();
+    let system = analysis.system();
+    let n = system.free_count;
+    let ours = system.memory_bytes()
+        + 8 * (system.nonzeros() + 3 * model.dof_count() + 2 * n)
+        + linear.memory_bytes()
+        - 8 * linear.factor_len();
+    let factor = 8 * linear.factor_len();
+    let has_lu = linear.has_lu();
+    let slip = analysis
+        .results()
+        .gaps
+        .iter()
+        .map(|g| g.slip_x)
+        .fold(0.0_f64, |m, s| m.max(s.abs()));
+    let peak_analysis = peak_rss();
+    let mut factorizations = factorizations;
+    factorizations.sort();
+    // Median of the samples.
+    let bare_factor = factorizations[factorizations.len() / 2];
+    let per_iteration = run / iterations.max(1) as u32;
+    let rest = run.saturating_sub(p.total());
+    let per = |d: Duration| ms(d) / iterations.max(1) as f64;
+    println!(
+        "| {r} | {n} | {method} | {steps} | {increments} | {cutbacks} | {iterations} | {}/{}/{}/{} | {} | {:.1} / {} | {:.1} s | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} ms | {:.2} | {:.0} | {:.0} | {:.2} | {:.0} | {} | {:.4e} |",
+        counts[0],
+        counts[1],
+        counts[2],
+        counts[3],
+        p.woodbury_columns / p.woodbury_count.max(1),
+        p.gmres_iterations as f64 / p.gmres_count.max(1) as f64,
+        p.gmres_max,
+        setup.as_secs_f64(),
+        ms(per_iteration),
+        per(p.symmetric_part),
+        per(p.ldlt),
+        per(p.woodbury),
+        per(p.gmres),
+        per(p.accuracy),
+        per(p.lu + p.symbolic),
+        per(rest),
+        ms(bare_factor),
+        ms(per_iteration) / ms(bare_factor),
+        mib(ours),
+        mib(factor),
+        ours as f64 / factor.max(1) as f64,
+        mib(peak_analysis),
+        if has_lu { "yes" } else { "no" },
+        slip,
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let option = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|i| args.get(i + 1))
+            .cloned()
+    };
+    if let Some(r) = option("--lu-symbolic") {
+        // What an eager LU symbolic analysis (held before issue 11 item 2 at scale) costs.
+        let spec = ParallelArch {
+            refinement: r.parse().unwrap(),
+            ..ParallelArch::with_height(0.3)
+        };
+        let system = System::new(&spec.model().unwrap(), false).unwrap();
+        let (before, started) = (current_rss(), Instant::now());
+        let lu = LinearSolver::new(&system, false).unwrap();
+        println!(
+            "LU symbolic analysis at {} free DOF: {:.0} ms, {:.0} MiB resident",
+            system.free_count,
+            ms(started.elapsed()),
+            mib(current_rss().saturating_sub(before))
+        );
+        drop(lu);
+        return;
+    }
+    if let Some(one) = option("--one") {
+        let parts: Vec<&str> = one.split(',').collect();
+        case(
+            parts[0].parse().unwrap(),
+            parts[1].parse().unwrap(),
+            parts[2],
+        );
+        return;
+    }
+    let refine: Vec<usize> = option("--refine")
+        .unwrap_or_else(|| "1,4,16".into())
+        .split(',')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let steps: usize = option("--steps").map_or(20, |v| v.parse().unwrap());
+    let methods = option("--methods").unwrap_or_else(|| "auto,gmres".into());
+    println!(
+        "## one Newton iteration of the consistent tangent on the refined 300 mm specimen ({steps} of 20 steps)\n"
+    );
+    println!(
+        "Times per Newton iteration (ms): sym = symmetric-part pass, ldlt = LDLᵀ factorization, wood = Woodbury, gmres = GMRES, acc = accuracy checks, lu = LU fallbacks + symbolic analyses, rest = assembly, line search, updates; bare = one LDLᵀ factorization of the same pattern alone.\n"
+    );
+    println!(
+        "| r | free DOF | method | steps | increments | cut-backs | iterations | LU/LDLᵀ/rejected/unsym solves | Woodbury columns | GMRES mean / max | setup | per iteration | sym | ldlt | wood | gmres | acc | lu | rest | bare LDLᵀ | iteration / bare | our MiB | factor MiB | ours / factor | peak RSS MiB | LU built | largest slip |"
+    );
+    println!("|{}", "---|".repeat(27));
+    let exe = std::env::current_exe().unwrap();
+    for &r in &refine {
+        for method in methods.split(',') {
+            let out = std::process::Command::new(&exe)
+                .args(["--one", &format!("{r},{steps},{method}")])
+                .output()
+                .unwrap();
+            print!("{}", String::from_utf8_lossy(&out.stdout));
+            if !out.status.success() {
+                println!(
+                    "| {r} | failed ({method}): {} |",
+                    String::from_utf8_lossy(&out.stderr)
+                        .lines()
+                        .last()
+                        .unwrap_or("")
+                );
+            }
+        }
+    }
+}
