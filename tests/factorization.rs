@@ -7,6 +7,7 @@
 //! LU throughout — its unsymmetric iterations solved by GMRES preconditioned with the LDLᵀ of
 //! the symmetric part (item 2); a follower pressure makes every iteration unsymmetric.
 
+use membrane_contact::mech::linear::UnsymmetricMethod;
 use membrane_contact::mech::{Analysis, LoadLevels, Model, ParallelArch, SolverSettings};
 
 fn run(model: &Model, symmetric: bool, loads: &LoadLevels, angle: f64) -> (Vec<f64>, [usize; 4]) {
@@ -97,4 +98,42 @@ fn specimen_mixes_ldlt_and_gmres_as_its_gaps_stick_and_slip_to_the_lus_answer() 
     );
     let scale = lu.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     assert!(max_difference(&mixed, &lu) < 1e-6 * scale);
+}
+
+#[test]
+fn specimen_takes_the_same_newton_iterations_and_answer_by_woodbury_or_gmres_and_never_analyses_an_lu()
+ {
+    let spec = ParallelArch::default();
+    let model = spec.model().unwrap();
+    let mut outcomes = vec![];
+    for method in [
+        UnsymmetricMethod::Auto,
+        UnsymmetricMethod::Gmres,
+        UnsymmetricMethod::Woodbury,
+    ] {
+        let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+        analysis.set_unsymmetric_method(method);
+        let mut iterations = vec![];
+        for k in 1..=4 {
+            let target = spec.target().map(|v| v * k as f64 / 4.0);
+            iterations.extend(analysis.step_to(&[target], 2).unwrap().iterations);
+        }
+        assert!(!analysis.linear_solver().has_lu(), "{method:?}");
+        outcomes.push((
+            iterations,
+            analysis.state().displacement.clone(),
+            analysis.solve_profile(),
+        ));
+    }
+    let (auto, gmres) = (&outcomes[0].2, &outcomes[1].2);
+    assert!(auto.woodbury_count > 0 && auto.gmres_count == 0, "{auto:?}");
+    assert!(
+        gmres.gmres_count > 0 && gmres.woodbury_count == 0,
+        "{gmres:?}"
+    );
+    let scale = outcomes[0].1.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for (iterations, u, _) in &outcomes[1..] {
+        assert_eq!(iterations, &outcomes[0].0);
+        assert!(max_difference(u, &outcomes[0].1) < 1e-10 * scale);
+    }
 }
