@@ -130,7 +130,6 @@ fn case(r: usize, steps: usize, method: &str) {
         .map(|g| g.slip_x)
         .fold(0.0_f64, |m, s| m.max(s.abs()));
     let peak_analysis = peak_rss();
-    let mut factorizations = factorizations;
     factorizations.sort();
     // Median of the samples.
     let bare_factor = factorizations[factorizations.len() / 2];

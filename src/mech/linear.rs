@@ -121,7 +121,7 @@ enum Kind {
     },
     Full {
         /// Built at creation without a symmetric part, else at the first fallback.
-        lu: Option<LuPart>,
+        lu: Option<Box<LuPart>>,
         /// The LDLᵀ of the same pattern's symmetric part, when the fast paths are allowed.
         symmetric: Option<Box<SymmetricPart>>,
     },
@@ -512,7 +512,9 @@ impl Clone for LinearSolver {
                 factor: vec![0.0; factor.len()],
             },
             Kind::Full { lu, symmetric } => Kind::Full {
-                lu: lu.as_ref().map(|l| LuPart::new(l.symbolic.clone())),
+                lu: lu
+                    .as_ref()
+                    .map(|l| Box::new(LuPart::new(l.symbolic.clone()))),
                 symmetric: symmetric.as_ref().map(|p| Box::new(p.fresh_copy())),
             },
         };
@@ -560,7 +562,7 @@ impl LinearSolver {
             }
         } else {
             Kind::Full {
-                lu: Some(LuPart::analyse(system.pattern())?),
+                lu: Some(Box::new(LuPart::analyse(system.pattern())?)),
                 symmetric: None,
             }
         };
@@ -646,6 +648,14 @@ impl LinearSolver {
         let n = self.equation_dofs.len().max(1);
         let values = (self.factor_len() / 4).max(WOODBURY_SMALL);
         (values / n).saturating_sub(1).min(WOODBURY_MOST)
+    }
+
+    /// Whether an LU of this system is cheap enough to replace the fast paths for the rest of
+    /// a cut-back step: the symmetric part's LDLᵀ factor holds at most [`LU_AFFORDABLE`]
+    /// values (the LU of the unsymmetric pattern was measured at about 6× the LDLᵀ's memory
+    /// and 4–6× its time on the refined specimens).
+    pub fn lu_affordable(&self) -> bool {
+        self.factor_len() <= LU_AFFORDABLE
     }
 
     /// Bytes held for the solves beyond the symbolic analyses: factor values, the symmetric
@@ -800,7 +810,7 @@ impl LinearSolver {
                     let analysed = timed(&mut self.profile.symbolic, || {
                         LuPart::analyse(matrix.symbolic())
                     })?;
-                    *lu = Some(analysed);
+                    *lu = Some(Box::new(analysed));
                 }
                 let lu = lu.as_mut().expect("analysed above");
                 self.counts[0] += 1;
@@ -828,6 +838,10 @@ impl LinearSolver {
 
 /// Most DOFs of the skew part for the Woodbury correction (its dense `|C| × |C|` system).
 const WOODBURY_MOST: usize = 512;
+
+/// LDLᵀ factors of up to this many values (32 MiB; the refined specimen up to ≈ 30 k DOF)
+/// let a cut-back step fall back to LU (see [`LinearSolver::lu_affordable`]).
+const LU_AFFORDABLE: usize = 1 << 22;
 
 /// Woodbury blocks of up to this many values are always affordable (512 KiB).
 const WOODBURY_SMALL: usize = 1 << 16;

@@ -763,10 +763,15 @@ impl Analysis {
             };
             let levels = base_loads.interpolate(loads, next);
             // Once an increment of this step has been cut back, the rest of the step is solved
-            // by LU: the unpivoted LDLᵀ and the Krylov solve are fast on ordinary iterations, but
-            // on the edge of a mechanism (a film slack across, gaps opening) LU's pivoting was
-            // measured to converge where they stall (robustness bench, arch-edge family).
-            self.linear.set_fast(report.cutbacks == 0);
+            // by LU where the LU is cheap: the unpivoted LDLᵀ and its Woodbury or Krylov solves
+            // are fast on ordinary iterations, but on the edge of a mechanism (a film slack
+            // across, gaps opening) LU's pivoting was measured to converge where they stall
+            // (robustness bench: arch-edge family with GMRES, two strip paths with Woodbury).
+            // On large meshes the LU is not affordable (10 GiB at 1 M DOF): the fast paths stay,
+            // every solution still checked.
+            let lu_after_cutback = self.linear.lu_affordable();
+            self.linear
+                .set_fast(report.cutbacks == 0 || !lu_after_cutback);
             match self.solve_increment(&current, &at(next), &levels) {
                 Ok((state, history)) => {
                     current = state;
@@ -795,7 +800,7 @@ impl Analysis {
                     while reached.is_none() && larger < 2.0 * (1.0 - done) {
                         let next = (done + larger).min(1.0);
                         let levels = base_loads.interpolate(loads, next);
-                        self.linear.set_fast(false);
+                        self.linear.set_fast(!lu_after_cutback);
                         if let Ok(converged) = self.solve_increment(&current, &at(next), &levels) {
                             reached = Some((next, converged));
                         }
