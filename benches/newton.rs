@@ -56,6 +56,92 @@ fn parse_method(name: &str) -> UnsymmetricMethod {
     }
 }
 
+/// One Newton linear step at a synthetic deformed state whose gaps slip (the plastic slip set
+/// 10 mm behind), without running the analysis there: assembly of the consistent tangent plus
+/// our solve (`LinearSolver` with the symmetric part), twice, against the bare LDLᵀ of the same
+/// pattern's lower triangle, twice; best of each.
+fn iteration(r: usize) {
+    let spec = ParallelArch {
+        refinement: r,
+        ..ParallelArch::with_height(0.3)
+    };
+    let model = spec.model().unwrap();
+    let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
+    let mut u = vec![0.0; model.dof_count()];
+    for (i, p) in model.nodes.iter().enumerate() {
+        let r = (p[0].powi(2) + p[1].powi(2)).sqrt().min(1.0);
+        u[3 * i + 2] = -0.02 * r * r;
+        u[3 * i] = 1e-4 * p[0];
+    }
+    let history = vec![Vector2::new(-0.01, 0.0); laws.len()];
+    let shift = 1e-3 * model.material.membrane_stiffness();
+    let mut free = 0;
+    let mut run = |lower_only: bool| -> (Duration, Duration, [usize; 4], usize, usize, usize) {
+        let system = System::new(&model, lower_only).unwrap();
+        free = system.free_count;
+        let mut linear = LinearSolver::new(&system, true).unwrap();
+        let mut internal = vec![0.0; model.dof_count()];
+        let mut values = vec![0.0; system.nonzeros()];
+        let p = system.pattern();
+        let diagonal: Vec<usize> = (0..system.free_count)
+            .map(|j| {
+                let rows = &p.row_idx()[p.col_ptr()[j]..p.col_ptr()[j + 1]];
+                p.col_ptr()[j] + rows.binary_search(&j).unwrap()
+            })
+            .collect();
+        let (mut best, mut best_factor) = (Duration::MAX, Duration::MAX);
+        for _ in 0..2 {
+            let started = Instant::now();
+            system.assemble(&u, &mut internal, Some(&mut values), |g, d| {
+                let r = laws[g].evaluate(d, history[g]);
+                let k = if lower_only {
+                    laws[g].ju_rowlands_matrix(r.status, r.direction)
+                } else {
+                    laws[g].consistent_tangent(&r)
+                };
+                (r.force, k)
+            });
+            for &d in &diagonal {
+                values[d] += shift;
+            }
+            let mut rhs = vec![1.0; system.free_count];
+            let before = linear.profile().ldlt;
+            linear
+                .factorize_and_solve(system.matrix(&values), &mut rhs)
+                .unwrap();
+            best = best.min(started.elapsed());
+            best_factor = best_factor.min(linear.profile().ldlt - before);
+        }
+        let ours = system.memory_bytes()
+            + 8 * (system.nonzeros() + 3 * model.dof_count() + 2 * system.free_count)
+            + linear.memory_bytes()
+            - 8 * linear.factor_len();
+        (
+            best,
+            best_factor,
+            linear.counts(),
+            linear.profile().woodbury_columns / linear.profile().woodbury_count.max(1),
+            ours,
+            8 * linear.factor_len(),
+        )
+    };
+    let (ours_time, ours_factor, counts, columns, ours, factor) = run(false);
+    let (_, bare, _, _, _, _) = run(true);
+    println!(
+        "| {r} | {} | {:?} | {columns} | {:.0} ms | {:.0} ms | {:.0} ms | **{:.2}** | {:.0} MiB | {:.0} MiB | {:.2} | {:.0} MiB |",
+        free,
+        counts,
+        ms(ours_time),
+        ms(ours_factor),
+        ms(bare),
+        ms(ours_time) / ms(bare),
+        mib(ours),
+        mib(factor),
+        ours as f64 / factor.max(1) as f64,
+        mib(peak_rss()),
+    );
+}
+
 fn system_free(analysis: &Analysis) -> usize {
     analysis.system().free_count
 }
@@ -173,6 +259,10 @@ fn main() {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
+    if let Some(r) = option("--iteration") {
+        iteration(r.parse().unwrap());
+        return;
+    }
     if let Some(r) = option("--lu-symbolic") {
         // What an eager LU symbolic analysis (held before issue 11 item 2 at scale) costs.
         let spec = ParallelArch {
