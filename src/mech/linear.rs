@@ -64,7 +64,7 @@ pub struct SolveProfile {
     pub symbolic: Duration,
     /// The pass forming the symmetric part, the row norms and the skew entries.
     pub symmetric_part: Duration,
-    /// LDLᵀ numeric factorizations, and their number.
+    /// LDLᵀ numeric factorizations.
     pub ldlt: Duration,
     /// Number of LDLᵀ numeric factorizations.
     pub ldlt_count: usize,
@@ -72,15 +72,15 @@ pub struct SolveProfile {
     pub ldlt_solve: Duration,
     /// Woodbury corrections (block solve and the small dense system).
     pub woodbury: Duration,
-    /// Woodbury solves, and the right-hand sides of their block solves (`|C| + 1` each).
+    /// Woodbury solves.
     pub woodbury_count: usize,
-    /// Total right-hand sides of the Woodbury block solves.
+    /// Total right-hand sides of the Woodbury block solves (`|C| + 1` each).
     pub woodbury_columns: usize,
     /// GMRES solves (preconditioner solves, products, orthogonalization).
     pub gmres: Duration,
     /// GMRES solves started.
     pub gmres_count: usize,
-    /// GMRES iterations in all, and the most in one solve.
+    /// GMRES iterations in all.
     pub gmres_iterations: usize,
     /// Most GMRES iterations in one solve.
     pub gmres_max: usize,
