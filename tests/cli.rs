@@ -202,6 +202,36 @@ fn no_line_search_option_reaches_the_same_inflated_state() {
     }
 }
 
+/// The `linear solves:` line counts the factorizations: the disc of circular_membrane.json
+/// (follower pressure, rim held) has a symmetric consistent tangent, so every Newton iteration
+/// is one LDLᵀ and none is an LU, with and without the line search.
+#[test]
+fn pressurised_disc_held_at_its_rim_is_factored_by_one_ldlt_per_newton_iteration() {
+    let model = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/circular_membrane.json"
+    );
+    for extra in [None, Some("--no-line-search")] {
+        let mut args = vec!["model", model, "--steps", "4", "--quiet"];
+        args.extend(extra);
+        let (ok, out, err) = cli(&args);
+        assert!(ok, "{err}");
+        let numbers = |prefix: &str| -> Vec<usize> {
+            let line = out.lines().find(|l| l.starts_with(prefix)).unwrap();
+            line.split([' ', ',', '('])
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        };
+        // "Newton: 4 steps, 4 increments, 0 cut-backs, 0 enlarged, N iterations (…"
+        let iterations = numbers("Newton:")[4];
+        let [lu, ldlt, gmres, redone] = numbers("linear solves:")[..] else {
+            panic!("{out}")
+        };
+        assert!(iterations > 0, "{out}");
+        assert_eq!((lu, ldlt, gmres, redone), (0, iterations, 0, 0), "{out}");
+    }
+}
+
 /// The solver settings the FMU has are CLI options too: increments per step, cut-backs and
 /// both tolerances; a bad value is refused naming the setting.
 #[test]

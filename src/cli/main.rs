@@ -211,6 +211,11 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         iterations,
         elapsed.as_secs_f64() * 1e3
     );
+    let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
+    out!(
+        "linear solves: {lu} LU, {ldlt} LDLᵀ, {gmres} GMRES on the symmetric part's LDLᵀ, \
+         {redone} of these redone by LU"
+    );
     if o.vtk.is_some() {
         out!(
             "VTK ({}): {} .vtu files, {:.2} MB, {:.1} ms to encode and write",
