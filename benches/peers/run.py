@@ -36,7 +36,8 @@ LABELS = {
 
 
 def timed(cmd, cwd, env, timeout):
-    """Runs cmd under nice and /usr/bin/time -v; returns (stdout, stderr, wall s, peak MiB)."""
+    """Runs cmd under nice and /usr/bin/time -v; returns (stdout, stderr, wall s, peak MiB,
+    CPU s = user + system)."""
     full = ["nice", "-n", "5", "/usr/bin/time", "-v"] + cmd
     t0 = time.perf_counter()
     p = subprocess.run(full, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
@@ -44,30 +45,31 @@ def timed(cmd, cwd, env, timeout):
     if p.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout[-2000:]}\n{p.stderr[-2000:]}")
     rss = re.search(r"Maximum resident set size \(kbytes\): (\d+)", p.stderr)
-    return p.stdout, p.stderr, wall, int(rss.group(1)) / 1024 if rss else float("nan")
+    cpu = sum(float(m) for m in re.findall(r"(?:User|System) time \(seconds\): ([0-9.]+)", p.stderr))
+    return p.stdout, p.stderr, wall, int(rss.group(1)) / 1024 if rss else float("nan"), cpu
 
 
 def run_ours(files, plain, args, env):
     cmd = [args.bin, "model", files["ours"], "--steps", str(sheet.STEPS), "--quiet"]
     if plain:
         cmd.append("--no-line-search")
-    out, _, wall, rss = timed(cmd, os.path.dirname(files["ours"]), env, args.timeout)
+    out, _, wall, rss, cpu = timed(cmd, os.path.dirname(files["ours"]), env, args.timeout)
     w = re.search(r"output point centre \(node \d+\): displacement \(([^,]+), ([^,]+), ([^)]+)\) m", out)
     newton = re.search(r"Newton: .*?, (\d+) iterations .*; ([0-9.]+) ms", out)
     if not (w and newton):
         raise RuntimeError(f"unexpected output of {' '.join(cmd)}:\n{out}")
-    return {"w": float(w.group(3)), "iterations": int(newton.group(1)), "wall": wall, "rss": rss,
+    return {"w": float(w.group(3)), "iterations": int(newton.group(1)), "wall": wall, "cpu": cpu, "rss": rss,
             "solve": float(newton.group(2)) / 1e3}
 
 
 def run_kratos(files, args, env):
     cmd = [args.kratos_python, os.path.join(HERE, "run_kratos.py"), files["kratos"]]
-    out, _, wall, rss = timed(cmd, os.path.dirname(files["kratos"]), env, args.timeout)
+    out, _, wall, rss, cpu = timed(cmd, os.path.dirname(files["kratos"]), env, args.timeout)
     line = next((ln for ln in out.splitlines() if ln.startswith('{"solver": "kratos"')), None)
     if line is None:
         raise RuntimeError(f"no result line from Kratos:\n{out[-3000:]}")
     r = json.loads(line)
-    return {"w": r["centre"][2], "iterations": sum(r["iterations"]), "wall": wall, "rss": rss,
+    return {"w": r["centre"][2], "iterations": sum(r["iterations"]), "wall": wall, "cpu": cpu, "rss": rss,
             "solve": r["solve_s"]}
 
 
@@ -75,7 +77,7 @@ def run_ccx(files, args, env):
     inp = files["ccx"]
     job = os.path.splitext(os.path.basename(inp))[0]
     cwd = os.path.dirname(inp)
-    _, _, wall, rss = timed([args.ccx, "-i", job], cwd, env, args.timeout)
+    _, _, wall, rss, cpu = timed([args.ccx, "-i", job], cwd, env, args.timeout)
     with open(os.path.join(cwd, job + ".sta")) as f:
         rows = [ln.split() for ln in f if re.match(r"\s+\d+\s+\d+\s+\d+\s+\d+\s", ln)]
     if not rows or float(rows[-1][4]) < 1.0 - 1e-9:
@@ -85,7 +87,7 @@ def run_ccx(files, args, env):
     blocks = dat.split("displacements (vx,vy,vz) for set CENTRE")
     lines = [ln for ln in blocks[-1].splitlines() if ln.strip()]
     z = float(lines[1].split()[3])
-    return {"w": z, "iterations": sum(int(r[3]) for r in rows), "wall": wall, "rss": rss,
+    return {"w": z, "iterations": sum(int(r[3]) for r in rows), "wall": wall, "cpu": cpu, "rss": rss,
             "solve": None}
 
 
@@ -140,7 +142,7 @@ def main():
                     res = run_ccx(files, args, env)
                 res.update(solver=s, n=n, repeat=r)
                 print(f"  n={n} repeat {r + 1} {s}: w={res['w'] * 1e3:.4f} mm, {res['iterations']} it, "
-                      f"{res['wall']:.2f} s, {res['rss']:.0f} MiB", file=sys.stderr, flush=True)
+                      f"{res['wall']:.2f} s wall, {res['cpu']:.2f} s CPU, {res['rss']:.0f} MiB", file=sys.stderr, flush=True)
                 if args.json:
                     with open(args.json, "a") as f:
                         f.write(json.dumps(res) + "\n")
@@ -148,25 +150,33 @@ def main():
         table(n, solvers, runs, args.repeats)
 
 
+def ratio(a, b):
+    """a / b to three digits; a dash when b is below the clock's resolution."""
+    return f"{a / b:.3g}" if b > 0 else "–"
+
+
 def table(n, solvers, runs, repeats):
     free = 3 * (n - 2) ** 2
     ref = next((s for s in ("ours-plain", "ours") if s in solvers), solvers[0])
-    med = {s: {key: statistics.median(r[key] for r in runs[s]) for key in ("wall", "rss")} for s in solvers}
+    med = {s: {key: statistics.median(r[key] for r in runs[s]) for key in ("wall", "cpu", "rss")} for s in solvers}
     for s in solvers:
         med[s]["w"] = runs[s][0]["w"]
         med[s]["iterations"] = runs[s][0]["iterations"]
         med[s]["per_it"] = med[s]["wall"] / med[s]["iterations"]
+        med[s]["cpu_it"] = med[s]["cpu"] / med[s]["iterations"]
     print(f"### n = {n}: {3 * n * n} DOF ({free} free), {2 * (n - 1) ** 2} triangles, "
           f"median of {repeats}\n")
-    print(f"| solver | centre w (mm) | vs {ref} | Newton iterations | wall (s) | wall / iteration (s) | "
-          f"peak RSS (MiB) | per iteration ÷ {ref} | wall ÷ {ref} |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print(f"| solver | centre w (mm) | vs {ref} | Newton iterations | wall (s) | CPU (s) | "
+          f"CPU / iteration (s) | peak RSS (MiB) | wall / iteration ÷ {ref} | CPU / iteration ÷ {ref} | "
+          f"wall ÷ {ref} | CPU ÷ {ref} |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     b = med[ref]
     for s in solvers:
         m = med[s]
         print(f"| {LABELS[s]} | {m['w'] * 1e3:.4f} | {100 * (m['w'] / b['w'] - 1):+.2f} % | "
-              f"{m['iterations']} | {m['wall']:.2f} | {m['per_it']:.4f} | {m['rss']:.0f} | "
-              f"{m['per_it'] / b['per_it']:.3g} | {m['wall'] / b['wall']:.3g} |")
+              f"{m['iterations']} | {m['wall']:.2f} | {m['cpu']:.2f} | {m['cpu_it']:.4f} | {m['rss']:.0f} | "
+              f"{ratio(m['per_it'], b['per_it'])} | {ratio(m['cpu_it'], b['cpu_it'])} | "
+              f"{ratio(m['wall'], b['wall'])} | {ratio(m['cpu'], b['cpu'])} |")
     print()
     sys.stdout.flush()
 
