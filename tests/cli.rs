@@ -290,7 +290,7 @@ fn cli(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-/// The printed results without the Newton statistics, a printed negative zero (`-0.000`) read
+/// The printed results without the Newton and linear-solve statistics, a printed negative zero (`-0.000`) read
 /// as zero.
 fn results_text(out: &str) -> String {
     let zero = |word: &str| {
@@ -302,7 +302,7 @@ fn results_text(out: &str) -> String {
         }
     };
     out.lines()
-        .filter(|l| !l.starts_with("Newton:"))
+        .filter(|l| !l.starts_with("Newton:") && !l.starts_with("linear solves:"))
         .map(|l| {
             l.split_inclusive([' ', ',', '(', ')'])
                 .map(|w| {
