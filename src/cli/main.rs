@@ -124,6 +124,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             .unwrap_or(defaults.displacement_tolerance),
         residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
         line_search: !o.no_line_search,
+        threads: o.threads,
         ..defaults
     };
     for w in membrane_contact::mech::summary::model_warnings(&model) {

@@ -734,6 +734,7 @@ impl Instance {
                     model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
                 }
                 (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
+                (Binding::Threads, Value::Integer(x)) => settings.threads = count(x, 0)?,
                 (Binding::UseJuRowlands, Value::Boolean(b)) => {
                     settings.iteration_matrix = if b {
                         IterationMatrix::JuRowlands

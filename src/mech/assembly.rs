@@ -6,6 +6,17 @@
 //! (node-to-node gaps never change it); every entry of every element matrix gets a precomputed
 //! slot in the CSC value array, so an iteration only zeroes and adds values (top88's
 //! `iK/jK` vs `sK`). A symmetric pattern keeps the lower triangle only.
+//!
+//! With more than one thread ([`System::set_threads`]) the triangles are assembled in blocks:
+//! each thread computes its share of a block's element forces and tangents into its own buffer,
+//! then every thread adds the whole block's entries that fall in its own range of `values` and
+//! `internal`, in element order. Each entry thus receives the same additions in the same order
+//! as in the serial loop: the result is bit-identical for every thread count. The threads are
+//! scoped: they end before [`System::assemble`] returns (no pool outlives a call, which an FMU
+//! unloaded by `dlclose` needs).
+
+use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
+use std::sync::{Barrier, PoisonError, RwLock};
 
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
@@ -14,6 +25,18 @@ use super::element::{ElementMatrix, ElementVector, Material, MembraneTriangle};
 use super::model::{GapSupport, Model};
 
 const NO_SLOT: u32 = u32::MAX;
+
+/// Triangles each thread computes per block of a parallel assembly (90 values each, 720 bytes:
+/// a block's buffers stay in cache between the compute and the scatter phase).
+pub const PARALLEL_BLOCK: usize = 1024;
+
+/// Below this many triangles the automatic thread count is 1: spawning threads and their two
+/// barriers per block cost more than the element work they share (docs/benchmarks.md,
+/// issue 11 item 3).
+pub const PARALLEL_MIN_TRIANGLES: usize = 4096;
+
+/// Most threads the automatic thread count uses.
+pub const AUTOMATIC_MAX_THREADS: usize = 2;
 
 /// What a global DOF is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,6 +81,11 @@ pub struct System {
     gap_offsets: Vec<usize>,
     /// Whether only the lower triangle is stored.
     lower_only: bool,
+    /// Smallest and largest slot of each triangle's entries (`(NO_SLOT, 0)` when none): a
+    /// thread skips triangles that have no entry in its range of `values`.
+    spans: Vec<(u32, u32)>,
+    /// Threads of an assembly (at least 1).
+    threads: usize,
 }
 
 /// Why a system cannot be built (only for sizes beyond the index type).
@@ -168,6 +196,14 @@ impl System {
                     (col_ptr[*j] + rows.binary_search(i).expect("entry is in the pattern")) as u32
                 }
             })
+            .collect::<Vec<u32>>();
+        let spans = slots[..81 * triangles.len()]
+            .chunks(81)
+            .map(|c| {
+                c.iter()
+                    .filter(|&&s| s != NO_SLOT)
+                    .fold((NO_SLOT, 0), |(lo, hi), &s| (lo.min(s), hi.max(s)))
+            })
             .collect();
         Ok(Self {
             dofs,
@@ -179,7 +215,27 @@ impl System {
             slots,
             gap_offsets,
             lower_only,
+            spans,
+            threads: 1,
         })
+    }
+
+    /// Sets the threads of [`System::assemble`]: `requested` when positive, else the automatic
+    /// count (1 below [`PARALLEL_MIN_TRIANGLES`] triangles, else the available cores up to
+    /// [`AUTOMATIC_MAX_THREADS`]).
+    pub fn set_threads(&mut self, requested: usize) {
+        self.threads = match requested {
+            0 if self.triangles.len() < PARALLEL_MIN_TRIANGLES => 1,
+            0 => std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(AUTOMATIC_MAX_THREADS),
+            n => n,
+        };
+    }
+
+    /// Threads [`System::assemble`] uses.
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// The symbolic structure of the free–free tangent.
@@ -202,6 +258,7 @@ impl System {
             + self.dofs.len() * size_of::<Dof>()
             + self.triangles.len() * size_of::<([usize; 3], MembraneTriangle)>()
             + self.gaps.len() * size_of::<GapGeometry>()
+            + self.spans.len() * size_of::<(u32, u32)>()
     }
 
     /// Whether only the lower triangle is stored (symmetric iteration matrix).
@@ -250,20 +307,17 @@ impl System {
         if let Some(v) = values.as_deref_mut() {
             v.fill(0.0);
         }
-        let with_tangent = values.is_some();
-        for (e, (nodes, tri)) in self.triangles.iter().enumerate() {
-            let global = node_dofs(nodes);
-            let ue = ElementVector::from_fn(|i, _| u[global[i]]);
-            let (r, k) = tri.force_and_tangent(&self.material, &ue, with_tangent);
-            for (i, &gi) in global.iter().enumerate() {
-                internal[gi] += r[i];
-            }
-            if let Some(v) = values.as_deref_mut() {
-                let slots = &self.slots[81 * e..81 * (e + 1)];
-                for (s, kij) in slots.iter().zip(k.iter()) {
-                    if *s != NO_SLOT {
-                        v[*s as usize] += kij;
-                    }
+        if self.threads > 1 {
+            self.assemble_triangles_parallel(u, internal, values.as_deref_mut());
+        } else {
+            let with_tangent = values.is_some();
+            for e in 0..self.triangles.len() {
+                let (r, k) = self.element(e, u, with_tangent);
+                for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
+                    internal[gi] += r[i];
+                }
+                if let Some(v) = values.as_deref_mut() {
+                    self.add_element_matrix(e, &k, v);
                 }
             }
         }
@@ -294,6 +348,151 @@ impl System {
             }
         }
     }
+}
+
+impl System {
+    /// Force and tangent (zero unless `with_tangent`) of triangle `e` at `u`.
+    fn element(&self, e: usize, u: &[f64], with_tangent: bool) -> (ElementVector, ElementMatrix) {
+        let (nodes, tri) = &self.triangles[e];
+        let global = node_dofs(nodes);
+        let ue = ElementVector::from_fn(|i, _| u[global[i]]);
+        tri.force_and_tangent(&self.material, &ue, with_tangent)
+    }
+
+    /// The triangles' part of [`System::assemble`] on `self.threads` scoped threads (see the
+    /// module doc): per block, a compute phase into per-thread buffers, a barrier, a scatter
+    /// phase in which thread `t` adds every entry of the block that lies in its parts of
+    /// `internal` and `values`, and a barrier before the buffers are refilled.
+    fn assemble_triangles_parallel(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        values: Option<&mut [f64]>,
+    ) {
+        let threads = self.threads;
+        let with_tangent = values.is_some();
+        let stride = if with_tangent { 90 } else { 9 };
+        let buffers: Vec<RwLock<Vec<f64>>> = (0..threads)
+            .map(|_| RwLock::new(vec![0.0; PARALLEL_BLOCK * stride]))
+            .collect();
+        let barrier = Barrier::new(threads);
+        let internal_parts = split_even(internal, threads);
+        let value_parts: Vec<Option<(usize, &mut [f64])>> = match values {
+            Some(v) => split_even(v, threads).into_iter().map(Some).collect(),
+            None => (0..threads).map(|_| None).collect(),
+        };
+        let block = threads * PARALLEL_BLOCK;
+        let blocks = self.triangles.len().div_ceil(block);
+        std::thread::scope(|scope| {
+            let parts = internal_parts.into_iter().zip(value_parts).enumerate();
+            for (t, ((d0, forces), mut matrix)) in parts {
+                let (buffers, barrier) = (&buffers, &barrier);
+                let mut work = move || {
+                    // A panic is kept until every barrier has been passed (the other threads
+                    // would wait for this one forever), then raised again: `scope` passes it on.
+                    let mut panic = None;
+                    for b in 0..blocks {
+                        let start = b * block;
+                        let end = (start + block).min(self.triangles.len());
+                        if panic.is_none() {
+                            let first = (start + t * PARALLEL_BLOCK).min(end);
+                            let last = (first + PARALLEL_BLOCK).min(end);
+                            let mut out =
+                                buffers[t].write().unwrap_or_else(PoisonError::into_inner);
+                            let computed = catch_unwind(AssertUnwindSafe(|| {
+                                for (e, out) in (first..last).zip(out.chunks_exact_mut(stride)) {
+                                    let (r, k) = self.element(e, u, with_tangent);
+                                    out[..9].copy_from_slice(r.as_slice());
+                                    if with_tangent {
+                                        out[9..].copy_from_slice(k.as_slice());
+                                    }
+                                }
+                            }));
+                            panic = computed.err();
+                        }
+                        barrier.wait();
+                        if panic.is_none() {
+                            let scattered = catch_unwind(AssertUnwindSafe(|| {
+                                for (owner, buffer) in buffers.iter().enumerate() {
+                                    let first = (start + owner * PARALLEL_BLOCK).min(end);
+                                    let last = (first + PARALLEL_BLOCK).min(end);
+                                    let data =
+                                        buffer.read().unwrap_or_else(PoisonError::into_inner);
+                                    for (e, data) in (first..last).zip(data.chunks_exact(stride)) {
+                                        self.scatter_part(
+                                            e,
+                                            data,
+                                            (d0, &mut *forces),
+                                            matrix.as_mut().map(|(v0, v)| (*v0, &mut **v)),
+                                        );
+                                    }
+                                }
+                            }));
+                            panic = scattered.err();
+                        }
+                        barrier.wait();
+                    }
+                    if let Some(p) = panic {
+                        resume_unwind(p);
+                    }
+                };
+                if t + 1 < threads {
+                    scope.spawn(work);
+                } else {
+                    work();
+                }
+            }
+        });
+    }
+
+    /// Adds triangle `e`'s force and tangent (`data`: 9 force values, then the 81 matrix
+    /// entries when present) to the parts of `internal` and `values` that start at global
+    /// index `d0` and slot `v0`.
+    fn scatter_part(
+        &self,
+        e: usize,
+        data: &[f64],
+        (d0, forces): (usize, &mut [f64]),
+        matrix: Option<(usize, &mut [f64])>,
+    ) {
+        for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
+            // Indices below d0 wrap to huge values: `get_mut` skips them like those past the end.
+            if let Some(x) = forces.get_mut(gi.wrapping_sub(d0)) {
+                *x += data[i];
+            }
+        }
+        let Some((v0, values)) = matrix else {
+            return;
+        };
+        let (lo, hi) = self.spans[e];
+        if lo == NO_SLOT || (hi as usize) < v0 || lo as usize >= v0 + values.len() {
+            return;
+        }
+        let slots = &self.slots[81 * e..81 * (e + 1)];
+        for (s, kij) in slots.iter().zip(&data[9..]) {
+            // NO_SLOT lies past every part (nonzeros < NO_SLOT).
+            if let Some(x) = values.get_mut((*s as usize).wrapping_sub(v0)) {
+                *x += kij;
+            }
+        }
+    }
+}
+
+/// `v` cut into `parts` consecutive pieces of (nearly) equal length, each with its offset.
+fn split_even(v: &mut [f64], parts: usize) -> Vec<(usize, &mut [f64])> {
+    let n = v.len();
+    let mut rest = v;
+    let mut offset = 0;
+    (0..parts)
+        .map(|p| {
+            let len = n * (p + 1) / parts - offset;
+            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = tail;
+            let piece = (offset, head);
+            offset += len;
+            piece
+        })
+        .collect()
 }
 
 /// The nine global DOFs of a triangle.
