@@ -2001,7 +2001,7 @@ fn control_characters_in_the_description_are_refused_naming_the_field() {
     }
 }
 
-/// Residual and Newton matrix of the refined specimen (3 200+ triangles, wrinkling film) with its
+/// Residual and Newton matrix of the refined specimen (1 800 triangles, wrinkling film) with
 /// every other gap, curved supports taken from the curved-support variant on the other nodes, a
 /// follower pressure and self-weight, at a displacement away from equilibrium: the
 /// same bits for 1, 2 and 3 assembly threads (each entry receives the same additions in the
@@ -2009,12 +2009,11 @@ fn control_characters_in_the_description_are_refused_naming_the_field() {
 #[test]
 fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
     use membrane_contact::mech::LoadLevels;
-    use membrane_contact::mech::assembly::PARALLEL_BLOCK;
     use membrane_contact::mech::material::Wrinkling;
     use membrane_contact::mech::model::{AllElements, ElementSelection, PressureSet};
     use membrane_contact::mech::specimen::SpecimenContact;
     let spec = ParallelArch {
-        refinement: 6,
+        refinement: 3,
         ..ParallelArch::with_height(0.3)
     };
     let mut model = spec.model().unwrap();
@@ -2045,8 +2044,6 @@ fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
         elements: ElementSelection::All(AllElements::All),
         pressure: 300.0,
     });
-    // Two blocks or more at three threads, so that every thread computes and scatters.
-    assert!(model.triangles.len() > 2 * 3 * PARALLEL_BLOCK);
     let levels = LoadLevels::of_model(&model);
     let u: Vec<f64> = (0..model.dof_count())
         .map(|i| 2e-3 * (i as f64 * 0.37).sin() - 4e-3 * ((i % 3 == 2) as u8 as f64))
@@ -2060,6 +2057,8 @@ fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
             };
             let mut analysis = Analysis::new(model.clone(), settings).unwrap();
             assert_eq!(analysis.system().threads(), threads);
+            // Some triangles lie across two threads' DOFs: both compute them, each adds its part.
+            assert!(threads == 1 || analysis.system().computed_share() > 1.0);
             analysis.residual_and_matrix(&u, &levels)
         };
         let (serial_force, serial_matrix) = run(1);

@@ -7,16 +7,15 @@
 //! slot in the CSC value array, so an iteration only zeroes and adds values (top88's
 //! `iK/jK` vs `sK`). A symmetric pattern keeps the lower triangle only.
 //!
-//! With more than one thread ([`System::set_threads`]) the triangles are assembled in blocks:
-//! each thread computes its share of a block's element forces and tangents into its own buffer,
-//! then every thread adds the whole block's entries that fall in its own range of `values` and
-//! `internal`, in element order. Each entry thus receives the same additions in the same order
-//! as in the serial loop: the result is bit-identical for every thread count. The threads are
-//! scoped: they end before [`System::assemble`] returns (no pool outlives a call, which an FMU
-//! unloaded by `dlclose` needs).
-
-use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
-use std::sync::{Barrier, PoisonError, RwLock};
+//! With more than one thread ([`System::set_threads`]) the owner computes: the columns are cut
+//! into one range per thread of about equal nonzeros; each thread owns its columns' slots of
+//! `values` and the matching range of global DOFs of `internal`, computes every triangle with a
+//! DOF in its range (in element order) and adds only the entries it owns. A triangle across two
+//! ranges is computed by both (0.6–5 % of the triangles on the benchmarks' meshes); no two
+//! threads write the same entry, and each entry receives the same additions in the same order as
+//! in the serial loop: the result is bit-identical for every thread count. The threads are scoped:
+//! they end before [`System::assemble`] returns (no pool outlives a call, which an FMU unloaded by
+//! `dlclose` needs), and a panic in one reaches the caller.
 
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
@@ -26,13 +25,8 @@ use super::model::{GapSupport, Model};
 
 const NO_SLOT: u32 = u32::MAX;
 
-/// Triangles each thread computes per block of a parallel assembly (90 values each, 720 bytes:
-/// a block's buffers stay in cache between the compute and the scatter phase).
-pub const PARALLEL_BLOCK: usize = 1024;
-
-/// Below this many triangles the automatic thread count is 1: spawning threads and their two
-/// barriers per block cost more than the element work they share (docs/benchmarks.md,
-/// issue 11 item 3).
+/// Below this many triangles the automatic thread count is 1: spawning a thread costs more than
+/// the element work it takes over (docs/benchmarks.md, issue 11 item 3).
 pub const PARALLEL_MIN_TRIANGLES: usize = 4096;
 
 /// Most threads the automatic thread count uses.
@@ -81,11 +75,19 @@ pub struct System {
     gap_offsets: Vec<usize>,
     /// Whether only the lower triangle is stored.
     lower_only: bool,
-    /// Smallest and largest slot of each triangle's entries (`(NO_SLOT, 0)` when none): a
-    /// thread skips triangles that have no entry in its range of `values`.
-    spans: Vec<(u32, u32)>,
     /// Threads of an assembly (at least 1).
     threads: usize,
+    /// What each thread of a parallel assembly owns (empty when serial).
+    parts: Vec<Part>,
+}
+
+/// One thread's share of a parallel assembly: the global DOFs and slots it writes and
+/// the triangles with a DOF among them (ascending), computed by every thread they touch.
+#[derive(Clone, Debug)]
+struct Part {
+    dofs: std::ops::Range<usize>,
+    slots: std::ops::Range<usize>,
+    triangles: Vec<u32>,
 }
 
 /// Why a system cannot be built (only for sizes beyond the index type).
@@ -196,14 +198,6 @@ impl System {
                     (col_ptr[*j] + rows.binary_search(i).expect("entry is in the pattern")) as u32
                 }
             })
-            .collect::<Vec<u32>>();
-        let spans = slots[..81 * triangles.len()]
-            .chunks(81)
-            .map(|c| {
-                c.iter()
-                    .filter(|&&s| s != NO_SLOT)
-                    .fold((NO_SLOT, 0), |(lo, hi), &s| (lo.min(s), hi.max(s)))
-            })
             .collect();
         Ok(Self {
             dofs,
@@ -215,8 +209,8 @@ impl System {
             slots,
             gap_offsets,
             lower_only,
-            spans,
             threads: 1,
+            parts: vec![],
         })
     }
 
@@ -231,6 +225,70 @@ impl System {
                 .min(AUTOMATIC_MAX_THREADS),
             n => n,
         };
+        self.parts = if self.threads > 1 {
+            self.partition(self.threads)
+        } else {
+            vec![]
+        };
+    }
+
+    /// Cuts the free DOFs into `threads` ranges of consecutive columns holding about equal
+    /// numbers of nonzeros; each part owns its columns' slots and the global DOFs from its
+    /// first column's DOF up to the next part's (constrained DOFs go with the free DOF before).
+    fn partition(&self, threads: usize) -> Vec<Part> {
+        let col_ptr = self.symbolic.col_ptr();
+        let nnz = self.nonzeros();
+        let global_of: Vec<usize> = self
+            .dofs
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| matches!(d, Dof::Free(_)))
+            .map(|(g, _)| g)
+            .collect();
+        let first_column = |t: usize| {
+            if t == 0 {
+                0
+            } else if t == threads {
+                self.free_count
+            } else {
+                col_ptr
+                    .partition_point(|&p| p < nnz * t / threads)
+                    .min(self.free_count)
+            }
+        };
+        let first_dof = |c: usize| match c {
+            0 => 0,
+            c if c == self.free_count => self.dofs.len(),
+            c => global_of[c],
+        };
+        let mut parts: Vec<Part> = (0..threads)
+            .map(|t| {
+                let (c0, c1) = (first_column(t), first_column(t + 1));
+                Part {
+                    dofs: first_dof(c0)..first_dof(c1),
+                    slots: col_ptr[c0]..col_ptr[c1],
+                    triangles: vec![],
+                }
+            })
+            .collect();
+        for (e, (nodes, _)) in self.triangles.iter().enumerate() {
+            for part in parts.iter_mut() {
+                if node_dofs(nodes).iter().any(|g| part.dofs.contains(g)) {
+                    part.triangles.push(e as u32);
+                }
+            }
+        }
+        parts
+    }
+
+    /// Triangles computed per assembly over all threads, relative to the triangle count (1 when
+    /// serial; above 1 by the triangles computed by two threads or more).
+    pub fn computed_share(&self) -> f64 {
+        if self.parts.is_empty() {
+            return 1.0;
+        }
+        let computed: usize = self.parts.iter().map(|p| p.triangles.len()).sum();
+        computed as f64 / self.triangles.len().max(1) as f64
     }
 
     /// Threads [`System::assemble`] uses.
@@ -258,7 +316,11 @@ impl System {
             + self.dofs.len() * size_of::<Dof>()
             + self.triangles.len() * size_of::<([usize; 3], MembraneTriangle)>()
             + self.gaps.len() * size_of::<GapGeometry>()
-            + self.spans.len() * size_of::<(u32, u32)>()
+            + self
+                .parts
+                .iter()
+                .map(|p| p.triangles.len() * size_of::<u32>())
+                .sum::<usize>()
     }
 
     /// Whether only the lower triangle is stored (symmetric iteration matrix).
@@ -308,7 +370,7 @@ impl System {
             v.fill(0.0);
         }
         if self.threads > 1 {
-            self.assemble_triangles_parallel(u, internal, values.as_deref_mut());
+            self.assemble_triangles_owned(u, internal, values.as_deref_mut());
         } else {
             let with_tangent = values.is_some();
             for e in 0..self.triangles.len() {
@@ -359,84 +421,44 @@ impl System {
         tri.force_and_tangent(&self.material, &ue, with_tangent)
     }
 
-    /// The triangles' part of [`System::assemble`] on `self.threads` scoped threads (see the
-    /// module doc): per block, a compute phase into per-thread buffers, a barrier, a scatter
-    /// phase in which thread `t` adds every entry of the block that lies in its parts of
-    /// `internal` and `values`, and a barrier before the buffers are refilled.
-    fn assemble_triangles_parallel(
+    /// The triangles' part of [`System::assemble`] on scoped threads, owner computes (see the
+    /// module doc): thread `t` computes every triangle of its part and adds the entries that
+    /// fall in its own DOFs and slots.
+    fn assemble_triangles_owned(
         &self,
         u: &[f64],
         internal: &mut [f64],
         values: Option<&mut [f64]>,
     ) {
-        let threads = self.threads;
         let with_tangent = values.is_some();
-        let stride = if with_tangent { 90 } else { 9 };
-        let buffers: Vec<RwLock<Vec<f64>>> = (0..threads)
-            .map(|_| RwLock::new(vec![0.0; PARALLEL_BLOCK * stride]))
-            .collect();
-        let barrier = Barrier::new(threads);
-        let internal_parts = split_even(internal, threads);
-        let value_parts: Vec<Option<(usize, &mut [f64])>> = match values {
-            Some(v) => split_even(v, threads).into_iter().map(Some).collect(),
-            None => (0..threads).map(|_| None).collect(),
-        };
-        let block = threads * PARALLEL_BLOCK;
-        let blocks = self.triangles.len().div_ceil(block);
+        let mut forces = internal;
+        let mut matrix = values;
         std::thread::scope(|scope| {
-            let parts = internal_parts.into_iter().zip(value_parts).enumerate();
-            for (t, ((d0, forces), mut matrix)) in parts {
-                let (buffers, barrier) = (&buffers, &barrier);
-                let mut work = move || {
-                    // A panic is kept until every barrier has been passed (the other threads
-                    // would wait for this one forever), then raised again: `scope` passes it on.
-                    let mut panic = None;
-                    for b in 0..blocks {
-                        let start = b * block;
-                        let end = (start + block).min(self.triangles.len());
-                        if panic.is_none() {
-                            let first = (start + t * PARALLEL_BLOCK).min(end);
-                            let last = (first + PARALLEL_BLOCK).min(end);
-                            let mut out =
-                                buffers[t].write().unwrap_or_else(PoisonError::into_inner);
-                            let computed = catch_unwind(AssertUnwindSafe(|| {
-                                for (e, out) in (first..last).zip(out.chunks_exact_mut(stride)) {
-                                    let (r, k) = self.element(e, u, with_tangent);
-                                    out[..9].copy_from_slice(r.as_slice());
-                                    if with_tangent {
-                                        out[9..].copy_from_slice(k.as_slice());
-                                    }
-                                }
-                            }));
-                            panic = computed.err();
-                        }
-                        barrier.wait();
-                        if panic.is_none() {
-                            let scattered = catch_unwind(AssertUnwindSafe(|| {
-                                for (owner, buffer) in buffers.iter().enumerate() {
-                                    let first = (start + owner * PARALLEL_BLOCK).min(end);
-                                    let last = (first + PARALLEL_BLOCK).min(end);
-                                    let data =
-                                        buffer.read().unwrap_or_else(PoisonError::into_inner);
-                                    for (e, data) in (first..last).zip(data.chunks_exact(stride)) {
-                                        self.scatter_part(
-                                            e,
-                                            data,
-                                            (d0, &mut *forces),
-                                            matrix.as_mut().map(|(v0, v)| (*v0, &mut **v)),
-                                        );
-                                    }
-                                }
-                            }));
-                            panic = scattered.err();
-                        }
-                        barrier.wait();
+            for (t, part) in self.parts.iter().enumerate() {
+                let (mine, rest) = std::mem::take(&mut forces).split_at_mut(part.dofs.len());
+                forces = rest;
+                let mine_values = match matrix.take() {
+                    Some(v) => {
+                        let (mine, rest) = v.split_at_mut(part.slots.len());
+                        matrix = Some(rest);
+                        Some((part.slots.start, mine))
                     }
-                    if let Some(p) = panic {
-                        resume_unwind(p);
+                    None => None,
+                };
+                let work = move || {
+                    let mut mine_values = mine_values;
+                    for &e in &part.triangles {
+                        let e = e as usize;
+                        let (r, k) = self.element(e, u, with_tangent);
+                        self.scatter_part(
+                            e,
+                            (&r, &k),
+                            (part.dofs.start, &mut *mine),
+                            mine_values.as_mut().map(|(v0, v)| (*v0, &mut **v)),
+                        );
                     }
                 };
-                if t + 1 < threads {
+                if t + 1 < self.parts.len() {
                     scope.spawn(work);
                 } else {
                     work();
@@ -445,54 +467,31 @@ impl System {
         });
     }
 
-    /// Adds triangle `e`'s force and tangent (`data`: 9 force values, then the 81 matrix
-    /// entries when present) to the parts of `internal` and `values` that start at global
-    /// index `d0` and slot `v0`.
+    /// Adds triangle `e`'s force `r` and, when `matrix` is given, its tangent `k` to the parts of
+    /// `internal` and `values` that start at global DOF `d0` and slot `v0`.
     fn scatter_part(
         &self,
         e: usize,
-        data: &[f64],
+        (r, k): (&ElementVector, &ElementMatrix),
         (d0, forces): (usize, &mut [f64]),
         matrix: Option<(usize, &mut [f64])>,
     ) {
         for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
             // Indices below d0 wrap to huge values: `get_mut` skips them like those past the end.
             if let Some(x) = forces.get_mut(gi.wrapping_sub(d0)) {
-                *x += data[i];
+                *x += r[i];
             }
         }
-        let Some((v0, values)) = matrix else {
-            return;
-        };
-        let (lo, hi) = self.spans[e];
-        if lo == NO_SLOT || (hi as usize) < v0 || lo as usize >= v0 + values.len() {
-            return;
-        }
-        let slots = &self.slots[81 * e..81 * (e + 1)];
-        for (s, kij) in slots.iter().zip(&data[9..]) {
-            // NO_SLOT lies past every part (nonzeros < NO_SLOT).
-            if let Some(x) = values.get_mut((*s as usize).wrapping_sub(v0)) {
-                *x += kij;
+        if let Some((v0, values)) = matrix {
+            let slots = &self.slots[81 * e..81 * (e + 1)];
+            for (s, kij) in slots.iter().zip(k.iter()) {
+                // NO_SLOT lies past every part (nonzeros < NO_SLOT).
+                if let Some(x) = values.get_mut((*s as usize).wrapping_sub(v0)) {
+                    *x += kij;
+                }
             }
         }
     }
-}
-
-/// `v` cut into `parts` consecutive pieces of (nearly) equal length, each with its offset.
-fn split_even(v: &mut [f64], parts: usize) -> Vec<(usize, &mut [f64])> {
-    let n = v.len();
-    let mut rest = v;
-    let mut offset = 0;
-    (0..parts)
-        .map(|p| {
-            let len = n * (p + 1) / parts - offset;
-            let (head, tail) = std::mem::take(&mut rest).split_at_mut(len);
-            rest = tail;
-            let piece = (offset, head);
-            offset += len;
-            piece
-        })
-        .collect()
 }
 
 /// The nine global DOFs of a triangle.
