@@ -2019,7 +2019,7 @@ fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
     let mut model = spec.model().unwrap();
     let curved = ParallelArch {
         contact: SpecimenContact::CurvedSupport,
-        ..spec.clone()
+        ..spec
     }
     .model()
     .unwrap();

@@ -147,8 +147,8 @@ pub struct RunArgs {
     /// no safeguard for a first step from a slack flat film.
     #[arg(long)]
     pub no_line_search: bool,
-    /// Threads of the element assembly (0 = automatic: one on small meshes, else up to two;
-    /// results are identical for every count).
+    /// Threads of the element assembly (0 = automatic: one below 100 000 triangles, else up to
+    /// two; results are identical for every count).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub threads: usize,
     /// Write the gap results of every step as CSV.

@@ -727,7 +727,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Value::Integer(saturating_i32(solver.threads)),
             None,
             "threads of the element assembly, ended before each call returns (0: automatic, one on meshes \
-             below 4096 triangles, else up to two); the results are identical for every count",
+             below 100 000 triangles, else up to two); the results are identical for every count",
             Binding::Threads,
         ),
     ];

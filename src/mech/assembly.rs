@@ -25,9 +25,9 @@ use super::model::{GapSupport, Model};
 
 const NO_SLOT: u32 = u32::MAX;
 
-/// Below this many triangles the automatic thread count is 1: spawning a thread costs more than
-/// the element work it takes over (docs/benchmarks.md, issue 11 item 3).
-pub const PARALLEL_MIN_TRIANGLES: usize = 4096;
+/// Below this many triangles the automatic thread count is 1: on the shared 2-core machine a
+/// second thread lost time on every smaller mesh measured (docs/benchmarks.md, issue 11 item 3).
+pub const PARALLEL_MIN_TRIANGLES: usize = 100_000;
 
 /// Most threads the automatic thread count uses.
 pub const AUTOMATIC_MAX_THREADS: usize = 2;
