@@ -2004,8 +2004,9 @@ fn control_characters_in_the_description_are_refused_naming_the_field() {
 /// Residual and Newton matrix of the refined specimen (1 800 triangles, wrinkling film) with
 /// every other gap, curved supports taken from the curved-support variant on the other nodes, a
 /// follower pressure and self-weight, at a displacement away from equilibrium: the
-/// same bits for 1, 2 and 3 assembly threads (each entry receives the same additions in the
-/// same order), for the consistent tangent and the Ju–Rowlands matrix.
+/// same bits for 1, 2, 3 and 64 assembly threads (each entry receives the same additions in the
+/// same order; 64 parts of a few columns each), for the consistent tangent and the Ju–Rowlands
+/// matrix.
 #[test]
 fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
     use membrane_contact::mech::LoadLevels;
@@ -2063,7 +2064,7 @@ fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
         };
         let (serial_force, serial_matrix) = run(1);
         assert!(serial_matrix.iter().any(|v| *v != 0.0));
-        for threads in [2, 3] {
+        for threads in [2, 3, 64] {
             let (force, values) = run(threads);
             let same = |a: &[f64], b: &[f64]| {
                 a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
