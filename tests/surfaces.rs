@@ -822,3 +822,104 @@ fn polyline_inscribed_in_a_circle_converges_to_the_circle_support() {
     assert!(errors[1].0 < 2e-5 && errors[2].0 < 2e-5, "{errors:?}");
     assert!(errors[2].1 < 5e-3, "{errors:?}");
 }
+
+/// Parabola and polyline centrelines read from a model file; bad ones (and bad tube radii for
+/// circles) are refused with a message naming the support and the item.
+#[test]
+fn parabola_and_polyline_supports_read_from_model_files_and_bad_ones_are_refused_by_name() {
+    let mut m = patch(0.2);
+    let text = m.to_json();
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let extra = r#"[
+      {"name": "arch", "centreline": {"parabola": {"apex": [0, 0, 0], "up": [0, 0, 1],
+        "along": [1, 0, 0], "half_span": 1.0, "rise": 0.3}}, "tube_radius": 0.1, "nodes": [0],
+        "normal_stiffness": 1e6, "tangential_stiffness": 2e5, "friction": 0.2},
+      {"name": "rail", "centreline": {"polyline": {"points": [[-1, 0, 0], [0, 0, 0.01],
+        [1, 0, 0]]}}, "tube_radius": 0.09, "nodes": [0],
+        "normal_stiffness": 1e6, "tangential_stiffness": 2e5, "friction": 0.2}]"#;
+    value["curved_supports"]
+        .as_array_mut()
+        .unwrap()
+        .extend(serde_json::from_str::<Vec<serde_json::Value>>(extra).unwrap());
+    let parsed = Model::from_json(&value.to_string()).unwrap();
+    assert_eq!(parsed.curved_supports.len(), 3);
+    assert_eq!(Model::from_json(&parsed.to_json()).unwrap(), parsed);
+    let parabola = |rise: f64, along: [f64; 3]| Centreline::Parabola {
+        apex: [0.0; 3],
+        up: [0.0, 0.0, 1.0],
+        along,
+        half_span: 1.0,
+        rise,
+    };
+    let polyline =
+        |points: Vec<[f64; 3]>, normal: Option<[f64; 3]>| Centreline::Polyline { points, normal };
+    let circle = |radius: f64, angles: Option<[f64; 2]>| Centreline::Circle {
+        centre: [0.0, 0.0, -1.0],
+        axis: [0.0, 1.0, 0.0],
+        radius,
+        angles,
+        start_direction: None,
+    };
+    let cases: Vec<(Centreline, &str)> = vec![
+        (
+            parabola(0.0, [1.0, 0.0, 0.0]),
+            "parabola rise = 0 must be > 0",
+        ),
+        (
+            parabola(0.3, [0.0, 0.0, 2.0]),
+            "parabola along is zero or parallel to up",
+        ),
+        (
+            // Radius of curvature at the crown 1/(2·6) < r = 0.1.
+            parabola(6.0, [1.0, 0.0, 0.0]),
+            "smaller than the parabola's radius of curvature",
+        ),
+        (polyline(vec![[0.0; 3]], None), "polyline has 1 point(s)"),
+        (
+            polyline(vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], None),
+            "points[1] and points[2] coincide",
+        ),
+        (
+            polyline(vec![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], None),
+            "collinear: give its plane's normal",
+        ),
+        (
+            polyline(
+                vec![
+                    [-1.0, 0.0, 0.0],
+                    [0.0, 0.0, 0.1],
+                    [1.0, 0.0, 0.0],
+                    [2.0, 0.5, 0.0],
+                ],
+                None,
+            ),
+            "points[3] leaves the plane",
+        ),
+        (
+            polyline(
+                vec![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]],
+                None,
+            ),
+            "turns back on itself at points[1]",
+        ),
+        (
+            polyline(vec![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], Some([0.0; 3])),
+            "polyline normal is zero",
+        ),
+        (
+            // Through node 0 at (0, 0, R).
+            polyline(vec![[-1.0, 0.0, R], [1.0, 0.0, R]], Some([0.0, 1.0, 0.0])),
+            "node 0 lies on the centreline",
+        ),
+        (circle(0.05, None), "smaller than the circle's radius"),
+        (circle(1.0, Some([0.0, 7.0])), "span more than a full turn"),
+    ];
+    for (centreline, expected) in cases {
+        m.curved_supports[0].centreline = centreline;
+        let e = m.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("curved support 'drum'") && e.contains(expected),
+            "{expected}: {e}"
+        );
+    }
+}

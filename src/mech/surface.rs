@@ -1,33 +1,52 @@
 //! Node-to-surface friction contact on rigid curved supports (issue 10): a film node against a
-//! tube of radius `r` around a straight or circular centreline, whose closest point, normal and
-//! sliding directions follow the node (the paper's fixed gap frames, §4.3–4.4, do not).
+//! tube of radius `r` around a centreline — a straight line (a cylinder) or a plane curve
+//! (circle/arc, parabola, polyline) — whose closest point, normal and sliding directions
+//! follow the node (the paper's fixed gap frames, §4.3–4.4, do not).
 //!
-//! Geometry (axis unit vector `a`, centre `c0`, `Π = I − a⊗a`, `q = Π(x − c0)`, `ρ = |q|`,
-//! `e_ρ = q/ρ`, `T = a × e_ρ`, angle `φ` of `e_ρ` about `a`, unwrapped from the last converged
-//! value):
+//! **Cylinder** (axis `a` through `c0`, `q = (I − a⊗a)(x − c0)`, `ρ = |q|`, `e_ρ = q/ρ`,
+//! `T = a × e_ρ`, angle `φ` of `e_ρ` about `a` unwrapped from the last converged value):
+//! `d = ρ`, `n = e_ρ`, `∂n/∂x = T⊗T/d`; `ξ1 = r φ` round the axis (`∇ξ1 = (r/ρ) T`,
+//! `∇²ξ1 = −(r/ρ²)(e_ρ⊗T + T⊗e_ρ)`), `ξ2 = a·(x − c0)` along it.
 //!
-//! * **cylinder** (straight centreline along `a` through `c0`, a capstan, a straight rail):
-//!   `d = ρ`, `n = e_ρ`, `∂n/∂x = T⊗T/d`;
-//! * **ring** (circular centreline of radius `Rc` about `a` through `c0`, the parallel arches'
-//!   pipes): closest centreline point `C = c0 + Rc e_ρ`, `w = x − C`, `d = |w|`, `n = w/d`,
-//!   `b = n × T`, `∂n/∂x = b⊗b/d + (n·e_ρ/ρ) T⊗T`; an `arc` limits `φ` to a range: outside it
-//!   the node is not in contact with this support.
+//! **Plane curve** `C(u)` in the plane of unit normal `p` (a circle's axis; `up × along` for a
+//! parabola; a polyline's `normal`), closed by hemispherical caps at the ends of an open curve.
+//! The closest point of the curve (ends included) to `x`, `w = x − C`, `d = |w|`, `n = w/d`:
+//!
+//! * on a smooth part, `w·C′(u) = 0` gives `∇u = C′/D`, `D = |C′|² − w·C″`,
+//!   `∇²u = (C′⊗C″ + C″⊗C′)/D² − (3 C′·C″ − w·C‴) C′⊗C′/D³` (`w·C‴ = 0` on these curves:
+//!   `C‴ ∥ C′` on a circle, `C‴ = 0` on a parabola or a segment),
+//!   `∂n/∂x = (I − n⊗n − C′⊗C′/D)/d`; with `ξ1 = g(u)`: `∇ξ1 = g′ ∇u`,
+//!   `∇²ξ1 = g″ ∇u⊗∇u + g′ ∇²u` (for a ring `D = Rc ρ`: the ring formulas);
+//! * at a polyline's inner vertex `V` (the node in the wedge between the two segments'
+//!   normals, on the convex side of the turn): `C = V`, `∂n/∂x = (I − n⊗n)/d`,
+//!   `ξ1 = ξ1(V⁻) + r ψ`, `ψ` the angle of `w`'s in-plane part about `p` from the incoming
+//!   segment's normal: the cylinder's formulas about the line through `V` along `p`;
+//! * beyond an end `E` (tangent `t_E`): `C = E`, `∂n/∂x = (I − n⊗n)/d`,
+//!   `ξ1 = ξ1(E) + t_E·w` (the distance past the end's normal plane), `∇ξ1 = t_E`.
+//!
+//! `ξ1` is the length along the tube's surface on the side `t × p` (the outer side of a circle
+//! turning counter-clockwise about `p`, the top of an arch): `g(u) = s(u) + r θ(u)`, `s` the
+//! centreline's arc length, `θ` its tangent's turning angle about `p` — `(Rc + r) φ` on a ring,
+//! `s + r atan(2ku)` (plus constants) on a parabola `apex + u along − k u² up`, segment lengths
+//! plus `r ×` each corner's turn on a polyline; continuous over corners and caps. `ξ2 = p·(x − C0)`
+//! across (exact for a straight tube, to first order in the normal's tilt out of the plane on a
+//! curved one). On the concave side of a polyline's vertex the two segments' tubes meet in a
+//! crease where the closest point jumps from one segment to the next: the normal turns by the
+//! vertex's angle `Δ` at once and `ξ1` jumps by `2d tan(|Δ|/2) ∓ r|Δ|` (`−` on the `t × p`
+//! side, `+` on the other); use finer polylines or a parabola where a film slides there.
 //!
 //! Normal: gap `g = d − r`, contact force `λN = k_n ⟨−g⟩` along `n` (the paper's penalty).
-//! Tangential coordinates (surface lengths): `ξ1 = R φ` around the axis (`R = r` for a cylinder,
-//! the circumference; `R = Rc + r` for a ring, the outer surface along the arch), with
-//! `∇ξ1 = (R/ρ) T`, `∇²ξ1 = −(R/ρ²)(e_ρ⊗T + T⊗e_ρ)`; `ξ2 = a·(x − c0)` along the axis
-//! (`∇ξ2 = a`; for a ring this is across the pipe, equal to the surface length to first order in
-//! the normal's tilt out of the ring plane). Friction (penalty `k_s`, history `ξ̄` of the last
-//! converged state): trial `f = −k_s (ξ − ξ̄)`; `isotropic`: Coulomb cone `|f| ≤ μλN`, returned to
-//! it along `f`; `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays
-//! elastic. Force on the film `F = λN n + Σ fα ∇ξα`; consistent tangent of `−F`:
+//! Friction (penalty `k_s`, history `ξ̄` of the last converged state): trial
+//! `f = −k_s (ξ − ξ̄)`; `isotropic`: Coulomb cone `|f| ≤ μλN`, returned to it along `f`;
+//! `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays elastic.
+//! Force on the film `F = λN n + Σ fα ∇ξα`; consistent tangent of `−F`:
 //! `k_n n⊗n − λN ∂n/∂x − Σ (∂fα/∂ξβ) ∇ξα⊗∇ξβ − Σ (∂fα/∂λN) ∇ξα⊗∇λN − Σ fα ∇²ξα`
-//! (`∇λN = −k_n n`), checked against central differences in every status
+//! (`∇λN = −k_n n`), checked against central differences in every status and region
 //! (`tangent_matches_finite_differences_in_every_status`). The slip reported is `ξ1 − ξ1(0)`:
-//! the arc length the node has travelled along the support, as the experiment measured it.
+//! the length the node has travelled along the support, as the experiment measured it.
 //! Source of the formulas: the project's note on node-to-curve contact (derived and
-//! FD-checked there), following Wriggers, *Computational Contact Mechanics* (2006), ch. 4.
+//! FD-checked there), following Wriggers, *Computational Contact Mechanics* (2006), ch. 4
+//! (closest-point projection on a curve: `∇u`, the curvature terms).
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
@@ -272,11 +291,13 @@ impl Polyline {
                 n.normalize()
             }
             None => {
-                let turning: Vector3<f64> = tangents.windows(2).map(|t| t[0].cross(&t[1])).sum();
-                if turning.norm() <= 1e-9 {
+                // The plane of the first turn, oriented so that the turns add up positive.
+                let turns = tangents.windows(2).map(|t| t[0].cross(&t[1]));
+                let Some(first) = turns.clone().find(|c| c.norm() > 1e-9) else {
                     return Err("polyline points are collinear: give its plane's normal".into());
-                }
-                turning.normalize()
+                };
+                let total: Vector3<f64> = turns.sum();
+                first.normalize() * total.dot(&first).signum()
             }
         };
         if let Some(j) = tangents.iter().position(|t| t.dot(&normal).abs() > 1e-6) {
@@ -336,10 +357,10 @@ enum Shape {
 
 /// The closest point of a plane curve (with end caps) to a node.
 enum Foot {
-    /// On a smooth part, at parameter `u`: `C, C', C'', C'''` and `g, g', g''` of `ξ1 = g(u)`.
+    /// On a smooth part, at parameter `u`: `C, C', C''` and `g, g', g''` of `ξ1 = g(u)`.
     Smooth {
         u: f64,
-        c: [Vector3<f64>; 4],
+        c: [Vector3<f64>; 3],
         g: [f64; 3],
     },
     /// At an inner vertex of a polyline (arc length `u`): `ξ1 = base + r ψ`, `ψ` the angle
@@ -433,7 +454,7 @@ impl Path {
                 let (c, e, t) = at(angle);
                 Foot::Smooth {
                     u: angle,
-                    c: [c, t * rc, -e * rc, -t * rc],
+                    c: [c, t * rc, -e * rc],
                     g: [reference * angle, reference, 0.0],
                 }
             }
@@ -494,7 +515,7 @@ impl Path {
                         2.0 * k * w / root - 8.0 * k * k * r * w / ((1.0 + w * w) * (1.0 + w * w));
                     Foot::Smooth {
                         u: s,
-                        c: [point(s), c1v, -up * (2.0 * k), Vector3::zeros()],
+                        c: [point(s), c1v, -up * (2.0 * k)],
                         g: [g, g1, g2],
                     }
                 } else {
@@ -528,7 +549,7 @@ impl Path {
                     let t = p.tangents[j];
                     return Foot::Smooth {
                         u: p.length[j] + tau,
-                        c: [p.points[j] + t * tau, t, Vector3::zeros(), Vector3::zeros()],
+                        c: [p.points[j] + t * tau, t, Vector3::zeros()],
                         g: [p.length[j] + tau + r * p.turn[j], 1.0, 0.0],
                     };
                 };
@@ -712,9 +733,7 @@ impl SurfaceContact {
                 let dd = c[1].norm_squared() - w.dot(&c[2]);
                 let grad_u = c[1] / dd;
                 let hess_u = sym(&c[1], &c[2]) / (dd * dd)
-                    - c[1]
-                        * c[1].transpose()
-                        * ((3.0 * c[1].dot(&c[2]) - w.dot(&c[3])) / dd.powi(3));
+                    - c[1] * c[1].transpose() * (3.0 * c[1].dot(&c[2]) / dd.powi(3));
                 (
                     u,
                     Region::Tube,
