@@ -426,7 +426,7 @@ impl Path {
                 let angle = match arc {
                     None => angle,
                     Some([lo, hi]) => {
-                        // The arc's range, shifted by whole turns toward the angle.
+                        // The angle, shifted by whole turns toward the middle of the arc.
                         let tau = std::f64::consts::TAU;
                         let phi = angle - tau * ((angle - 0.5 * (lo + hi)) / tau).round();
                         if !(*lo..=*hi).contains(&phi) {
