@@ -923,3 +923,78 @@ fn parabola_and_polyline_supports_read_from_model_files_and_bad_ones_are_refused
         );
     }
 }
+
+/// TEST GOAL (issue 10 item 1, end caps): a node dragged past the end of an arc is held by the
+/// end's hemispherical cap — its distance from the end point `E` is `r − λN/k_n`, its slip
+/// the arc's surface length to `E` plus the distance past the end's normal plane, its normal
+/// force falls steadily (measured: 0.97 N at 1.2 mm past the end to 0.01 N at 21.5 mm) —
+/// until the film lets it go; every step converges (before, the contact vanished at the end).
+#[test]
+fn node_dragged_off_an_arc_end_is_held_by_the_cap_then_lets_go() {
+    let rc = 0.5;
+    let top = -std::f64::consts::FRAC_PI_2;
+    let end = top + 0.2;
+    let mut m = patch_at([0.0, 0.0, R], Some([0.0, 0.0, -rc]));
+    // A soft film (normal stiffness ≈ 400 N/m) presses the node on over a few mm.
+    m.material.youngs_modulus = 1.0e7;
+    m.curved_supports.push(support_along(
+        "arch",
+        Centreline::Circle {
+            centre: [0.0, 0.0, -rc],
+            axis: [0.0, 1.0, 0.0],
+            radius: rc,
+            angles: Some([top - 0.3, end]),
+            start_direction: Some([1.0, 0.0, 0.0]),
+        },
+        0.0,
+    ));
+    // φ from +x toward −z (= y × x) about +y; the top is φ = −π/2.
+    let radial = Vector3::new(end.cos(), 0.0, -end.sin());
+    let e = Vector3::new(0.0, 0.0, -rc) + radial * rc;
+    let t_e = Vector3::y().cross(&radial);
+    let mut analysis = Analysis::new(m.clone(), SolverSettings::default()).unwrap();
+    let (mut on_cap, mut released, mut force) = (0, false, f64::INFINITY);
+    // To 0.15 rad in 3 steps, then 1.2 mm of travel a step past the end (at 0.2 rad).
+    let angles = (1..=3)
+        .map(|k| 0.05 * k as f64)
+        .chain((1..=60).map(|k| 0.15 + 0.002 * k as f64));
+    for (k, angle) in angles.enumerate() {
+        analysis
+            .step_to_motion(&[[0.0; 3]], &[angle], &LoadLevels::zero(&m), 2)
+            .unwrap_or_else(|e| panic!("step {k}: {e}"));
+        let x = Vector3::from(m.nodes[0]) + analysis.node_displacement(0);
+        let c = analysis.results().surface_contacts[0];
+        if (x - e).dot(&t_e) <= 0.0 {
+            continue;
+        }
+        if c.status == GapStatus::Open {
+            assert!((x - e).norm() > R, "step {k}: open inside the cap");
+            released = true;
+            continue;
+        }
+        assert!(!released, "step {k}: touches again");
+        on_cap += 1;
+        println!(
+            "step {k}: {:.2} mm past the end, normal force {:.3} N",
+            1e3 * (x - e).dot(&t_e),
+            c.normal_force
+        );
+        let expected = R - c.normal_force / 1.0e6;
+        assert!(((x - e).norm() - expected).abs() < 1e-12, "step {k}");
+        let slip = (rc + R) * 0.2 + (x - e).dot(&t_e);
+        assert!(
+            (c.slip - slip).abs() < 1e-12,
+            "step {k}: {} vs {slip}",
+            c.slip
+        );
+        assert!(
+            c.normal_force < force,
+            "step {k}: the force grows on the cap"
+        );
+        force = c.normal_force;
+    }
+    assert!(
+        on_cap >= 10 && released,
+        "{on_cap} steps on the cap, released {released}"
+    );
+}
