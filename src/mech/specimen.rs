@@ -253,8 +253,9 @@ impl ParallelArch {
             return [0.0; 3];
         };
         let (r, h) = (self.arch_radius(), self.arch_height);
-        let stretch = 1.0 + t * extension;
-        let theta = t * (self.arch_half_span / r).asin();
+        // First half: wound onto the arch; second half: the boundary extended.
+        let stretch = 1.0 + (2.0 * t - 1.0).clamp(0.0, 1.0) * extension;
+        let theta = (2.0 * t).min(1.0) * (self.arch_half_span / r).asin();
         let s = stretch * p[1];
         let (y, z) = if s <= r * theta {
             (r * (s / r).sin(), h - r + r * (s / r).cos())
