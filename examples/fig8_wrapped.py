@@ -62,13 +62,21 @@ class Specimen:
         self.fmu = build_fmu(model, out_dir=Path(out) / "wrapped-fmu")
 
     def slips(self, eps):
-        """{point: (slip mm, status)} at the end of the wrapped path extended by eps."""
-        from membrane_contact import Film
+        """({point: (slip mm, status)}, eps reached) at the end of the wrapped path extended by
+        eps, or where the FMU stopped when a step stays refused (the state it keeps)."""
+        from membrane_contact import Film, StepRefused
 
         _, table = export(self.height_mm, self.contact, eps, self.steps, self.out)
         with Film(self.fmu, logging=False) as film:
             film.initialize(inputs={"mu": MU})
-            film.run(table, outputs=[])
+            try:
+                film.run(table, outputs=[])
+                reached = eps
+            except StepRefused as e:
+                # The second half of the path extends the boundary: eps grows linearly with t.
+                reached = eps * min(max(2.0 * e.time - 1.0, 0.0), 1.0)
+                print(f"  {self.height_mm} mm {self.contact}: stalled at t = {e.time:.4f} "
+                      f"(eps {100 * reached:.2f} % of {100 * eps:.2f} %)")
             result = {}
             for p, g in archfmu.OBSERVED.items():
                 if self.contact == "gaps":
@@ -77,20 +85,20 @@ class Specimen:
                     node = self.model["curved_supports"][0]["nodes"][int(g[1:]) - 1]
                     name = f"arch.node{node}"
                 result[p] = (film[f"{name}.slip"] * 1e3, archfmu.STATUS[int(film[f"{name}.status"])])
-            return result
+            return result, reached
 
 
 def fit(specimen, measured):
     """Least-squares eps on FIT_POINTS from two probe runs (slip = a + b eps), clamped to
-    [0, 0.1], and the run at it: (eps, slips, rms misfit mm)."""
-    lo, hi = (specimen.slips(e) for e in PROBES)
+    [0, 0.1], and the run at it: (eps, slips, rms misfit mm, eps reached)."""
+    (lo, _), (hi, _) = (specimen.slips(e) for e in PROBES)
     b = {p: (hi[p][0] - lo[p][0]) / (PROBES[1] - PROBES[0]) for p in FIT_POINTS}
     a = {p: lo[p][0] - b[p] * PROBES[0] for p in FIT_POINTS}
     eps = sum(b[p] * (measured[p] - a[p]) for p in FIT_POINTS) / sum(b[p] ** 2 for p in FIT_POINTS)
     eps = min(max(eps, 0.0), 0.1)
-    at = specimen.slips(eps)
+    at, reached = specimen.slips(eps)
     rms = (sum((at[p][0] - measured[p]) ** 2 for p in FIT_POINTS) / len(FIT_POINTS)) ** 0.5
-    return eps, at, rms
+    return eps, at, rms, reached
 
 
 def plot(results, table1, steps, path):
@@ -102,10 +110,11 @@ def plot(results, table1, steps, path):
         ax.plot(FIT_POINTS, [table1[h][p] for p in FIT_POINTS], "s--", color="tab:red",
                 label="experiment (Table 1)")
         for contact in MODELS:
-            eps, at, rms = results[h][contact]
+            eps, at, rms, reached = results[h][contact]
             line, marker, color, label = style[contact]
+            stalled = "" if reached == eps else f" (stalls at {100 * reached:.2f} %)"
             ax.plot(FIT_POINTS, [at[p][0] for p in FIT_POINTS], line, marker=marker, color=color,
-                    label=f"{label}: ε = {100 * eps:.2f} %, RMS {rms:.1f} mm")
+                    label=f"{label}: ε = {100 * eps:.2f} %{stalled}, RMS {rms:.1f} mm")
         ax.set_xticks(FIT_POINTS, [f"{p}\n({archfmu.OBSERVED[p]})" for p in FIT_POINTS])
         ax.set_title(f"{h} mm arch (all nine nodes touch)", fontsize=10)
         ax.set_xlabel("observed point (arch node)")
@@ -126,18 +135,20 @@ def main(argv=None):
     out.mkdir(parents=True, exist_ok=True)
     table1 = archfmu.read_table1()
     results = {h: {c: fit(Specimen(h, c, a.steps, out), table1[h]) for c in MODELS} for h in HEIGHTS_MM}
-    header = ["arch_height_mm", "contact", "eps", "rms_mm", "point", "slip_mm", "status", "experiment_mm"]
-    rows = [[h, c, eps, rms, p, at[p][0], at[p][1], table1[h][p]]
-            for h in HEIGHTS_MM for c, (eps, at, rms) in results[h].items() for p in archfmu.OBSERVED]
+    header = ["arch_height_mm", "contact", "eps", "eps_reached", "rms_mm", "point", "slip_mm", "status",
+              "experiment_mm"]
+    rows = [[h, c, eps, reached, rms, p, at[p][0], at[p][1], table1[h][p]]
+            for h in HEIGHTS_MM for c, (eps, at, rms, reached) in results[h].items() for p in archfmu.OBSERVED]
     csv_path = archfmu.write_csv(out / "fig8_wrapped.csv", header, rows)
     png = out / "fig8_wrapped.png"
     plot(results, table1, a.steps, png)
     print("wrapped specimens: boundary extension eps fitted on points 2-5 (slips mm, points 1-5)")
     for h in HEIGHTS_MM:
         print(f"{h} mm  Table 1: " + " ".join(f"{table1[h][p]:6.1f}" for p in archfmu.OBSERVED))
-        for c, (eps, at, rms) in results[h].items():
+        for c, (eps, at, rms, reached) in results[h].items():
             touching = sum(s != "open" for _, s in at.values())
-            print(f"  {c:<15} eps = {100 * eps:5.2f} %  RMS {rms:5.2f} mm  "
+            stalled = "" if reached == eps else f" (stalls at {100 * reached:.2f} %)"
+            print(f"  {c:<15} eps = {100 * eps:5.2f} %{stalled}  RMS {rms:5.2f} mm  "
                   + " ".join(f"{at[p][0]:6.2f}" for p in archfmu.OBSERVED) + f"  ({touching}/5 touching)")
     print(f"wrote {png} and {csv_path}")
     return results
