@@ -601,7 +601,8 @@ pub struct ContactHistory {
     /// [`Projection::parameter`] at the converged state: the unwrapped angle is the branch for
     /// the next projection, the parabola's parameter the start of its Newton iteration.
     pub angle: f64,
-    /// `ξ1` of the reference configuration (slip is measured from it).
+    /// `ξ1` from which the slip is measured: that of the reference configuration, moved with
+    /// the node over every step that starts open.
     pub origin: f64,
     /// Status at convergence.
     pub status: GapStatus,
@@ -889,7 +890,13 @@ impl SurfaceContact {
             anchor: p.xi.into(),
             angle: p.parameter,
             origin: p.xi.x,
-            status: GapStatus::Open,
+            // A node that starts on the support is in contact from the start (its first step
+            // slides); the others approach first.
+            status: if p.gap <= 0.0 && p.on_support {
+                GapStatus::Stick
+            } else {
+                GapStatus::Open
+            },
             friction: mu,
         }
     }
@@ -898,8 +905,13 @@ impl SurfaceContact {
 /// Results of one contact node.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SurfaceContactResult {
-    /// Arc length travelled along the support since the start, `ξ1 − ξ1(0)` (m).
+    /// Arc length slid along the support while in contact (m): the change of `ξ1` summed over
+    /// the converged steps that start in contact (a step that starts open is approach, not
+    /// sliding); for a node in contact from the start, `ξ1 − ξ1(0)`.
     pub slip: f64,
+    /// Arc length the node has travelled along the support since the start, `ξ1 − ξ1(0)`, in
+    /// contact or not (what a fixed-frame gap's local-x displacement approximates) (m).
+    pub travel: f64,
     /// Travel along the axis (across a ring), `ξ2 − ξ2(0)` (m).
     pub slip_across: f64,
     /// Gap `d − r` (m; negative: penetration).
@@ -1022,6 +1034,13 @@ impl SurfaceContacts {
                 anchor: r.next_anchor.into(),
                 angle: r.angle,
                 status: r.status,
+                // Slip is sliding in contact: a step that starts open (where the anchor is the
+                // node's `ξ1`) moves the origin with the node, so its travel is not counted.
+                origin: if h.status == GapStatus::Open {
+                    h.origin + r.xi.x - h.anchor[0]
+                } else {
+                    h.origin
+                },
                 ..*h
             })
             .collect()
@@ -1040,6 +1059,7 @@ impl SurfaceContacts {
                 SurfaceContactResult {
                     contact_point: (x - p.normal * p.gap).into(),
                     slip: p.xi.x - h.origin,
+                    travel: p.xi.x - x0.xi.x,
                     slip_across: p.xi.y - x0.xi.y,
                     gap: p.gap,
                     normal_force: r.normal_force,
@@ -1374,5 +1394,49 @@ mod tests {
             };
             assert_eq!((regions, creases), (expected, expected_creases), "{kind}");
         }
+    }
+
+    /// A node that travels round a cylinder while clear of it, then lands and is dragged on:
+    /// only the arc length after landing is slip; the travel counts both.
+    #[test]
+    fn slip_counts_sliding_in_contact_not_the_approach() {
+        let s = CurvedSupport {
+            centreline: Centreline::Line {
+                point: [0.0; 3],
+                axis: [0.0, 1.0, 0.0],
+            },
+            friction: 0.0,
+            ..support(kinds().remove(0).1, FrictionLaw::Isotropic)
+        };
+        let c = SurfaceContact::new(&s, 0);
+        let r = s.tube_radius;
+        let at = |radius: f64, phi: f64| {
+            c.frame.centre + (c.frame.e1 * phi.cos() + c.frame.e2 * phi.sin()) * radius
+        };
+        let mut history = c.initial_history(&at(1.5 * r, 0.0), 0.0);
+        assert_eq!(history.status, GapStatus::Open);
+        let path = [
+            (1.5 * r, 0.4),
+            (0.99 * r, 0.6),
+            (0.99 * r, 0.9),
+            (0.99 * r, 1.3),
+        ];
+        let mut slips = vec![];
+        for (radius, phi) in path {
+            let response = c.respond(&at(radius, phi), &history);
+            history = SurfaceContacts::commit(&[response], &[history])[0];
+            slips.push(response.xi.x - history.origin);
+        }
+        // Open, then landing (approach: not slip), then two steps dragged in contact.
+        let expected = [0.0, 0.0, r * 0.3, r * 0.7];
+        for (k, (s, e)) in slips.iter().zip(expected).enumerate() {
+            assert!((s - e).abs() < 1e-12, "step {k}: slip {s} vs {e}");
+        }
+        let touching = c.initial_history(&at(0.99 * r, 0.0), 0.0);
+        assert_eq!(
+            touching.status,
+            GapStatus::Stick,
+            "a node on the support starts in contact"
+        );
     }
 }
