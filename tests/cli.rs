@@ -442,3 +442,34 @@ fn help_lists_every_command_and_the_solver_options() {
         assert!(out.contains(option), "{option} missing:\n{out}");
     }
 }
+
+/// `specimen --wrap EPS` runs the crown-to-foot reconstruction (every arch node in contact at the
+/// end, its 21 frame groups reported); a bad extension and `--wrap` with a frame target are
+/// refused naming the option.
+#[test]
+fn wrapped_specimen_runs_from_the_command_line_and_bad_wraps_are_refused() {
+    let (ok, out, err) = cli(&[
+        "specimen",
+        "--height",
+        "300",
+        "--contact",
+        "curved-support",
+        "--wrap",
+        "0.02",
+        "--steps",
+        "10",
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let contacts: Vec<&str> = out.lines().filter(|l| l.starts_with("arch.node")).collect();
+    assert_eq!(contacts.len(), 9, "{out}");
+    assert!(contacts.iter().all(|l| !l.ends_with("Open")), "{out}");
+    assert_eq!(out.matches("reaction of group node").count(), 21, "{out}");
+    let (ok, _, err) = cli(&["specimen", "--wrap", "0.5", "--steps", "1"]);
+    assert!(
+        !ok && err.contains("extension 0.5 must lie in 0..=0.1"),
+        "{err}"
+    );
+    let (ok, _, err) = cli(&["specimen", "--wrap", "0.02", "--target-dz-per-height", "-1"]);
+    assert!(!ok && err.contains("--wrap"), "{err}");
+}

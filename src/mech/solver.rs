@@ -54,6 +54,10 @@ pub struct SolverSettings {
     /// Factorize a consistent tangent that is symmetric (no slipping gap, no follower pressure)
     /// by LDLᵀ instead of LU (`linear.rs`); false: always LU.
     pub symmetric_factorization: bool,
+    /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
+    /// below [`super::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results
+    /// are bit-identical for every count.
+    pub threads: usize,
 }
 
 impl Default for SolverSettings {
@@ -66,6 +70,7 @@ impl Default for SolverSettings {
             max_cutbacks: 12,
             line_search: true,
             symmetric_factorization: true,
+            threads: 0,
         }
     }
 }
@@ -86,9 +91,18 @@ impl SolverSettings {
         if self.max_cutbacks > 60 {
             return Err("max_cutbacks must be at most 60".into());
         }
+        if self.threads > MAX_THREADS {
+            return Err(format!(
+                "threads = {} must be at most {MAX_THREADS} (0: automatic)",
+                self.threads
+            ));
+        }
         Ok(())
     }
 }
+
+/// Most assembly threads [`SolverSettings::threads`] accepts.
+pub const MAX_THREADS: usize = 256;
 
 /// Where the boundary groups are at one point of a step: translation and hinge angle of each.
 #[derive(Clone, Debug)]
@@ -508,7 +522,8 @@ impl Analysis {
         model.validate().map_err(SetupError::Model)?;
         settings.validate().map_err(SetupError::Settings)?;
         let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
-        let system = System::new(&model, lower_only)?;
+        let mut system = System::new(&model, lower_only)?;
+        system.set_threads(settings.threads);
         if system.free_count == 0 {
             return Err(SetupError::System("the model has no free DOF".into()));
         }
@@ -593,12 +608,14 @@ impl Analysis {
         &self.settings
     }
 
-    /// Changes tolerances and limits (not the iteration matrix, which fixes the pattern).
+    /// Changes tolerances, limits and threads (not the iteration matrix, which fixes the
+    /// pattern).
     pub fn set_limits(&mut self, settings: SolverSettings) -> Result<(), String> {
         settings.validate()?;
         if settings.iteration_matrix != self.settings.iteration_matrix {
             return Err("the iteration matrix is fixed when the analysis is created".into());
         }
+        self.system.set_threads(settings.threads);
         self.settings = settings;
         Ok(())
     }
