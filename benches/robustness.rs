@@ -5,7 +5,7 @@
 //! many paths converge, Newton iterations per increment (mean over all converged increments,
 //! and the most in one increment), cut-backs, and the first failure; then the total.
 //!
-//! Options (after `--`): `--family NAME` (specimen, panel, strip, arch-edge; repeatable),
+//! Options (after `--`): `--family NAME` (specimen, panel, strip, arch-edge, wrapped; repeatable),
 //! `--quick` (every 10th path of each family), `--failures` (print every failed path),
 //! `--threads N` (paths run in parallel, default: available cores).
 //!

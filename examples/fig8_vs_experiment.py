@@ -8,8 +8,9 @@ movement relative to the arch point below it, not sliding on the arch; it is dra
 
 The same specimens with the nine arch nodes in node-to-surface contact with the arch pipe
 (``export-specimen --contact curved-support``, packed as an FMU of its own; issue 10) are drawn
-beside them (dash-dot): their slip is the arc length along the arch, the quantity the experiment
-measured, where the gaps give the displacement along the arch's starting tangent.
+beside them (dash-dot): their slip is the arc length slid along the arch while in contact (the
+approach of a node that lands late is not sliding; an open node has slid 0), where the gaps give
+the displacement along the arch's starting tangent since the start.
 
 Writes fig8_vs_experiment.png and fig8_vs_experiment.csv into --out and prints the table of
 differences (analysis - experiment, mm) for points 1-5.
@@ -81,7 +82,7 @@ def plot(rows, steps, path):
         ax.plot(pts, [r["analysis_mm"] for r in rs], "-", color="tab:blue",
                 label=f"analysis, gaps (paper), μ = {MU:g}")
         ax.plot(pts, [r["curved_support_mm"] for r in rs], "-.", color="tab:green", marker="^",
-                label="analysis, curved support (slip along the arch)")
+                label="analysis, curved support (slid along the arch in contact)")
         for r in rs:
             is_open = r["status"] == "open"
             ax.plot(r["point"], r["analysis_mm"], "o", color="tab:blue",

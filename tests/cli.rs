@@ -202,6 +202,36 @@ fn no_line_search_option_reaches_the_same_inflated_state() {
     }
 }
 
+/// The `linear solves:` line counts the factorizations: the disc of circular_membrane.json
+/// (follower pressure, rim held) has a symmetric consistent tangent, so every Newton iteration
+/// is one LDLᵀ and none is an LU, with and without the line search.
+#[test]
+fn pressurised_disc_held_at_its_rim_is_factored_by_one_ldlt_per_newton_iteration() {
+    let model = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/circular_membrane.json"
+    );
+    for extra in [None, Some("--no-line-search")] {
+        let mut args = vec!["model", model, "--steps", "4", "--quiet"];
+        args.extend(extra);
+        let (ok, out, err) = cli(&args);
+        assert!(ok, "{err}");
+        let numbers = |prefix: &str| -> Vec<usize> {
+            let line = out.lines().find(|l| l.starts_with(prefix)).unwrap();
+            line.split([' ', ',', '('])
+                .filter_map(|w| w.parse().ok())
+                .collect()
+        };
+        // "Newton: 4 steps, 4 increments, 0 cut-backs, 0 enlarged, N iterations (…"
+        let iterations = numbers("Newton:")[4];
+        let [lu, ldlt, gmres, redone] = numbers("linear solves:")[..] else {
+            panic!("{out}")
+        };
+        assert!(iterations > 0, "{out}");
+        assert_eq!((lu, ldlt, gmres, redone), (0, iterations, 0, 0), "{out}");
+    }
+}
+
 /// The solver settings the FMU has are CLI options too: increments per step, cut-backs and
 /// both tolerances; a bad value is refused naming the setting.
 #[test]
@@ -260,7 +290,7 @@ fn cli(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-/// The printed results without the Newton statistics, a printed negative zero (`-0.000`) read
+/// The printed results without the Newton and linear-solve statistics, a printed negative zero (`-0.000`) read
 /// as zero.
 fn results_text(out: &str) -> String {
     let zero = |word: &str| {
@@ -272,7 +302,7 @@ fn results_text(out: &str) -> String {
         }
     };
     out.lines()
-        .filter(|l| !l.starts_with("Newton:"))
+        .filter(|l| !l.starts_with("Newton:") && !l.starts_with("linear solves:"))
         .map(|l| {
             l.split_inclusive([' ', ',', '(', ')'])
                 .map(|w| {
@@ -411,4 +441,35 @@ fn help_lists_every_command_and_the_solver_options() {
     ] {
         assert!(out.contains(option), "{option} missing:\n{out}");
     }
+}
+
+/// `specimen --wrap EPS` runs the crown-to-foot reconstruction (every arch node in contact at the
+/// end, its 21 frame groups reported); a bad extension and `--wrap` with a frame target are
+/// refused naming the option.
+#[test]
+fn wrapped_specimen_runs_from_the_command_line_and_bad_wraps_are_refused() {
+    let (ok, out, err) = cli(&[
+        "specimen",
+        "--height",
+        "300",
+        "--contact",
+        "curved-support",
+        "--wrap",
+        "0.02",
+        "--steps",
+        "10",
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    let contacts: Vec<&str> = out.lines().filter(|l| l.starts_with("arch.node")).collect();
+    assert_eq!(contacts.len(), 9, "{out}");
+    assert!(contacts.iter().all(|l| !l.ends_with("Open")), "{out}");
+    assert_eq!(out.matches("reaction of group node").count(), 21, "{out}");
+    let (ok, _, err) = cli(&["specimen", "--wrap", "0.5", "--steps", "1"]);
+    assert!(
+        !ok && err.contains("extension 0.5 must lie in 0..=0.1"),
+        "{err}"
+    );
+    let (ok, _, err) = cli(&["specimen", "--wrap", "0.02", "--target-dz-per-height", "-1"]);
+    assert!(!ok && err.contains("--wrap"), "{err}");
 }

@@ -56,6 +56,13 @@ pub enum Command {
     ExportSpecimen {
         #[command(flatten)]
         specimen: SpecimenArgs,
+        /// Also write the specimen's frame path as a staged table (FMU input names, one row per
+        /// step) for `--path` or an FMU master.
+        #[arg(long, value_name = "FILE")]
+        path_out: Option<std::path::PathBuf>,
+        /// Steps of the table written by --path-out.
+        #[arg(long, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+        steps: u32,
         /// Friction law of every gap.
         #[arg(long, value_name = "LAW", value_parser = parse_friction_law)]
         friction_law: Option<FrictionLaw>,
@@ -81,8 +88,18 @@ pub struct SpecimenArgs {
     #[arg(long, value_name = "MODEL", default_value = "gaps", value_parser = parse_contact)]
     pub contact: SpecimenContact,
     /// Frame target dz as a multiple of the arch height (default -0.5: lowered by H/2).
-    #[arg(allow_negative_numbers = true, long, value_name = "X")]
+    #[arg(
+        allow_negative_numbers = true,
+        long,
+        value_name = "X",
+        conflicts_with = "wrap"
+    )]
     pub target_dz_per_height: Option<f64>,
+    /// Wrap the film over the arch from crown to foot instead of lowering the frame: every frame
+    /// node follows the wrapped film extended by the strain EPS (0 ..= 0.1), one boundary group
+    /// per frame node (the crown-to-foot reconstruction, docs/mechanics.md).
+    #[arg(long, value_name = "EPS")]
+    pub wrap: Option<f64>,
 }
 
 /// Newton iteration matrix.
@@ -147,6 +164,10 @@ pub struct RunArgs {
     /// no safeguard for a first step from a slack flat film.
     #[arg(long)]
     pub no_line_search: bool,
+    /// Threads of the element assembly (0 = automatic: one below 100 000 triangles, else up to
+    /// two; results are identical for every count).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub threads: usize,
     /// Write the gap results of every step as CSV.
     #[arg(long, value_name = "FILE")]
     pub csv: Option<PathBuf>,

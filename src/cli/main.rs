@@ -8,7 +8,7 @@ use std::process::ExitCode;
 
 use membrane_contact::mech::element::state_counts;
 use membrane_contact::mech::model::ElementSelection;
-use membrane_contact::mech::specimen::{OBSERVED_GAPS, table1};
+use membrane_contact::mech::specimen::{FramePath, OBSERVED_GAPS, table1};
 use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
     Analysis, FrictionLaw, LoadLevels, Model, ParallelArch, Results, SolverSettings,
@@ -63,15 +63,24 @@ fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArc
         target_dz_per_height: args
             .target_dz_per_height
             .unwrap_or(defaults.target_dz_per_height),
+        frame_path: args
+            .wrap
+            .map_or(FramePath::Lowered, |extension| FramePath::Wrapped {
+                extension,
+            }),
         ..ParallelArch::with_height(args.height / 1000.0)
     };
     spec.check()?;
     Ok(spec)
 }
 
-/// The targets of each step: the staged table's rows, or the model file's targets and loads
-/// reached linearly in `--steps` steps.
-fn load_path(model: &Model, o: &RunArgs) -> Result<StagedPath, String> {
+/// The targets of each step: the staged table's rows, the specimen's frame path, or the model
+/// file's targets and loads reached linearly in `--steps` steps.
+fn load_path(
+    model: &Model,
+    spec: Option<&ParallelArch>,
+    o: &RunArgs,
+) -> Result<StagedPath, String> {
     if let Some(file) = &o.path {
         let source = file.display().to_string();
         let text = std::fs::read_to_string(file).map_err(|e| format!("{source}: {e}"))?;
@@ -85,11 +94,14 @@ fn load_path(model: &Model, o: &RunArgs) -> Result<StagedPath, String> {
     let rows = times
         .iter()
         .map(|&f| StepInputs {
-            targets: model
-                .groups
-                .iter()
-                .map(|g| g.target.map(|v| v * f))
-                .collect(),
+            targets: match spec {
+                Some(spec) => spec.boundary_targets(model, f),
+                None => model
+                    .groups
+                    .iter()
+                    .map(|g| g.target.map(|v| v * f))
+                    .collect(),
+            },
             angles: model
                 .groups
                 .iter()
@@ -124,12 +136,17 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             .unwrap_or(defaults.displacement_tolerance),
         residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
         line_search: !o.no_line_search,
+        threads: o.threads,
         ..defaults
     };
     for w in membrane_contact::mech::summary::model_warnings(&model) {
         eprintln!("warning: {w}");
     }
-    let path = load_path(&model, o)?;
+    let spec = match &source {
+        Source::Specimen { spec, .. } => Some(spec),
+        Source::File(_) => None,
+    };
+    let path = load_path(&model, spec, o)?;
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
@@ -210,6 +227,11 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         total as f64 / increments.max(1) as f64,
         iterations,
         elapsed.as_secs_f64() * 1e3
+    );
+    let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
+    out!(
+        "linear solves: {lu} LU, {ldlt} LDLᵀ, {gmres} GMRES on the symmetric part's LDLᵀ, \
+         {redone} of these redone by LU"
     );
     if o.vtk.is_some() {
         out!(
@@ -462,9 +484,10 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     }
     if !model.curved_supports.is_empty() {
         out!(
-            "\n{:<14} {:>11} {:>11} {:>10} {:>10}  status   (curved supports: slip = arc length along the support)",
+            "\n{:<14} {:>11} {:>11} {:>11} {:>10} {:>10}  status   (curved supports: slip = arc length slid in contact, travel = along the support since the start)",
             "contact",
             "slip mm",
+            "travel mm",
             "across mm",
             "N (N)",
             "|T| (N)"
@@ -476,8 +499,9 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
         .flat_map(|s| s.nodes.iter().map(move |v| format!("{}.node{v}", s.name)));
     for (name, c) in contacts.zip(&results.surface_contacts) {
         out!(
-            "{name:<14} {:>11.3} {:>11.3} {:>10.3} {:>10.3}  {:?}",
+            "{name:<14} {:>11.3} {:>11.3} {:>11.3} {:>10.3} {:>10.3}  {:?}",
             c.slip * 1e3,
+            c.travel * 1e3,
             c.slip_across * 1e3,
             c.normal_force,
             c.friction_force,
@@ -677,10 +701,20 @@ fn main() -> ExitCode {
         } => import(mesh, mapping, output.as_deref(), python.as_deref()),
         Command::ExportSpecimen {
             specimen: args,
+            path_out,
+            steps,
             friction_law,
-        } => specimen(args, *friction_law)
-            .and_then(|spec| spec.model())
-            .map(|model| out!("{}", model.to_json())),
+        } => specimen(args, *friction_law).and_then(|spec| {
+            let model = spec.model()?;
+            if let Some(file) = path_out {
+                let table = path::write(&model, *steps as usize, |t| {
+                    spec.boundary_targets(&model, t)
+                });
+                std::fs::write(file, table).map_err(|e| format!("{}: {e}", file.display()))?;
+            }
+            out!("{}", model.to_json());
+            Ok(())
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

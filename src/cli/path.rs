@@ -103,6 +103,23 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
     Ok(StagedPath { times, steps: rows })
 }
 
+/// Writes the staged table of `steps` steps whose groups reach `targets_at(k / steps)` at step
+/// `k` (columns `time` and every group's `.dx, .dy, .dz`), the form [`read`] reads back.
+pub fn write(model: &Model, steps: usize, targets_at: impl Fn(f64) -> Vec<[f64; 3]>) -> String {
+    let mut header = vec!["time".to_string()];
+    for g in &model.groups {
+        header.extend(["dx", "dy", "dz"].map(|c| format!("{}.{c}", g.name)));
+    }
+    let mut text = header.join(",") + "\n";
+    for k in 1..=steps {
+        let t = k as f64 / steps as f64;
+        let mut cells = vec![t.to_string()];
+        cells.extend(targets_at(t).iter().flatten().map(f64::to_string));
+        text += &(cells.join(",") + "\n");
+    }
+    text
+}
+
 /// The table row of the input `name`, or an error that says what the name is instead.
 fn column(table: &[Variable], name: &str, header: &[&str]) -> Result<usize, String> {
     if header.iter().filter(|&&n| n == name).count() > 1 {
@@ -156,6 +173,30 @@ mod tests {
         let without_time = read("frame.dx\n0.01\n0.02\n", &specimen(), "t.csv").unwrap();
         assert_eq!(without_time.times, vec![0.5, 1.0]);
         assert_eq!(without_time.steps[0].mu, None);
+    }
+
+    #[test]
+    fn a_written_frame_path_reads_back_as_the_same_steps() {
+        use membrane_contact::mech::specimen::FramePath;
+        let spec = ParallelArch {
+            frame_path: FramePath::Wrapped { extension: 0.02 },
+            ..ParallelArch::default()
+        };
+        let model = spec.model().unwrap();
+        let text = write(&model, 4, |t| spec.boundary_targets(&model, t));
+        let path = read(&text, &model, "wrap.csv").unwrap();
+        assert_eq!(path.times, vec![0.25, 0.5, 0.75, 1.0]);
+        for (k, step) in path.steps.iter().enumerate() {
+            let t = (k + 1) as f64 / 4.0;
+            assert_eq!(step.targets, spec.boundary_targets(&model, t));
+        }
+        assert_eq!(model.groups.len(), 21);
+        assert!(
+            path.steps[3]
+                .targets
+                .iter()
+                .any(|d| d[2] < -spec.arch_height)
+        );
     }
 
     #[test]

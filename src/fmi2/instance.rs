@@ -68,7 +68,7 @@ use crate::mech::{
     Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SolverSettings,
     StepError, StepReport, check_results,
     model::MAX_FRICTION,
-    solver::IncrementFailure,
+    solver::{IncrementFailure, MAX_THREADS},
     summary::{model_warnings, result_warnings},
     vtk,
 };
@@ -734,6 +734,12 @@ impl Instance {
                     model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
                 }
                 (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
+                (Binding::Threads, Value::Integer(x)) => {
+                    settings.threads = count(x, 0)?;
+                    if settings.threads > MAX_THREADS {
+                        return Err(format!("{} = {x} must be at most {MAX_THREADS}", v.name));
+                    }
+                }
                 (Binding::UseJuRowlands, Value::Boolean(b)) => {
                     settings.iteration_matrix = if b {
                         IterationMatrix::JuRowlands

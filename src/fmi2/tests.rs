@@ -1524,3 +1524,49 @@ fn result_beyond_the_yield_stress_is_a_warning_not_an_error() {
     assert_eq!(fmu.set_real("frame.dz", -0.14), 0);
     assert_ne!(fmu.step(1.0, 1.0), Status::Error.raw());
 }
+
+#[test]
+fn solver_threads_is_read_back_refused_out_of_range_by_name_and_leaves_the_outputs_unchanged() {
+    let (u, log) = (Unpacked::specimen("threads"), Log::default());
+    // Out of range: ExitInitializationMode fails naming the parameter.
+    for (value, expect) in [
+        (-1, "solver.threads = -1 must be ≥ 0"),
+        (100_000, "solver.threads = 100000 must be at most 256"),
+    ] {
+        let fmu = Fmu::new(&u, &log);
+        unsafe {
+            assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+            assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+        }
+        assert_eq!(fmu.set_integer("solver.threads", value), 0);
+        assert_eq!(
+            unsafe { fmi2_exit_initialization_mode(fmu.c) },
+            Status::Error.raw()
+        );
+        assert!(log.contains(Status::Error, expect), "{:?}", log.take());
+    }
+    // 0 (automatic, the start value) and 1 against 2 and 3 threads: the same bits throughout.
+    let run = |threads: i32| {
+        let fmu = Fmu::initialized(&u, &log, &[], &[("solver.threads", threads)]);
+        assert_eq!(fmu.integer("solver.threads"), threads);
+        fmu.ramp(0, 3, 20);
+        fmu.all_values()
+    };
+    let serial = run(1);
+    assert_eq!(
+        Fmu::initialized(&u, &log, &[], &[]).integer("solver.threads"),
+        0,
+        "start value: automatic"
+    );
+    for threads in [0, 2, 3] {
+        let mut values = run(threads);
+        let at = u
+            .variables
+            .iter()
+            .filter(|v| v.var_type == super::variables::VarType::Integer)
+            .position(|v| v.name == "solver.threads")
+            .unwrap();
+        values.1[at] = 1;
+        assert_eq!(values, serial, "{threads} threads");
+    }
+}

@@ -23,6 +23,7 @@
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch` | | parameter | | Newton settings |
+//! | `solver.threads` | Integer | parameter | | threads of the element assembly (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
@@ -191,6 +192,8 @@ pub enum Binding {
     UseJuRowlands,
     /// Backtracking line search on (true) or off.
     LineSearch,
+    /// Threads of the element assembly (0: automatic).
+    Threads,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
     /// it does not change the analysis, and no output depends on it.
     ResultsDirectory,
@@ -667,7 +670,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          (the paper's: slides along the gap's local x, or along the support, only); empty: each keeps the model file's",
         Binding::FrictionLaw,
     );
-    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 7] = [
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 8] = [
         (
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
@@ -718,6 +721,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
              and closing); false: plain Newton steps, about half the iterations when each step starts near \
              its answer (a prestressed film under a gradually raised pressure)",
             Binding::LineSearch,
+        ),
+        (
+            "threads",
+            Value::Integer(saturating_i32(solver.threads)),
+            None,
+            "threads of the element assembly, ended before each call returns (0: automatic, one on meshes \
+             below 100 000 triangles, else up to two); the results are identical for every count",
+            Binding::Threads,
         ),
     ];
     for (name, start, unit, description, binding) in solver_parameters {

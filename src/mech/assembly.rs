@@ -6,6 +6,16 @@
 //! (node-to-node gaps never change it); every entry of every element matrix gets a precomputed
 //! slot in the CSC value array, so an iteration only zeroes and adds values (top88's
 //! `iK/jK` vs `sK`). A symmetric pattern keeps the lower triangle only.
+//!
+//! With more than one thread ([`System::set_threads`]) the owner computes: the columns are cut
+//! into one range per thread of about equal nonzeros; each thread owns its columns' slots of
+//! `values` and the matching range of global DOFs of `internal`, computes every triangle with a
+//! DOF in its range (in element order) and adds only the entries it owns. A triangle across two
+//! ranges is computed by both (0.3–11 % of the triangles on the benchmarks' meshes); no two
+//! threads write the same entry, and each entry receives the same additions in the same order as
+//! in the serial loop: the result is bit-identical for every thread count. The threads are scoped:
+//! they end before [`System::assemble`] returns (no pool outlives a call, which an FMU unloaded by
+//! `dlclose` needs), and a panic in one reaches the caller.
 
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
@@ -14,6 +24,13 @@ use super::element::{ElementMatrix, ElementVector, Material, MembraneTriangle};
 use super::model::{GapSupport, Model};
 
 const NO_SLOT: u32 = u32::MAX;
+
+/// Below this many triangles the automatic thread count is 1: on the shared 2-core machine a
+/// second thread lost time on every smaller mesh measured (docs/benchmarks.md, issue 11 item 3).
+pub const PARALLEL_MIN_TRIANGLES: usize = 100_000;
+
+/// Most threads the automatic thread count uses.
+pub const AUTOMATIC_MAX_THREADS: usize = 2;
 
 /// What a global DOF is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -58,6 +75,19 @@ pub struct System {
     gap_offsets: Vec<usize>,
     /// Whether only the lower triangle is stored.
     lower_only: bool,
+    /// Threads of an assembly (at least 1).
+    threads: usize,
+    /// What each thread of a parallel assembly owns (empty when serial).
+    parts: Vec<Part>,
+}
+
+/// One thread's share of a parallel assembly: the global DOFs and slots it writes and
+/// the triangles with a DOF among them (ascending), computed by every thread they touch.
+#[derive(Clone, Debug)]
+struct Part {
+    dofs: std::ops::Range<usize>,
+    slots: std::ops::Range<usize>,
+    triangles: Vec<u32>,
 }
 
 /// Why a system cannot be built (only for sizes beyond the index type).
@@ -179,7 +209,92 @@ impl System {
             slots,
             gap_offsets,
             lower_only,
+            threads: 1,
+            parts: vec![],
         })
+    }
+
+    /// Sets the threads of [`System::assemble`]: `requested` when positive, else the automatic
+    /// count (1 below [`PARALLEL_MIN_TRIANGLES`] triangles, else the available cores up to
+    /// [`AUTOMATIC_MAX_THREADS`]).
+    pub fn set_threads(&mut self, requested: usize) {
+        self.threads = match requested {
+            0 if self.triangles.len() < PARALLEL_MIN_TRIANGLES => 1,
+            0 => std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(AUTOMATIC_MAX_THREADS),
+            n => n,
+        };
+        self.parts = if self.threads > 1 {
+            self.partition(self.threads)
+        } else {
+            vec![]
+        };
+    }
+
+    /// Cuts the free DOFs into `threads` ranges of consecutive columns holding about equal
+    /// numbers of nonzeros; each part owns its columns' slots and the global DOFs from its
+    /// first column's DOF up to the next part's (constrained DOFs go with the free DOF before).
+    fn partition(&self, threads: usize) -> Vec<Part> {
+        let col_ptr = self.symbolic.col_ptr();
+        let nnz = self.nonzeros();
+        let global_of: Vec<usize> = self
+            .dofs
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| matches!(d, Dof::Free(_)))
+            .map(|(g, _)| g)
+            .collect();
+        // Part t starts at column `first_column(t)` and at global DOF `first_dof(t)`.
+        let first_column = |t: usize| {
+            col_ptr
+                .partition_point(|&p| p < nnz * t / threads)
+                .min(self.free_count)
+        };
+        let first_dof = |t: usize| match first_column(t) {
+            _ if t == 0 => 0,
+            _ if t == threads => self.dofs.len(),
+            c if c == self.free_count => self.dofs.len(),
+            c => global_of[c],
+        };
+        let mut parts: Vec<Part> = (0..threads)
+            .map(|t| {
+                let (c0, c1) = (first_column(t), first_column(t + 1));
+                let c1 = if t + 1 == threads {
+                    self.free_count
+                } else {
+                    c1
+                };
+                Part {
+                    dofs: first_dof(t)..first_dof(t + 1),
+                    slots: col_ptr[c0]..col_ptr[c1],
+                    triangles: vec![],
+                }
+            })
+            .collect();
+        for (e, (nodes, _)) in self.triangles.iter().enumerate() {
+            for part in parts.iter_mut() {
+                if node_dofs(nodes).iter().any(|g| part.dofs.contains(g)) {
+                    part.triangles.push(e as u32);
+                }
+            }
+        }
+        parts
+    }
+
+    /// Triangles computed per assembly over all threads, relative to the triangle count (1 when
+    /// serial; above 1 by the triangles computed by two threads or more).
+    pub fn computed_share(&self) -> f64 {
+        if self.parts.is_empty() {
+            return 1.0;
+        }
+        let computed: usize = self.parts.iter().map(|p| p.triangles.len()).sum();
+        computed as f64 / self.triangles.len().max(1) as f64
+    }
+
+    /// Threads [`System::assemble`] uses.
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// The symbolic structure of the free–free tangent.
@@ -202,6 +317,11 @@ impl System {
             + self.dofs.len() * size_of::<Dof>()
             + self.triangles.len() * size_of::<([usize; 3], MembraneTriangle)>()
             + self.gaps.len() * size_of::<GapGeometry>()
+            + self
+                .parts
+                .iter()
+                .map(|p| p.triangles.len() * size_of::<u32>())
+                .sum::<usize>()
     }
 
     /// Whether only the lower triangle is stored (symmetric iteration matrix).
@@ -250,20 +370,17 @@ impl System {
         if let Some(v) = values.as_deref_mut() {
             v.fill(0.0);
         }
-        let with_tangent = values.is_some();
-        for (e, (nodes, tri)) in self.triangles.iter().enumerate() {
-            let global = node_dofs(nodes);
-            let ue = ElementVector::from_fn(|i, _| u[global[i]]);
-            let (r, k) = tri.force_and_tangent(&self.material, &ue, with_tangent);
-            for (i, &gi) in global.iter().enumerate() {
-                internal[gi] += r[i];
-            }
-            if let Some(v) = values.as_deref_mut() {
-                let slots = &self.slots[81 * e..81 * (e + 1)];
-                for (s, kij) in slots.iter().zip(k.iter()) {
-                    if *s != NO_SLOT {
-                        v[*s as usize] += kij;
-                    }
+        if self.threads > 1 {
+            self.assemble_triangles_owned(u, internal, values.as_deref_mut());
+        } else {
+            let with_tangent = values.is_some();
+            for e in 0..self.triangles.len() {
+                let (r, k) = self.element(e, u, with_tangent);
+                for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
+                    internal[gi] += r[i];
+                }
+                if let Some(v) = values.as_deref_mut() {
+                    self.add_element_matrix(e, &k, v);
                 }
             }
         }
@@ -290,6 +407,88 @@ impl System {
                             v[s as usize] += sign * ka[(a % 3, b % 3)];
                         }
                     }
+                }
+            }
+        }
+    }
+}
+
+impl System {
+    /// Force and tangent (zero unless `with_tangent`) of triangle `e` at `u`.
+    fn element(&self, e: usize, u: &[f64], with_tangent: bool) -> (ElementVector, ElementMatrix) {
+        let (nodes, tri) = &self.triangles[e];
+        let global = node_dofs(nodes);
+        let ue = ElementVector::from_fn(|i, _| u[global[i]]);
+        tri.force_and_tangent(&self.material, &ue, with_tangent)
+    }
+
+    /// The triangles' part of [`System::assemble`] on scoped threads, owner computes (see the
+    /// module doc): thread `t` computes every triangle of its part and adds the entries that
+    /// fall in its own DOFs and slots.
+    fn assemble_triangles_owned(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        values: Option<&mut [f64]>,
+    ) {
+        let with_tangent = values.is_some();
+        let mut forces = internal;
+        let mut matrix = values;
+        std::thread::scope(|scope| {
+            for (t, part) in self.parts.iter().enumerate() {
+                let (mine, rest) = std::mem::take(&mut forces).split_at_mut(part.dofs.len());
+                forces = rest;
+                let mine_values = match matrix.take() {
+                    Some(v) => {
+                        let (mine, rest) = v.split_at_mut(part.slots.len());
+                        matrix = Some(rest);
+                        Some((part.slots.start, mine))
+                    }
+                    None => None,
+                };
+                let work = move || {
+                    let mut mine_values = mine_values;
+                    for &e in &part.triangles {
+                        let e = e as usize;
+                        let (r, k) = self.element(e, u, with_tangent);
+                        self.scatter_part(
+                            e,
+                            (&r, &k),
+                            (part.dofs.start, &mut *mine),
+                            mine_values.as_mut().map(|(v0, v)| (*v0, &mut **v)),
+                        );
+                    }
+                };
+                if t + 1 < self.parts.len() {
+                    scope.spawn(work);
+                } else {
+                    work();
+                }
+            }
+        });
+    }
+
+    /// Adds triangle `e`'s force `r` and, when `matrix` is given, its tangent `k` to the parts of
+    /// `internal` and `values` that start at global DOF `d0` and slot `v0`.
+    fn scatter_part(
+        &self,
+        e: usize,
+        (r, k): (&ElementVector, &ElementMatrix),
+        (d0, forces): (usize, &mut [f64]),
+        matrix: Option<(usize, &mut [f64])>,
+    ) {
+        for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
+            // Indices below d0 wrap to huge values: `get_mut` skips them like those past the end.
+            if let Some(x) = forces.get_mut(gi.wrapping_sub(d0)) {
+                *x += r[i];
+            }
+        }
+        if let Some((v0, values)) = matrix {
+            let slots = &self.slots[81 * e..81 * (e + 1)];
+            for (s, kij) in slots.iter().zip(k.iter()) {
+                // NO_SLOT lies past every part (nonzeros < NO_SLOT).
+                if let Some(x) = values.get_mut((*s as usize).wrapping_sub(v0)) {
+                    *x += kij;
                 }
             }
         }

@@ -52,6 +52,7 @@ pub fn check_results(
     for (r, (s, v)) in results.surface_contacts.iter().zip(contacts) {
         let values = [
             r.slip,
+            r.travel,
             r.slip_across,
             r.gap,
             r.normal_force,

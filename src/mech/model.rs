@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 use super::contact::{FrictionLaw, GapFrame, GapLaw};
 use super::element::{Material, MembraneTriangle};
-use super::surface::{Centreline, CurvedSupport};
+use super::surface::{Centreline, CurvedSupport, SurfaceContact};
 
 /// A global axis, used for supports and symmetry planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -843,8 +843,9 @@ impl Model {
                 gap: format!("curved support '{}'", s.name),
                 message,
             };
-            let (point, axis, ring) = match &s.centreline {
-                Centreline::Line { point, axis } => (*point, *axis, None),
+            let axis_line = match &s.centreline {
+                Centreline::Parabola { .. } | Centreline::Polyline { .. } => None,
+                Centreline::Line { point, axis } => Some((*point, *axis, None)),
                 Centreline::Circle {
                     centre,
                     axis,
@@ -875,15 +876,16 @@ impl Model {
                             return Err(bad("start_direction is parallel to the axis".into()));
                         }
                     }
-                    (*centre, *axis, Some(*radius))
+                    Some((*centre, *axis, Some(*radius)))
                 }
             };
-            if point.iter().chain(&axis).any(|v| !v.is_finite()) {
-                return Err(bad("centreline point or axis not finite".into()));
-            }
-            let a = Vector3::from(axis);
-            if a.norm() == 0.0 {
-                return Err(bad("centreline axis is the zero vector".into()));
+            if let Some((point, axis, _)) = axis_line {
+                if point.iter().chain(&axis).any(|v| !v.is_finite()) {
+                    return Err(bad("centreline point or axis not finite".into()));
+                }
+                if Vector3::from(axis).norm() == 0.0 {
+                    return Err(bad("centreline axis is the zero vector".into()));
+                }
             }
             let positive = |v: f64| v > 0.0 && v.is_finite();
             for (what, v) in [
@@ -901,10 +903,10 @@ impl Model {
                     s.friction
                 )));
             }
+            s.centreline.check(s.tube_radius).map_err(bad)?;
             if s.nodes.is_empty() {
                 return Err(bad("lists no nodes".into()));
             }
-            let a = a.normalize();
             for &v in &s.nodes {
                 let Some(x) = self.nodes.get(v) else {
                     return Err(ModelError::UnknownNode {
@@ -916,12 +918,21 @@ impl Model {
                 if !in_triangle[v] {
                     return Err(bad(format!("node {v} belongs to no triangle")));
                 }
-                let rel = Vector3::from(*x) - Vector3::from(point);
-                let rho = (rel - a * a.dot(&rel)).norm();
-                let scale = ring.unwrap_or(s.tube_radius);
-                if rho < 1e-9 * scale {
+                let x = Vector3::from(*x);
+                if let Some((point, axis, ring)) = axis_line {
+                    let (rel, a) = (x - Vector3::from(point), Vector3::from(axis).normalize());
+                    let rho = (rel - a * a.dot(&rel)).norm();
+                    if rho < 1e-9 * ring.unwrap_or(s.tube_radius) {
+                        return Err(bad(format!(
+                            "node {v} lies on the centreline's axis: its closest point is \
+                             undefined"
+                        )));
+                    }
+                }
+                let distance = SurfaceContact::new(s, v).project(&x, 0.0).gap + s.tube_radius;
+                if distance.is_nan() || distance < 1e-9 * s.tube_radius {
                     return Err(bad(format!(
-                        "node {v} lies on the centreline's axis: its closest point is undefined"
+                        "node {v} lies on the centreline: its normal is undefined"
                     )));
                 }
             }

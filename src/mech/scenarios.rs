@@ -53,6 +53,11 @@
 //! to foot), prestressed along the arch only (none across the edge, which is free); the far
 //! edge and the foot line are the frame, lowered.
 //!
+//! **Wrapped specimen** ([`WrappedSpecimen`], issue 10): the specimen wound onto the arch from
+//! crown to foot and its boundary extended by `ε` (`FramePath::Wrapped`), one step per stage of
+//! the non-linear frame path; gaps or curved supports; optionally released back to the wound
+//! film (the extension retraced).
+//!
 //! **Circular membrane** ([`CircularMembrane`], issue 8): a flat disc meshed in rings (the
 //! centre, then `6k` nodes on ring `k`), its rim a boundary group `rim` held at zero (so the FMU
 //! reports the rim reaction), a pressure set `top` on every triangle (normals +Z). Hencky's
@@ -75,7 +80,7 @@ use super::model::{
     Model, OutputPoint, OutputSpec, PressureSet, Support, Symmetry,
 };
 use super::solver::{Analysis, SolverSettings, StepError};
-use super::specimen::ParallelArch;
+use super::specimen::{FramePath, ParallelArch, SpecimenContact};
 
 // ------------------------------------------------------------------------------- load paths
 
@@ -118,11 +123,19 @@ pub enum Family {
     Strip,
     /// [`ArchEdge`].
     ArchEdge,
+    /// [`WrappedSpecimen`].
+    Wrapped,
 }
 
 impl Family {
     /// Every family, in table order.
-    pub const ALL: [Family; 4] = [Self::Specimen, Self::Panel, Self::Strip, Self::ArchEdge];
+    pub const ALL: [Family; 5] = [
+        Self::Specimen,
+        Self::Panel,
+        Self::Strip,
+        Self::ArchEdge,
+        Self::Wrapped,
+    ];
 
     /// Short name (the benchmark's `--family` filter).
     pub fn name(self) -> &'static str {
@@ -131,6 +144,7 @@ impl Family {
             Self::Panel => "panel",
             Self::Strip => "strip",
             Self::ArchEdge => "arch-edge",
+            Self::Wrapped => "wrapped",
         }
     }
 }
@@ -543,6 +557,71 @@ impl SpecimenPath {
             name: format!(
                 "specimen H={:.2} mu={} depth={}H steps={} {shape}",
                 h, self.specimen.friction, self.depth, self.steps
+            ),
+            model,
+            path: LoadPath {
+                stages,
+                increments_per_step: self.increments_per_step,
+            },
+        })
+    }
+}
+
+// ------------------------------------------------------------------------- wrapped specimen
+
+/// The specimen wound onto the arch from crown to foot and its boundary extended
+/// ([`FramePath::Wrapped`](super::specimen::FramePath)), one communication step per stage of
+/// the frame path (the path is not linear between its stages).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WrappedSpecimen {
+    /// The specimen, its `frame_path` wrapped.
+    pub specimen: ParallelArch,
+    /// Communication steps to the end of the path.
+    pub steps: usize,
+    /// Then back to the wound film without extension in this many steps (0: no release).
+    pub release_steps: usize,
+    /// Increments per communication step.
+    pub increments_per_step: usize,
+}
+
+impl WrappedSpecimen {
+    /// The scenario (validated model, path).
+    pub fn scenario(&self) -> Result<Scenario, String> {
+        let spec = &self.specimen;
+        let FramePath::Wrapped { extension } = spec.frame_path else {
+            return Err("wrapped specimen: the frame path must be wrapped".into());
+        };
+        if self.steps == 0 {
+            return Err("wrapped specimen: steps must be ≥ 1".into());
+        }
+        let model = spec.model()?;
+        let stage = |t: f64| Stage {
+            targets: spec.boundary_targets(&model, t),
+            steps: 1,
+            friction: None,
+        };
+        let mut stages: Vec<Stage> = (1..=self.steps)
+            .map(|k| stage(k as f64 / self.steps as f64))
+            .collect();
+        // Releasing the extension retraces the second half of the path back to t = 1/2.
+        stages.extend(
+            (1..=self.release_steps)
+                .map(|k| stage(1.0 - 0.5 * k as f64 / self.release_steps as f64)),
+        );
+        Ok(Scenario {
+            family: Family::Wrapped,
+            name: format!(
+                "wrapped H={:.2} {:?} mu={} eps={} steps={}{}",
+                spec.arch_height,
+                spec.contact,
+                spec.friction,
+                extension,
+                self.steps,
+                if self.release_steps > 0 {
+                    format!(" release={}", self.release_steps)
+                } else {
+                    String::new()
+                }
             ),
             model,
             path: LoadPath {
@@ -1151,6 +1230,31 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
             };
             for steps in [20, 80] {
                 out.push(edge.lowered(0.5, steps, ips)?);
+            }
+        }
+    }
+    for h in [0.2, 0.3, 0.4] {
+        for contact in [SpecimenContact::Gaps, SpecimenContact::CurvedSupport] {
+            for mu in [0.0, 0.2, 0.8] {
+                for (extension, steps, release_steps) in
+                    [(0.02, 10, 0), (0.04, 40, 0), (0.04, 40, 10)]
+                {
+                    let specimen = ParallelArch {
+                        contact,
+                        friction: mu,
+                        frame_path: FramePath::Wrapped { extension },
+                        ..ParallelArch::with_height(h)
+                    };
+                    out.push(
+                        WrappedSpecimen {
+                            specimen,
+                            steps,
+                            release_steps,
+                            increments_per_step: ips,
+                        }
+                        .scenario()?,
+                    );
+                }
             }
         }
     }

@@ -54,6 +54,10 @@ pub struct SolverSettings {
     /// Factorize a consistent tangent that is symmetric (no slipping gap, no follower pressure)
     /// by LDLᵀ instead of LU (`linear.rs`); false: always LU.
     pub symmetric_factorization: bool,
+    /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
+    /// below [`super::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results
+    /// are bit-identical for every count.
+    pub threads: usize,
 }
 
 impl Default for SolverSettings {
@@ -66,6 +70,7 @@ impl Default for SolverSettings {
             max_cutbacks: 12,
             line_search: true,
             symmetric_factorization: true,
+            threads: 0,
         }
     }
 }
@@ -86,9 +91,18 @@ impl SolverSettings {
         if self.max_cutbacks > 60 {
             return Err("max_cutbacks must be at most 60".into());
         }
+        if self.threads > MAX_THREADS {
+            return Err(format!(
+                "threads = {} must be at most {MAX_THREADS} (0: automatic)",
+                self.threads
+            ));
+        }
         Ok(())
     }
 }
+
+/// Most assembly threads [`SolverSettings::threads`] accepts.
+pub const MAX_THREADS: usize = 256;
 
 /// Where the boundary groups are at one point of a step: translation and hinge angle of each.
 #[derive(Clone, Debug)]
@@ -476,6 +490,7 @@ pub struct Analysis {
     surfaces: SurfaceContacts,
     state: AnalysisState,
     work: Workspace,
+
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
     /// the input check.
     length_scale: f64,
@@ -508,7 +523,8 @@ impl Analysis {
         model.validate().map_err(SetupError::Model)?;
         settings.validate().map_err(SetupError::Settings)?;
         let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
-        let system = System::new(&model, lower_only)?;
+        let mut system = System::new(&model, lower_only)?;
+        system.set_threads(settings.threads);
         if system.free_count == 0 {
             return Err(SetupError::System("the model has no free DOF".into()));
         }
@@ -609,12 +625,14 @@ impl Analysis {
         &self.settings
     }
 
-    /// Changes tolerances and limits (not the iteration matrix, which fixes the pattern).
+    /// Changes tolerances, limits and threads (not the iteration matrix, which fixes the
+    /// pattern).
     pub fn set_limits(&mut self, settings: SolverSettings) -> Result<(), String> {
         settings.validate()?;
         if settings.iteration_matrix != self.settings.iteration_matrix {
             return Err("the iteration matrix is fixed when the analysis is created".into());
         }
+        self.system.set_threads(settings.threads);
         self.settings = settings;
         Ok(())
     }
@@ -989,6 +1007,8 @@ impl Analysis {
         let (mut best, mut best_correction, mut best_at) = (f64::INFINITY, f64::INFINITY, 0);
         // Levenberg–Marquardt shift of the free diagonal, relative to its mean.
         let mut damping = 0.0_f64;
+        // The watchdog of the line search: non-monotone excursions until one fails.
+        let mut watch = Watchdog::Ready;
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
             let residual = if assembled {
@@ -1116,7 +1136,7 @@ impl Analysis {
             }
             previous_u.clone_from(&u);
             let (step, with_tangent, decreased) =
-                self.line_search(&mut u, &laws, &history, levels, iteration + 1);
+                self.line_search(&mut u, &laws, &history, levels, iteration + 1, &mut watch);
             assembled = with_tangent;
             correction_norm *= step;
             // Levenberg–Marquardt: a direction that cannot lower the residual (a mechanism of an
@@ -1193,6 +1213,7 @@ impl Analysis {
         history: &[Vector2<f64>],
         levels: &LoadLevels,
         next_iteration: usize,
+        watch: &mut Watchdog,
     ) -> (f64, bool, bool) {
         let apply = |u: &mut [f64], dofs: &[Dof], delta: &[f64], scale: f64| {
             for (i, d) in dofs.iter().enumerate() {
@@ -1209,8 +1230,45 @@ impl Analysis {
         }
         let phi0 = 0.5 * self.free_norm2().powi(2);
         let consistent = self.settings.iteration_matrix == IterationMatrix::Consistent;
+        // The contact statuses at this iterate: a full step that changes one crosses into
+        // another branch of the piecewise law, where the watchdog's premise fails.
+        let statuses = |w: &Workspace| -> Vec<GapStatus> {
+            w.responses
+                .iter()
+                .map(|r| r.status)
+                .chain(w.contact_responses.iter().map(|r| r.status))
+                .collect()
+        };
+        if let Watchdog::Watching {
+            start,
+            phi,
+            left,
+            status,
+        } = watch
+        {
+            // Full Newton steps while the excursion lasts; back to its start if it fails.
+            apply(u, &self.system.dofs, &delta, 1.0);
+            self.assemble_at(u, laws, history, levels, Some(next_iteration));
+            let now = 0.5 * self.free_norm2().powi(2);
+            self.work.rhs = delta;
+            let same = *status == statuses(&self.work);
+            if same && now <= (1.0 - 2e-4) * *phi {
+                // It paid: the next full step that raises the residual may be kept again.
+                *watch = Watchdog::Ready;
+            } else if same && now.is_finite() && *left > 1 {
+                *left -= 1;
+            } else {
+                u.copy_from_slice(start);
+                self.assemble_at(u, laws, history, levels, Some(next_iteration));
+                *watch = Watchdog::Used;
+                // No correction measured: the restored iterate cannot pass for converged.
+                return (f64::INFINITY, true, true);
+            }
+            return (1.0, true, true);
+        }
         let (mut best, mut best_phi, mut applied) = (1.0, f64::INFINITY, 0.0);
         let mut scale: f64 = 1.0;
+        let before = matches!(watch, Watchdog::Ready).then(|| statuses(&self.work));
         for trial in 0..Self::LINE_SEARCH_TRIALS {
             apply(u, &self.system.dofs, &delta, scale - applied);
             applied = scale;
@@ -1221,6 +1279,26 @@ impl Analysis {
             if phi <= (1.0 - 2e-4 * scale) * phi0 {
                 self.work.rhs = delta;
                 return (scale, trial == 0, true);
+            }
+            if trial == 0
+                && consistent
+                && phi.is_finite()
+                && before.as_ref().is_some_and(|b| *b == statuses(&self.work))
+            {
+                // A full Newton step that raises the residual is often the way to a
+                // solution that backtracking crawls to (a flat film taking its first load:
+                // 18 damped iterations against 6 full ones): keep it for a few iterations and
+                // return to this point if the residual has not fallen below it by then.
+                let mut start = u.to_vec();
+                apply(&mut start, &self.system.dofs, &delta, -1.0);
+                *watch = Watchdog::Watching {
+                    start,
+                    phi: phi0,
+                    left: Self::WATCHDOG_STEPS,
+                    status: statuses(&self.work),
+                };
+                self.work.rhs = delta;
+                return (1.0, true, true);
             }
             if phi < best_phi && (scale >= Self::SMALLEST_FALLBACK || consistent) {
                 (best, best_phi) = (scale, phi);
@@ -1241,6 +1319,8 @@ impl Analysis {
 
     /// Trials of the line search before it takes the best one.
     const LINE_SEARCH_TRIALS: usize = 8;
+    /// Full Newton steps the watchdog allows beyond the one that raised the residual.
+    const WATCHDOG_STEPS: usize = 6;
     /// Smallest scale the Ju–Rowlands iteration takes when no trial decreases `φ`: a tiny step
     /// would freeze it (its direction is not Newton's, it relies on moving on). With the
     /// consistent tangent the best trial is taken whatever its size: a full step that raised the
@@ -1506,6 +1586,24 @@ impl Analysis {
     pub fn node_displacement(&self, v: usize) -> Vector3<f64> {
         node_vector(&self.state.displacement, v)
     }
+}
+
+/// The line search's watchdog (Chamberlain et al., 1982): a full Newton step that raised the
+/// residual may be kept for a few more full steps; after an excursion that failed, the rest of
+/// the increment backtracks monotonically.
+enum Watchdog {
+    /// May start an excursion (none yet in this increment, or the last one paid).
+    Ready,
+    /// Full steps since `start`, whose merit was `phi`; `left` of them remain while the
+    /// contact statuses stay `status`.
+    Watching {
+        start: Vec<f64>,
+        phi: f64,
+        left: usize,
+        status: Vec<GapStatus>,
+    },
+    /// An excursion failed: monotone backtracking for the rest of the increment.
+    Used,
 }
 
 /// `max |v|`, NaN when any value is NaN (`f64::max` alone would skip a NaN and report the

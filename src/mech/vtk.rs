@@ -19,8 +19,8 @@
 //!   model has gaps ([`Block::of`]).
 //! * **contacts** ([`Block::Contacts`]): for the curved supports, points are the deformed
 //!   contact nodes (point `k`) followed by their closest points on the support surface (point
-//!   `C + k`), one line per contact; cell data `film_node`, `contact_slip` (arc length along the
-//!   support), `contact_slip_across`, `contact_gap` (m), `contact_normal_force`,
+//!   `C + k`), one line per contact; cell data `film_node`, `contact_slip` (arc length slid along the
+//!   support in contact), `contact_travel` (along the support since the start), `contact_slip_across`, `contact_gap` (m), `contact_normal_force`,
 //!   `contact_friction_force` (N), `contact_status`. Written only when the model has curved
 //!   supports.
 //! * **cables** ([`Block::Cables`]): one line per cable segment between its deformed nodes (two
@@ -212,6 +212,7 @@ pub fn contact_grid(
                 Values::I64(nodes.iter().map(|&n| n as i64).collect()),
             ),
             ("contact_slip", 1, cell(&|k| cr[k].slip)),
+            ("contact_travel", 1, cell(&|k| cr[k].travel)),
             ("contact_slip_across", 1, cell(&|k| cr[k].slip_across)),
             ("contact_gap", 1, cell(&|k| cr[k].gap)),
             ("contact_normal_force", 1, cell(&|k| cr[k].normal_force)),

@@ -118,6 +118,30 @@ def test_line_search_parameter_reaches_the_same_state_in_fewer_iterations(membra
     assert results[False][1] < results[True][1]
 
 
+def test_thread_count_parameter_gives_the_same_bits_and_a_negative_count_is_refused_by_name(membrane_fmu):
+    """``solver.threads`` 1, 2 and 3 (the assembly's scoped threads) through fmpy: every output of
+    every step equal bit for bit; −1 fails ``fmi2ExitInitializationMode`` with a message naming
+    ``solver.threads``."""
+    from membrane_contact.film import FmuError
+
+    observed = ["rim.Rz", "film.maxEquivalentStress", "solver.iterations"]
+    runs = {}
+    for threads in (1, 2, 3):
+        with Slave(membrane_fmu) as s:
+            s.initialize(parameters={"solver.threads": threads}, inputs={"top.pressure": 0.0})
+            assert s.get("solver.threads") == threads
+            values = []
+            for k in range(STEPS):
+                s.set({"top.pressure": PRESSURE * (k + 1) / STEPS})
+                assert s.step(k / STEPS, 1 / STEPS) == OK, s.messages[-3:]
+                values.append([s.get(n) for n in observed])
+            runs[threads] = values
+    assert runs[2] == runs[1] and runs[3] == runs[1]
+    with Slave(membrane_fmu) as s:
+        with pytest.raises(FmuError, match="solver.threads = -1 must be ≥ 0"):
+            s.initialize(parameters={"solver.threads": -1})
+
+
 def test_cushion_example_inflates_through_simulate_fmu_to_the_cli_answer(tmp_path):
     """README's cushion: ``examples/inflate_cushion.py`` drives ``Cushion.fmu`` through fmpy's
     ``simulate_fmu`` to 300 Pa and ends where the CLI's run of ``examples/cushion.json`` ends
