@@ -25,6 +25,7 @@ import csv
 import json
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -37,9 +38,9 @@ FIT_POINTS = [2, 3, 4, 5]
 PROBES = (0.01, 0.03)
 
 
-def export(height_mm, contact, eps, steps, out):
-    """Model dict and staged table (dict of columns) of a wrapped specimen."""
-    table = Path(out) / f"wrap_{height_mm}_{contact}_{eps:.6f}.csv"
+def export(height_mm, contact, eps, steps, work):
+    """Model dict and staged table (dict of columns) of a wrapped specimen (files in work)."""
+    table = Path(work) / f"wrap_{height_mm}_{contact}_{eps:.6f}.csv"
     text = subprocess.run([str(archfmu.CLI), "export-specimen", "--height", str(height_mm),
                            "--contact", contact, "--wrap", repr(eps), "--path-out", str(table),
                            "--steps", str(steps)], check=True, capture_output=True, text=True).stdout
@@ -52,21 +53,21 @@ def export(height_mm, contact, eps, steps, out):
 class Specimen:
     """One packed FMU per specimen and contact model; any eps is a table for it."""
 
-    def __init__(self, height_mm, contact, steps, out):
+    def __init__(self, height_mm, contact, steps, work):
         from membrane_contact import build_fmu
 
-        self.height_mm, self.contact, self.steps, self.out = height_mm, contact, steps, out
-        model, _ = export(height_mm, contact, PROBES[-1], steps, out)
+        self.height_mm, self.contact, self.steps, self.work = height_mm, contact, steps, work
+        model, _ = export(height_mm, contact, PROBES[-1], steps, work)
         model["name"] = f"ParallelArchWrapped{height_mm}{'Curved' if contact != 'gaps' else 'Gaps'}"
         self.model = model
-        self.fmu = build_fmu(model, out_dir=Path(out) / "wrapped-fmu")
+        self.fmu = build_fmu(model, out_dir=Path(work) / "wrapped-fmu")
 
     def slips(self, eps):
         """({point: (slip mm, status)}, eps reached) at the end of the wrapped path extended by
         eps, or where the FMU stopped when a step stays refused (the state it keeps)."""
         from membrane_contact import Film, StepRefused
 
-        _, table = export(self.height_mm, self.contact, eps, self.steps, self.out)
+        _, table = export(self.height_mm, self.contact, eps, self.steps, self.work)
         with Film(self.fmu, logging=False) as film:
             film.initialize(inputs={"mu": MU})
             try:
@@ -134,7 +135,10 @@ def main(argv=None):
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     table1 = archfmu.read_table1()
-    results = {h: {c: fit(Specimen(h, c, a.steps, out), table1[h]) for c in MODELS} for h in HEIGHTS_MM}
+    # Models, tables and FMUs of the runs are intermediate: kept out of --out (docs/figures).
+    with tempfile.TemporaryDirectory(prefix="fig8-wrapped-") as work:
+        results = {h: {c: fit(Specimen(h, c, a.steps, work), table1[h]) for c in MODELS}
+                   for h in HEIGHTS_MM}
     header = ["arch_height_mm", "contact", "eps", "eps_reached", "rms_mm", "point", "slip_mm", "status",
               "experiment_mm"]
     rows = [[h, c, eps, reached, rms, p, at[p][0], at[p][1], table1[h][p]]
