@@ -1280,9 +1280,11 @@ impl Analysis {
                 self.work.rhs = delta;
                 return (scale, trial == 0, true);
             }
+            // Only with room to spare: a failed excursion must not eat the iteration limit.
             if trial == 0
                 && consistent
                 && phi.is_finite()
+                && next_iteration + 2 * Self::WATCHDOG_STEPS <= self.settings.max_iterations
                 && before.as_ref().is_some_and(|b| *b == statuses(&self.work))
             {
                 // A full Newton step that raises the residual is often the way to a
