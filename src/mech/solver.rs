@@ -501,6 +501,9 @@ pub struct Analysis {
 /// Buffers reused by every iteration.
 #[derive(Clone, Debug)]
 struct Workspace {
+    /// Whether the line search may keep full steps that raise the residual (its watchdog):
+    /// until an increment of the step has been cut back.
+    watchdog: bool,
     internal: Vec<f64>,
     values: Vec<f64>,
     rhs: Vec<f64>,
@@ -561,6 +564,7 @@ impl Analysis {
             diagonal: diagonal_slots(&system),
             contact_start: state.contacts.clone(),
             contact_responses: Vec::new(),
+            watchdog: true,
         };
         let loads = Loads::new(&model, &system);
         let cables = Cables::new(&model);
@@ -790,6 +794,9 @@ impl Analysis {
             let lu_after_cutback = self.linear.lu_affordable();
             self.linear
                 .set_fast(report.cutbacks == 0 || !lu_after_cutback);
+            // Likewise the watchdog: after a cut-back, monotone backtracking only (a failed
+            // excursion per halved increment was measured to turn a hard path into a failure).
+            self.work.watchdog = report.cutbacks == 0;
             match self.solve_increment(&current, &at(next), &levels) {
                 Ok((state, history)) => {
                     current = state;
@@ -1008,7 +1015,11 @@ impl Analysis {
         // Levenberg–Marquardt shift of the free diagonal, relative to its mean.
         let mut damping = 0.0_f64;
         // The watchdog of the line search: non-monotone excursions until one fails.
-        let mut watch = Watchdog::Ready;
+        let mut watch = if self.work.watchdog {
+            Watchdog::Ready
+        } else {
+            Watchdog::Used
+        };
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
             let residual = if assembled {
@@ -1138,6 +1149,11 @@ impl Analysis {
             let (step, with_tangent, decreased) =
                 self.line_search(&mut u, &laws, &history, levels, iteration + 1, &mut watch);
             assembled = with_tangent;
+            if step.is_infinite() {
+                // The watchdog went back to where its excursion started: the iterations spent
+                // on it are not a stall of the iteration from here.
+                best_at = iteration + 1;
+            }
             correction_norm *= step;
             // Levenberg–Marquardt: a direction that cannot lower the residual (a mechanism of an
             // unstressed film, an indefinite compressed one) gets a diagonal shift, raised until

@@ -112,13 +112,16 @@ def test_fig8_vs_experiment(tmp_path, fmu_path):
         assert a[h, "G2"][1] != "open" and a[h, "G4"][1] != "open"
     for g in ("G2", "G4"):
         assert a[200, g][0] < a[300, g][0] < a[400, g][0], f"{g} not growing with the arch"
-    # The curved-support specimens (issue 10): where the film touches the arch they agree with
-    # the gaps within 10 %; every value finite.
+    # The curved-support specimens (issue 10): their slip is the arc length slid since each node
+    # landed, so where the film touches the arch it is positive and below the gaps' local x,
+    # which counts the approach too; an open node has slid nothing; every value finite.
     assert_finite(rows, ["curved_support_mm", "curved_support_difference_mm"])
     for r in rows:
+        curved, gap = float(r["curved_support_mm"]), float(r["analysis_mm"])
         if r["gap"] in ("G2", "G4"):
-            assert float(r["curved_support_mm"]) == pytest.approx(float(r["analysis_mm"]), rel=0.1)
-            assert r["curved_support_status"] != "open"
+            assert r["curved_support_status"] != "open" and 0 < curved < gap, r
+        if r["curved_support_status"] == "open":
+            assert curved == pytest.approx(0.0, abs=1e-9), r
 
 
 def test_fig6_stress(tmp_path, fmu_path, archfmu):

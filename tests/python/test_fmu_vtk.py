@@ -205,9 +205,13 @@ def test_curved_support_contacts_are_written_as_their_own_lines(tmp_path):
     lines = next(c.data for c in mesh.cells if c.type == "line")
     assert lines.shape == (9, 2)
     slip = mesh.cell_data["contact_slip"][0]
+    travel = mesh.cell_data["contact_travel"][0]
     status = mesh.cell_data["contact_status"][0]
-    assert slip[0] == pytest.approx(0.0, abs=1e-9) and np.all(np.diff(slip) > 0)  # crown to foot
+    # Travel along the arch grows from the crown to the foot; slip (slid in contact) is at most
+    # the travel, and nothing where the film has not touched.
+    assert travel[0] == pytest.approx(0.0, abs=1e-9) and np.all(np.diff(travel) > 0)
     touching = status > 0
+    assert np.all(np.abs(slip) <= np.abs(travel) + 1e-12) and np.all(np.abs(slip[~touching]) < 1e-12)
     gap = mesh.cell_data["contact_gap"][0]
     assert np.all(gap[touching] < 0) and np.all(gap[~touching] >= 0)
     # The contact points lie on the pipe: the line lengths are the gaps.
