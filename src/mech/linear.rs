@@ -1129,16 +1129,22 @@ mod tests {
         );
     }
 
+    /// Node 3's x and y coupled as `[[0, 1], [1, 0]]` (symmetric, indefinite, zero diagonal),
+    /// the identity elsewhere, and a right-hand side whose solution there is `(3, 1)`.
+    fn indefinite_pair(system: &System) -> (Vec<f64>, Vec<f64>) {
+        let mut entries = diagonal_except(&[4, 5]);
+        entries.extend([(4, 5, 1.0), (5, 4, 1.0)]);
+        let mut rhs = vec![1.0; system.free_count];
+        rhs[5] = 3.0;
+        (values(system, &entries), rhs)
+    }
+
     #[test]
     fn symmetric_matrix_the_ldlt_cannot_pivot_is_solved_by_the_lu() {
         // Node 3's x and y: [[0, 1], [1, 0]] (symmetric, indefinite, zero diagonal).
         let system = system(false);
         let mut solver = LinearSolver::new(&system, true).unwrap();
-        let mut entries = diagonal_except(&[4, 5]);
-        entries.extend([(4, 5, 1.0), (5, 4, 1.0)]);
-        let v = values(&system, &entries);
-        let mut rhs = vec![1.0; system.free_count];
-        rhs[5] = 3.0;
+        let (v, mut rhs) = indefinite_pair(&system);
         solver
             .factorize_and_solve(system.matrix(&v), &mut rhs)
             .unwrap();
@@ -1227,11 +1233,7 @@ mod tests {
             .unwrap();
         assert!(!solver.has_lu() && solver.counts() == [0, 1, 0, 0]);
         // Node 3's x and y: [[0, 1], [1, 0]] — the unpivoted LDLᵀ fails, the LU is built.
-        let mut entries = diagonal_except(&[4, 5]);
-        entries.extend([(4, 5, 1.0), (5, 4, 1.0)]);
-        let v = values(&system, &entries);
-        let mut rhs = vec![1.0; system.free_count];
-        rhs[5] = 3.0;
+        let (v, mut rhs) = indefinite_pair(&system);
         solver
             .factorize_and_solve(system.matrix(&v), &mut rhs)
             .unwrap();
