@@ -233,11 +233,26 @@ impl SymmetricPart {
             Default::default(),
         )
         .map_err(|e| format!("{e:?}"))?;
+        Ok(Self::with_analysis(
+            Arc::new(lower),
+            Arc::new(symbolic),
+            transpose.into(),
+            structural,
+        ))
+    }
+
+    /// The part over an analysed pattern, with empty work arrays (one place lists them).
+    fn with_analysis(
+        lower: Arc<SymbolicSparseColMat<usize>>,
+        symbolic: Arc<SymbolicCholesky<usize>>,
+        transpose: Arc<[u32]>,
+        structural: bool,
+    ) -> Self {
         let mut part = Self {
-            lower: Arc::new(lower),
-            symbolic: Arc::new(symbolic),
+            lower,
+            symbolic,
             factor: Vec::new(),
-            transpose: transpose.into(),
+            transpose,
             structural,
             rhs: Vec::new(),
             symmetric_values: Vec::new(),
@@ -251,7 +266,7 @@ impl SymmetricPart {
             scratch: MemBuffer::new(StackReq::EMPTY),
         };
         part.scratch = MemBuffer::new(part.scratch_req());
-        Ok(part)
+        part
     }
 
     fn scratch_req(&self) -> StackReq {
@@ -263,23 +278,12 @@ impl SymmetricPart {
     }
 
     fn fresh_copy(&self) -> Self {
-        Self {
-            lower: self.lower.clone(),
-            symbolic: self.symbolic.clone(),
-            factor: Vec::new(),
-            transpose: self.transpose.clone(),
-            structural: self.structural,
-            rhs: Vec::new(),
-            symmetric_values: Vec::new(),
-            row_norms: Vec::new(),
-            skew: Vec::new(),
-            skew_overflow: false,
-            dofs: Vec::new(),
-            block: Vec::new(),
-            block_scratch: MemBuffer::new(StackReq::EMPTY),
-            block_columns: 0,
-            scratch: MemBuffer::new(self.scratch_req()),
-        }
+        Self::with_analysis(
+            self.lower.clone(),
+            self.symbolic.clone(),
+            self.transpose.clone(),
+            self.structural,
+        )
     }
 
     /// One pass over the lower triangle of `a`: the symmetric part, the row sums of `|A|` and
