@@ -284,7 +284,11 @@ fn edit_snapshot(s: &mut Snapshot, rng: &mut Rng) {
                 }
                 Value::Integer(_) => Value::Integer(rng.next() as i32 % 1000),
                 Value::Boolean(b) => Value::Boolean(!b),
-                Value::String(_) => Value::String("\u{1}x".into()),
+                // A control character in a path below the temporary directory: a mutated
+                // `results.directory` must never write into the working tree.
+                Value::String(_) => Value::String(
+                    std::env::temp_dir().join("membrane-contact-fuzz\u{1}x").display().to_string(),
+                ),
             };
         }
         10 => {
