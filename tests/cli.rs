@@ -239,7 +239,7 @@ fn solver_settings_of_the_fmu_are_cli_options() {
     let newton = |out: &str| {
         out.lines()
             .find(|l| l.starts_with("Newton:"))
-            .unwrap_or_default()
+            .unwrap_or_else(|| panic!("no Newton: line in {out}"))
             .to_string()
     };
     let increments = |line: &str| -> usize {

@@ -189,9 +189,17 @@ fn benchmark_sample_of_arch_edge_paths_converges() {
 fn gaps_on_arc_reproduces_the_specimens_section_4_3_gaps() {
     let spec = ParallelArch::default();
     let model = spec.model().unwrap();
-    let radius = spec.arch_radius();
+    // The arch of the assumption table (specimen.rs), not the program's `arch_radius()`: rise
+    // 0.3 m, span 1.6 m, in the plane x = 0.4; the circle through the crown (0, 0.3) and the
+    // feet (±0.8, 0) has R = (0.8² + 0.3²) / (2 · 0.3).
+    let (rise, half_span, arch_x) = (0.3, 0.8, 0.4);
+    assert_eq!(
+        (spec.arch_height, spec.arch_half_span, spec.arch_offset),
+        (rise, half_span, arch_x)
+    );
+    let radius = (half_span * half_span + rise * rise) / (2.0 * rise);
     let support = CircularSupport {
-        centre: [spec.arch_offset, 0.0, spec.arch_height - radius],
+        centre: [arch_x, 0.0, rise - radius],
         axis: [1.0, 0.0, 0.0],
         radius,
     };

@@ -4,8 +4,13 @@ Given measured outputs at the end of a load path (slips at observed points, a re
 :func:`fit` finds the unknowns a user names — the friction coefficient ``mu``, any FMU parameter
 (``film.E``, ``archHeight``, …), or a scale on a column of the load path (``scale:frame.dz``: the
 measured boundary movement known up to a factor) — by Levenberg–Marquardt on the residuals
-``model − measured``, each model evaluation a fresh run of the FMU through
+``(model − measured) / scale``, each model evaluation a fresh run of the FMU through
 :class:`membrane_contact.Film`. The Jacobian is taken by central differences of those runs.
+
+Each measurement has a scale in its own unit (its measurement uncertainty, say 0.1 mm for a
+slip read off a gauge, 1 N for a load cell), so that the misfit is dimensionless and a slip
+and a reaction can be fitted together; without scales, every measured output must have the
+same unit (the scale is then 1 in that unit), else the fit is refused naming the units.
 
 It reports the fitted values, their sensitivities (the Jacobian ``∂output/∂unknown`` at the
 fit), standard errors from the residual scatter (``s²(JᵀJ)⁻¹``, when there are more
@@ -13,6 +18,8 @@ measurements than unknowns) and the remaining misfit per measurement.
 
     python -m membrane_contact.inverse --fmu target/fmu/ParallelArch.fmu \\
         --measured table1_300.csv --unknown mu=0.2:0:1 --path path.csv --parameter archHeight=0.3
+
+The measured CSV has the columns ``output,value`` and optionally ``scale``.
 """
 
 from __future__ import annotations
@@ -24,7 +31,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from fmpy import read_model_description
+
 from .film import Film
+from .fmu import find_fmu
 
 
 @dataclass
@@ -60,26 +70,35 @@ class FitResult:
     iterations: int
     converged: bool
     history: list[tuple[list[float], float]] = field(default_factory=list)
+    #: The measurement scale of each output (its unit), dividing its residual.
+    scales: dict[str, float] = field(default_factory=dict)
 
     @property
     def misfit(self) -> dict[str, float]:
-        """``model − measured`` per measurement."""
+        """``model − measured`` per measurement, in the output's unit."""
         return {k: self.fitted[k] - v for k, v in self.measured.items()}
 
     @property
+    def scaled_misfit(self) -> dict[str, float]:
+        """``(model − measured) / scale`` per measurement: dimensionless."""
+        return {k: m / self.scales.get(k, 1.0) for k, m in self.misfit.items()}
+
+    @property
     def rms(self) -> float:
-        return float(np.sqrt(np.mean([m * m for m in self.misfit.values()])))
+        """RMS of the scaled misfit (dimensionless: in measurement scales)."""
+        return float(np.sqrt(np.mean([m * m for m in self.scaled_misfit.values()])))
 
     def report(self) -> str:
         lines = ["unknown          value      std. error"]
         for n, v, e in zip(self.names, self.values, self.standard_errors):
             lines.append(f"{n:<14} {v:>10.5g}   {e:>10.3g}")
-        lines.append("\nmeasurement            measured       fitted      misfit   " +
+        lines.append("\nmeasurement            measured       fitted      misfit       scale   " +
                      "   ".join(f"d/d{n}" for n in self.names))
         for i, (k, v) in enumerate(self.measured.items()):
             sens = "   ".join(f"{s:>10.4g}" for s in self.sensitivities[i])
-            lines.append(f"{k:<20} {v:>11.5g} {self.fitted[k]:>12.5g} {self.fitted[k] - v:>11.4g}   {sens}")
-        lines.append(f"\nRMS misfit {self.rms:.4g} after {self.iterations} iterations, "
+            lines.append(f"{k:<20} {v:>11.5g} {self.fitted[k]:>12.5g} {self.fitted[k] - v:>11.4g} "
+                         f"{self.scales.get(k, 1.0):>11.4g}   {sens}")
+        lines.append(f"\nRMS misfit {self.rms:.4g} (in measurement scales) after {self.iterations} iterations, "
                      f"{self.evaluations} FMU runs{'' if self.converged else ' (not converged)'}")
         return "\n".join(lines)
 
@@ -91,6 +110,34 @@ def read_measurements(path) -> dict[str, float]:
     if not rows or not {"output", "value"} <= set(rows[0]):
         raise ValueError(f"{path}: needs the columns output,value")
     return {r["output"].strip(): float(r["value"]) for r in rows}
+
+
+def read_scales(path) -> dict[str, float]:
+    """The optional ``scale`` column of a measured CSV (empty when it has none)."""
+    with open(path, newline="") as f:
+        rows = [r for r in csv.DictReader(line for line in f if not line.startswith("#"))]
+    return {r["output"].strip(): float(r["scale"]) for r in rows if (r.get("scale") or "").strip()}
+
+
+def measurement_scales(fmu, outputs: list[str], scales: dict[str, float] | None) -> dict[str, float]:
+    """Every output's scale: the given one (> 0), else 1 in its unit when all the outputs
+    without a scale share one unit; different units without scales are refused."""
+    scales = dict(scales or {})
+    for name, value in scales.items():
+        if name not in outputs:
+            raise KeyError(f"scale given for '{name}', which is not a measured output")
+        if not (value > 0 and np.isfinite(value)):
+            raise ValueError(f"scale of '{name}' is {value}: it must be > 0 (a measurement uncertainty)")
+    missing = [o for o in outputs if o not in scales]
+    if missing:
+        variables = {v.name: v for v in read_model_description(str(find_fmu(fmu))).modelVariables}
+        units = {o: variables[o].unit if o in variables else None for o in missing}
+        if len(set(units.values())) > 1:
+            listed = ", ".join(f"{o} ({u or 'no unit'})" for o, u in units.items())
+            raise ValueError(f"the measured outputs have different units: {listed}; give each a "
+                             "measurement scale in its unit (scales=..., or a 'scale' column)")
+        scales.update({o: 1.0 for o in missing})
+    return scales
 
 
 def read_path(path) -> dict[str, list[float]]:
@@ -123,10 +170,14 @@ def _run(fmu, path, parameters, unknowns, values, outputs):
 
 
 def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, parameters: dict | None = None,
-        max_iterations: int = 30, tolerance: float = 1e-8, relative_step: float = 1e-4) -> FitResult:
-    """Levenberg–Marquardt on ``model(unknowns) − measured`` over the outputs named in
-    ``measured`` at the end of the staged ``path`` (a table for :meth:`Film.run`)."""
+        max_iterations: int = 30, tolerance: float = 1e-8, relative_step: float = 1e-4,
+        scales: dict[str, float] | None = None) -> FitResult:
+    """Levenberg–Marquardt on ``(model(unknowns) − measured) / scale`` over the outputs named in
+    ``measured`` at the end of the staged ``path`` (a table for :meth:`Film.run`); ``scales``:
+    each output's measurement scale in its unit (see :func:`measurement_scales`)."""
     outputs = list(measured)
+    scales = measurement_scales(fmu, outputs, scales)
+    w = np.array([1.0 / scales[o] for o in outputs])
     y = np.array([measured[o] for o in outputs], dtype=float)
     x = np.array([u.start for u in unknowns], dtype=float)
     lo = np.array([u.lower for u in unknowns])
@@ -134,9 +185,12 @@ def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, pa
     evaluations = 0
 
     def model(v):
+        """The outputs divided by their scales."""
         nonlocal evaluations
         evaluations += 1
-        return _run(fmu, path, parameters, unknowns, v, outputs)
+        return w * _run(fmu, path, parameters, unknowns, v, outputs)
+
+    y = w * y
 
     def jacobian(v):
         cols = []
@@ -183,15 +237,16 @@ def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, pa
         errors = np.sqrt(np.abs(np.diag(cov)))
     except np.linalg.LinAlgError:
         errors = np.full(n, np.inf)
-    fitted = dict(zip(outputs, (f + y).tolist()))
-    return FitResult([u.name for u in unknowns], x, jac, errors, dict(measured), fitted, evaluations,
-                     iterations, converged, history)
+    fitted = dict(zip(outputs, ((f + y) / w).tolist()))
+    return FitResult([u.name for u in unknowns], x, jac / w[:, None], errors, dict(measured), fitted,
+                     evaluations, iterations, converged, history, scales)
 
 
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--fmu", required=True)
-    p.add_argument("--measured", required=True, help="CSV with columns output,value (SI units)")
+    p.add_argument("--measured", required=True,
+                   help="CSV with columns output,value (SI units) and optionally scale (the measurement scale)")
     p.add_argument("--path", required=True, help="load path CSV: time and input columns")
     p.add_argument("--unknown", action="append", required=True, help="name=start[:lower:upper], repeatable")
     p.add_argument("--parameter", action="append", default=[], help="name=value, set at initialization")
@@ -200,8 +255,12 @@ def main(argv=None) -> int:
     for text in a.parameter:
         k, _, v = text.partition("=")
         params[k] = float(v)
-    result = fit(a.fmu, read_measurements(a.measured), [Unknown.parse(u) for u in a.unknown],
-                 read_path(a.path), params)
+    try:
+        result = fit(a.fmu, read_measurements(a.measured), [Unknown.parse(u) for u in a.unknown],
+                     read_path(a.path), params, scales=read_scales(a.measured))
+    except (KeyError, ValueError) as e:
+        print(f"error: {e.args[0] if e.args else e}", file=sys.stderr)
+        return 2
     print(result.report())
     return 0 if result.converged else 1
 

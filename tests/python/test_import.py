@@ -70,6 +70,11 @@ MAPPING = EXAMPLE / "mapping.json"
 CENTRE_XZ, RADIUS = np.array([1.5, -2.25]), 2.55
 ARCH_Y = {"S": 0.6, "N": 1.4}
 TARGET_DZ, STEPS = -0.15, 5
+# Tight Newton tolerances for every run through the solver, so that the balance below is checked
+# against a bound derived from them (RESIDUAL_TOLERANCE) rather than against a fitted number.
+RESIDUAL_TOLERANCE = 1e-10
+TIGHT = {"solver.residualTolerance": RESIDUAL_TOLERANCE, "solver.displacementTolerance": RESIDUAL_TOLERANCE}
+TIGHT_CLI = ["--residual-tolerance", str(RESIDUAL_TOLERANCE), "--displacement-tolerance", str(RESIDUAL_TOLERANCE)]
 
 
 def mapping() -> dict:
@@ -511,8 +516,8 @@ def read_csv(path):
 @pytest.fixture(scope="module")
 def cli_run(model_file, tmp_path_factory):
     out = tmp_path_factory.mktemp("cli") / "gaps.csv"
-    run = subprocess.run([str(CLI), "model", str(model_file), "--steps", str(STEPS), "--csv", str(out), "--quiet"],
-                         capture_output=True, text=True)
+    run = subprocess.run([str(CLI), "model", str(model_file), "--steps", str(STEPS), "--csv", str(out), "--quiet",
+                          *TIGHT_CLI], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     return run, *read_csv(out)
 
@@ -526,17 +531,20 @@ def test_the_imported_model_runs_in_the_cli(model, cli_run):
         crown, foot_a, foot_b = final[f"{prefix}7"], final[f"{prefix}1"], final[f"{prefix}13"]
         assert crown["status"] != "Open" and float(crown["normal_force_N"]) > 100.0, "the crown gap closes"
         assert foot_a["status"] == "Open" == foot_b["status"], "the feet stay open at this target"
-        # symmetric about the crown: slips outward, equal and opposite
+        # Symmetric about the crown: slips outward, equal and opposite. Not exactly: the gmsh
+        # mesh is not a mirror image of itself about x = 1.5 (its nodes lie up to 0.11 m from
+        # the mirror images of others), and that asymmetry of the discretisation is the whole
+        # error covered here. Measured: pairs differ by 0.003 … 0.154 mm, the largest at N6/N8
+        # (1.57 vs 1.72 mm, 9 %), the relative ones below 1.2 % from the 5.7 mm slips of the
+        # fifth pair outward. The band is 5 % or 0.2 mm, whichever is larger.
         for i in range(1, 7):
             a, b = float(final[f"{prefix}{i}"]["slip_x_mm"]), float(final[f"{prefix}{14 - i}"]["slip_x_mm"])
             assert a < 0 < b and a == pytest.approx(-b, rel=0.05, abs=0.2), (prefix, i)
-    # equilibrium: the frame's reaction balances the gap forces (normal N z plus friction ≤ μN
-    # in the tangent plane): |R + Σ N z| ≤ Σ |T|
-    rx, ry, rz = map(float, re.search(r"reaction of group frame: \((\S+), (\S+), (\S+)\) N", run.stdout).groups())
-    push = sum(float(final[g["name"]]["normal_force_N"]) * frame_of(g)[2] for g in model["gaps"])
-    friction = sum(float(final[g["name"]]["friction_force_N"]) for g in model["gaps"])
+    # The frame pushes the film down onto the arches. The exact balance of the frame's reaction
+    # with the gap forces needs the friction components, which the CLI does not print: it is
+    # checked from the FMU's outputs in the next test, whose steps equal these.
+    rz = float(re.search(r"reaction of group frame: \(\S+, \S+, (\S+)\) N", run.stdout)[1])
     assert rz < -1000.0
-    assert np.linalg.norm(np.array([rx, ry, rz]) + push) <= friction + 1e-6 * abs(rz)
 
 
 @pytest.fixture(scope="module")
@@ -553,7 +561,7 @@ def test_an_fmu_of_the_imported_model_steps_like_the_cli(model, fmu, cli_run):
     names = [g["name"] for g in model["gaps"]]
     with Slave(fmu) as s:
         assert {"frame.dz", "S7.slip", "N13.normalForce", "centre.uz", "film.maxEquivalentStress"} <= set(s.variables)
-        s.initialize(parameters={"solver.incrementsPerStep": 1})
+        s.initialize(parameters={"solver.incrementsPerStep": 1, **TIGHT})
         for k in range(STEPS):
             s.ramp({"frame.dz": TARGET_DZ}, STEPS, first=k, last=k + 1)
             assert s.get("solver.iterations") > 0
@@ -562,14 +570,24 @@ def test_an_fmu_of_the_imported_model_steps_like_the_cli(model, fmu, cli_run):
                 assert s.get(f"{g}.slip") * 1e3 == pytest.approx(float(row["slip_x_mm"]), abs=2e-6), (k, g)
                 assert s.get(f"{g}.normalForce") == pytest.approx(float(row["normal_force_N"]), abs=2e-6), (k, g)
         assert s.get("centre.uz") < -0.005
-        # exact balance from the FMU's outputs: frame reaction + Σ (N z + T_x x + T_y y) = 0
+        # Exact balance from the FMU's outputs: the film is held in all three directions by the
+        # frame only and loaded by the gaps only, so frame reaction + Σ (N z + T_x x + T_y y) is
+        # the sum of the out-of-balance forces of the free nodes. Newton stops with each of
+        # them below RESIDUAL_TOLERANCE · F_ref, F_ref the largest nodal force (SolverSettings),
+        # here no larger than the largest of |R| and the gap forces, so the sum is below
+        # √3 · (free nodes) · RESIDUAL_TOLERANCE · F_ref.
         reaction = np.array(s.get("frame.Rx", "frame.Ry", "frame.Rz"))
-        total = reaction.copy()
+        total, largest = reaction.copy(), np.linalg.norm(reaction)
         for g in model["gaps"]:
             f = frame_of(g)
             n, tx, ty = s.get(f"{g['name']}.normalForce", f"{g['name']}.frictionX", f"{g['name']}.frictionY")
-            total += n * f[2] + tx * f[0] + ty * f[1]
-        assert np.linalg.norm(total) < 1e-6 * np.linalg.norm(reaction), (total, reaction)
+            force = n * f[2] + tx * f[0] + ty * f[1]
+            total += force
+            largest = max(largest, np.linalg.norm(force))
+        free = len(model["nodes"]) - len(model["groups"][0]["nodes"])
+        assert len(model["groups"]) == 1 and not model["supports"] and not model["symmetry"]
+        bound = np.sqrt(3) * free * RESIDUAL_TOLERANCE * largest
+        assert np.linalg.norm(total) <= bound, (total, bound)
         assert s.get("reactions.Rz") == pytest.approx(reaction[2], rel=1e-12)
         status = s.step(1.0, 0.2)  # one more step at the same target: nothing moves
         assert status == OK
@@ -585,7 +603,7 @@ def test_mesh_to_fmu_to_the_python_package_with_a_staged_path_and_a_rollback(mod
     _, rows, _ = cli_run
     times = [(k + 1) / STEPS for k in range(STEPS)]
     with Film(fmu) as film:
-        film.initialize(parameters={"solver.incrementsPerStep": 1})
+        film.initialize(parameters={"solver.incrementsPerStep": 1, **TIGHT})
         first = film.run({"time": times, "frame.dz": [TARGET_DZ * t for t in times]})
         for k in range(STEPS):
             row = next(r for r in rows if int(r["step"]) == k + 1 and r["gap"] == "S5")

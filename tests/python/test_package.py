@@ -25,6 +25,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pandas as pd  # a test requirement (tests/python/requirements.txt): required, never skipped
 import pytest
 from conftest import ROOT, pack
 
@@ -97,7 +98,6 @@ def test_staged_table_reaches_what_stepping_by_hand_reaches(fmu_path):
         final = film.values()
     assert final == by_hand(fmu_path, times, dz)
     # Other table shapes give the same steps.
-    pd = pytest.importorskip("pandas")
     for table in ([{"time": t, "frame.dz": z} for t, z in zip(times, dz)],
                   np.array(list(zip(times, dz)), dtype=[("time", float), ("frame.dz", float)]),
                   pd.DataFrame({"time": times, "frame.dz": dz})):
@@ -248,7 +248,6 @@ def test_plots_draw_slip_reactions_and_a_stress_map(fmu_path, tmp_path):
 
 
 def test_results_as_pandas_and_other_models(tmp_path):
-    pd = pytest.importorskip("pandas")
     fmu = pack(ROOT / "examples" / "hinged_panel.json", tmp_path)
     with Film(fmu) as film:
         results = film.run({"time": [0.5, 1.0], "rail.angle": [0.05, 0.1], "snow.pressure": [-50, -100]},

@@ -36,6 +36,7 @@ def test_wrapped_specimen_runs_through_the_fmu_as_through_the_cli(cli, tmp_path)
     assert len(columns) == 1 + 3 * 21
 
     nodes = model["curved_supports"][0]["nodes"]
+    assert len(nodes) == 9  # the checks below loop over them
     with Film(pack(model_file, tmp_path / "fmu"), logging=False) as film:
         assert {f"{g['name']}.{c}" for g in model["groups"] for c in ("dx", "dy", "dz")} <= set(film.inputs)
         film.initialize(parameters={"solver.incrementsPerStep": 1}, inputs={"mu": 0.2})
