@@ -79,7 +79,8 @@ def find_fmu(path=None, model: str | None = None) -> Path:
     raise FileNotFoundError(
         f"no {name}.fmu found: pass its path, set {FMU_VARIABLE}, or pack it with "
         f"membrane_contact.build_fmu({'model_file' if model else ''}) "
-        "(cargo run --release --bin fmu-pack [-- model.json])"
+        "(fmu-pack [model.json] installed with the wheel, or cargo run --release --bin fmu-pack "
+        "[-- model.json] in a checkout)"
     )
 
 
