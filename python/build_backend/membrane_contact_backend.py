@@ -25,6 +25,10 @@ LIBRARY = "libmembrane_contact.so"
 #: Wheel data → PREFIX/lib/membrane-contact (keep in step with INSTALLED_LIBRARY_DIR in fmu/pack.rs).
 STAGED = PYTHON / "membrane_contact.data" / "data" / "lib" / "membrane-contact"
 
+# A build from source uses the cargo on PATH; without one it stops with a message instead of
+# letting maturin download a Rust toolchain into a temporary directory.
+os.environ.setdefault("MATURIN_NO_INSTALL_RUST", "1")
+
 get_requires_for_build_wheel = maturin.get_requires_for_build_wheel
 prepare_metadata_for_build_wheel = maturin.prepare_metadata_for_build_wheel
 build_sdist = maturin.build_sdist
