@@ -10,12 +10,15 @@
 //!   the model (`membrane_contact::fmi2::description`);
 //! * `binaries/linux64/<modelIdentifier>.so`, a copy of the crate's cdylib (the newer of
 //!   `target/release/libmembrane_contact.so` and `target/release/deps/…`: `cargo run --bin
-//!   fmu-pack` refreshes only the latter);
+//!   fmu-pack` refreshes only the latter; an `fmu-pack` installed from the Python wheel in
+//!   `PREFIX/bin` ships `PREFIX/lib/membrane-contact/libmembrane_contact.so`);
 //! * `resources/parallel_arch.json` or `resources/model.json`, from which `fmi2Instantiate`
 //!   rebuilds the model, the variable table and the GUID;
 //! * `documentation/index.html`.
 //!
-//! A model file that does not validate is refused before anything is written.
+//! A model file that does not validate is refused before anything is written. The FMU goes to
+//! `--out DIR`, else to `target/fmu` when this program runs from cargo's target directory, else
+//! (an installed `fmu-pack`) to the current directory.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -35,9 +38,11 @@ Packs an FMI 2.0 Co-Simulation FMU. Without MODEL.json it packs the paper's para
 specimen (ParallelArch.fmu); with it, an FMU of that model, named after the model's `name`.
 
 options:
-  --out DIR        where to write <modelIdentifier>.fmu (default: target/fmu)
+  --out DIR        where to write <modelIdentifier>.fmu (default: target/fmu when run from
+                   cargo's target directory, else the current directory)
   --library PATH   the shared library to ship (default: the newest libmembrane_contact.so
-                   next to this program, in target/release or target/release/deps)
+                   next to this program, in target/release or target/release/deps; for an
+                   fmu-pack installed with pip, PREFIX/lib/membrane-contact/)
   -h, --help       this text";
 
 const LIBRARY: &str = "libmembrane_contact.so";
@@ -113,20 +118,38 @@ fn program_dir() -> Result<PathBuf, String> {
         .to_path_buf())
 }
 
-/// The newest `libmembrane_contact.so` next to this program.
+/// Where the wheel installs the library, relative to the directory of its programs
+/// (`PREFIX/bin` → `PREFIX/lib/membrane-contact`; python/pyproject.toml puts it there).
+const INSTALLED_LIBRARY_DIR: &str = "../lib/membrane-contact";
+
+/// The newest `libmembrane_contact.so` next to this program (cargo's `target/release` or its
+/// `deps/`), else the one installed beside it by the Python wheel.
 fn find_library(dir: &Path) -> Result<PathBuf, String> {
     let modified = |p: &Path| std::fs::metadata(p).and_then(|m| m.modified()).ok();
+    let installed = dir.join(INSTALLED_LIBRARY_DIR).join(LIBRARY);
     [dir.join(LIBRARY), dir.join("deps").join(LIBRARY)]
         .into_iter()
         .filter_map(|p| modified(&p).map(|t| (t, p)))
         .max_by_key(|(t, _): &(SystemTime, PathBuf)| *t)
         .map(|(_, p)| p)
+        .or_else(|| installed.is_file().then_some(installed))
         .ok_or_else(|| {
             format!(
-                "no {LIBRARY} in {} or its deps/: run `cargo build --release` first (or pass --library)",
-                dir.display()
+                "no {LIBRARY} in {dir}, {dir}/deps or {dir}/{INSTALLED_LIBRARY_DIR}: run `cargo build \
+                 --release` first, reinstall the wheel, or pass --library",
+                dir = dir.display()
             )
         })
+}
+
+/// The default output directory: `target/fmu` when this program runs from cargo's target
+/// directory (`target/release`, whose parent cargo marks with `CACHEDIR.TAG`), else the current
+/// directory (an installed `fmu-pack`, whose own directory is no place for FMUs).
+fn default_out_dir(dir: &Path) -> PathBuf {
+    match dir.parent() {
+        Some(target) if target.join("CACHEDIR.TAG").is_file() => target.join("fmu"),
+        _ => PathBuf::from("."),
+    }
 }
 
 fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> Result<(), String> {
@@ -177,10 +200,7 @@ fn run(o: &Options) -> Result<(), String> {
         std::fs::read(&library_path).map_err(|e| format!("{}: {e}", library_path.display()))?;
     let out_dir = match &o.out {
         Some(d) => d.clone(),
-        None => dir
-            .parent()
-            .ok_or("fmu-pack is not inside a target directory: pass --out")?
-            .join("fmu"),
+        None => default_out_dir(&dir),
     };
     std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
     let path = out_dir.join(format!("{}.fmu", description.model_identifier));

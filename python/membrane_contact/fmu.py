@@ -1,7 +1,9 @@
-"""Where FMUs come from: the repository's ``target/fmu/`` or ``fmu-pack`` run on a model file."""
+"""Where FMUs come from: the repository's ``target/fmu/`` or ``fmu-pack`` run on a model file
+(the checkout's, through cargo, or the one installed with this package from the wheel)."""
 
 from __future__ import annotations
 
+import importlib.metadata
 import json
 import os
 import subprocess
@@ -12,6 +14,17 @@ FMU_VARIABLE = "MEMBRANE_CONTACT_FMU"
 #: Environment variable naming the repository (for ``build_fmu`` and ``find_fmu``) when the
 #: package is installed outside it.
 ROOT_VARIABLE = "MEMBRANE_CONTACT_ROOT"
+
+
+def _is_repository(path: Path) -> bool:
+    return (path / "Cargo.toml").is_file() and (path / "fmu").is_dir()
+
+
+def _own_checkout() -> Path | None:
+    """The checkout this package lives in (``python/membrane_contact`` inside it), or None (the
+    package is installed)."""
+    root = Path(__file__).resolve().parents[2]
+    return root if _is_repository(root) else None
 
 
 def repository_root() -> Path | None:
@@ -25,8 +38,26 @@ def repository_root() -> Path | None:
     cwd = Path.cwd().resolve()
     candidates += [cwd, *cwd.parents]
     for c in candidates:
-        if (c / "Cargo.toml").is_file() and (c / "fmu").is_dir():
+        if _is_repository(c):
             return c
+    return None
+
+
+def installed_program(name: str) -> Path | None:
+    """The program ``name`` (``fmu-pack``, ``membrane-contact``) installed with this very package
+    from the wheel (``PREFIX/bin``, found in the distribution's file list), or None: the package
+    runs from a checkout, or was installed without the programs."""
+    try:
+        dist = importlib.metadata.distribution("membrane-contact")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    if Path(dist.locate_file("membrane_contact/fmu.py")).resolve() != Path(__file__).resolve():
+        return None  # another copy of the package (e.g. a checkout ahead of it on sys.path)
+    for f in dist.files or []:
+        if f.name == name and f.parent.name == "bin":
+            path = Path(dist.locate_file(f)).resolve()
+            if path.is_file():
+                return path
     return None
 
 
@@ -48,21 +79,46 @@ def find_fmu(path=None, model: str | None = None) -> Path:
     raise FileNotFoundError(
         f"no {name}.fmu found: pass its path, set {FMU_VARIABLE}, or pack it with "
         f"membrane_contact.build_fmu({'model_file' if model else ''}) "
-        "(cargo run --release --bin fmu-pack [-- model.json])"
+        "(fmu-pack [model.json] installed with the wheel, or cargo run --release --bin fmu-pack "
+        "[-- model.json] in a checkout)"
     )
 
 
+def fmu_pack_command(root=None) -> tuple[list[str], Path | None]:
+    """How :func:`build_fmu` runs ``fmu-pack``, and in which directory: ``cargo run --release
+    --bin fmu-pack --`` in the repository ``root`` or ``$MEMBRANE_CONTACT_ROOT``, or in the
+    checkout this package lives in (so that the FMU holds the checkout's current code); else the
+    ``fmu-pack`` installed with this package (the wheel: no Rust toolchain needed); else cargo in
+    the repository around the current directory. Raises RuntimeError when there is none."""
+    cargo = ["cargo", "run", "--quiet", "--release", "--bin", "fmu-pack", "--"]
+    if root is not None:
+        return cargo, Path(root)
+    if os.environ.get(ROOT_VARIABLE):
+        return cargo, Path(os.environ[ROOT_VARIABLE])
+    if _own_checkout() is not None:
+        return cargo, _own_checkout()
+    program = installed_program("fmu-pack")
+    if program is not None:
+        return [str(program)], None
+    found = repository_root()
+    if found is not None:
+        return cargo, found
+    raise RuntimeError("no fmu-pack: install the membrane-contact wheel (pip install membrane_contact-*.whl), "
+                       f"or set {ROOT_VARIABLE} to a checkout of the repository (packed with cargo)")
+
+
 def build_fmu(model_file=None, out_dir=None, root=None) -> Path:
-    """Packs an FMU with ``cargo run --release --bin fmu-pack`` in the repository: of
-    ``model_file`` (a model JSON file or a dict, written to ``out_dir`` first) or, without one,
-    the paper's ParallelArch specimen. Returns the path of the ``.fmu``; raises RuntimeError with
-    fmu-pack's message when the model is refused."""
-    root = Path(root) if root is not None else repository_root()
-    if root is None:
-        raise RuntimeError(f"the membrane-contact repository was not found: set {ROOT_VARIABLE}")
-    out_dir = Path(out_dir) if out_dir is not None else root / "target" / "fmu"
+    """Packs an FMU with ``fmu-pack`` (:func:`fmu_pack_command`: the checkout's through cargo, or
+    the one installed from the wheel) of ``model_file`` (a model JSON file or a dict, written to
+    ``out_dir`` first) or, without one, the paper's ParallelArch specimen, into ``out_dir``
+    (default: the repository's ``target/fmu``; the current directory for the installed
+    ``fmu-pack``). Returns the path of the ``.fmu``; raises RuntimeError with fmu-pack's message
+    when the model is refused."""
+    args, cwd = fmu_pack_command(root)
+    if out_dir is None:
+        out_dir = cwd / "target" / "fmu" if cwd is not None else Path.cwd()
+    out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    args = ["cargo", "run", "--quiet", "--release", "--bin", "fmu-pack", "--"]
     if isinstance(model_file, dict):
         path = out_dir / f"{model_file['name']}.json"
         path.write_text(json.dumps(model_file, indent=1))
@@ -73,7 +129,7 @@ def build_fmu(model_file=None, out_dir=None, root=None) -> Path:
     else:
         name = "ParallelArch"
     args += ["--out", str(out_dir.resolve())]
-    r = subprocess.run(args, cwd=root, capture_output=True, text=True)
+    r = subprocess.run(args, cwd=cwd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"fmu-pack failed: {r.stderr.strip()}")
     path = out_dir / f"{name}.fmu"

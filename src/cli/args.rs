@@ -48,7 +48,8 @@ pub enum Command {
         #[arg(short, long, value_name = "FILE")]
         output: Option<PathBuf>,
         /// The Python interpreter with the package and meshio (default: $MEMBRANE_CONTACT_PYTHON,
-        /// else the checkout's .venv/bin/python, else python3).
+        /// else the python beside this program (a venv it was pip-installed into), else the
+        /// checkout's .venv/bin/python, else python3).
         #[arg(long, value_name = "PATH")]
         python: Option<PathBuf>,
     },

@@ -630,6 +630,13 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     }
 }
 
+/// The `python` in this program's own directory: the environment's interpreter when the program
+/// was installed into it from the wheel (`PREFIX/bin/membrane-contact`), which has the package.
+fn beside_this_program() -> Option<std::path::PathBuf> {
+    let python = std::env::current_exe().ok()?.parent()?.join("python");
+    python.is_file().then_some(python)
+}
+
 /// Runs the Python mesh importer (`python -m membrane_contact.mesh`): one implementation of
 /// the import, on meshio, which reads gmsh 2.2 and 4.1 (the Rust crate mshio reads 4.1 only).
 /// The package is taken from this checkout's `python/` directory when the interpreter lacks it.
@@ -643,6 +650,7 @@ fn import(
     let python = python
         .map(std::path::PathBuf::from)
         .or_else(|| std::env::var_os("MEMBRANE_CONTACT_PYTHON").map(Into::into))
+        .or_else(beside_this_program)
         .or_else(|| {
             let venv = root.join(".venv/bin/python");
             venv.is_file().then_some(venv)
