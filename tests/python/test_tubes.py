@@ -204,11 +204,11 @@ def dense_parabola(n=20001):
     return parabola_points(n)
 
 
-def run_cli(model: dict, tmp_path, name: str, steps: int = 5) -> tuple[str, dict]:
+def run_cli(model: dict, tmp_path, name: str, steps: int = 5, extra=()) -> tuple[str, dict]:
     path = tmp_path / f"{name}.json"
     path.write_text(json.dumps(model))
     out = tmp_path / f"{name}.csv"
-    run = subprocess.run([str(CLI), "model", str(path), "--steps", str(steps), "--csv", str(out), "--quiet"],
+    run = subprocess.run([str(CLI), "model", str(path), "--steps", str(steps), "--csv", str(out), "--quiet", *extra],
                          capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     rows = list(csv.DictReader(out.open())) if out.exists() else []
@@ -226,7 +226,7 @@ def contacts(stdout: str) -> dict:
 
 def test_feet_report_no_slip_before_they_touch_unlike_gaps(tube_model, mesh_file, tmp_path):
     model, _ = tube_model
-    stdout, _ = run_cli(model, tmp_path, "tubes")
+    stdout, _ = run_cli(model, tmp_path, "tubes", extra=["--report", str(tmp_path / "tubes.md")])
     c = contacts(stdout)
     nodes = np.array(model["nodes"])
     s_nodes = model["curved_supports"][0]["nodes"]
@@ -246,7 +246,7 @@ def test_feet_report_no_slip_before_they_touch_unlike_gaps(tube_model, mesh_file
         warnings.simplefilter("ignore", MeshImportWarning)
         gap_model = import_mesh(mesh_file, gap_map)
     assert gap_model["nodes"] == model["nodes"]
-    _, final = run_cli(gap_model, tmp_path, "gaps")
+    _, final = run_cli(gap_model, tmp_path, "gaps", extra=["--report", str(tmp_path / "gaps.md")])
     by_node = {g["film_node"]: final[g["name"]] for g in gap_model["gaps"]}
     for v in feet:
         assert by_node[v]["status"] == "Open"
@@ -254,6 +254,25 @@ def test_feet_report_no_slip_before_they_touch_unlike_gaps(tube_model, mesh_file
         # which the contact reports as travel along the support, not as slip
         gap_slip, travel = float(by_node[v]["slip_x_mm"]), c[("archS", v)][1]
         assert abs(gap_slip) > 10.0 and abs(travel) > 10.0 and np.sign(gap_slip) == np.sign(travel), (v, by_node[v])
+    # the CLI's run reports show the same slips: per gap (as the CSV), per curved-support node
+    gap_rows = report_rows(tmp_path / "gaps.md", "### Gaps")
+    for g in gap_model["gaps"]:
+        row = gap_rows[g["name"]]
+        assert row[1] == str(g["film_node"]) and row[6] == final[g["name"]]["status"]
+        assert float(row[2]) == pytest.approx(float(final[g["name"]]["slip_x_mm"]), rel=1e-5, abs=1e-6)
+    contact_rows = report_rows(tmp_path / "tubes.md", "### Curved support `archS`")
+    for v in s_nodes:
+        slip, travel, _, status = c[("archS", v)]
+        row = contact_rows[str(v)]
+        assert row[6] == status and float(row[1]) == pytest.approx(slip, abs=5e-4)
+        assert float(row[2]) == pytest.approx(travel, abs=5e-4)
+
+
+def report_rows(path, heading: str) -> dict:
+    """The rows of the table under ``heading`` of a CLI run report, by their first cell."""
+    block = path.read_text().split(heading, 1)[1].split("\n#", 1)[0]
+    rows = [[c.strip() for c in ln.strip("|").split("|")] for ln in block.splitlines() if ln.startswith("|")][2:]
+    return {r[0]: r for r in rows}
 
 
 def test_a_film_node_inside_a_tube_is_refused_by_name(mesh_file):
