@@ -7,7 +7,8 @@ solver's statistics.
 
 The CLI writes the same sections from the core (``membrane-contact model … --report FILE.md``),
 with the reactions per unit length along each group (``--line-reactions``) that the FMU's
-outputs do not carry (the FMU's VTK film files do, as point data ``line_reaction``).
+outputs do not carry; the VTK film files do (point data ``line_reaction``), and
+:func:`line_reactions` reads them per group and support set.
 """
 
 from __future__ import annotations
@@ -140,6 +141,31 @@ def markdown(results, *, title: str = "run", variables: dict | None = None, mess
         rows.append([f"{s} (sum)", str(int(np.nansum(results[s][1:])))])
     out.append("## Solver\n\n" + _table(["quantity", "value"], rows, "---"))
     return "\n".join(out)
+
+
+def line_reactions(vtu_file, model: dict) -> dict[str, np.ndarray]:
+    """Reactions per unit length (N/m) along each boundary group and named support set of
+    ``model`` (the model dict or JSON file the FMU was packed from) in a film VTK file the FMU
+    (``results.directory``) or the CLI (``--vtk``) wrote: ``{name: rows}``, one row per node of
+    the group or set in the model's order, ``[node, x, y, z, qx, qy, qz]`` (reference
+    coordinates). The core computes them (point data ``line_reaction``: each node's reaction over
+    its tributary length, half its film edges along the line; ``src/mech/lines.rs``); a node on
+    two lines carries their sum. Needs meshio."""
+    import json
+
+    import meshio
+
+    if not isinstance(model, dict):
+        model = json.loads(Path(model).read_text())
+    field = meshio.read(str(vtu_file)).point_data.get("line_reaction")
+    if field is None:
+        raise KeyError(f"{vtu_file}: no point data 'line_reaction' (a film file of this version's FMU or CLI)")
+    nodes = np.asarray(model["nodes"], dtype=float)
+    owners: dict[str, list[int]] = {g["name"]: list(g["nodes"]) for g in model.get("groups", [])}
+    for s in model.get("supports", []):
+        if "name" in s and s["node"] not in owners.setdefault(s["name"], []):
+            owners[s["name"]].append(s["node"])
+    return {name: np.column_stack([np.asarray(vs, float), nodes[vs], field[vs]]) for name, vs in owners.items()}
 
 
 def _status(v) -> str:
