@@ -282,3 +282,34 @@ def test_a_film_node_inside_a_tube_is_refused_by_name(mesh_file):
         with pytest.raises(TubeError, match=r"curved support 'archS': film node \d+ at \(1.5, 0.6, 0.335\) lies "
                                             r"0.005 m inside the tube"):
             import_mesh(mesh_file, m)
+
+
+def test_mesh_with_tube_arches_to_an_fmu_and_a_python_master_that_sees_the_yield_warning(mesh_file, tmp_path):
+    """The user's flow: gmsh mesh with tube axes → curved supports → FMU → ``Film`` master; the
+    film passes a (deliberately low) yield stress and the run report shows the FMU's warning."""
+    from conftest import pack
+
+    from membrane_contact import Film
+
+    m = tube_mapping()
+    m["material"] = {**MATERIAL, "yield_stress": 1.0e6}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", MeshImportWarning)
+        model = import_mesh(mesh_file, m)
+    path = tmp_path / "tubes.json"
+    path.write_text(json.dumps(model))
+    fmu = pack(path, tmp_path)
+    nodes = np.array(model["nodes"])
+    s_nodes = model["curved_supports"][0]["nodes"]
+    foot = min(s_nodes, key=lambda v: nodes[v][0])
+    crown = min(s_nodes, key=lambda v: abs(nodes[v][0] - 1.5))
+    with Film(fmu) as film:
+        results = film.run({"time": [1.0, 2.0], "frame.dz": [-0.075, -0.15]})
+        report = film.report(results, tmp_path / "run.md").read_text()
+    # never touched: slip 0 to rounding (the FMU's 10 increments per step leave 1e-17 m)
+    assert abs(results[f"archS.node{foot}.slip"][-1]) < 1e-12 and results[f"archS.node{foot}.status"][-1] == 0
+    assert results[f"archS.node{crown}.normalForce"][-1] > 100.0
+    said = report.split("## Warnings", 1)[1].split("\n#", 1)[0]
+    assert "yield_stress" in said, said
+    row = report_rows(tmp_path / "run.md", "### Curved support `archS`")[f"node{foot}"]
+    assert abs(float(row[1])) < 1e-9 and row[-1] == "Open", row
