@@ -175,6 +175,14 @@ class Results:
         names = list(gaps) if gaps is not None else self.gap_names
         return names, np.stack([self[f"{g}.{component}"] for g in names], axis=1) if names else np.zeros((len(self), 0))
 
+    def report(self, path, *, title: str = "run", variables: dict | None = None, messages: list | None = None):
+        """Writes a Markdown run report of these results to ``path`` (``report.py``: load steps,
+        reactions, stresses, slips, warnings from ``messages``, solver statistics); returns the
+        path. :meth:`Film.report` fills in the model and the FMU's log."""
+        from .report import write
+
+        return write(self, path, title=title, variables=variables, messages=messages)
+
     def reaction(self, group: str) -> np.ndarray:
         """Reaction ``[Rx, Ry, Rz]`` (N) of a group or support set over time (NaN for a component
         it does not have)."""
@@ -378,6 +386,13 @@ class Film:
             return row
 
         return read
+
+    def report(self, results: Results, path):
+        """Writes the run report of ``results`` (from :meth:`run`) to ``path``: the model from the
+        FMU's parameters, the FMU's warnings from its log; returns the path."""
+        params = {n: self.get(n) for n in self.parameters if self.variables[n].type in ("Real", "Integer", "String")
+                  and not n.endswith((".kn", ".ks"))}
+        return results.report(path, title=self.md.modelName, variables=params, messages=self.messages)
 
     # -- stepping
 

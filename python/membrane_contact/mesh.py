@@ -4,8 +4,9 @@
 and every format meshio knows), takes its triangles as the film, renumbers the nodes compactly,
 and turns the named groups of the mesh (gmsh physical groups; ``cell_sets`` and
 ``point_sets`` of other formats) into model items through the mapping: element sets, pressure
-and force sets, supports, boundary groups, symmetry planes, output points, cables, and friction
-gaps over arches (``arches.py``). The result is a dict in the model format of
+and force sets, supports, boundary groups, symmetry planes, output points, cables, friction
+gaps over arches (``arches.py``) and curved supports, tubes around a physical curve whose
+centreline is fitted to its points (``tubes.py``). The result is a dict in the model format of
 ``docs/model-format.md``, ready for ``json.dump`` and for ``membrane-contact model`` /
 ``fmu-pack``. The mapping file format is documented in ``python/README-import.md``.
 
@@ -38,8 +39,10 @@ import numpy as np
 if __package__ in (None, ""):  # run as a script: python path/to/mesh.py
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from membrane_contact.arches import ArchError, gaps_on_curve, make_curve  # noqa: E402
+    from membrane_contact.tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes  # noqa: E402
 else:
     from .arches import ArchError, gaps_on_curve, make_curve
+    from .tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes
 
 
 class MeshImportError(ValueError):
@@ -79,6 +82,8 @@ TOP_KEYS = {"name", "description", "material", "physical_groups", "gap_defaults"
 
 GAP_KEYS = {"curve", "prefix", "offset", "max_gap", "plane_tolerance", "normal_stiffness",
             "tangential_stiffness", "friction", "friction_law"}
+#: The contact constants a curved support takes from ``gap_defaults``.
+CONTACT_KEYS = {"normal_stiffness", "tangential_stiffness", "friction", "friction_law"}
 
 # role → (required keys, optional keys)
 ROLES: dict[str, tuple[set[str], set[str]]] = {
@@ -91,6 +96,8 @@ ROLES: dict[str, tuple[set[str], set[str]]] = {
     "output_point": (set(), {"name"}),
     "cable": ({"area", "youngs_modulus"}, {"name", "prestress_force"}),
     "gaps": ({"curve"}, GAP_KEYS - {"curve"}),
+    "curved_support": ({"tube_radius", "nodes"}, {"name", "shape", "fit_tolerance", "normal_stiffness",
+                                                  "tangential_stiffness", "friction", "friction_law"}),
     "ignore": (set(), set()),
 }
 
@@ -193,6 +200,37 @@ def mesh_groups(mesh) -> dict[str, Group]:
 # ----------------------------------------------------------------------------- the importer
 
 
+def _chain(segments: list[tuple[int, int]], where: str, label) -> list[int]:
+    """The nodes of 2-node segments as one chain, from a free end that its segments leave (gmsh's
+    curve direction); a closed loop starts at the first segment's first node and lists it again
+    at the end. Branches and several chains are errors naming ``where`` (``label(node)``)."""
+    neighbours: dict[int, list[int]] = {}
+    for a, b in segments:
+        neighbours.setdefault(a, []).append(b)
+        neighbours.setdefault(b, []).append(a)
+    for v, adj in neighbours.items():
+        if len(adj) > 2:
+            _fail(f"{where}: branches at {label(v)} ({len(adj)} segments meet): "
+                  "a chain cannot branch; split it into several physical groups")
+    ends = [v for v, adj in neighbours.items() if len(adj) == 1]
+    firsts = {a for a, _ in segments}
+    start = min(ends, key=lambda v: (v not in firsts, v)) if ends else segments[0][0]
+    chain, previous = [start], None
+    while len(chain) <= len(segments):
+        options = [w for w in neighbours[chain[-1]] if w != previous]
+        if not options:
+            break
+        previous = chain[-1]
+        chain.append(options[0])
+        if chain[-1] == start:
+            break
+    visited = set(chain)
+    if len(visited) != len(neighbours):
+        _fail(f"{where}: its line elements form several separate chains "
+              f"({len(visited)} of {len(neighbours)} nodes in the first): one chain per physical group")
+    return chain
+
+
 class _Importer:
     def __init__(self, path, mapping):
         import meshio
@@ -215,6 +253,8 @@ class _Importer:
             raise MeshImportError(
                 f"mesh file {self.path}: meshio cannot read it ({reason or 'no reason given'})") from None
         self.groups = mesh_groups(self.mesh)
+        #: The centreline fit of each curved support (by item name).
+        self.fits: dict = {}
 
     # --------------------------------------------------------------- helpers
 
@@ -283,6 +323,9 @@ class _Importer:
                 required, optional = ROLES[role]
                 if role == "gaps":
                     entry = {**m.get("gap_defaults", {}), **entry}
+                    required = required | {"normal_stiffness", "tangential_stiffness", "friction"}
+                elif role == "curved_support":
+                    entry = {**{k: v for k, v in m.get("gap_defaults", {}).items() if k in CONTACT_KEYS}, **entry}
                     required = required | {"normal_stiffness", "tangential_stiffness", "friction"}
                 missing = sorted(required - set(entry))
                 if missing:
@@ -370,7 +413,7 @@ class _Importer:
         # nodes: those of the triangles and of every mapped group that names nodes
         used = [self.mesh_triangles.ravel()]
         for name, entry in self.entries:
-            if entry["role"] not in ("element_set", "pressure", "ignore"):
+            if entry["role"] not in ("element_set", "pressure", "ignore", "curved_support"):
                 used.append(self.group_nodes(self.groups[name]))
         used = np.unique(np.concatenate(used))
         self.new_index = np.full(len(mesh.points), -1, dtype=int)
@@ -405,6 +448,11 @@ class _Importer:
         return sorted(int(v) for v in self.new_index[mesh_nodes])
 
     def cable_chain(self, name: str) -> list[int]:
+        return _chain(self.line_segments(name, "cable"), self.where(name, "cable"), self.node_label)
+
+    def line_segments(self, name: str, role: str, index=None) -> list[tuple[int, int]]:
+        """The 2-node line elements of a group (``index``: node numbering, default the model's)."""
+        index = self.new_index if index is None else index
         g = self.groups[name]
         segments = []
         for i, rows in g.blocks.items():
@@ -412,37 +460,64 @@ class _Importer:
             if kind == "vertex":
                 continue
             if kind != "line":
-                _fail(f"{self.where(name, 'cable')}: holds {kind} cells; a cable is a chain of 2-node line elements")
-            segments += [tuple(int(v) for v in self.new_index[row]) for row in self.mesh.cells[i].data[rows]]
+                _fail(f"{self.where(name, role)}: holds {kind} cells; a {role} is a chain of 2-node line elements")
+            segments += [tuple(int(v) for v in index[row]) for row in self.mesh.cells[i].data[rows]]
         if not segments:
-            _fail(f"{self.where(name, 'cable')}: has no line elements (it holds {self.describe_group(g)})")
-        neighbours: dict[int, list[int]] = {}
-        for a, b in segments:
-            neighbours.setdefault(a, []).append(b)
-            neighbours.setdefault(b, []).append(a)
-        for v, adj in neighbours.items():
-            if len(adj) > 2:
-                _fail(f"{self.where(name, 'cable')}: branches at {self.node_label(v)} ({len(adj)} segments meet): "
-                      "a cable is one chain; split it into several physical groups")
-        ends = [v for v, adj in neighbours.items() if len(adj) == 1]
-        firsts = {a for a, _ in segments}
-        # an open chain starts at the end its line elements leave (gmsh's curve direction);
-        # a closed one at the first element's first node, and lists it again at the end
-        start = min(ends, key=lambda v: (v not in firsts, v)) if ends else segments[0][0]
-        chain, previous = [start], None
-        while len(chain) <= len(segments):
-            options = [w for w in neighbours[chain[-1]] if w != previous]
-            if not options:
-                break
-            previous = chain[-1]
-            chain.append(options[0])
-            if chain[-1] == start:
-                break
-        visited = set(chain)
-        if len(visited) != len(neighbours):
-            _fail(f"{self.where(name, 'cable')}: its line elements form several separate chains "
-                  f"({len(visited)} of {len(neighbours)} nodes in the first): one cable per physical group")
-        return chain
+            _fail(f"{self.where(name, role)}: has no line elements (it holds {self.describe_group(g)})")
+        return segments
+
+    def curved_support(self, name: str, entry: dict) -> dict:
+        """The ``curved_supports`` item of a ``curved_support`` role: the centreline fitted to the
+        group's line chain (a note reports the fit), and its film nodes."""
+        where = self.where(name, "curved_support")
+        role = "curved_support"
+        identity = np.arange(len(self.mesh.points))
+        points = np.asarray(self.mesh.points, dtype=float)
+        if points.shape[1] == 2:
+            points = np.column_stack([points, np.zeros(len(points))])
+        point_label = lambda v: f"mesh point {v} at ({points[v][0]:.6g}, {points[v][1]:.6g}, {points[v][2]:.6g})"  # noqa: E731
+        chain = _chain(self.line_segments(name, role, identity), where, point_label)
+        radius = _number(entry["tube_radius"], f"{where}: tube_radius", positive=True)
+        tolerance = _number(entry.get("fit_tolerance", DEFAULT_TOLERANCE_SHARE * radius), f"{where}: fit_tolerance",
+                            positive=True)
+        fit = fit_centreline(points[chain], tolerance, entry.get("shape", "auto"), name)
+        spec = entry["nodes"]
+        film = sorted(int(v) for v in np.unique(self.triangles))
+        if isinstance(spec, str):
+            if spec not in self.groups:
+                _fail(f"{where}: 'nodes' names physical group {spec!r}, which the mesh does not have")
+            pool, band = self.nodes_of(spec, role), None
+            strays = sorted(set(pool) - set(film))
+            if strays:
+                _fail(f"{where}: {self.node_label(strays[0])} of group {spec!r} belongs to no film triangle")
+        elif isinstance(spec, dict) and "band" in spec and set(spec) <= {"band", "group"}:
+            band = _number(spec["band"], f"{where}: nodes band", non_negative=True)
+            pool = film
+            if "group" in spec:
+                if spec["group"] not in self.groups:
+                    _fail(f"{where}: 'nodes' group {spec['group']!r} is not a physical group of the mesh")
+                pool = sorted(set(film) & set(self.nodes_of(spec["group"], role)))
+        else:
+            _fail(f"{where}: 'nodes' = {spec!r} must be a physical group's name or "
+                  "{\"band\": metres from the tube surface, optional \"group\": a physical group}")
+        label = _identifier(entry.get("name", name), where)
+        nodes = tube_nodes(fit.centreline, radius, self.nodes, pool, band, label, self.node_label)
+        if not nodes:
+            _fail(f"{where}: no film node lies within the band {band} m of the tube: no contact nodes")
+        item = {"name": label, "centreline": fit.centreline,
+                "tube_radius": radius, "nodes": nodes,
+                "normal_stiffness": _number(entry["normal_stiffness"], f"{where}: normal_stiffness", positive=True),
+                "tangential_stiffness": _number(entry["tangential_stiffness"], f"{where}: tangential_stiffness",
+                                                positive=True),
+                "friction": _number(entry["friction"], f"{where}: friction", non_negative=True)}
+        if "friction_law" in entry:
+            if entry["friction_law"] not in ("isotropic", "sliding-direction"):
+                _fail(f"{where}: friction_law {entry['friction_law']!r} must be \"isotropic\" or \"sliding-direction\"")
+            item["friction_law"] = entry["friction_law"]
+        self.fits[item["name"]] = fit
+        warnings.warn(f"curved support '{item['name']}' from the {len(chain)} points of physical group '{name}': "
+                      f"{fit.describe()}; {len(nodes)} film nodes", MeshImportWarning, stacklevel=3)
+        return item
 
     # --------------------------------------------------------------- assembly of the model
 
@@ -457,7 +532,7 @@ class _Importer:
         in_boundary: dict[int, str] = {}
         fixed_by: dict[tuple[int, str], str] = {}
         prescribed: list[tuple[str, list[int], list[str]]] = []
-        arch_entries = []
+        arch_entries, tube_entries = [], []
         for name, entry in self.entries:
             role = entry["role"]
             where = self.where(name, role)
@@ -531,6 +606,8 @@ class _Importer:
                 cables.append(cable)
             elif role == "gaps":
                 arch_entries.append((name, {**m.get("gap_defaults", {}), **entry}, self.nodes_of(name, role)))
+            elif role == "curved_support":
+                tube_entries.append((name, entry))
         for k, entry in enumerate(m.get("arches", [])):
             if not isinstance(entry, dict):
                 _fail(f"mapping 'arches'[{k}] must be an object")
@@ -606,9 +683,11 @@ class _Importer:
                              "support": {"point": (gap.support_point + 0.0).tolist()},
                              "frame": {"x": x, "y": y, "z": z}, "initial_gap": gap.initial_gap, **constants})
 
+        curved = [self.curved_support(name, entry) for name, entry in tube_entries]
+
         # ---------------------------------------------------------------- names unique
         seen: dict[str, str] = {}
-        named = ([(g["name"], "gap") for g in gaps] + [(g["name"], "boundary group") for g in groups]
+        named = ([(g["name"], "gap") for g in gaps] + [(c["name"], "curved support") for c in curved] + [(g["name"], "boundary group") for g in groups]
                  + [(p["name"], "pressure set") for p in pressures] + [(f["name"], "force set") for f in forces]
                  + [(p["name"], "output point") for p in points] + [(s["name"], "element set") for s in element_sets]
                  + [(c["name"], "cable") for c in cables]
@@ -647,6 +726,8 @@ class _Importer:
             model["outputs"] = {"points": points, "element_sets": element_sets}
         if cables:
             model["cables"] = cables
+        if curved:
+            model["curved_supports"] = curved
         return model
 
 
@@ -674,6 +755,9 @@ def summary(model: dict) -> str:
         lines.append(f"  symmetry plane {s['name']} (normal {s['normal']}): {len(s['nodes'])} nodes")
     for c in model.get("cables", []):
         lines.append(f"  cable {c['name']}: {len(c['nodes'])} nodes")
+    for c in model.get("curved_supports", []):
+        lines.append(f"  curved support {c['name']}: {next(iter(c['centreline']))} centreline, tube radius "
+                     f"{c['tube_radius']} m, {len(c['nodes'])} film nodes")
     for p in model.get("outputs", {}).get("points", []):
         lines.append(f"  output point {p['name']}: node {p['node']}")
     return "\n".join(lines)
@@ -693,7 +777,7 @@ def main(argv=None) -> int:
         warnings.simplefilter("always", MeshImportWarning)
         try:
             model = import_mesh(args.mesh, args.mapping)
-        except (MeshImportError, ArchError) as e:
+        except (MeshImportError, ArchError, TubeError) as e:
             print(f"error: {e}", file=sys.stderr)
             return 1
     for w in caught:

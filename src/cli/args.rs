@@ -175,6 +175,15 @@ pub struct RunArgs {
     /// Write the element results (stresses, strains, wrinkling state) of every step as CSV.
     #[arg(long, value_name = "FILE")]
     pub elements_csv: Option<PathBuf>,
+    /// Write the reactions per unit length along every boundary group and named support set
+    /// of every step as CSV (N/m: each node's reaction over its tributary length, half its film
+    /// edges along the line).
+    #[arg(long, value_name = "FILE")]
+    pub line_reactions: Option<PathBuf>,
+    /// Write a run report (Markdown): model, load steps, reactions, reactions per unit length,
+    /// extreme stresses, wrinkled areas, slips along the supports, warnings, solver statistics.
+    #[arg(long, value_name = "FILE.md")]
+    pub report: Option<PathBuf>,
     /// Write every step as VTK: DIR/<model>_film_NNNN.vtu, DIR/<model>_gaps_NNNN.vtu and a
     /// .pvd of each for ParaView (the FMU's numbering: 0000 is the initial state).
     #[arg(long, value_name = "DIR")]

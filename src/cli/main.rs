@@ -16,6 +16,7 @@ use membrane_contact::mech::{
 
 mod args;
 mod path;
+mod report;
 
 use args::{Cli, Command, RunArgs, SpecimenArgs};
 use clap::Parser;
@@ -152,6 +153,11 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         analysis.set_friction(mu)?;
     }
     let mut csv = CsvFiles::create(o)?;
+    let mut outputs = report::Outputs::create(
+        analysis.model(),
+        o.line_reactions.as_deref(),
+        o.report.as_deref(),
+    )?;
     let (mut vtk_steps, mut vtk_written) = (Vec::new(), VtkWritten::default());
     if let Some(dir) = &o.vtk {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -190,7 +196,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         enlarged += report.enlarged;
         increments += report.iterations.len();
         iterations.push(report.total_iterations());
-        let results = (csv.any() || o.vtk.is_some()).then(|| analysis.results());
+        let results =
+            (csv.any() || o.vtk.is_some() || outputs.wants_results()).then(|| analysis.results());
         if let (Some(dir), Some(results)) = (&o.vtk, &results) {
             vtk_steps.push((time, step));
             write_vtk(
@@ -204,6 +211,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         }
         if let Some(results) = &results {
             csv.write_step(step, time, analysis.model(), results)?;
+            outputs.step(step, time, inputs, &report, &analysis, results)?;
         }
         progress.step(step);
     }
@@ -217,6 +225,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         Source::File(_) => None,
     };
     report(height_mm, &analysis, &results);
+    outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
     for w in membrane_contact::mech::summary::result_warnings(analysis.model(), &results) {
         eprintln!("warning: {w}");
     }

@@ -15,6 +15,7 @@
 //! | [`linear`] | sparse LDLᵀ / LU with a reused symbolic analysis |
 //! | [`solver`] | Newton–Raphson with increments and cut-backs (eqs. 2.11–2.12, §3) |
 //! | [`summary`] | output points and field summaries over element sets |
+//! | [`lines`] | reactions per unit length along boundary groups and support sets |
 //! | [`specimen`] | the parallel-arch specimens of §4 and every assumption about them |
 //! | [`scenarios`] | load-path generators (specimen family, arch panel, cylinder strip, arch edge) |
 //! | [`vtk`] | VTK text of the deformed film and its stresses (Fig. 6) |
@@ -25,6 +26,7 @@ pub mod contact;
 pub mod element;
 pub mod finite;
 pub mod linear;
+pub mod lines;
 pub mod load;
 pub mod material;
 pub mod model;

@@ -452,6 +452,11 @@ pub struct Results {
     /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the
     /// gaps' forces on their support points are reported per gap, not here).
     pub total_reaction: [f64; 3],
+    /// Restraint force on each node (N), global axes: `f_int − f_ext` at its supported,
+    /// symmetry-fixed and prescribed components, 0 at its free ones (the nodal reactions that
+    /// [`super::lines`] spreads along groups and support sets).
+    #[serde(default)]
+    pub node_reactions: Vec<[f64; 3]>,
     /// Stress state of each triangle.
     pub elements: Vec<ElementStress>,
     /// Displacement of each output point of the model (m).
@@ -1506,12 +1511,14 @@ impl Analysis {
             .collect();
         let mut reactions = vec![[0.0; 3]; self.model.groups.len()];
         let mut total_reaction = [0.0; 3];
+        let mut node_reactions = vec![[0.0; 3]; self.model.nodes.len()];
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { group, component } = d {
                 reactions[*group][*component] += self.work.internal[i];
             }
             if !matches!(d, Dof::Free(_)) {
                 total_reaction[i % 3] += self.work.internal[i];
+                node_reactions[i / 3][i % 3] = self.work.internal[i];
             }
         }
         let moments = self.hinge_moments();
@@ -1573,6 +1580,7 @@ impl Analysis {
             surface_contacts: self.surfaces.results(u, &self.state.contacts),
             support_reactions,
             total_reaction,
+            node_reactions,
             elements,
             points,
             sets: summaries,

@@ -6,7 +6,9 @@
 //! range over von Mises stress sees triangles only):
 //!
 //! * **film** ([`Block::Film`]): points are the deformed node positions, cells the triangles
-//!   (VTK type 5). Point data `displacement`. Cell data `von_mises`, `principal_1`,
+//!   (VTK type 5). Point data `displacement`, `reaction` (N: the restraint force on a supported,
+//!   symmetry or group node) and `line_reaction` (N/m: reaction per unit length along the
+//!   boundary groups and support sets, [`super::lines`]; 0 off them). Cell data `von_mises`, `principal_1`,
 //!   `principal_2` (Pa), `stress` (σx, σy, τxy in the element frame), `strain` (Green–Lagrange
 //!   εx, εy, γxy in the element frame), `principal_strain_1`, `principal_strain_2`,
 //!   `wrinkling_state` (0 taut, 1 wrinkled, 2 slack) and `tension_direction` (unit vector along
@@ -250,11 +252,27 @@ pub fn film_grid(
             .collect(),
         offsets: (1..=tris as i64).map(|i| 3 * i).collect(),
         types: vec![5; tris],
-        point_data: vec![(
-            "displacement",
-            3,
-            Values::F64(displacement[..3 * model.nodes.len()].to_vec()),
-        )],
+        point_data: vec![
+            (
+                "displacement",
+                3,
+                Values::F64(displacement[..3 * model.nodes.len()].to_vec()),
+            ),
+            (
+                "reaction",
+                3,
+                Values::F64(
+                    (0..model.nodes.len())
+                        .flat_map(|v| results.node_reactions.get(v).copied().unwrap_or([0.0; 3]))
+                        .collect(),
+                ),
+            ),
+            (
+                "line_reaction",
+                3,
+                Values::F64(line_reaction_field(model, results)),
+            ),
+        ],
         cell_data: vec![
             ("von_mises", 1, cell(&|e| el[e].von_mises)),
             ("principal_1", 1, cell(&|e| el[e].principal[0])),
@@ -274,6 +292,20 @@ pub fn film_grid(
         cell_scalars: Some("von_mises"),
     };
     piece.encode(encoding)
+}
+
+/// Reaction per unit length of each node (N/m, three per node): its line reaction along the
+/// boundary groups and support sets it belongs to ([`super::lines`]), summed; 0 elsewhere.
+pub fn line_reaction_field(model: &Model, results: &Results) -> Vec<f64> {
+    let mut field = vec![0.0; 3 * model.nodes.len()];
+    for line in super::lines::reaction_lines(model).0 {
+        for r in line.reactions(results) {
+            for (c, q) in r.per_length.iter().enumerate() {
+                field[3 * r.node + c] += q;
+            }
+        }
+    }
+    field
 }
 
 /// The gaps `.vtu` of one state: a line per gap from its film node to its support, with the
