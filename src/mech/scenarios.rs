@@ -1349,6 +1349,7 @@ impl CircularMembrane {
                     name: "top".into(),
                     elements: ElementSelection::All(AllElements::All),
                     pressure: self.pressure,
+                    towards: None,
                 }],
                 ..LoadSpec::default()
             },
