@@ -693,9 +693,9 @@ fn flipped_triangles_in_a_pressure_set_without_towards_are_warned_naming_how_man
     one.triangles[7].swap(0, 1);
     let found = warnings(&one, None);
     assert!(
-        found.iter().any(|w| w.contains(&format!(
-            "'top': 1 of its {count} triangles are pushed"
-        ))),
+        found
+            .iter()
+            .any(|w| w.contains(&format!("'top': 1 of its {count} triangles are pushed"))),
         "{found:?}"
     );
     for (model, towards) in [
@@ -704,12 +704,18 @@ fn flipped_triangles_in_a_pressure_set_without_towards_are_warned_naming_how_man
         (&base, Some(Towards::Side(Side::MinusZ))),
     ] {
         let found = warnings(model, towards);
-        assert!(!found.iter().any(|w| w.contains("pressure set")), "{found:?}");
+        assert!(
+            !found.iter().any(|w| w.contains("pressure set")),
+            "{found:?}"
+        );
     }
     let mut model = flipped.clone();
     model.loads.pressures = vec![set(Some(Towards::Side(Side::PlusZ)))];
     let o = orientation(&model, &model.loads.pressures[0]);
-    assert_eq!((o.triangles, o.turned, o.against_neighbours), (count, count / 2, 0));
+    assert_eq!(
+        (o.triangles, o.turned, o.against_neighbours),
+        (count, count / 2, 0)
+    );
     assert!((o.mean_direction[2] - 1.0).abs() < 1e-12, "{o:?}");
 }
 
@@ -737,7 +743,9 @@ fn pressure_towards_is_read_checked_and_written() {
     }
     let error = Model::from_json(&text("\"up\"")).unwrap_err().to_string();
     assert!(error.contains("Towards"), "{error}");
-    let error = Model::from_json(&text("[0, 0, 0]")).unwrap_err().to_string();
+    let error = Model::from_json(&text("[0, 0, 0]"))
+        .unwrap_err()
+        .to_string();
     assert!(
         error.contains("pressure set 'top': towards [0.0, 0.0, 0.0] must be a finite, non-zero"),
         "{error}"

@@ -553,7 +553,7 @@ def test_an_fmu_of_the_imported_model_steps_like_the_cli(model, fmu, cli_run):
     names = [g["name"] for g in model["gaps"]]
     with Slave(fmu) as s:
         assert {"frame.dz", "S7.slip", "N13.normalForce", "centre.uz", "film.maxEquivalentStress"} <= set(s.variables)
-        s.initialize(parameters={"solver.incrementsPerStep": 1})
+        s.initialize()
         for k in range(STEPS):
             s.ramp({"frame.dz": TARGET_DZ}, STEPS, first=k, last=k + 1)
             assert s.get("solver.iterations") > 0
@@ -585,7 +585,7 @@ def test_mesh_to_fmu_to_the_python_package_with_a_staged_path_and_a_rollback(mod
     _, rows, _ = cli_run
     times = [(k + 1) / STEPS for k in range(STEPS)]
     with Film(fmu) as film:
-        film.initialize(parameters={"solver.incrementsPerStep": 1})
+        film.initialize()
         first = film.run({"time": times, "frame.dz": [TARGET_DZ * t for t in times]})
         for k in range(STEPS):
             row = next(r for r in rows if int(r["step"]) == k + 1 and r["gap"] == "S5")
