@@ -359,7 +359,11 @@ def test_a_closed_line_loop_becomes_a_closed_cable(tmp_path):
     assert len(chain) == 17 and chain[0] == chain[-1] and len(set(chain)) == 16
     path = tmp_path / "loop.json"
     path.write_text(json.dumps(model))
-    run = subprocess.run([str(CLI), "model", str(path), "--steps", "2", "--quiet"], capture_output=True, text=True)
+    # One increment per step: with the default ten (the FMU's, issue 17) the first step stalls on
+    # this slack square (corrections along a direction with almost no stiffness), whatever the
+    # number of steps (2, 4, 10 measured); one increment gets through with 6 cut-backs.
+    run = subprocess.run([str(CLI), "model", str(path), "--steps", "2", "--increments", "1", "--quiet"],
+                         capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
 
 
