@@ -741,8 +741,16 @@ fn pressure_towards_is_read_checked_and_written() {
         assert_eq!(model.loads.pressures[0].towards, Some(expect));
         assert_eq!(Model::from_json(&model.to_json()).unwrap(), model);
     }
-    let error = Model::from_json(&text("\"up\"")).unwrap_err().to_string();
-    assert!(error.contains("Towards"), "{error}");
+    for bad in ["\"up\"", "[0, 1]", "3"] {
+        let error = Model::from_json(&text(bad)).unwrap_err().to_string();
+        assert!(
+            error.contains(&format!(
+                "towards {} is neither a direction [x, y, z] nor one of \"+x\"",
+                bad.replace(' ', "")
+            )),
+            "{error}"
+        );
+    }
     let error = Model::from_json(&text("[0, 0, 0]"))
         .unwrap_err()
         .to_string();

@@ -233,7 +233,7 @@ pub struct PressureSet {
 /// The world direction a pressure set pushes the film to (`"towards"`): a vector or a signed
 /// global axis.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(untagged)]
+#[serde(try_from = "serde_json::Value", into = "serde_json::Value")]
 pub enum Towards {
     /// A direction `[x, y, z]` (any length, not zero).
     Direction([f64; 3]),
@@ -262,6 +262,31 @@ pub enum Side {
     /// −Z.
     #[serde(rename = "-z")]
     MinusZ,
+}
+
+impl TryFrom<serde_json::Value> for Towards {
+    type Error = String;
+
+    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+        serde_json::from_value(value.clone())
+            .map(Self::Direction)
+            .or_else(|_| serde_json::from_value(value.clone()).map(Self::Side))
+            .map_err(|_| {
+                format!(
+                    "towards {value} is neither a direction [x, y, z] nor one of \"+x\", \"-x\", \
+                     \"+y\", \"-y\", \"+z\", \"-z\""
+                )
+            })
+    }
+}
+
+impl From<Towards> for serde_json::Value {
+    fn from(towards: Towards) -> Self {
+        match towards {
+            Towards::Direction(d) => serde_json::json!(d),
+            Towards::Side(side) => serde_json::json!(side),
+        }
+    }
 }
 
 impl Towards {
