@@ -101,6 +101,12 @@ def test_modulus_in_mpa_warns_at_packing_at_initialization_and_in_the_importer(t
         with pytest.warns(SolverWarning, match=expected):
             results = film.run({"time": [0.0]}, quiet=True)
     assert any(expected in w for w in results.warnings)
+    # Initialized by the master before the run: warned then, and in the run's results.
+    with Film(path) as film:
+        with pytest.warns(SolverWarning, match=expected):
+            film.initialize()
+        results = film.run({"time": [0.0]}, quiet=True)
+    assert any(expected in w for w in results.warnings)
 
     from membrane_contact.mesh import MeshImportWarning, import_mesh
 
