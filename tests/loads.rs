@@ -740,6 +740,17 @@ fn pressure_towards_is_read_checked_and_written() {
         let model = Model::from_json(&text(given)).unwrap();
         assert_eq!(model.loads.pressures[0].towards, Some(expect));
         assert_eq!(Model::from_json(&model.to_json()).unwrap(), model);
+        // The FMU's input says which way it pushes.
+        let description = membrane_contact::fmi2::description::describe(
+            &membrane_contact::fmi2::resources::Source::Model(model),
+        )
+        .unwrap();
+        let input = description
+            .variables
+            .iter()
+            .find(|v| v.name == "top.pressure");
+        let towards = format!("positive pushes towards {:?}", expect.vector());
+        assert!(input.unwrap().description.contains(&towards), "{input:?}");
     }
     for bad in ["\"up\"", "[0, 1]", "3"] {
         let error = Model::from_json(&text(bad)).unwrap_err().to_string();

@@ -535,8 +535,12 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             p.pressure,
             "Pa",
             &format!(
-                "follower pressure on pressure set '{}' (positive along the triangles' normals), reached at the end of a step",
-                p.name
+                "follower pressure on pressure set '{}' (positive {}), reached at the end of a step",
+                p.name,
+                match p.towards {
+                    None => "along the triangles' normals".to_string(),
+                    Some(t) => format!("pushes towards {:?}", t.vector()),
+                }
             ),
             Binding::Pressure(set),
         );
