@@ -8,7 +8,7 @@ support on the arch, cell data ``gap_status``).
 Where the .vtu files come from (--source): the FMU, through its String parameter
 ``results.directory`` (it writes <dir>/ParallelArch_film_NNNN.vtu and ..._gaps_NNNN.vtu after
 every step; the default when the FMU has it), or the core's CLI (``membrane-contact specimen
---vtk DIR``, the same solver without FMI, one increment per step); or a film file given with
+--vtk DIR``, the same solver without FMI, the same increments per step); or a film file given with
 --vtu (its ``_gaps_`` sibling is read if there). The 1/4 model is mirrored about its two symmetry planes (x = 0 between the arches,
 y = 0 through the crowns) to show the whole specimen.
 

@@ -16,9 +16,10 @@
 //!   rebuilds the model, the variable table and the GUID;
 //! * `documentation/index.html`.
 //!
-//! A model file that does not validate is refused before anything is written. The FMU goes to
-//! `--out DIR`, else to `target/fmu` when this program runs from cargo's target directory, else
-//! (an installed `fmu-pack`) to the current directory.
+//! A model file that does not validate is refused before anything is written; one that looks
+//! wrong (`mech::summary::model_warnings`: E in MPa, …) is packed with the warnings on stderr.
+//! The FMU goes to `--out DIR`, else to `target/fmu` when this program runs from cargo's target
+//! directory, else (an installed `fmu-pack`) to the current directory.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -191,6 +192,13 @@ fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> R
 
 fn run(o: &Options) -> Result<(), String> {
     let (source, description) = source(o)?;
+    // What looks wrong in a model that validates (E in MPa, flipped pressure triangles, …): the
+    // CLI's and the FMU's check, printed as the CLI prints it; the FMU is still packed.
+    if let Source::Model(model) = &source {
+        for w in membrane_contact::mech::summary::model_warnings(model) {
+            eprintln!("warning: {w}");
+        }
+    }
     let dir = program_dir()?;
     let library_path = match &o.library {
         Some(p) => p.clone(),

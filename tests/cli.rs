@@ -222,7 +222,7 @@ fn pressurised_disc_held_at_its_rim_is_factored_by_one_ldlt_per_newton_iteration
                 .filter_map(|w| w.parse().ok())
                 .collect()
         };
-        // "Newton: 4 steps, 4 increments, 0 cut-backs, 0 enlarged, N iterations (…"
+        // "Newton: 4 steps, 40 increments, 0 cut-backs, 0 enlarged, N iterations (…"
         let iterations = numbers("Newton:")[4];
         let [lu, ldlt, gmres, redone] = numbers("linear solves:")[..] else {
             panic!("{out}")
@@ -252,7 +252,7 @@ fn solver_settings_of_the_fmu_are_cli_options() {
     assert!(ok, "{err}");
     let (ok, four, err) = specimen(&[
         "--increments",
-        "4",
+        "20",
         "--max-cutbacks",
         "6",
         "--displacement-tolerance",
@@ -315,6 +315,13 @@ fn results_text(out: &str) -> String {
         .join("\n")
 }
 
+/// Writes `text` to `dir/name` and returns the path.
+fn write_file(dir: &std::path::Path, name: &str, text: &str) -> String {
+    let file = dir.join(name);
+    std::fs::write(&file, text).unwrap();
+    file.to_str().unwrap().to_string()
+}
+
 const HINGED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hinged_panel.json");
 
 /// TEST GOAL (issue 9 item 4): a staged table of FMU inputs drives the CLI: the table of the
@@ -326,11 +333,7 @@ const HINGED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/hinged_panel
 fn staged_table_of_fmu_inputs_drives_the_steps() {
     let dir = std::env::temp_dir().join(format!("membrane-contact-path-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let table = |name: &str, text: &str| {
-        let file = dir.join(name);
-        std::fs::write(&file, text).unwrap();
-        file.to_str().unwrap().to_string()
-    };
+    let table = |name: &str, text: &str| write_file(&dir, name, text);
     let ramp = table(
         "ramp.csv",
         "time, rail.angle, snow.pressure\n0.25, 0.025, -25\n0.5, 0.05, -50\n0.75, 0.075, -75\n1.0, 0.1, -100\n",
@@ -417,7 +420,7 @@ fn element_results_are_written_as_csv() {
 fn help_lists_every_command_and_the_solver_options() {
     let (ok, out, _) = cli(&["--help"]);
     assert!(ok);
-    for command in ["specimen", "model", "export-specimen"] {
+    for command in ["specimen", "model", "check", "export-specimen"] {
         assert!(out.contains(command), "{out}");
     }
     let (ok, out, _) = cli(&["model", "--help"]);
@@ -472,4 +475,125 @@ fn wrapped_specimen_runs_from_the_command_line_and_bad_wraps_are_refused() {
     );
     let (ok, _, err) = cli(&["specimen", "--wrap", "0.02", "--target-dz-per-height", "-1"]);
     assert!(!ok && err.contains("--wrap"), "{err}");
+}
+
+/// TEST GOAL (issue 17, item 8): the CLI and the FMU take the same default increments per step
+/// (one constant of the core): a specimen run of 2 steps without cut-backs takes
+/// 2 · `solver.incrementsPerStep`'s start value increments.
+#[test]
+fn cli_takes_the_fmus_default_increments_per_step() {
+    use membrane_contact::fmi2::description::describe;
+    use membrane_contact::fmi2::resources::Source;
+    use membrane_contact::mech::ParallelArch;
+    let description = describe(&Source::ParallelArch(ParallelArch::default())).unwrap();
+    let start = description
+        .variables
+        .iter()
+        .find(|v| v.name == "solver.incrementsPerStep")
+        .map(|v| format!("{:?}", v.start))
+        .unwrap();
+    let (ok, out, err) = specimen(&[]);
+    assert!(ok, "{err}");
+    let newton = out.lines().find(|l| l.starts_with("Newton:")).unwrap();
+    let per_step = membrane_contact::mech::solver::DEFAULT_INCREMENTS_PER_STEP;
+    assert!(
+        start.contains(&format!("Integer({per_step})")),
+        "FMU start value {start}"
+    );
+    assert!(
+        newton.starts_with(&format!(
+            "Newton: 2 steps, {} increments, 0 cut-backs",
+            2 * per_step
+        )),
+        "{newton}"
+    );
+}
+
+/// TEST GOAL (issue 17, item 8): a run whose step fails prints, before the error, the summary
+/// of the last converged state on stdout (gaps, reactions, stresses): the same text a run that
+/// stops there prints. Here a staged table jumps in its third row further than one increment of
+/// at most 10 iterations reaches.
+#[test]
+fn failed_run_prints_the_summary_of_its_last_converged_state() {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-fail-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let table = |name: &str, text: &str| write_file(&dir, name, text);
+    let jump = table("jump.csv", "time,frame.dz\n1,-0.005\n2,-0.01\n3,-0.1\n");
+    let reached = table("reached.csv", "time,frame.dz\n1,-0.005\n2,-0.01\n");
+    let run = |path: &str| {
+        cli(&[
+            "specimen",
+            "--height",
+            "200",
+            "--quiet",
+            "--path",
+            path,
+            "--increments",
+            "1",
+            "--max-cutbacks",
+            "0",
+            "--max-iterations",
+            "10",
+        ])
+    };
+    let (ok, failed, err) = run(&jump);
+    assert!(!ok && err.contains("error: step 3/3:"), "{err}");
+    let (ok, stopped, err) = run(&reached);
+    assert!(ok, "{err}");
+    let (head, summary) = failed.split_once('\n').unwrap();
+    assert_eq!(
+        head,
+        "step 3/3 failed; the last converged state (step 2, time 2):"
+    );
+    let expected: String = stopped
+        .split_inclusive('\n')
+        .take_while(|l| !l.starts_with("Newton:"))
+        .collect();
+    assert!(expected.contains("reaction of group frame") && expected.contains("Slip"));
+    assert_eq!(summary.trim_end(), expected.trim_end());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 17, items 5 and 6): `check` validates a model without running it, prints
+/// the model warnings on stderr as a run does (E in MPa) and each pressure set's orientation on
+/// stdout; an invalid model is refused naming the item.
+#[test]
+fn check_prints_the_warnings_and_the_orientation_of_each_pressure_set() {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-check-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/circular_membrane.json"
+    );
+    let mut model =
+        membrane_contact::mech::Model::from_json(&std::fs::read_to_string(example).unwrap())
+            .unwrap();
+    let (ok, out, err) = cli(&["check", example]);
+    assert!(ok && err.is_empty(), "{err}");
+    assert!(out.contains("CircularMembrane: valid"), "{out}");
+    assert!(
+        out.contains("pressure set 'top': 96 triangles, a positive pressure pushes along each triangle's node-order normal; mean pushed normal [0.000, 0.000, 1.000]; 0 triangles pushed against their neighbours"),
+        "{out}"
+    );
+    model.material.youngs_modulus = 800.0;
+    model.triangles[3].swap(1, 2);
+    let file = dir.join("mpa.json");
+    std::fs::write(&file, model.to_json()).unwrap();
+    let (ok, out, err) = cli(&["check", file.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: material youngs_modulus = 800 Pa looks like a value in MPa"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: pressure set 'top': 1 of its 96 triangles"),
+        "{err}"
+    );
+    assert!(
+        out.contains("1 triangles pushed against their neighbours"),
+        "{out}"
+    );
+    let (ok, _, err) = cli(&["check", "/nonexistent/model.json"]);
+    assert!(!ok && err.contains("/nonexistent/model.json"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

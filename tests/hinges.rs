@@ -322,6 +322,7 @@ fn hinged_panel() -> Model {
         name: "snow".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: -100.0,
+        towards: None,
     });
     m.outputs.points.push(OutputPoint {
         name: "mid".into(),

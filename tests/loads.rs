@@ -8,12 +8,13 @@
 use membrane_contact::mech::assembly::{Dof, System};
 use membrane_contact::mech::element::{ElementVector, Material};
 use membrane_contact::mech::load::{
-    ExternalLoad, LoadLevels, Loads, pressure_force, pressure_stiffness,
+    ExternalLoad, LoadLevels, Loads, orientation, pressure_force, pressure_signs,
+    pressure_stiffness,
 };
 use membrane_contact::mech::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
 use membrane_contact::mech::model::{
     AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, ForceSet, LoadSpec, Model,
-    OutputPoint, OutputSpec, PressureSet, Support,
+    OutputPoint, OutputSpec, PressureSet, Side, Support, Towards,
 };
 use membrane_contact::mech::scenarios::CircularMembrane;
 use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings, StepError};
@@ -74,6 +75,7 @@ fn pressure_everywhere(name: &str, p: f64) -> PressureSet {
         name: name.into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: p,
+        towards: None,
     }
 }
 
@@ -159,14 +161,30 @@ fn residual(
 #[test]
 fn assembled_tangent_with_pressure_matches_central_differences_of_the_assembled_residual() {
     let mut model = patch(3, 2, 1.5, 1.0);
+    // Triangles 1 and 4 wound the other way (normal −Z): the set "oriented" pushes every one of
+    // its triangles down, so its pressure is turned on 2 and 5 and not on 1 and 4.
+    for e in [1, 4] {
+        model.triangles[e].swap(1, 2);
+    }
     model.loads.pressures = vec![
         pressure_everywhere("all", 700.0),
         PressureSet {
             name: "part".into(),
             elements: ElementSelection::List(vec![0, 3, 4]),
             pressure: -300.0,
+            towards: None,
+        },
+        PressureSet {
+            name: "oriented".into(),
+            elements: ElementSelection::List(vec![1, 2, 4, 5]),
+            pressure: 450.0,
+            towards: Some(Towards::Side(Side::MinusZ)),
         },
     ];
+    assert_eq!(
+        pressure_signs(&model, &model.loads.pressures[2]),
+        [(1, 1.0), (2, -1.0), (4, 1.0), (5, -1.0)]
+    );
     model.material.density = 1750.0;
     model.loads.forces = vec![ForceSet {
         name: "tip".into(),
@@ -440,6 +458,12 @@ fn disc(a: f64, rings: usize, material: Material) -> Model {
 fn inflate(model: &Model, q: f64, path: &[f64]) -> (f64, f64) {
     let mut model = model.clone();
     model.loads.pressures = vec![pressure_everywhere("top", q)];
+    inflate_as_given(&model, path)
+}
+
+/// [`inflate`] with the model's own pressure sets.
+fn inflate_as_given(model: &Model, path: &[f64]) -> (f64, f64) {
+    let model = model.clone();
     // Plain Newton: its first correction from a flat film stretches it in-plane, which raises
     // ‖R‖ before the next iterations converge quadratically (5–8 per step); the backtracking
     // line search rejects that step and crawls (residual −10 % per iteration, 260 s here).
@@ -590,6 +614,168 @@ fn ju_rowlands_matrix_with_the_symmetric_part_reaches_the_same_inflated_state() 
     );
 }
 
+/// A disc whose every other triangle is wound the other way (node order 0, 2, 1): half its
+/// node-order normals point down.
+fn half_flipped(model: &Model) -> Model {
+    let mut model = model.clone();
+    for t in model.triangles.iter_mut().step_by(2) {
+        t.swap(1, 2);
+    }
+    model
+}
+
+/// With `towards` the pressure pushes every triangle to the named side, so a disc inflates the
+/// same whatever its triangles' winding: half of them flipped gives the deflection of the
+/// consistently wound disc (to round-off), `"towards": [0, 0, 1]` and `"+z"` alike; without
+/// `towards` the flipped half pushes down and the disc barely moves.
+#[test]
+fn oriented_pressure_deflects_a_disc_the_same_whatever_the_triangles_winding() {
+    let base = disc(1.0, 4, film(1e6));
+    let path = [0.25, 0.5, 0.75, 1.0];
+    let with = |model: &Model, towards: Option<Towards>| {
+        let mut model = model.clone();
+        model.loads.pressures = vec![PressureSet {
+            towards,
+            ..pressure_everywhere("top", 300.0)
+        }];
+        model.validate().unwrap();
+        inflate_as_given(&model, &path).0
+    };
+    let reference = with(&base, None);
+    assert!(reference > 1e-3, "the disc bulges up: {reference}");
+    let flipped = half_flipped(&base);
+    for towards in [
+        Towards::Direction([0.0, 0.0, 1.0]),
+        Towards::Side(Side::PlusZ),
+    ] {
+        for model in [&base, &flipped] {
+            let w = with(model, Some(towards));
+            assert!(
+                (w - reference).abs() <= 1e-9 * reference,
+                "{towards:?}: {w} vs {reference}"
+            );
+        }
+    }
+    // Pushing down: the mirror image.
+    let down = with(&flipped, Some(Towards::Direction([0.0, 0.1, -2.0])));
+    assert!((down + reference).abs() <= 1e-9 * reference, "{down}");
+    let unoriented = with(&flipped, None);
+    assert!(unoriented.abs() < 0.2 * reference, "{unoriented}");
+}
+
+/// A pressure set with flipped triangles and no `towards` is warned about, naming how many of
+/// its triangles push against their neighbours; with `towards` (which turns them) and on the
+/// consistently wound disc there is no such warning. `orientation` reports the turned count.
+#[test]
+fn flipped_triangles_in_a_pressure_set_without_towards_are_warned_naming_how_many() {
+    use membrane_contact::mech::summary::model_warnings;
+    let base = disc(1.0, 4, film(1e6));
+    let flipped = half_flipped(&base);
+    let count = base.triangles.len();
+    let set = |towards| PressureSet {
+        towards,
+        ..pressure_everywhere("top", 300.0)
+    };
+    let warnings = |model: &Model, towards| {
+        let mut model = model.clone();
+        model.loads.pressures = vec![set(towards)];
+        model.validate().unwrap();
+        model_warnings(&model)
+    };
+    let expected = format!(
+        "pressure set 'top': {} of its {count} triangles are pushed to the other side than their neighbours",
+        count / 2
+    );
+    let found = warnings(&flipped, None);
+    assert!(found.iter().any(|w| w.starts_with(&expected)), "{found:?}");
+    // One flipped triangle is the minority of one.
+    let mut one = base.clone();
+    one.triangles[7].swap(0, 1);
+    let found = warnings(&one, None);
+    assert!(
+        found
+            .iter()
+            .any(|w| w.contains(&format!("'top': 1 of its {count} triangles are pushed"))),
+        "{found:?}"
+    );
+    for (model, towards) in [
+        (&flipped, Some(Towards::Side(Side::PlusZ))),
+        (&base, None),
+        (&base, Some(Towards::Side(Side::MinusZ))),
+    ] {
+        let found = warnings(model, towards);
+        assert!(
+            !found.iter().any(|w| w.contains("pressure set")),
+            "{found:?}"
+        );
+    }
+    let mut model = flipped.clone();
+    model.loads.pressures = vec![set(Some(Towards::Side(Side::PlusZ)))];
+    let o = orientation(&model, &model.loads.pressures[0]);
+    assert_eq!(
+        (o.triangles, o.turned, o.against_neighbours),
+        (count, count / 2, 0)
+    );
+    assert!((o.mean_direction[2] - 1.0).abs() < 1e-12, "{o:?}");
+}
+
+/// `towards` is read as a vector or a signed axis and written back; an unknown side, a zero
+/// direction and a triangle edge-on to the direction are refused naming the set.
+#[test]
+fn pressure_towards_is_read_checked_and_written() {
+    let text = |towards: &str| {
+        format!(
+            r#"{{"name": "P", "nodes": [[0,0,0],[1,0,0],[0,1,0]], "triangles": [[0,1,2]],
+            "material": {{"youngs_modulus": 1e9, "poisson_ratio": 0.43, "thickness": 2e-4}},
+            "supports": [{{"node": 0, "fixed": ["x","y","z"]}}, {{"node": 1, "fixed": ["x","y","z"]}},
+                         {{"node": 2, "fixed": ["x","y","z"]}}],
+            "loads": {{"pressures": [{{"name": "top", "elements": "all", "pressure": 1,
+                                       "towards": {towards}}}]}}}}"#
+        )
+    };
+    for (given, expect) in [
+        ("\"-z\"", Towards::Side(Side::MinusZ)),
+        ("[0, 0.5, 2]", Towards::Direction([0.0, 0.5, 2.0])),
+    ] {
+        let model = Model::from_json(&text(given)).unwrap();
+        assert_eq!(model.loads.pressures[0].towards, Some(expect));
+        assert_eq!(Model::from_json(&model.to_json()).unwrap(), model);
+        // The FMU's input says which way it pushes.
+        let description = membrane_contact::fmi2::description::describe(
+            &membrane_contact::fmi2::resources::Source::Model(model),
+        )
+        .unwrap();
+        let input = description
+            .variables
+            .iter()
+            .find(|v| v.name == "top.pressure");
+        let towards = format!("positive pushes towards {:?}", expect.vector());
+        assert!(input.unwrap().description.contains(&towards), "{input:?}");
+    }
+    for bad in ["\"up\"", "[0, 1]", "3"] {
+        let error = Model::from_json(&text(bad)).unwrap_err().to_string();
+        assert!(
+            error.contains(&format!(
+                "towards {} is neither a direction [x, y, z] nor one of \"+x\"",
+                bad.replace(' ', "")
+            )),
+            "{error}"
+        );
+    }
+    let error = Model::from_json(&text("[0, 0, 0]"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("pressure set 'top': towards [0.0, 0.0, 0.0] must be a finite, non-zero"),
+        "{error}"
+    );
+    let error = Model::from_json(&text("\"+x\"")).unwrap_err().to_string();
+    assert!(
+        error.contains("pressure set 'top': triangle 0 is edge-on to towards"),
+        "{error}"
+    );
+}
+
 #[test]
 fn load_sets_are_validated_naming_the_bad_item() {
     let base = patch(1, 1, 1.0, 1.0);
@@ -601,6 +787,7 @@ fn load_sets_are_validated_naming_the_bad_item() {
                     name: "top".into(),
                     elements: ElementSelection::List(vec![0, 5]),
                     pressure: 1.0,
+                    towards: None,
                 }]
             }),
             "pressure set 'top': triangle 5 does not exist",
@@ -611,6 +798,7 @@ fn load_sets_are_validated_naming_the_bad_item() {
                     name: "top".into(),
                     elements: ElementSelection::List(vec![]),
                     pressure: 1.0,
+                    towards: None,
                 }]
             }),
             "pressure set 'top': has no elements",

@@ -2043,6 +2043,7 @@ fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
         name: "wind".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: 300.0,
+        towards: None,
     });
     let levels = LoadLevels::of_model(&model);
     let u: Vec<f64> = (0..model.dof_count())

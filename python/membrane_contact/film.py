@@ -14,12 +14,19 @@
   and why (the FMU's last messages), the film at its last converged state.
 * :meth:`Film.save` / :meth:`Film.restore` roll the instance back (fmi2Get/SetFMUstate);
   :meth:`Film.serialize` / :meth:`Film.deserialize` give bytes to keep a state on disk.
+* The FMU's warnings (a stress above ``yield_stress``, E that looks like MPa, flipped pressure
+  triangles) reach the master: each distinct one is emitted once per run as a
+  :class:`SolverWarning` (Python ``warnings``), kept in ``Results.warnings`` and summed up in one
+  printed line; ``strict=True`` raises :class:`SolverWarningError` at the first one instead.
 """
 
 from __future__ import annotations
 
 import itertools
+import re
 import shutil
+import sys
+import warnings
 from ctypes import byref, c_double, c_int
 
 import numpy as np
@@ -91,6 +98,27 @@ class FmuError(RuntimeError):
         super().__init__(f"{function} returned {STATUS_NAMES[status]}: {tail}")
 
 
+class SolverWarning(UserWarning):
+    """A warning of the FMU (logged with fmi2Warning): the result stands but leaves the model's
+    assumptions (a stress above ``yield_stress``, strains beyond the small-strain range), or the
+    model looks wrong (E that looks like MPa, flipped pressure triangles)."""
+
+
+class SolverWarningError(RuntimeError):
+    """Raised instead of a :class:`SolverWarning` with ``strict=True``: the film stays at the
+    state that warned (its step stood); ``message`` is the FMU's text."""
+
+    def __init__(self, message: str, time: float | None):
+        self.message, self.time = message, time
+        super().__init__(f"the FMU warned (strict) at t = {time}: {message}")
+
+
+def warning_kind(message: str) -> str:
+    """What makes two FMU warnings the same kind: the text without its numbers (the time, the
+    stress, the triangle) — a run that stays above the yield stress warns once, not per step."""
+    return re.sub(r"[-+]?\d+(\.\d+)?([eE][-+]?\d+)?", "#", message)
+
+
 class StepRefused(RuntimeError):
     """A step the FMU kept refusing (fmi2Discard) after every allowed halving. The instance is
     at its last converged state, ``time``."""
@@ -122,6 +150,9 @@ class Results:
         self._time: list[float] = []
         self._rows: list[list[float]] = []
         self._inputs: list[list[float]] = []
+        #: The FMU's distinct warnings of the run (the first message of each kind, see
+        #: :func:`warning_kind`), each also emitted as a :class:`SolverWarning`.
+        self.warnings: list[str] = []
         #: Steps split in halves after a refusal, steps taken in all, and refused steps rolled
         #: back to the state saved before them (fmi2SetFMUstate).
         self.halvings = 0
@@ -228,7 +259,7 @@ class Film:
     variable names. Use it as a context manager, or call :meth:`close`."""
 
     def __init__(self, fmu=None, *, name: str | None = None, logging: bool = True, echo: bool = False,
-                 model: str | None = None):
+                 model: str | None = None, strict: bool = False, quiet: bool = False):
         self.path = find_fmu(fmu, model)
         self.md = read_model_description(str(self.path))
         self.variables = {v.name: v for v in self.md.modelVariables}
@@ -239,6 +270,17 @@ class Film:
                              modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=self.name)
         self._callbacks = callbacks_for(self.messages, self.name, echo)
         self.fmu.instantiate(callbacks=self._callbacks, loggingOn=logging)
+        if not logging:
+            # Warnings reach the master even without the event log.
+            self.fmu.setDebugLogging(True, ["logStatusWarning"])
+        #: ``strict``: raise :class:`SolverWarningError` at the FMU's first warning;
+        #: ``quiet``: no printed summary line of a run's warnings.
+        self.strict, self.quiet = strict, quiet
+        # Messages already looked at for warnings, warning kinds of the current run, and the
+        # warnings seen outside a run (initialize), handed to the next run's results.
+        self._looked_at = 0
+        self._kinds: set[str] = set()
+        self._pending: list[str] = []
         self.time: float | None = None
         self._states: list = []
         real_inputs = [v for v in self.md.modelVariables if v.causality == "input" and v.type == "Real"]
@@ -290,7 +332,26 @@ class Film:
         self.time = float(start_time)
         if "mu" in self._reached:
             self._reached["mu"] = self._set_inputs["mu"]
+        self._surface(self._pending, self.strict)
         return self
+
+    def _surface(self, into: list, strict: bool):
+        """Emits each new warning-level FMU message of a kind not yet seen in this run as a
+        :class:`SolverWarning` and appends it to ``into``; with ``strict`` raises
+        :class:`SolverWarningError` instead."""
+        new = self.messages[self._looked_at:]
+        self._looked_at = len(self.messages)
+        for status, _, text in new:
+            if status != WARNING:
+                continue
+            kind = warning_kind(text)
+            if kind in self._kinds:
+                continue
+            self._kinds.add(kind)
+            into.append(text)
+            if strict:
+                raise SolverWarningError(text, self.time)
+            warnings.warn(f"{self.name}: {text}", SolverWarning, stacklevel=4)
 
     def close(self):
         """Frees the saved states and the instance and removes the unpacked FMU."""
@@ -450,7 +511,7 @@ class Film:
         return state
 
     def run(self, table, outputs: list[str] | None = None, max_halvings: int = 6, dt: float | None = None,
-            rollback: bool | None = None) -> Results:
+            rollback: bool | None = None, strict: bool | None = None, quiet: bool | None = None) -> Results:
         """Steps a staged load path. ``table``: a dict of columns, a list of row dicts, a numpy
         structured array or a pandas DataFrame, with a ``time`` column and columns named after
         inputs; each row's inputs are reached at its time (rows up to the film's current time
@@ -465,7 +526,15 @@ class Film:
         row's value), at most ``max_halvings`` deep; then :class:`StepRefused` naming the time
         and the FMU's log, the film at its last converged state. Initializes the film first
         (start time 0) if it is not. Returns the ``outputs`` (default: all) and the table's
-        inputs at the start and after every step taken."""
+        inputs at the start and after every step taken.
+
+        The FMU's warnings: each distinct one (:func:`warning_kind`) of the run, those of the
+        initialization included, is emitted once as a :class:`SolverWarning` and kept in
+        ``Results.warnings``; a one-line summary is printed after the run (not with ``quiet``).
+        ``strict`` (default: the film's) raises :class:`SolverWarningError` at the first one.
+        ``strict`` and ``quiet`` default to the film's."""
+        strict = self.strict if strict is None else strict
+        quiet = self.quiet if quiet is None else quiet
         columns = _columns(table)
         if "time" not in columns:
             raise KeyError("the table needs a 'time' column")
@@ -482,12 +551,22 @@ class Film:
                 raise KeyError(f"column '{name}' is {what}, not an input; inputs: {', '.join(sorted(inputs))}")
             if not np.all(np.isfinite(columns[name])):
                 raise ValueError(f"column '{name}' holds values that are not finite")
+        self._kinds = set()
+        pending, self._pending = self._pending, []
         if self.time is None:
-            self.initialize()
+            self.strict, saved = strict, self.strict
+            try:
+                self.initialize()
+            finally:
+                self.strict = saved
+            pending += self._pending
+            self._pending = []
         if rollback is None:
             rollback = bool(self.md.coSimulation.canGetAndSetFMUstate)
         names = self.outputs if outputs is None else list(outputs)
         results = Results(names, [g for g in self.gaps if f"{g}.slip" in names], list(columns))
+        results.warnings = pending
+        self._strict_run = strict
         read_outputs = self._reader(names)
 
         def read():
@@ -514,6 +593,10 @@ class Film:
         finally:
             if checkpoint is not None and checkpoint.value:
                 self._raw("fmi2FreeFMUstate", byref(checkpoint))
+        if results.warnings and not quiet:
+            more = f" and {len(results.warnings) - 1} more" if len(results.warnings) > 1 else ""
+            print(f"{self.name}: {len(results.warnings)} solver warning(s) in this run (Results.warnings): "
+                  f"{results.warnings[0]}{more}", file=sys.stderr)
         return results
 
     def _advance(self, t0, t1, v0, v1, depth, max_halvings, results, read, checkpoint):
@@ -529,6 +612,7 @@ class Film:
             # Land exactly on the row's time (no drift from summing step sizes).
             self.time = t1
             results._append(t1, *read())
+            self._surface(results.warnings, self._strict_run)
             return
         if checkpoint is not None:
             # FMI 2.0: after fmi2Discard the master restores a state before it steps again.

@@ -39,9 +39,11 @@ import numpy as np
 if __package__ in (None, ""):  # run as a script: python path/to/mesh.py
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from membrane_contact.arches import ArchError, gaps_on_curve, make_curve  # noqa: E402
+    from membrane_contact.fmu import repository_root  # noqa: E402
     from membrane_contact.tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes  # noqa: E402
 else:
     from .arches import ArchError, gaps_on_curve, make_curve
+    from .fmu import repository_root
     from .tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes
 
 
@@ -88,7 +90,7 @@ CONTACT_KEYS = {"normal_stiffness", "tangential_stiffness", "friction", "frictio
 # role → (required keys, optional keys)
 ROLES: dict[str, tuple[set[str], set[str]]] = {
     "element_set": (set(), {"name"}),
-    "pressure": ({"pressure"}, {"name"}),
+    "pressure": ({"pressure"}, {"name", "towards"}),
     "force": ({"force"}, {"name"}),
     "support": (set(), {"fixed", "set"}),
     "boundary": (set(), {"name", "target", "components"}),
@@ -545,7 +547,8 @@ class _Importer:
             elif role == "pressure":
                 pressures.append({"name": _identifier(label("name"), where),
                                   "elements": self.group_triangles(name, role),
-                                  "pressure": _number(entry["pressure"], f"{where}: pressure")})
+                                  "pressure": _number(entry["pressure"], f"{where}: pressure"),
+                                  **_towards(entry, where)})
             elif role == "force":
                 forces.append({"name": _identifier(label("name"), where), "nodes": self.nodes_of(name, role),
                                "force": _vector(entry["force"], f"{where}: force")})
@@ -731,13 +734,80 @@ class _Importer:
         return model
 
 
-def import_mesh(path, mapping) -> dict:
+def _towards(entry: dict, where: str) -> dict:
+    """A pressure entry's ``towards`` (a direction or ``"+x"`` … ``"-z"``), as the model takes it."""
+    if "towards" not in entry:
+        return {}
+    t = entry["towards"]
+    if isinstance(t, str):
+        if t not in SIDES:
+            _fail(f"{where}: towards '{t}' is not one of {', '.join(SIDES)} or a direction [x, y, z]")
+        return {"towards": t}
+    return {"towards": _vector(t, f"{where}: towards")}
+
+
+SIDES = ("+x", "-x", "+y", "-y", "+z", "-z")
+#: The solver's command line, run by :func:`solver_check` (default: the checkout's
+#: ``target/release/membrane-contact``, else ``membrane-contact`` on the PATH).
+CLI_VARIABLE = "MEMBRANE_CONTACT_CLI"
+
+
+@dataclass
+class SolverCheck:
+    """What ``membrane-contact check`` says of a model: its warnings (the CLI's, ``fmu-pack``'s
+    and the FMU's check: E that looks like MPa, pressure triangles pushed against their
+    neighbours, …) and one line per pressure set on the side it pushes to."""
+    warnings: list[str]
+    report: list[str]
+
+
+def solver_check(model: dict) -> SolverCheck | None:
+    """Runs the solver's own check of ``model`` (``membrane-contact check``, the one function the
+    CLI, ``fmu-pack`` and the FMU use), or None when the program is not found (set
+    ``$MEMBRANE_CONTACT_CLI`` or build the checkout)."""
+    import os
+    import shutil
+    import subprocess
+    import tempfile
+
+    program = os.environ.get(CLI_VARIABLE)
+    root = repository_root()
+    if not program and root is not None and (root / "target" / "release" / "membrane-contact").is_file():
+        program = str(root / "target" / "release" / "membrane-contact")
+    program = program or shutil.which("membrane-contact")
+    if not program:
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "model.json"
+        path.write_text(json.dumps(model))
+        r = subprocess.run([program, "check", str(path)], capture_output=True, text=True)
+    found = SolverCheck([], [])
+    for line in r.stderr.splitlines():
+        if line.startswith("warning: "):
+            found.warnings.append(line[len("warning: "):])
+        elif line.startswith("error: "):
+            reason = line[len("error: "):].removeprefix(f"{path}: ")
+            found.warnings.append(f"the solver refuses the model: {reason}")
+    found.report = [line for line in r.stdout.splitlines() if line.startswith("pressure set ")]
+    return found
+
+
+def import_mesh(path, mapping, report: list | None = None) -> dict:
     """The model dict (docs/model-format.md) of the mesh at ``path`` mapped by ``mapping`` (a
     dict or the path of a JSON file; format in python/README-import.md).
 
     Raises :class:`MeshImportError` or :class:`~membrane_contact.arches.ArchError` naming the bad
-    item; warns :class:`MeshImportWarning` about what it did on the user's behalf."""
-    return _Importer(path, mapping).build()
+    item; warns :class:`MeshImportWarning` about what it did on the user's behalf and about what
+    the solver's check (:func:`solver_check`) finds wrong, E in MPa and flipped pressure triangles
+    among them. ``report``: a list that receives the check's line on each pressure set (the side
+    it pushes to, the triangles turned or pushed against their neighbours)."""
+    model = _Importer(path, mapping).build()
+    found = solver_check(model)
+    for line in found.warnings if found else []:
+        warnings.warn(line, MeshImportWarning, stacklevel=2)
+    if found and report is not None:
+        report.extend(found.report)
+    return model
 
 
 def summary(model: dict) -> str:
@@ -773,10 +843,11 @@ def main(argv=None) -> int:
     parser.add_argument("-o", "--output", help="the model JSON file to write (default: standard output)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no summary on standard error")
     args = parser.parse_args(argv)
+    report: list[str] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", MeshImportWarning)
         try:
-            model = import_mesh(args.mesh, args.mapping)
+            model = import_mesh(args.mesh, args.mapping, report)
         except (MeshImportError, ArchError, TubeError) as e:
             print(f"error: {e}", file=sys.stderr)
             return 1
@@ -789,6 +860,8 @@ def main(argv=None) -> int:
         sys.stdout.write(text + "\n")
     if not args.quiet:
         print(summary(model), file=sys.stderr)
+        for line in report:
+            print(f"  {line}", file=sys.stderr)
     return 0
 
 

@@ -5,6 +5,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use membrane_contact::mech::solver::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::specimen::SpecimenContact;
 use membrane_contact::mech::vtk::Encoding;
 use membrane_contact::mech::{FrictionLaw, IterationMatrix};
@@ -52,6 +53,12 @@ pub enum Command {
         /// checkout's .venv/bin/python, else python3).
         #[arg(long, value_name = "PATH")]
         python: Option<PathBuf>,
+    },
+    /// Checks a model file without running it: validates it, prints what looks wrong
+    /// (warnings on standard error) and how each pressure set faces (standard output).
+    Check {
+        /// The model file (JSON).
+        file: PathBuf,
     },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {
@@ -148,9 +155,9 @@ pub struct RunArgs {
     /// Newton iterations per increment before it is halved (default 100).
     #[arg(long, value_name = "N")]
     pub max_iterations: Option<usize>,
-    /// The largest increment is 1/N of a step (the FMU's solver.incrementsPerStep);
-    /// increments halve on failure and grow back.
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    /// The largest increment is 1/N of a step (the FMU's solver.incrementsPerStep, with the
+    /// same default); increments halve on failure and grow back.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_INCREMENTS_PER_STEP as u32, value_parser = clap::value_parser!(u32).range(1..))]
     pub increments: u32,
     /// Halvings of an increment before a step fails (default 12).
     #[arg(long, value_name = "N")]

@@ -148,6 +148,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         Source::File(_) => None,
     };
     let path = load_path(&model, spec, o)?;
+    let height_mm = match source {
+        Source::Specimen { height_mm, .. } => Some(height_mm),
+        Source::File(_) => None,
+    };
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
@@ -184,14 +188,25 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         if let Some(mu) = inputs.mu {
             analysis.set_friction(mu)?;
         }
-        let report = analysis
-            .step_to_motion(
-                &inputs.targets,
-                &inputs.angles,
-                &inputs.loads,
-                o.increments as usize,
-            )
-            .map_err(|e| format!("step {step}/{count}: {e}"))?;
+        let report = match analysis.step_to_motion(
+            &inputs.targets,
+            &inputs.angles,
+            &inputs.loads,
+            o.increments as usize,
+        ) {
+            Ok(report) => report,
+            Err(e) => {
+                // What was reached stands: the summary of the last converged state, then the error.
+                progress.finish();
+                let done = if k == 0 { 0.0 } else { path.times[k - 1] };
+                out!(
+                    "step {step}/{count} failed; the last converged state (step {k}, time {done}):"
+                );
+                let results = analysis.results();
+                report(height_mm, &analysis, &results);
+                return Err(format!("step {step}/{count}: {e}"));
+            }
+        };
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;
         increments += report.iterations.len();
@@ -220,10 +235,6 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     let results = analysis.results();
     membrane_contact::mech::check_results(analysis.model(), &results, None)
         .map_err(|e| format!("the results are not finite ({e}): refused"))?;
-    let height_mm = match source {
-        Source::Specimen { height_mm, .. } => Some(height_mm),
-        Source::File(_) => None,
-    };
     report(height_mm, &analysis, &results);
     outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
     for w in membrane_contact::mech::summary::result_warnings(analysis.model(), &results) {
@@ -458,17 +469,22 @@ fn report_loads(analysis: &Analysis) {
     }
 }
 
-/// Prints the results; `height_mm`: the specimen's, whose observed points are compared with
-/// Table 1.
-fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
-    let model = analysis.model();
-    out!(
-        "{}: {} nodes, {} triangles, {} gaps",
+/// `<name><separator> N nodes, N triangles, N gaps`.
+fn size_line(model: &Model, separator: &str) -> String {
+    format!(
+        "{}{separator} {} nodes, {} triangles, {} gaps",
         model.name,
         model.nodes.len(),
         model.triangles.len(),
         model.gaps.len()
-    );
+    )
+}
+
+/// Prints the results; `height_mm`: the specimen's, whose observed points are compared with
+/// Table 1.
+fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
+    let model = analysis.model();
+    out!("{}", size_line(model, ":"));
     report_loads(analysis);
     if !model.gaps.is_empty() {
         out!(
@@ -694,6 +710,22 @@ fn import(
     }
 }
 
+/// `membrane-contact check FILE`: validates the model, prints its warnings on stderr (as a run
+/// does) and how each pressure set faces on stdout.
+fn check(file: &std::path::Path) -> Result<(), String> {
+    let name = file.display();
+    let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
+    let model = Model::from_json(&text).map_err(|e| format!("{name}: {e}"))?;
+    for w in membrane_contact::mech::summary::model_warnings(&model) {
+        eprintln!("warning: {w}");
+    }
+    out!("{}", size_line(&model, ": valid,"));
+    for line in membrane_contact::mech::load::orientation_report(&model) {
+        out!("{line}");
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -710,6 +742,7 @@ fn main() -> ExitCode {
             )
         }),
         Command::Model { file, run: o } => run(Source::File(file), o),
+        Command::Check { file } => check(file),
         Command::Import {
             mesh,
             mapping,

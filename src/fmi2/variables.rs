@@ -372,8 +372,10 @@ pub const RESERVED_NAMES: [&str; 9] = [
     "results",
 ];
 
-/// Default of `solver.incrementsPerStep`.
-pub const DEFAULT_INCREMENTS_PER_STEP: i32 = 10;
+/// Default of `solver.incrementsPerStep`: the core's
+/// [`crate::mech::solver::DEFAULT_INCREMENTS_PER_STEP`], the CLI's default too.
+pub const DEFAULT_INCREMENTS_PER_STEP: i32 =
+    crate::mech::solver::DEFAULT_INCREMENTS_PER_STEP as i32;
 
 /// Checks that the model's gap, group, pressure-set and force-set names can prefix variable names.
 pub fn check_names(model: &Model) -> Result<(), String> {
@@ -533,8 +535,12 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             p.pressure,
             "Pa",
             &format!(
-                "follower pressure on pressure set '{}' (positive along the triangles' normals), reached at the end of a step",
-                p.name
+                "follower pressure on pressure set '{}' (positive {}), reached at the end of a step",
+                p.name,
+                match p.towards {
+                    None => "along the triangles' normals".to_string(),
+                    Some(t) => format!("pushes towards {:?}", t.vector()),
+                }
             ),
             Binding::Pressure(set),
         );

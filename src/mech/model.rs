@@ -221,8 +221,92 @@ pub struct PressureSet {
     /// The triangles it acts on.
     pub elements: ElementSelection,
     /// Pressure of a standard run (Pa); positive pushes along the triangle normal
-    /// `(x2 − x1) × (x3 − x1)` of its node order.
+    /// `(x2 − x1) × (x3 − x1)` of its node order, or towards [`Self::towards`] when given.
     pub pressure: f64,
+    /// The side a positive pressure pushes the film to, in world terms: each triangle's
+    /// pressure is oriented so that it pushes along the side of its initial normal facing this
+    /// direction, whatever its node order (`None`: the node order decides).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub towards: Option<Towards>,
+}
+
+/// The world direction a pressure set pushes the film to (`"towards"`): a vector or a signed
+/// global axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "serde_json::Value", into = "serde_json::Value")]
+pub enum Towards {
+    /// A direction `[x, y, z]` (any length, not zero).
+    Direction([f64; 3]),
+    /// A signed global axis, `"+x"` … `"-z"`.
+    Side(Side),
+}
+
+/// A signed global axis (`"+z"`: towards global +Z).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Side {
+    /// +X.
+    #[serde(rename = "+x")]
+    PlusX,
+    /// −X.
+    #[serde(rename = "-x")]
+    MinusX,
+    /// +Y.
+    #[serde(rename = "+y")]
+    PlusY,
+    /// −Y.
+    #[serde(rename = "-y")]
+    MinusY,
+    /// +Z.
+    #[serde(rename = "+z")]
+    PlusZ,
+    /// −Z.
+    #[serde(rename = "-z")]
+    MinusZ,
+}
+
+impl TryFrom<serde_json::Value> for Towards {
+    type Error = String;
+
+    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+        serde_json::from_value(value.clone())
+            .map(Self::Direction)
+            .or_else(|_| serde_json::from_value(value.clone()).map(Self::Side))
+            .map_err(|_| {
+                format!(
+                    "towards {value} is neither a direction [x, y, z] nor one of \"+x\", \"-x\", \
+                     \"+y\", \"-y\", \"+z\", \"-z\""
+                )
+            })
+    }
+}
+
+impl From<Towards> for serde_json::Value {
+    fn from(towards: Towards) -> Self {
+        match towards {
+            Towards::Direction(d) => serde_json::json!(d),
+            Towards::Side(side) => serde_json::json!(side),
+        }
+    }
+}
+
+impl Towards {
+    /// The direction as a vector (not normalised; a side is a unit axis).
+    pub fn vector(self) -> [f64; 3] {
+        match self {
+            Self::Direction(d) => d,
+            Self::Side(side) => {
+                let (axis, sign) = match side {
+                    Side::PlusX => (0, 1.0),
+                    Side::MinusX => (0, -1.0),
+                    Side::PlusY => (1, 1.0),
+                    Side::MinusY => (1, -1.0),
+                    Side::PlusZ => (2, 1.0),
+                    Side::MinusZ => (2, -1.0),
+                };
+                std::array::from_fn(|c| if c == axis { sign } else { 0.0 })
+            }
+        }
+    }
 }
 
 /// A dead force on each node of a named node set.
@@ -1027,6 +1111,10 @@ impl Model {
                     item: item(),
                     message,
                 })?;
+            super::load::check_towards(self, p).map_err(|message| ModelError::Load {
+                item: item(),
+                message,
+            })?;
         }
         for f in &l.forces {
             check_name(names, "force set", &f.name)?;

@@ -101,7 +101,8 @@ pub struct LoadPath {
     /// Stages in order; the first starts from zero displacement.
     pub stages: Vec<Stage>,
     /// Increments per communication step given to `step_to` (the FMU's
-    /// `solver.incrementsPerStep` default is 10, the CLI uses 1).
+    /// `solver.incrementsPerStep` and the CLI's `--increments` default to
+    /// [`super::solver::DEFAULT_INCREMENTS_PER_STEP`]).
     pub increments_per_step: usize,
 }
 
@@ -1349,6 +1350,7 @@ impl CircularMembrane {
                     name: "top".into(),
                     elements: ElementSelection::All(AllElements::All),
                     pressure: self.pressure,
+                    towards: None,
                 }],
                 ..LoadSpec::default()
             },

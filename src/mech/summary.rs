@@ -20,7 +20,8 @@ pub const SMALL_STRAIN_LIMIT: f64 = 0.05;
 pub const SUSPICIOUS_MODULUS: f64 = 1e5;
 
 /// Warnings about a model that validates but looks wrong (checked once, before any step): a
-/// Young's modulus that looks like MPa, and gaps whose `initial_gap` differs slightly (up to
+/// Young's modulus that looks like MPa, pressure sets with triangles pushed against their
+/// neighbours ([`super::load::orientation_warnings`]), and gaps whose `initial_gap` differs slightly (up to
 /// [`super::model::GAP_GEOMETRY_TOLERANCE`] of the size; beyond, validation refuses the model)
 /// from the distance along the gap's local z between film node and support (§4.3:
 /// `g0 = z · (X_A − X_B)`).
@@ -33,6 +34,7 @@ pub fn model_warnings(model: &Model) -> Vec<String> {
              the model file takes Pa"
         ));
     }
+    warnings.extend(super::load::orientation_warnings(model));
     let size = super::solver::bounding_diagonal(&model.nodes);
     for gap in &model.gaps {
         let n = model.nodes.len();

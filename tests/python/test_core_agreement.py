@@ -1,8 +1,9 @@
 """The FMU computes what the core computes, and what mechanics requires.
 
 SOURCE: the core's CLI (``membrane-contact specimen|model … --steps N --csv``), which steps
-every group to ``target · k/N`` with one increment per step; the FMU does the same with
-``solver.incrementsPerStep = 1`` and the input ``frame.dz = target · k/N`` before step k. The
+every group to ``target · k/N`` in its default increments per step; the FMU does the same with
+its default ``solver.incrementsPerStep`` (the same core constant) and the input
+``frame.dz = target · k/N`` before step k. The
 CLI's CSV prints slips in mm with 6 decimals, so "to round-off" means within 1e-6 mm here.
 
 TEST GOAL:
@@ -45,7 +46,7 @@ def run_fmu(fmu_path, group, target_dz, steps, parameters=None, inputs=None, gap
     """Ramps ``<group>.dz`` and returns, per step, {gap: (slip_x mm, slip_y mm, N, status)}."""
     per_step = []
     with Slave(fmu_path) as s:
-        s.initialize(parameters={"solver.incrementsPerStep": 1, **(parameters or {})}, inputs=inputs)
+        s.initialize(parameters=parameters or {}, inputs=inputs)
         for k in range(steps):
             s.ramp({f"{group}.dz": target_dz}, steps, first=k, last=k + 1)
             per_step.append({

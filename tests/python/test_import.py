@@ -364,7 +364,11 @@ def test_a_closed_line_loop_becomes_a_closed_cable(tmp_path):
     assert len(chain) == 17 and chain[0] == chain[-1] and len(set(chain)) == 16
     path = tmp_path / "loop.json"
     path.write_text(json.dumps(model))
-    run = subprocess.run([str(CLI), "model", str(path), "--steps", "2", "--quiet"], capture_output=True, text=True)
+    # One increment per step: with the default ten (the FMU's, issue 17) the first step stalls on
+    # this slack square (corrections along a direction with almost no stiffness), whatever the
+    # number of steps (2, 4, 10 measured); one increment gets through with 6 cut-backs.
+    run = subprocess.run([str(CLI), "model", str(path), "--steps", "2", "--increments", "1", "--quiet"],
+                         capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
 
 
@@ -561,7 +565,7 @@ def test_an_fmu_of_the_imported_model_steps_like_the_cli(model, fmu, cli_run):
     names = [g["name"] for g in model["gaps"]]
     with Slave(fmu) as s:
         assert {"frame.dz", "S7.slip", "N13.normalForce", "centre.uz", "film.maxEquivalentStress"} <= set(s.variables)
-        s.initialize(parameters={"solver.incrementsPerStep": 1, **TIGHT})
+        s.initialize(parameters=TIGHT)
         for k in range(STEPS):
             s.ramp({"frame.dz": TARGET_DZ}, STEPS, first=k, last=k + 1)
             assert s.get("solver.iterations") > 0
@@ -603,7 +607,7 @@ def test_mesh_to_fmu_to_the_python_package_with_a_staged_path_and_a_rollback(mod
     _, rows, _ = cli_run
     times = [(k + 1) / STEPS for k in range(STEPS)]
     with Film(fmu) as film:
-        film.initialize(parameters={"solver.incrementsPerStep": 1, **TIGHT})
+        film.initialize(parameters=TIGHT)
         first = film.run({"time": times, "frame.dz": [TARGET_DZ * t for t in times]})
         for k in range(STEPS):
             row = next(r for r in rows if int(r["step"]) == k + 1 and r["gap"] == "S5")
