@@ -303,9 +303,12 @@ def test_mesh_with_tube_arches_to_an_fmu_and_a_python_master_that_sees_the_yield
     s_nodes = model["curved_supports"][0]["nodes"]
     foot = min(s_nodes, key=lambda v: nodes[v][0])
     crown = min(s_nodes, key=lambda v: abs(nodes[v][0] - 1.5))
-    with Film(fmu) as film:
+    from membrane_contact import SolverWarning
+
+    with Film(fmu) as film, pytest.warns(SolverWarning, match="yield_stress"):
         results = film.run({"time": [1.0, 2.0], "frame.dz": [-0.075, -0.15]})
         report = film.report(results, tmp_path / "run.md").read_text()
+    assert any("yield_stress" in w for w in results.warnings), results.warnings
     # never touched: slip 0 to rounding (the FMU's 10 increments per step leave 1e-17 m)
     assert abs(results[f"archS.node{foot}.slip"][-1]) < 1e-12 and results[f"archS.node{foot}.status"][-1] == 0
     assert results[f"archS.node{crown}.normalForce"][-1] > 100.0
