@@ -1,18 +1,30 @@
-//! Groups that prescribe chosen components only (issue 8, item 2).
+//! Supports, restraints and which models are well posed.
 //!
-//! TEST GOAL: a group with `components: ["z"]` prescribes z and leaves x and y to the film (they
-//! move, and the group carries no x/y reaction); validation accepts a roller (z-only group on a
-//! node whose x and y a support fixes) and refuses a component prescribed and fixed at once;
-//! a film held in-plane by nothing is still refused as singular; the FMU has inputs and
-//! reactions for the prescribed components only.
+//! TEST GOAL (issue 8, item 2): a group with `components: ["z"]` prescribes z and leaves x and y
+//! to the film (they move, and the group carries no x/y reaction); validation accepts a roller
+//! (z-only group on a node whose x and y a support fixes) and refuses a component prescribed and
+//! fixed at once; a film held in-plane by nothing is still refused as singular; the FMU has
+//! inputs and reactions for the prescribed components only.
 //!
 //! MODEL: a flat 1 m × 0.2 m strip of the specimen's prestressed ETFE (8 × 2 cells); its left
 //! edge is a full group (held), its right edge a z-only group lifted by 50 mm.
+//!
+//! TEST GOAL (issue 17, defect 4): well-posed models run. A prestressed triangle whose third
+//! node is held in x and y only is held across by its prestress and converges under a load to
+//! the closed form.
+//!
+//! ```text
+//!       2 (x2, h)      triangle: 0 and 1 held in x, y, z; 2 held in x, y (support set
+//!      / \             "Apex"); load P along Z on node 2
+//!     0 - 1 (a, 0)
+//! ```
 
 use membrane_contact::fmi2::description::describe;
 use membrane_contact::fmi2::resources::Source;
 use membrane_contact::mech::model::{Axis, BoundaryGroup, Model, Support};
 use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+
+mod common;
 
 const NX: usize = 8;
 const NY: usize = 2;
@@ -218,4 +230,101 @@ fn support_set_names_are_checked_and_become_fmu_outputs() {
     reserved.supports[0].name = Some("reactions".into());
     let err = describe(&Source::Model(reserved)).unwrap_err();
     assert!(err.contains("reserved"), "{err}");
+}
+
+// ------------------------------------------------------------------ well-posed models (issue 17)
+
+/// `E/(1 − ν²)`, `ν`, `t` and the prestress `[σx, σy, τxy]` of the film of these tests.
+const YOUNG: f64 = 1.0e9;
+const NU: f64 = 0.43;
+const THICKNESS: f64 = 250e-6;
+
+fn film(prestress: [f64; 3]) -> membrane_contact::mech::Material {
+    membrane_contact::mech::Material {
+        youngs_modulus: YOUNG,
+        poisson_ratio: NU,
+        thickness: THICKNESS,
+        prestress,
+        density: 0.0,
+        wrinkling: Default::default(),
+        wrinkling_regularisation:
+            membrane_contact::mech::material::DEFAULT_WRINKLING_REGULARISATION,
+        yield_stress: None,
+    }
+}
+
+/// The triangle of the header: `a` = 0.1 m, `h` = 0.1 m, `x2` = 0.05 m, load `p` on node 2.
+fn hinged_triangle(prestress: [f64; 3], p: f64) -> Model {
+    use membrane_contact::mech::model::ForceSet;
+    let mut model = common::film_model(
+        "Hinged",
+        vec![[0.0, 0.0, 0.0], [0.1, 0.0, 0.0], [0.05, 0.1, 0.0]],
+        vec![[0, 1, 2]],
+    );
+    model.material = film(prestress);
+    let held = |node, fixed: Vec<Axis>, name: Option<&str>| Support {
+        node,
+        fixed,
+        name: name.map(Into::into),
+    };
+    model.supports = vec![
+        held(0, vec![Axis::X, Axis::Y, Axis::Z], None),
+        held(1, vec![Axis::X, Axis::Y, Axis::Z], None),
+        held(2, vec![Axis::X, Axis::Y], Some("Apex")),
+    ];
+    model.loads.forces.push(ForceSet {
+        name: "Lift".into(),
+        nodes: vec![2],
+        force: [0.0, 0.0, p],
+    });
+    model
+}
+
+#[test]
+fn prestressed_triangle_held_in_plane_at_its_apex_takes_a_load_across_as_the_closed_form_says() {
+    use membrane_contact::mech::LoadLevels;
+    // Only node 2 moves, by w along Z: F = F0 + w e_z ∇N2ᵀ with ∇N2 = (0, 1/h), so
+    // E = [0, w²/(2h²), 0] and S_yy = σy + Ē w²/(2h²) (Ē = E/(1 − ν²)); node 2's force is
+    // V0 F S ∇N2: along Z, V0 w S_yy/h² = P; along Y, V0 S_yy/h (the support's reaction).
+    // P(w) is the cubic Ē V0/(2h⁴) w³ + V0 σy/h² w, solved by Cardano.
+    let (sigma_y, p, h) = (0.5e6, 1.0, 0.1);
+    let model = hinged_triangle([0.3e6, sigma_y, 0.0], p);
+    let bar = YOUNG / (1.0 - NU * NU);
+    let v0 = THICKNESS * 0.5 * 0.1 * h;
+    let (pp, q) = (
+        2.0 * h * h * sigma_y / bar,
+        -2.0 * p * h.powi(4) / (bar * v0),
+    );
+    let root = (q * q / 4.0 + pp.powi(3) / 27.0).sqrt();
+    let w = (-q / 2.0 + root).cbrt() + (-q / 2.0 - root).cbrt();
+    assert!(w > 0.0 && w < 0.05, "{w}");
+
+    let settings = SolverSettings {
+        residual_tolerance: 1e-10,
+        displacement_tolerance: 1e-10,
+        ..Default::default()
+    };
+    let levels = LoadLevels::of_model(&model);
+    let mut analysis = Analysis::new(model, settings).unwrap();
+    analysis.step_to_with_loads(&[], &levels, 4).unwrap();
+    let results = analysis.results();
+    let u = analysis.node_displacement(2);
+    assert!((u.z - w).abs() < 1e-9 * w, "w = {} vs {w}", u.z);
+    assert!(u.x == 0.0 && u.y == 0.0);
+    let s_yy = sigma_y + bar * w * w / (2.0 * h * h);
+    let apex = results.support_reactions[0];
+    assert!((apex[1] - v0 * s_yy / h).abs() < 1e-8 * apex[1], "{apex:?}");
+    assert!(
+        (results.total_reaction[2] + p).abs() < 1e-9,
+        "{:?}",
+        results.total_reaction
+    );
+    // Without the prestress across the hinge the model is singular and refused as before.
+    let err = Analysis::new(
+        hinged_triangle([0.3e6, 0.0, 0.0], p),
+        SolverSettings::default(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(err.contains("can rotate about an axis along X"), "{err}");
 }
