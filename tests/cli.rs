@@ -278,10 +278,12 @@ fn solver_settings_of_the_fmu_are_cli_options() {
 
 /// Runs `membrane-contact` with `args`; (success, stdout, stderr).
 fn cli(args: &[&str]) -> (bool, String, String) {
-    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
-        .args(args)
-        .output()
-        .unwrap();
+    program(env!("CARGO_BIN_EXE_membrane-contact"), args)
+}
+
+/// Runs the program `exe` with `args`; (success, stdout, stderr).
+fn program(exe: &str, args: &[&str]) -> (bool, String, String) {
+    let output = Command::new(exe).args(args).output().unwrap();
     let text = |b: Vec<u8>| String::from_utf8(b).unwrap();
     (
         output.status.success(),
@@ -472,4 +474,56 @@ fn wrapped_specimen_runs_from_the_command_line_and_bad_wraps_are_refused() {
     );
     let (ok, _, err) = cli(&["specimen", "--wrap", "0.02", "--target-dz-per-height", "-1"]);
     assert!(!ok && err.contains("--wrap"), "{err}");
+}
+
+/// TEST GOAL (issue 17, defect 4): a model without a free DOF runs from the command line (it
+/// was refused with "the model has no free DOF"): `examples/driven_gap.json` driven along
+/// `examples/driven_gap_path.csv` sticks at `k_s·dx`, slips at `μN` = 30 N and sticks again on
+/// the way back, each step a single evaluation without Newton iterations.
+#[test]
+fn a_model_without_free_dofs_runs_its_staged_path() {
+    let example = |file: &str| format!("{}/examples/{file}", env!("CARGO_MANIFEST_DIR"));
+    let csv = std::env::temp_dir().join(format!("membrane-contact-gap-{}.csv", std::process::id()));
+    let (ok, out, err) = cli(&[
+        "model",
+        &example("driven_gap.json"),
+        "--path",
+        &example("driven_gap_path.csv"),
+        "--csv",
+        csv.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("iterations per step [0, 0, 0, 0, 0, 0]"),
+        "{out}"
+    );
+    assert!(
+        out.contains("reaction of group Drive: (20.000, 0.000, -100.000) N"),
+        "{out}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let _ = std::fs::remove_file(&csv);
+    // k_n·1 mm = 100 N; k_s·dx until k_s·dx > μN = 30 N; back by 1 mm from the slip: 20 N.
+    let expected = [
+        ("0.000000", "Stick"),
+        ("10.000000", "Stick"),
+        ("20.000000", "Stick"),
+        ("30.000000", "Slip"),
+        ("30.000000", "Slip"),
+        ("20.000000", "Stick"),
+    ];
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), expected.len(), "{text}");
+    for (row, (friction, status)) in rows.iter().zip(expected) {
+        assert_eq!(
+            (row[5], row[6], row[7]),
+            ("100.000000", friction, status),
+            "{text}"
+        );
+    }
 }
