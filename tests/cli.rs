@@ -527,3 +527,84 @@ fn a_model_without_free_dofs_runs_its_staged_path() {
         );
     }
 }
+
+/// Runs `fmu-pack` with `args`; (success, stdout, stderr).
+fn fmu_pack(args: &[&str]) -> (bool, String, String) {
+    program(env!("CARGO_BIN_EXE_fmu-pack"), args)
+}
+
+/// Whether the FMU at `path` holds `resources/<file>`.
+fn fmu_holds(path: &std::path::Path, file: &str) -> bool {
+    let zip = zip::ZipArchive::new(std::fs::File::open(path).unwrap()).unwrap();
+    zip.index_for_name(&format!("resources/{file}")).is_some()
+}
+
+/// TEST GOAL (issue 17, defect 4): the model `export-specimen` prints (name `ParallelArch`) does
+/// not replace the built-in specimen FMU: refused at `target/fmu/ParallelArch.fmu` (by default
+/// or through `--out target/fmu`) and onto any file holding the specimen, with a message that
+/// proposes `-o`; `-o FILE` writes exactly that file; `--force` replaces the specimen FMU; `-o`
+/// needs `.fmu` and excludes `--out`.
+#[test]
+fn a_user_model_named_parallel_arch_does_not_replace_the_specimen_fmu() {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-pack-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (ok, spec, err) = cli(&["export-specimen", "--height", "200"]);
+    assert!(ok, "{err}");
+    let model = dir.join("spec200.json");
+    std::fs::write(&model, spec).unwrap();
+    let model = model.to_str().unwrap();
+
+    let target_fmu = std::path::Path::new(env!("CARGO_BIN_EXE_fmu-pack"))
+        .parent()
+        .and_then(|release| release.parent())
+        .unwrap()
+        .join("fmu");
+    let builtin = target_fmu.join("ParallelArch.fmu");
+    let before = std::fs::read(&builtin).ok();
+    for args in [
+        vec![model],
+        vec![model, "--out", target_fmu.to_str().unwrap()],
+    ] {
+        let (ok, _, err) = fmu_pack(&args);
+        assert!(!ok, "{args:?} was accepted");
+        assert!(
+            err.contains("the built-in specimen FMU") && err.contains("-o FILE"),
+            "{err}"
+        );
+    }
+    assert_eq!(
+        std::fs::read(&builtin).ok(),
+        before,
+        "{} changed",
+        builtin.display()
+    );
+
+    let mine = dir.join("my_arch.fmu");
+    let (ok, out, err) = fmu_pack(&[model, "-o", mine.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.starts_with(mine.to_str().unwrap()), "{out}");
+    assert!(fmu_holds(&mine, "model.json"));
+
+    // The specimen packed elsewhere is protected there too, unless --force.
+    let elsewhere = dir.join("specimen");
+    let (ok, _, err) = fmu_pack(&["--out", elsewhere.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let packed = elsewhere.join("ParallelArch.fmu");
+    assert!(fmu_holds(&packed, "parallel_arch.json"));
+    let (ok, _, err) = fmu_pack(&[model, "--out", elsewhere.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("holds the built-in specimen FMU"),
+        "{err}"
+    );
+    assert!(fmu_holds(&packed, "parallel_arch.json"));
+    let (ok, _, err) = fmu_pack(&[model, "--out", elsewhere.to_str().unwrap(), "--force"]);
+    assert!(ok, "{err}");
+    assert!(fmu_holds(&packed, "model.json"));
+
+    let (ok, _, err) = fmu_pack(&[model, "-o", dir.join("x.zip").to_str().unwrap()]);
+    assert!(!ok && err.contains("ends in .fmu"), "{err}");
+    let (ok, _, err) = fmu_pack(&[model, "-o", mine.to_str().unwrap(), "--out", "d"]);
+    assert!(!ok && err.contains("not both"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
