@@ -34,15 +34,16 @@
 //! * And the initial state is an equilibrium on the component's free DOFs: the initial nodal
 //!   forces along every axis that no support, symmetry plane or group holds are below `1e-6` of
 //!   the component's largest initial nodal force. Then `M` is the second variation of the energy
-//!   along the modes at a state of equilibrium, and with `M` positive definite the Newton matrix
-//!   is regular there. Otherwise the solver moves the unbalanced nodes until the prestress that
-//!   gave `M` is relieved: a square held at one corner and in z only gets
+//!   along the modes at a state of equilibrium: positive definite, no combination of them is a
+//!   motion without energy there (the Newton matrix has no null vector in their span).
+//!   Otherwise the solver moves the unbalanced nodes until the prestress that gave `M` is
+//!   relieved: a square held at one corner and in z only gets
 //!   `uᵀ K0 u = t·A·(σx + σy) ω² > 0` for its in-plane rotation, but its free edges contract to a
 //!   stress-free state in which the rotation is free again. Such modes are refused, the message
 //!   naming the unbalanced node.
 //!
-//! A refused mode is described by the combination of free modes with the least energy (all
-//! modes when the prestress holds none).
+//! A refused mode is described by the combination of free modes with the least energy (the
+//! first free mode, as the restraints alone find it, when the prestress holds none).
 //!
 //! **Limits.** The check is structural. Gaps count as restraints although every gap is open at
 //! the start (`g = g0 + d_z ≥ 0` at zero displacement) and carries nothing until it closes, and
@@ -225,12 +226,18 @@ fn initial_stiffness(
             })
             .collect();
         let m = 3 * nodes.len();
+        // K·u of each mode, then the energies uᵀ K u (the matrix is symmetric).
+        let ku: Vec<Vec<f64>> = u
+            .iter()
+            .map(|uq| {
+                (0..m)
+                    .map(|r| (0..m).map(|c| kt(r, c) * uq[c]).sum())
+                    .collect()
+            })
+            .collect();
         for p in 0..k {
             for q in p..k {
-                let e: f64 = (0..m)
-                    .flat_map(|r| (0..m).map(move |s| (r, s)))
-                    .map(|(r, s)| u[p][r] * kt(r, s) * u[q][s])
-                    .sum();
+                let e: f64 = (0..m).map(|r| u[p][r] * ku[q][r]).sum();
                 energy[(p, q)] += e;
                 if q != p {
                     energy[(q, p)] += e;
