@@ -3,6 +3,8 @@
 //! ```text
 //! fmu-pack                       → target/fmu/ParallelArch.fmu (the paper's specimen, 300 mm)
 //! fmu-pack path/to/model.json    → target/fmu/<model name>.fmu
+//! fmu-pack model.json --out DIR  → DIR/<model name>.fmu
+//! fmu-pack model.json -o FILE    → FILE (any name ending in .fmu)
 //! ```
 //!
 //! The archive holds
@@ -18,8 +20,16 @@
 //!
 //! A model file that does not validate is refused before anything is written; one that looks
 //! wrong (`mech::summary::model_warnings`: E in MPa, …) is packed with the warnings on stderr.
-//! The FMU goes to `--out DIR`, else to `target/fmu` when this program runs from cargo's target
-//! directory, else (an installed `fmu-pack`) to the current directory.
+//! The FMU goes to `-o FILE`, else into `--out DIR`, else into `target/fmu` when this program
+//! runs from cargo's target directory, else (an installed `fmu-pack`) the current directory.
+//!
+//! **The built-in specimen FMU is not replaced by a user model** (issue 17): a model file whose
+//! name is `ParallelArch` (what `membrane-contact export-specimen` prints) would land on
+//! `target/fmu/ParallelArch.fmu`, the specimen FMU with the `archHeight` parameter that the
+//! examples and the tests use. A user model is refused when its FMU would go to that path
+//! (however given: default, `--out target/fmu` or `-o`), or onto any existing file that holds
+//! the specimen (`resources/parallel_arch.json`), with a message proposing `-o FILE`, `--out
+//! DIR` or another `name`; `--force` replaces it anyway.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -27,13 +37,14 @@ use std::process::ExitCode;
 use std::time::SystemTime;
 
 use membrane_contact::fmi2::description::{Description, describe, documentation_html};
-use membrane_contact::fmi2::resources::Source;
+use membrane_contact::fmi2::resources::{SPECIMEN_FILE, Source};
+use membrane_contact::mech::specimen::MODEL_NAME;
 use membrane_contact::mech::{Model, ParallelArch};
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
 const USAGE: &str = "\
-usage: fmu-pack [MODEL.json] [--out DIR] [--library PATH]
+usage: fmu-pack [MODEL.json] [--out DIR | -o FILE] [--force] [--library PATH]
 
 Packs an FMI 2.0 Co-Simulation FMU. Without MODEL.json it packs the paper's parallel-arch
 specimen (ParallelArch.fmu); with it, an FMU of that model, named after the model's `name`.
@@ -41,6 +52,10 @@ specimen (ParallelArch.fmu); with it, an FMU of that model, named after the mode
 options:
   --out DIR        where to write <modelIdentifier>.fmu (default: target/fmu when run from
                    cargo's target directory, else the current directory)
+  -o, --output FILE
+                   the FMU file to write, any name ending in .fmu (instead of --out)
+  --force          let a user model replace the built-in specimen FMU (target/fmu/ParallelArch.fmu,
+                   or any file holding the specimen): refused without it
   --library PATH   the shared library to ship (default: the newest libmembrane_contact.so
                    next to this program, in target/release or target/release/deps; for an
                    fmu-pack installed with pip, PREFIX/lib/membrane-contact/)
@@ -51,6 +66,8 @@ const LIBRARY: &str = "libmembrane_contact.so";
 struct Options {
     model: Option<PathBuf>,
     out: Option<PathBuf>,
+    file: Option<PathBuf>,
+    force: bool,
     library: Option<PathBuf>,
 }
 
@@ -58,6 +75,8 @@ fn parse(args: &[String]) -> Result<Options, String> {
     let mut o = Options {
         model: None,
         out: None,
+        file: None,
+        force: false,
         library: None,
     };
     let mut it = args.iter();
@@ -70,6 +89,8 @@ fn parse(args: &[String]) -> Result<Options, String> {
         match a.as_str() {
             "-h" | "--help" => return Err(String::new()),
             "--out" => o.out = Some(value("--out")?),
+            "-o" | "--output" => o.file = Some(value(a)?),
+            "--force" => o.force = true,
             "--library" => o.library = Some(value("--library")?),
             s if s.starts_with('-') => return Err(format!("unknown option {s}")),
             s if o.model.is_none() => o.model = Some(PathBuf::from(s)),
@@ -79,6 +100,17 @@ fn parse(args: &[String]) -> Result<Options, String> {
                 ));
             }
         }
+    }
+    if o.out.is_some() && o.file.is_some() {
+        return Err("give either --out DIR or -o FILE, not both".into());
+    }
+    if let Some(file) = &o.file
+        && file.extension().is_none_or(|e| e != "fmu")
+    {
+        return Err(format!(
+            "-o {}: an FMU file name ends in .fmu (FMI 2.0 §2.3)",
+            file.display()
+        ));
     }
     Ok(o)
 }
@@ -146,11 +178,12 @@ fn find_library(dir: &Path) -> Result<PathBuf, String> {
 /// The default output directory: `target/fmu` when this program runs from cargo's target
 /// directory (`target/release`, whose parent cargo marks with `CACHEDIR.TAG`), else the current
 /// directory (an installed `fmu-pack`, whose own directory is no place for FMUs).
-fn default_out_dir(dir: &Path) -> PathBuf {
-    match dir.parent() {
-        Some(target) if target.join("CACHEDIR.TAG").is_file() => target.join("fmu"),
-        _ => PathBuf::from("."),
-    }
+/// `target/fmu` when this program runs from cargo's target directory (`dir`, the program's
+/// folder, inside a directory holding `CACHEDIR.TAG`); `None` for an installed `fmu-pack`.
+fn cargo_target_fmu_dir(dir: &Path) -> Option<PathBuf> {
+    dir.parent()
+        .filter(|target| target.join("CACHEDIR.TAG").is_file())
+        .map(|target| target.join("fmu"))
 }
 
 fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> Result<(), String> {
@@ -190,6 +223,49 @@ fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> R
     std::fs::rename(&tmp, path).map_err(|e| io(&e))
 }
 
+/// Refuses to write the FMU of the user model `name` to `path` when that is where the built-in
+/// specimen FMU goes (`specimen`: `target/fmu/ParallelArch.fmu`) or a file holding the specimen.
+fn refuse_to_replace_the_specimen(
+    path: &Path,
+    specimen: Option<&Path>,
+    name: &str,
+) -> Result<(), String> {
+    // Directories compared resolved (`--out target/fmu`, `-o ./target/fmu/…`); a file name as is.
+    let resolved = |p: &Path| -> Option<PathBuf> {
+        let dir = match p.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        Some(std::fs::canonicalize(dir).ok()?.join(p.file_name()?))
+    };
+    let reserved = specimen.is_some_and(|s| resolved(s).is_some() && resolved(s) == resolved(path));
+    let holds_specimen = path.is_file() && holds_the_specimen(path);
+    if !(reserved || holds_specimen) {
+        return Ok(());
+    }
+    let what = if holds_specimen {
+        "that file holds"
+    } else {
+        "that path is reserved for"
+    };
+    Err(format!(
+        "{}: refused to write the model '{name}' there: {what} the built-in specimen FMU \
+         (ParallelArch with its archHeight parameter), which the examples and tests use. Write \
+         yours elsewhere with -o FILE (e.g. -o {name}_model.fmu) or --out DIR, or give the model \
+         another \"name\"; --force replaces the specimen FMU",
+        path.display()
+    ))
+}
+
+/// Whether the FMU at `path` was packed from the built-in specimen (`resources/parallel_arch.json`).
+fn holds_the_specimen(path: &Path) -> bool {
+    let entry = format!("resources/{SPECIMEN_FILE}");
+    std::fs::File::open(path)
+        .ok()
+        .and_then(|f| zip::ZipArchive::new(f).ok())
+        .is_some_and(|zip| zip.index_for_name(&entry).is_some())
+}
+
 fn run(o: &Options) -> Result<(), String> {
     let (source, description) = source(o)?;
     // What looks wrong in a model that validates (E in MPa, flipped pressure triangles, …): the
@@ -206,12 +282,26 @@ fn run(o: &Options) -> Result<(), String> {
     };
     let library =
         std::fs::read(&library_path).map_err(|e| format!("{}: {e}", library_path.display()))?;
-    let out_dir = match &o.out {
-        Some(d) => d.clone(),
-        None => default_out_dir(&dir),
+    let cargo_fmu = cargo_target_fmu_dir(&dir);
+    let path = match (&o.file, &o.out) {
+        (Some(file), _) => file.clone(),
+        (None, Some(d)) => d.join(format!("{}.fmu", description.model_identifier)),
+        (None, None) => cargo_fmu
+            .clone()
+            .unwrap_or_else(|| PathBuf::from("."))
+            .join(format!("{}.fmu", description.model_identifier)),
+    };
+    let out_dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
     };
     std::fs::create_dir_all(&out_dir).map_err(|e| format!("{}: {e}", out_dir.display()))?;
-    let path = out_dir.join(format!("{}.fmu", description.model_identifier));
+    if let Source::Model(model) = &source
+        && !o.force
+    {
+        let specimen = cargo_fmu.map(|d| d.join(format!("{MODEL_NAME}.fmu")));
+        refuse_to_replace_the_specimen(&path, specimen.as_deref(), &model.name)?;
+    }
     write_fmu(&path, &description, &source, &library)?;
     let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
     println!(

@@ -278,10 +278,12 @@ fn solver_settings_of_the_fmu_are_cli_options() {
 
 /// Runs `membrane-contact` with `args`; (success, stdout, stderr).
 fn cli(args: &[&str]) -> (bool, String, String) {
-    let output = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
-        .args(args)
-        .output()
-        .unwrap();
+    program(env!("CARGO_BIN_EXE_membrane-contact"), args)
+}
+
+/// Runs the program `exe` with `args`; (success, stdout, stderr).
+fn program(exe: &str, args: &[&str]) -> (bool, String, String) {
+    let output = Command::new(exe).args(args).output().unwrap();
     let text = |b: Vec<u8>| String::from_utf8(b).unwrap();
     (
         output.status.success(),
@@ -595,5 +597,138 @@ fn check_prints_the_warnings_and_the_orientation_of_each_pressure_set() {
     );
     let (ok, _, err) = cli(&["check", "/nonexistent/model.json"]);
     assert!(!ok && err.contains("/nonexistent/model.json"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 17, defect 4): a model without a free DOF runs from the command line (it
+/// was refused with "the model has no free DOF"): `examples/driven_gap.json` driven along
+/// `examples/driven_gap_path.csv` sticks at `k_s·dx`, slips at `μN` = 30 N and sticks again on
+/// the way back, each step a single evaluation without Newton iterations.
+#[test]
+fn a_model_without_free_dofs_runs_its_staged_path() {
+    let example = |file: &str| format!("{}/examples/{file}", env!("CARGO_MANIFEST_DIR"));
+    let csv = std::env::temp_dir().join(format!("membrane-contact-gap-{}.csv", std::process::id()));
+    let (ok, out, err) = cli(&[
+        "model",
+        &example("driven_gap.json"),
+        "--path",
+        &example("driven_gap_path.csv"),
+        "--csv",
+        csv.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("iterations per step [0, 0, 0, 0, 0, 0]"),
+        "{out}"
+    );
+    assert!(
+        out.contains("reaction of group Drive: (20.000, 0.000, -100.000) N"),
+        "{out}"
+    );
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let _ = std::fs::remove_file(&csv);
+    // k_n·1 mm = 100 N; k_s·dx until k_s·dx > μN = 30 N; back by 1 mm from the slip: 20 N.
+    let expected = [
+        ("0.000000", "Stick"),
+        ("10.000000", "Stick"),
+        ("20.000000", "Stick"),
+        ("30.000000", "Slip"),
+        ("30.000000", "Slip"),
+        ("20.000000", "Stick"),
+    ];
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), expected.len(), "{text}");
+    for (row, (friction, status)) in rows.iter().zip(expected) {
+        assert_eq!(
+            (row[5], row[6], row[7]),
+            ("100.000000", friction, status),
+            "{text}"
+        );
+    }
+}
+
+/// Runs `fmu-pack` with `args`; (success, stdout, stderr).
+fn fmu_pack(args: &[&str]) -> (bool, String, String) {
+    program(env!("CARGO_BIN_EXE_fmu-pack"), args)
+}
+
+/// Whether the FMU at `path` holds `resources/<file>`.
+fn fmu_holds(path: &std::path::Path, file: &str) -> bool {
+    let zip = zip::ZipArchive::new(std::fs::File::open(path).unwrap()).unwrap();
+    zip.index_for_name(&format!("resources/{file}")).is_some()
+}
+
+/// TEST GOAL (issue 17, defect 4): the model `export-specimen` prints (name `ParallelArch`) does
+/// not replace the built-in specimen FMU: refused at `target/fmu/ParallelArch.fmu` (by default
+/// or through `--out target/fmu`) and onto any file holding the specimen, with a message that
+/// proposes `-o`; `-o FILE` writes exactly that file; `--force` replaces the specimen FMU; `-o`
+/// needs `.fmu` and excludes `--out`.
+#[test]
+fn a_user_model_named_parallel_arch_does_not_replace_the_specimen_fmu() {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-pack-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let (ok, spec, err) = cli(&["export-specimen", "--height", "200"]);
+    assert!(ok, "{err}");
+    let model = dir.join("spec200.json");
+    std::fs::write(&model, spec).unwrap();
+    let model = model.to_str().unwrap();
+
+    let target_fmu = std::path::Path::new(env!("CARGO_BIN_EXE_fmu-pack"))
+        .parent()
+        .and_then(|release| release.parent())
+        .unwrap()
+        .join("fmu");
+    let builtin = target_fmu.join("ParallelArch.fmu");
+    let before = std::fs::read(&builtin).ok();
+    for args in [
+        vec![model],
+        vec![model, "--out", target_fmu.to_str().unwrap()],
+    ] {
+        let (ok, _, err) = fmu_pack(&args);
+        assert!(!ok, "{args:?} was accepted");
+        assert!(
+            err.contains("the built-in specimen FMU") && err.contains("-o FILE"),
+            "{err}"
+        );
+    }
+    assert_eq!(
+        std::fs::read(&builtin).ok(),
+        before,
+        "{} changed",
+        builtin.display()
+    );
+
+    let mine = dir.join("my_arch.fmu");
+    let (ok, out, err) = fmu_pack(&[model, "-o", mine.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.starts_with(mine.to_str().unwrap()), "{out}");
+    assert!(fmu_holds(&mine, "model.json"));
+
+    // The specimen packed elsewhere is protected there too, unless --force.
+    let elsewhere = dir.join("specimen");
+    let (ok, _, err) = fmu_pack(&["--out", elsewhere.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let packed = elsewhere.join("ParallelArch.fmu");
+    assert!(fmu_holds(&packed, "parallel_arch.json"));
+    let (ok, _, err) = fmu_pack(&[model, "--out", elsewhere.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("holds the built-in specimen FMU"),
+        "{err}"
+    );
+    assert!(fmu_holds(&packed, "parallel_arch.json"));
+    let (ok, _, err) = fmu_pack(&[model, "--out", elsewhere.to_str().unwrap(), "--force"]);
+    assert!(ok, "{err}");
+    assert!(fmu_holds(&packed, "model.json"));
+
+    let (ok, _, err) = fmu_pack(&[model, "-o", dir.join("x.zip").to_str().unwrap()]);
+    assert!(!ok && err.contains("ends in .fmu"), "{err}");
+    let (ok, _, err) = fmu_pack(&[model, "-o", mine.to_str().unwrap(), "--out", "d"]);
+    assert!(!ok && err.contains("not both"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1570,3 +1570,58 @@ fn solver_threads_is_read_back_refused_out_of_range_by_name_and_leaves_the_outpu
         assert_eq!(values, serial, "{threads} threads");
     }
 }
+
+/// A model without a free DOF (issue 17: how single elements are verified) initializes and
+/// steps: `examples/driven_gap.json` driven down 2 mm and along x sticks at `k_s·dx`, slips at
+/// `μN` = 30 N beyond 3 mm and sticks again on the way back, as the core says
+/// (`tests/supports.rs`); the film feels the opposite of the gap's friction force and the drive
+/// carries both contact forces. Its FMU state round trip keeps the slip history.
+#[test]
+fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
+    let model =
+        crate::mech::Model::from_json(include_str!("../../examples/driven_gap.json")).unwrap();
+    let (u, log) = (
+        Unpacked::new("prescribed", Source::Model(model)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    let path = [
+        (0.0, 1, 0.0),
+        (1e-3, 1, 10.0),
+        (2e-3, 1, 20.0),
+        (4e-3, 2, 30.0),
+        (6e-3, 2, 30.0),
+        (5e-3, 1, 20.0),
+    ];
+    let mut saved = None;
+    for (k, &(dx, status, friction)) in path.iter().enumerate() {
+        assert_eq!(fmu.set_real("Drive.dx", dx), 0);
+        assert_eq!(fmu.set_real("Drive.dz", -2e-3), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+        let at = format!("step {k}, dx = {dx}");
+        assert_eq!(fmu.integer("G.status"), status, "{at}");
+        assert!((fmu.real("G.normalForce") - 100.0).abs() < 1e-9, "{at}");
+        assert!((fmu.real("G.frictionX") + friction).abs() < 1e-9, "{at}");
+        assert!((fmu.real("Drive.Rx") - friction).abs() < 1e-9, "{at}");
+        assert!((fmu.real("Drive.Rz") + 100.0).abs() < 1e-9, "{at}");
+        assert_eq!(fmu.integer("solver.iterations"), 0, "{at}");
+        if k == 4 {
+            let mut state: Fmi2FmuState = std::ptr::null_mut();
+            assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+            saved = Some(state);
+        }
+    }
+    // Back to the slipped state at 6 mm (history 3 mm): 5 mm sticks at 20 N again.
+    let mut state = saved.unwrap();
+    assert_eq!(
+        unsafe { fmi2_set_fmu_state(fmu.c, state) },
+        0,
+        "{:?}",
+        log.take()
+    );
+    assert_eq!(fmu.set_real("Drive.dx", 5e-3), 0);
+    assert_eq!(fmu.step(5.0, 1.0), 0, "{:?}", log.take());
+    assert_eq!(fmu.integer("G.status"), 1);
+    assert!((fmu.real("G.frictionX") + 20.0).abs() < 1e-9);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
+}

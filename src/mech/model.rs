@@ -491,6 +491,8 @@ pub enum ModelError {
         node_count: usize,
         /// The free motion in words ("can translate along Y").
         motion: String,
+        /// Why the prestress, which would stiffen the motion, does not hold it.
+        note: Option<String>,
     },
     /// Text that would go into modelDescription.xml holds a character XML cannot carry.
     Text { field: String, message: String },
@@ -539,6 +541,7 @@ impl fmt::Display for ModelError {
                 nodes,
                 node_count,
                 motion,
+                note,
             } => {
                 let listed: Vec<String> = nodes.iter().map(|v| v.to_string()).collect();
                 let more = if *node_count > nodes.len() {
@@ -551,7 +554,11 @@ impl fmt::Display for ModelError {
                     "the film part with nodes {}{more} ({node_count} nodes) {motion}: no support, symmetry \
                      plane, boundary group or gap restrains it (singular system)",
                     listed.join(", ")
-                )
+                )?;
+                match note {
+                    Some(note) => write!(f, "; {note}"),
+                    None => Ok(()),
+                }
             }
             Self::Text { field, message } => write!(f, "{field}: {message}"),
             Self::Load { item, message } | Self::Output { item, message } => {

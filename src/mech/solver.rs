@@ -5,7 +5,10 @@
 //! `(K_m + K_g) ΔU = −(R_m + R_g)` over the free DOFs; it converges when both the displacement
 //! correction (the paper's step (g)) and the residual force are small. A failed increment is
 //! halved, up to [`SolverSettings::max_cutbacks`] times; a step that still fails returns an error
-//! and leaves the last converged state untouched.
+//! and leaves the last converged state untouched. A model without free DOFs (every node held or
+//! prescribed: how single elements are verified) converges at the first assembly of each
+//! increment: forces, stresses, the gaps' return mapping and the reactions at the prescribed
+//! configuration, without a linear solve.
 
 use std::fmt;
 
@@ -540,9 +543,6 @@ impl Analysis {
         let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
         let mut system = System::new(&model, lower_only)?;
         system.set_threads(settings.threads);
-        if system.free_count == 0 {
-            return Err(SetupError::System("the model has no free DOF".into()));
-        }
         let linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
         let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
@@ -1015,7 +1015,14 @@ impl Analysis {
         self.work.contact_start.clone_from(&start.contacts);
         self.work.latched.iter_mut().for_each(|l| *l = None);
         self.work.closed.iter_mut().for_each(|c| *c = false);
-        let mut correction_norm = f64::INFINITY;
+        // A model without free DOFs (every node prescribed or fixed: how single elements are
+        // verified) has nothing to solve: the first assembly evaluates the forces, the gaps'
+        // return mapping and the reactions at the prescribed configuration, and converges.
+        let mut correction_norm = if self.system.free_count == 0 {
+            0.0
+        } else {
+            f64::INFINITY
+        };
         // The iterate before the last correction (to name elements whose state flips).
         let mut previous_u = u.clone();
         let mut residuals = Vec::new();
@@ -1053,7 +1060,7 @@ impl Analysis {
             let displacement_scale = moved.max(max_abs(&u)).max(1e-9 * self.length_scale);
             let force_scale = max_abs(&self.work.internal).max(self.force_floor);
             let tolerance = s.residual_tolerance * force_scale;
-            let converged = iteration > 0
+            let converged = (iteration > 0 || self.system.free_count == 0)
                 && correction_norm <= s.displacement_tolerance * displacement_scale
                 && residual <= tolerance;
             if converged {

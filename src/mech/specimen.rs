@@ -153,6 +153,9 @@ impl Default for ParallelArch {
 
 /// Number of gap elements along the half arch.
 pub const GAP_COUNT: usize = 9;
+
+/// The specimen model's name, hence the built-in FMU's model identifier (`ParallelArch.fmu`).
+pub const MODEL_NAME: &str = "ParallelArch";
 const CELLS: usize = 10;
 
 impl ParallelArch {
@@ -389,7 +392,7 @@ impl ParallelArch {
             outputs: Default::default(),
             cables: vec![],
             curved_supports,
-            name: "ParallelArch".into(),
+            name: MODEL_NAME.into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",
                 1000.0 * h,
