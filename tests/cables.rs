@@ -4,7 +4,7 @@
 //! taut configurations) and zero when slack; in a strip stretched homogeneously, two edge cables
 //! add exactly `2 N l/L` to the end reaction with `N = N0 + EA ε` (Green strain), and a
 //! compressed cable adds nothing; the model file names a cable that leaves the film's edges; the
-//! FMU reports `<cable>.maxForce`.
+//! FMU's `<cable>.maxForce` is the core's cable force and the closed form.
 //!
 //! MODEL: a flat strip `L × W` = 1 m × 0.2 m, 8 × 2 cells, the specimen's ETFE film; x-only
 //! groups at both ends (the right one moved by δ), every node held in z, one corner in y, so
@@ -81,6 +81,8 @@ fn strip(cables: bool, n0: f64) -> Model {
     }
 }
 
+/// The right end moved by `delta` in one step of 4 increments: its x reaction and the cables'
+/// largest forces.
 fn stretched(model: Model, delta: f64) -> (f64, Vec<f64>) {
     let mut analysis = Analysis::new(model, SolverSettings::default()).unwrap();
     analysis.step_to(&[[0.0; 3], [delta, 0.0, 0.0]], 4).unwrap();
@@ -185,17 +187,49 @@ fn a_cable_that_leaves_the_film_edges_is_refused_naming_it() {
     assert_eq!(Model::from_json(&text).unwrap(), strip(true, 5.0));
 }
 
+/// TEST GOAL: the FMU's `<cable>.maxForce` after a step equals the core's `results.cables`
+/// (same increments: identical to 1e-12) and the closed form of the homogeneous stretch,
+/// `N = N0 + EA (λ² − 1)/2` (the Green strain the cable uses), for each cable.
 #[test]
-fn the_fmu_reports_the_largest_cable_force() {
-    use membrane_contact::fmi2::description::describe;
+fn the_fmu_cable_force_is_the_cores_and_the_green_strain_closed_form() {
+    use membrane_contact::fmi2::instance::Instance;
+    use membrane_contact::fmi2::logger::Logger;
     use membrane_contact::fmi2::resources::Source;
-    let d = describe(&Source::Model(strip(true, 5.0))).unwrap();
-    let v = d
-        .variables
-        .iter()
-        .find(|v| v.name == "north.maxForce")
-        .unwrap();
-    assert_eq!(v.unit, Some("N"));
+    let (delta, n0, increments) = (0.01, 5.0, 4);
+    let mut fmu = Instance::from_source(Source::Model(strip(true, n0)), Logger::silent()).unwrap();
+    let vr = |fmu: &Instance, name: &str| {
+        let v = fmu.description().variables.iter().find(|v| v.name == name);
+        let v = v.unwrap_or_else(|| panic!("no {name}"));
+        if name.ends_with("maxForce") {
+            assert_eq!(v.unit, Some("N"), "{name}");
+        }
+        v.value_reference
+    };
+    let (right, steps) = (vr(&fmu, "right.dx"), vr(&fmu, "solver.incrementsPerStep"));
+    fmu.setup_experiment(0.0, None).unwrap();
+    fmu.enter_initialization_mode().unwrap();
+    fmu.set_integer(&[steps], &[increments]).unwrap();
+    fmu.exit_initialization_mode().unwrap();
+    fmu.set_real(&[right], &[delta]).unwrap();
+    fmu.do_step(0.0, 1.0).unwrap();
+
+    let (_, core) = stretched(strip(true, n0), delta);
+    let stretch = 1.0 + delta;
+    let closed_form = n0 + EA * 0.5 * (stretch * stretch - 1.0);
+    for (name, core) in ["south", "north"].into_iter().zip(core) {
+        let mut force = [f64::NAN];
+        fmu.get_real(&[vr(&fmu, &format!("{name}.maxForce"))], &mut force)
+            .unwrap();
+        let force = force[0];
+        assert!(
+            (force - core).abs() <= 1e-12 * core,
+            "{name}: {force} vs core {core}"
+        );
+        assert!(
+            (force - closed_form).abs() <= 1e-9 * closed_form,
+            "{name}: {force} vs N0 + EA ε = {closed_form}"
+        );
+    }
 }
 
 /// TEST GOAL: the cables' VTK block draws every segment with its axial force; the largest is

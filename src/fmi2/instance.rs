@@ -901,9 +901,15 @@ impl Instance {
             .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
         // Gravity is a parameter: the built model holds it, and the first step ramps it in.
         loads.gravity = built.analysis.model().loads.gravity;
-        // μ changes the state's friction before the step; a refused step must not keep it.
+        // μ changes the state's friction (gaps and curved-support contacts) before the step; a
+        // refused step must not keep it.
+        let state = built.analysis.state();
+        let changes = |mu: f64| {
+            let contacts = state.contacts.iter().map(|c| &c.friction);
+            state.friction.iter().chain(contacts).any(|&f| f != mu)
+        };
         let before = match mu {
-            Some(mu) if built.analysis.state().friction.iter().any(|&f| f != mu) => {
+            Some(mu) if changes(mu) => {
                 let before = built.analysis.state().clone();
                 built.analysis.set_friction(mu).map_err(Failure::error)?;
                 Some(before)

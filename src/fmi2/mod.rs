@@ -39,3 +39,5 @@ pub mod variables;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod wiring_tests;

@@ -30,10 +30,10 @@ use crate::mech::ParallelArch;
 
 /// Messages received by the test logger: (status, category, message).
 #[derive(Default)]
-struct Log(Mutex<Vec<(c_int, String, String)>>);
+pub(super) struct Log(Mutex<Vec<(c_int, String, String)>>);
 
 impl Log {
-    fn take(&self) -> Vec<(c_int, String, String)> {
+    pub(super) fn take(&self) -> Vec<(c_int, String, String)> {
         std::mem::take(&mut *self.0.lock().unwrap())
     }
 
@@ -111,15 +111,15 @@ fn callbacks(log: &Log) -> Fmi2CallbackFunctions {
 }
 
 /// A temporary unpacked FMU: `resources/` with the specimen, and its GUID and variables.
-struct Unpacked {
+pub(super) struct Unpacked {
     dir: PathBuf,
     guid: CString,
     uri: CString,
-    variables: Vec<Variable>,
+    pub(super) variables: Vec<Variable>,
 }
 
 impl Unpacked {
-    fn new(tag: &str, source: Source) -> Self {
+    pub(super) fn new(tag: &str, source: Source) -> Self {
         let id = format!(
             "mc fmi2 test {tag} {}-{:?}",
             std::process::id(),
@@ -145,7 +145,7 @@ impl Unpacked {
         Self::new(tag, Source::ParallelArch(ParallelArch::default()))
     }
 
-    fn vr(&self, name: &str) -> u32 {
+    pub(super) fn vr(&self, name: &str) -> u32 {
         self.variables
             .iter()
             .find(|v| v.name == name)
@@ -161,14 +161,14 @@ impl Drop for Unpacked {
 }
 
 /// One instance, driven through the exported functions.
-struct Fmu<'a> {
-    c: Fmi2Component,
+pub(super) struct Fmu<'a> {
+    pub(super) c: Fmi2Component,
     u: &'a Unpacked,
     log: &'a Log,
 }
 
 impl<'a> Fmu<'a> {
-    fn new(u: &'a Unpacked, log: &'a Log) -> Self {
+    pub(super) fn new(u: &'a Unpacked, log: &'a Log) -> Self {
         let f = callbacks(log);
         // SAFETY: valid strings and callbacks for the duration of the call.
         let c = unsafe {
@@ -213,15 +213,20 @@ impl<'a> Fmu<'a> {
         fmu
     }
 
-    fn set_real(&self, name: &str, v: f64) -> c_int {
+    pub(super) fn set_real(&self, name: &str, v: f64) -> c_int {
         unsafe { fmi2_set_real(self.c, &self.u.vr(name), 1, &v) }
     }
 
-    fn set_integer(&self, name: &str, v: i32) -> c_int {
+    pub(super) fn set_integer(&self, name: &str, v: i32) -> c_int {
         unsafe { fmi2_set_integer(self.c, &self.u.vr(name), 1, &v) }
     }
 
-    fn set_string(&self, name: &str, v: &str) -> c_int {
+    pub(super) fn set_boolean(&self, name: &str, v: bool) -> c_int {
+        let v = c_int::from(v);
+        unsafe { fmi2_set_boolean(self.c, &self.u.vr(name), 1, &v) }
+    }
+
+    pub(super) fn set_string(&self, name: &str, v: &str) -> c_int {
         let v = CString::new(v).unwrap();
         unsafe { fmi2_set_string(self.c, &self.u.vr(name), 1, &v.as_ptr()) }
     }
@@ -251,7 +256,7 @@ impl<'a> Fmu<'a> {
         unsafe { fmi2_exit_initialization_mode(self.c) }
     }
 
-    fn real(&self, name: &str) -> f64 {
+    pub(super) fn real(&self, name: &str) -> f64 {
         let mut v = f64::NAN;
         assert_eq!(
             unsafe { fmi2_get_real(self.c, &self.u.vr(name), 1, &mut v) },
@@ -261,7 +266,7 @@ impl<'a> Fmu<'a> {
         v
     }
 
-    fn integer(&self, name: &str) -> i32 {
+    pub(super) fn integer(&self, name: &str) -> i32 {
         let mut v = -1;
         assert_eq!(
             unsafe { fmi2_get_integer(self.c, &self.u.vr(name), 1, &mut v) },
@@ -271,7 +276,7 @@ impl<'a> Fmu<'a> {
         v
     }
 
-    fn step(&self, t: f64, h: f64) -> c_int {
+    pub(super) fn step(&self, t: f64, h: f64) -> c_int {
         unsafe { fmi2_do_step(self.c, t, h, 1) }
     }
 

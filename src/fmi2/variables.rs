@@ -10,7 +10,7 @@
 //! | name | type | causality | unit | meaning |
 //! |---|---|---|---|---|
 //! | `time` | Real | independent | | pseudo-time of the load path |
-//! | `mu` | Real | input | 1 | friction coefficient of every gap (applied once set; models with gaps only) |
+//! | `mu` | Real | input | 1 | friction coefficient of every gap and curved-support contact (applied once set; models with gaps or curved supports only) |
 //! | `<group>.dx/.dy/.dz` | Real | input | m | displacement of the group reached at the end of a step (prescribed components only) |
 //! | `<group>.angle` | Real | input | rad | angle of a hinged group about its axis reached at the end of a step |
 //! | `<pressureSet>.pressure` | Real | input | Pa | follower pressure of the set reached at the end of a step (start: the model's) |

@@ -690,7 +690,8 @@ impl Analysis {
         Ok(())
     }
 
-    /// Sets the friction coefficient `μ` of every gap for the following steps.
+    /// Sets the friction coefficient `μ` of every gap and curved-support contact for the
+    /// following steps.
     pub fn set_friction(&mut self, mu: f64) -> Result<(), String> {
         if !(mu >= 0.0 && mu.is_finite()) {
             return Err(format!("friction coefficient {mu} must be finite and ≥ 0"));

@@ -1,7 +1,12 @@
 """Fixtures of the FMU tests.
 
-* ``fmu_path``: ``target/fmu/ParallelArch.fmu`` (packed by ``tests/run.sh``; built here if
-  missing);
+Before any test, the session makes sure the release build (CLI and library) and
+``target/fmu/ParallelArch.fmu`` are newer than every source they are built from (the ``.rs``
+files of ``src/`` and ``fmu/``, ``Cargo.*``, ``modelDescription.xml.in``): when one is missing or
+older, it runs ``cargo build --release`` and ``fmu-pack`` (what ``fmu/prepare.sh`` runs), so
+that a pytest run outside ``tests/run.sh`` never compares stale copies.
+
+* ``fmu_path``: ``target/fmu/ParallelArch.fmu``;
 * ``custom_fmu``: an FMU of a user model file, packed in the test session with
   ``cargo run --release --bin fmu-pack -- custom.json``; the model is the 200 mm specimen as the
   CLI exports it, renamed (model ``CustomArch``, group ``rim``, gaps ``S1``..``S9``) so that every
@@ -43,11 +48,34 @@ def pack(model_file, out_dir) -> Path:
     return path
 
 
+def newest_source() -> float:
+    """The latest modification time of the files the release build and the FMU are made from."""
+    files = [ROOT / "Cargo.toml", ROOT / "Cargo.lock", ROOT / "modelDescription.xml.in"]
+    files += [p for d in ("src", "fmu") for p in (ROOT / d).rglob("*.rs")]
+    return max(p.stat().st_mtime for p in files if p.is_file())
+
+
+def stale_artefacts() -> list[Path]:
+    """The CLI and the ParallelArch FMU if missing or older than a source file."""
+    newest = newest_source()
+    return [p for p in (CLI, PARALLEL_ARCH_FMU) if not p.is_file() or p.stat().st_mtime < newest]
+
+
+def pytest_sessionstart(session):
+    """Rebuilds the CLI and repacks the FMU when stale (cargo is quick when up to date)."""
+    stale = stale_artefacts()
+    if not stale:
+        return
+    for args in (["build", "--release", "--locked"],
+                 ["run", "--release", "--locked", "--quiet", "--bin", "fmu-pack"]):
+        r = cargo(*args, check=False)
+        if r.returncode != 0:
+            pytest.exit(f"stale {', '.join(map(str, stale))}: cargo {' '.join(args)} failed:\n{r.stderr}",
+                        returncode=1)
+
+
 @pytest.fixture(scope="session")
 def fmu_path() -> Path:
-    if not PARALLEL_ARCH_FMU.exists():
-        cargo("build", "--release")
-        cargo("run", "--release", "--bin", "fmu-pack")
     return PARALLEL_ARCH_FMU
 
 
@@ -55,8 +83,6 @@ class Cli:
     """The core's command line: the FMU's reference."""
 
     def __init__(self, tmp: Path):
-        if not CLI.exists():
-            cargo("build", "--release")
         self.tmp = tmp
 
     def run(self, *args) -> list[dict]:
