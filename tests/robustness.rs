@@ -217,7 +217,8 @@ fn violations(
         magnitude += Vector3::from(c.force).norm();
     }
     let allowed = model.nodes.len() as f64 * step.residual + ROUND_OFF * magnitude;
-    if !(sum.amax() <= allowed) {
+    // A NaN component fails too (`amax` would skip it).
+    if !sum.iter().all(|v| v.is_finite()) || sum.amax() > allowed {
         fail(format!(
             "out of balance by {:.3e} N (allowed {allowed:.3e} N: {} nodes × ‖R_free‖∞ {:.3e} N)",
             sum.amax(),
@@ -243,7 +244,7 @@ fn violations(
                 g.name, res.slip_x, res.slip_y
             ));
         }
-        if !(n >= 0.0) {
+        if n.is_nan() || n < 0.0 {
             fail(format!("{}: normal force {n:e} N < 0", g.name));
         }
         if res.status == GapStatus::Open {
@@ -310,7 +311,7 @@ fn violations(
         let mu = state.contacts[k].friction;
         let name = format!("{} node {v}", c.name);
         let expected = c.normal_stiffness * (-res.gap).max(0.0);
-        if !(n >= 0.0) || (n - expected).abs() > ROUND_OFF * (n + expected) + 1e-12 {
+        if n.is_nan() || n < 0.0 || (n - expected).abs() > ROUND_OFF * (n + expected) + 1e-12 {
             fail(format!("{name}: N = {n:e} N, k_n ⟨−gap⟩ = {expected:e} N"));
         }
         if res.status == GapStatus::Open && (n != 0.0 || f != Vector2::zeros()) {
