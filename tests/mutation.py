@@ -3,8 +3,9 @@
 
 Applies each source mutation below in turn to a scratch copy of this checkout (never to the
 checkout itself), builds it, runs the tests, and records whether at least one test fails.
-Prints a table; exits 1 if a mutation survives (no test failed), 2 if a mutation could not be
-applied or does not build (the harness would test nothing), 0 when every mutation is caught.
+Prints a table; exits 1 if a mutation survives (no test failed) or hangs a test past
+`--timeout`, 2 if a mutation could not be applied or does not build (the harness would test
+nothing), 0 when every mutation is caught.
 
     tests/mutation.sh                       # every mutation
     tests/mutation.sh radius prestress      # a subset, by name
@@ -42,6 +43,7 @@ import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -209,13 +211,26 @@ def restore(copy: Path, m: Mutation) -> None:
 LOG: list[Path] = []
 
 
-def run(cmd: list[str], cwd: Path) -> tuple[int, str]:
+class Hung(Exception):
+    """A test command ran past the time limit (its process group was killed)."""
+
+
+def run(cmd: list[str], cwd: Path, timeout: float | None = None) -> tuple[int, str]:
     log("  $ " + shlex.join(cmd))
-    p = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    # Own process group: on a timeout the test binaries cargo started are killed with it.
+    p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                         text=True, start_new_session=True)
+    try:
+        out, _ = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        out, _ = p.communicate()
     if LOG:
         with LOG[0].open("a") as f:
-            f.write(f"$ {shlex.join(cmd)}\n{p.stdout}\n[exit {p.returncode}]\n")
-    return p.returncode, p.stdout
+            f.write(f"$ {shlex.join(cmd)}\n{out}\n[exit {p.returncode}]\n")
+    if p.returncode == -signal.SIGKILL and timeout is not None:
+        raise Hung(f"{shlex.join(cmd)} ran past {timeout:.0f} s")
+    return p.returncode, out
 
 
 def failed_tests(output: str) -> list[str]:
@@ -223,6 +238,10 @@ def failed_tests(output: str) -> list[str]:
     names = re.findall(r"^test (\S+) \.\.\. FAILED", output, re.M)
     names += re.findall(r"^FAILED (\S+)", output, re.M)
     return names or ["(a test target failed: see the log)"]
+
+
+# Time limit of one test command (s): `--timeout`.
+TIMEOUT: list[float] = [2400.0]
 
 
 def cargo_tests(copy: Path, args: str) -> str | None:
@@ -233,7 +252,7 @@ def cargo_tests(copy: Path, args: str) -> str | None:
     code, out = run([*base[:split], "--no-run"], copy)
     if code != 0:
         raise HarnessError(f"the mutated source does not build (cargo test {args}):\n{out[-3000:]}")
-    code, out = run(base, copy)
+    code, out = run(base, copy, TIMEOUT[0])
     return None if code == 0 else ", ".join(failed_tests(out)[:3]) + f"  [cargo test {args}]"
 
 
@@ -247,7 +266,7 @@ def fmu_tests(copy: Path, files: str) -> str | None:
         if code != 0:
             raise HarnessError(f"{shlex.join(cmd)} failed:\n{out[-3000:]}")
     code, out = run([str(python), "-m", "pytest", *shlex.split(files), "-x", "-q",
-                     "-p", "no:cacheprovider"], copy)
+                     "-p", "no:cacheprovider"], copy, TIMEOUT[0])
     return None if code == 0 else ", ".join(failed_tests(out)[:3]) + "  [pytest]"
 
 
@@ -283,8 +302,12 @@ def main() -> int:
     parser.add_argument("--no-pytest", action="store_true", help="skip the Python FMU tests")
     parser.add_argument("--pytest", metavar="FILES", default="tests/python",
                         help="pytest files of step 3 (default: tests/python)")
+    parser.add_argument("--timeout", type=float, default=TIMEOUT[0], metavar="SECONDS",
+                        help="time limit of one test command; past it the mutation counts as HUNG "
+                             "(no test failed) (default: %(default)s)")
     parser.add_argument("--list", action="store_true", help="list the mutations and exit")
     options = parser.parse_args()
+    TIMEOUT[0] = options.timeout
     known = {m.name: m for m in MUTATIONS}
     if options.list:
         for m in MUTATIONS:
@@ -315,6 +338,8 @@ def main() -> int:
         try:
             caught = check(copy, m, options)
             verdict = "caught" if caught else "SURVIVED"
+        except Hung as e:
+            caught, verdict = str(e), "HUNG"
         except HarnessError as e:
             caught, verdict = str(e).splitlines()[0], "ERROR"
             log(str(e))
@@ -329,7 +354,7 @@ def main() -> int:
         print("| " + " | ".join(row) + " |")
     if any(r[1] == "ERROR" for r in rows):
         return 2
-    return 1 if any(r[1] == "SURVIVED" for r in rows) else 0
+    return 1 if any(r[1] in ("SURVIVED", "HUNG") for r in rows) else 0
 
 
 if __name__ == "__main__":

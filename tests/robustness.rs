@@ -5,8 +5,12 @@
 //! and a fixed sample of the robustness benchmark's grid (`benches/robustness.rs`).
 //!
 //! TEST GOAL: every path converges in every communication step with `SolverSettings::default()`
-//! and, where the FMU is the issue's tool, the FMU's default increments per step; the generators
-//! build what their documentation says (gap frames of §4.3, rigid hinge rotation, gap counts).
+//! and, where the FMU is the issue's tool, the FMU's default increments per step; the sampled
+//! paths of every family of the grid converge to right answers (issue 23): whole-film
+//! equilibrium, the gap and curved-support laws, and, where an independent answer exists,
+//! symmetry, path independence without friction, and return to the start when released; the
+//! generators build what their documentation says (gap frames of §4.3, rigid hinge rotation, gap
+//! counts).
 //!
 //! MESH / BOUNDARY CONDITIONS / PARAMETERS: see the module doc of `mech::scenarios` (ASCII
 //! sketches of the panel and the strip) and each test's comment.
