@@ -7,7 +7,9 @@
 //!
 //! Options (after `--`): `--family NAME` (specimen, panel, strip, arch-edge, wrapped; repeatable),
 //! `--quick` (every 10th path of each family), `--failures` (print every failed path),
-//! `--threads N` (paths run in parallel, default: available cores).
+//! `--threads N` (paths run in parallel, default: available cores), `--check` (exit with status 1
+//! unless every path run converges, after listing the failures: CI runs
+//! `cargo bench --bench robustness -- --check --quick`).
 //!
 //! This measures convergence, not speed; the wall time is printed only so that the run can be
 //! planned.
@@ -18,12 +20,15 @@ use std::time::Instant;
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::SolverSettings;
-use membrane_contact::mech::scenarios::{Family, RunOutcome, Scenario, robustness_grid};
+use membrane_contact::mech::scenarios::{
+    Family, RunOutcome, Scenario, grid_slice, robustness_grid,
+};
 
 struct Options {
     families: Vec<Family>,
     quick: bool,
     failures: bool,
+    check: bool,
     threads: usize,
 }
 
@@ -32,6 +37,7 @@ fn parse() -> Result<Options, String> {
         families: vec![],
         quick: false,
         failures: false,
+        check: false,
         threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
     let mut args = std::env::args().skip(1);
@@ -40,6 +46,7 @@ fn parse() -> Result<Options, String> {
             "--bench" => {}
             "--quick" => o.quick = true,
             "--failures" => o.failures = true,
+            "--check" => o.check = true,
             "--family" => {
                 let name = args.next().ok_or("--family needs a name")?;
                 let f = Family::ALL
@@ -100,16 +107,12 @@ fn main() {
     };
     let increments = usize::try_from(DEFAULT_INCREMENTS_PER_STEP).unwrap();
     let grid = robustness_grid(increments).expect("the benchmark grid builds");
-    let mut paths: Vec<Scenario> = vec![];
-    for family in &o.families {
-        let of: Vec<Scenario> = grid
-            .iter()
-            .filter(|s| s.family == *family)
-            .cloned()
-            .collect();
-        let stride = if o.quick { 10 } else { 1 };
-        paths.extend(of.into_iter().step_by(stride));
-    }
+    let stride = if o.quick { 10 } else { 1 };
+    let paths: Vec<Scenario> = o
+        .families
+        .iter()
+        .flat_map(|family| grid_slice(&grid, *family, stride))
+        .collect();
     println!(
         "## robustness: {} load paths, default solver settings, {increments} increments per step \
          (1 for the CLI-style panel ramps), {} threads\n",
@@ -182,12 +185,23 @@ fn main() {
         total.5
     );
     println!("\nwall time {wall:.1} s");
-    if o.failures {
+    let failed = total.0 - total.1;
+    if o.failures || (o.check && failed > 0) {
         println!("\n### failed paths\n");
         for (s, (r, _)) in &pairs {
             if let Some(m) = r.failure_message() {
                 println!("- {}: {m}", s.name);
             }
         }
+    }
+    if o.check {
+        if total.0 == 0 || failed > 0 {
+            eprintln!(
+                "robustness check failed: {} of {} load paths converge",
+                total.1, total.0
+            );
+            std::process::exit(1);
+        }
+        println!("\ncheck passed: all {} load paths converge", total.0);
     }
 }

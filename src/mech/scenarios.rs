@@ -186,6 +186,8 @@ pub struct StepOutcome {
     pub cutbacks: usize,
     /// Increments made larger than asked because every smaller one failed.
     pub enlarged: usize,
+    /// `‖R_free‖∞` at the converged end of the step (N; 0 for a refused step).
+    pub residual: f64,
     /// The error text when the step was refused.
     pub error: Option<String>,
 }
@@ -260,6 +262,16 @@ impl Scenario {
     /// the path's increments per step, `μ` set at the start of a stage that gives one. Stops at
     /// the first refused step (the FMU would return `fmi2Discard` there).
     pub fn run(&self, settings: SolverSettings) -> RunOutcome {
+        self.run_observed(settings, |_, _| {})
+    }
+
+    /// [`Scenario::run`], calling `observe` after every converged step with the step's record
+    /// and the analysis at its converged state (to check what a path converges to).
+    pub fn run_observed(
+        &self,
+        settings: SolverSettings,
+        mut observe: impl FnMut(&StepOutcome, &mut Analysis),
+    ) -> RunOutcome {
         let mut outcome = RunOutcome::default();
         let mut analysis = match Analysis::new(self.model.clone(), settings) {
             Ok(a) => a,
@@ -291,6 +303,7 @@ impl Scenario {
                     increments: 0,
                     cutbacks: 0,
                     enlarged: 0,
+                    residual: 0.0,
                     error: None,
                 };
                 match analysis.step_to(&target, self.path.increments_per_step) {
@@ -301,6 +314,8 @@ impl Scenario {
                         record.increments = report.iterations.len();
                         record.cutbacks = report.cutbacks;
                         record.enlarged = report.enlarged;
+                        record.residual = report.residual;
+                        observe(&record, &mut analysis);
                         outcome.steps.push(record);
                     }
                     Err(e) => {
@@ -1142,9 +1157,14 @@ impl ArchEdge {
 /// * strip: `R` ∈ {0.2, 0.3, 0.5} m × `μ` ∈ {0, 0.2, 0.5} × pull (down, out) ∈ {(5, 0),
 ///   (10, 0), (10, 5)} mm × steps ∈ {1, 10} (54 paths);
 /// * arch edge: `H` ∈ {0.2, 0.3, 0.4} m × `μ` ∈ {0.1, 0.2, 0.5} × steps ∈ {20, 80} to `−H/2`
-///   (18 paths).
+///   (18 paths);
+/// * wrapped: `H` ∈ {0.2, 0.3, 0.4} m × contact ∈ {gaps, curved support} × `μ` ∈ {0, 0.2, 0.8}
+///   × {`ε` = 0.02 in 10 steps, 0.04 in 40, 0.04 in 40 then released in 10} (54 paths).
 ///
 /// `increments_per_step` is the FMU's default for every path except the CLI-style panel ramp.
+///
+/// The benchmark's `--quick` run and the robustness test draw their samples from this grid with
+/// [`grid_slice`].
 pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, String> {
     let ips = increments_per_step;
     let mut out = Vec::new();
@@ -1260,6 +1280,16 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
         }
     }
     Ok(out)
+}
+
+/// Every `stride`-th path of `family` in `grid`, from its first, in grid order (`stride` 0 is
+/// taken as 1).
+pub fn grid_slice(grid: &[Scenario], family: Family, stride: usize) -> Vec<Scenario> {
+    grid.iter()
+        .filter(|s| s.family == family)
+        .step_by(stride.max(1))
+        .cloned()
+        .collect()
 }
 
 // ------------------------------------------------------------------------ circular membrane

@@ -922,6 +922,12 @@ pub struct SurfaceContactResult {
     pub normal_force: f64,
     /// Friction force magnitude (N).
     pub friction_force: f64,
+    /// Friction force components along `ξ1` (the support's length) and `ξ2` (across) (N).
+    #[serde(default)]
+    pub friction: [f64; 2],
+    /// Force of the support on the film, global axes: normal and friction (N).
+    #[serde(default)]
+    pub force: [f64; 3],
     pub status: GapStatus,
 }
 
@@ -1064,6 +1070,8 @@ impl SurfaceContacts {
                     gap: p.gap,
                     normal_force: r.normal_force,
                     friction_force: r.friction.norm(),
+                    friction: r.friction.into(),
+                    force: (-r.residual).into(),
                     status: h.status,
                 }
             })
