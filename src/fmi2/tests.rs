@@ -1609,7 +1609,10 @@ fn round_trips_at_every_step(
         contact,
         ..ParallelArch::default()
     };
-    let u = Unpacked::new(&format!("roundtrip {contact:?} {law}"), Source::ParallelArch(spec));
+    let u = Unpacked::new(
+        &format!("roundtrip {contact:?} {law}"),
+        Source::ParallelArch(spec),
+    );
     let log = Log::default();
     let fmu = Fmu::new(&u, &log);
     unsafe {
@@ -1663,7 +1666,11 @@ fn round_trips_at_every_step(
             log.take()
         );
         assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, read) }, 0);
-        assert_eq!(step(), reference, "{contact:?} {law} step {k}: deserialized");
+        assert_eq!(
+            step(),
+            reference,
+            "{contact:?} {law} step {k}: deserialized"
+        );
         unsafe {
             assert_eq!(fmi2_free_fmu_state(fmu.c, &mut state), 0);
             assert_eq!(fmi2_free_fmu_state(fmu.c, &mut read), 0);
@@ -1760,11 +1767,18 @@ fn forged_variable_values_are_refused_as_fmi2_set_would_naming_the_variable() {
     assert_eq!(fmu.step(1e300, 0.1), Status::Error.raw());
     let messages = log.take();
     assert!(
-        messages.iter().any(|(_, _, m)| m.contains("communicationStepSize = -1e300 must be > 0"))
-            && messages.iter().any(|(_, _, m)| m.contains("currentCommunicationPoint = 1e300 differs")),
+        messages
+            .iter()
+            .any(|(_, _, m)| m.contains("communicationStepSize = -1e300 must be > 0"))
+            && messages
+                .iter()
+                .any(|(_, _, m)| m.contains("currentCommunicationPoint = 1e300 differs")),
         "{messages:?}"
     );
-    assert!(messages.iter().all(|(_, _, m)| !m.contains("0000000000")), "{messages:?}");
+    assert!(
+        messages.iter().all(|(_, _, m)| !m.contains("0000000000")),
+        "{messages:?}"
+    );
     // The genuine state is still accepted.
     assert_eq!(deserialize_status(&fmu, &bytes).0, 0);
 }

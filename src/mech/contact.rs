@@ -367,7 +367,10 @@ impl GapLaw {
             trial.y,
             limit,
             if moved > tolerance {
-                format!(", a further slip of {:e} m", moved / self.tangential_stiffness)
+                format!(
+                    ", a further slip of {:e} m",
+                    moved / self.tangential_stiffness
+                )
             } else {
                 String::new()
             }
@@ -475,7 +478,11 @@ mod tests {
                 let d = Vector3::from(d);
                 let r = law.evaluate(d, HISTORY);
                 let check = |status, slip| law.check_committed(status, d, slip, tolerance);
-                assert_eq!(check(status, r.plastic_slip), Ok(()), "{friction_law} {name}");
+                assert_eq!(
+                    check(status, r.plastic_slip),
+                    Ok(()),
+                    "{friction_law} {name}"
+                );
                 for other in [GapStatus::Open, GapStatus::Stick, GapStatus::Slip] {
                     if other != status && !(status == GapStatus::Slip && other == GapStatus::Stick)
                     {
