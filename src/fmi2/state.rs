@@ -31,6 +31,7 @@ use serde::{Deserialize, Serialize};
 use super::instance::Phase;
 use super::variables::Value;
 use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
+use crate::mech::surface::SurfaceContacts;
 use crate::mech::{AnalysisState, Model};
 
 /// Everything needed to continue an instance exactly.
@@ -143,7 +144,8 @@ pub fn model_size(model: &Model) -> f64 {
 /// Checks a (deserialized) analysis state against `model`: sizes, finite and bounded values,
 /// `μ ∈ [0, MAX_FRICTION]`, and each gap's stored status and slip history against the gap's
 /// own law ([`GapLaw::check_committed`](crate::mech::contact::GapLaw::check_committed), the
-/// law the solver evaluates, under either friction law).
+/// law the solver evaluates, under either friction law), and each curved-support contact's
+/// status and anchor likewise ([`SurfaceContacts::check_committed`]).
 pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), String> {
     let (n, gaps, groups) = (model.dof_count(), model.gaps.len(), model.groups.len());
     let sizes = [
@@ -261,6 +263,21 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             model.gaps[g].name
         ));
     }
+    SurfaceContacts::new(model)
+        .check_committed(&state.displacement, &state.contacts, size)
+        .map_err(|(k, e)| {
+            let (support, node) = model
+                .curved_supports
+                .iter()
+                .flat_map(|s| s.nodes.iter().map(move |&v| (&s.name, v)))
+                .nth(k)
+                .expect("one contact per node of a curved support");
+            format!(
+                "the state's status of node {node} on curved support '{support}' is {:?} with \
+                 its stored displacements and anchor, but {e}",
+                state.contacts[k].status
+            )
+        })?;
     let at = |v: usize| Vector3::from_fn(|c, _| state.displacement[3 * v + c]);
     for (g, spec) in model.gaps.iter().enumerate() {
         let ub = match spec.support {

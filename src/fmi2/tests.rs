@@ -1782,3 +1782,60 @@ fn forged_variable_values_are_refused_as_fmi2_set_would_naming_the_variable() {
     // The genuine state is still accepted.
     assert_eq!(deserialize_status(&fmu, &bytes).0, 0);
 }
+
+/// Issue 17, defect 1 for curved supports: a forged curved-support contact status or anchor
+/// that the contact's own law contradicts is refused at deserialization, naming the node and
+/// the support; the genuine state (round trips in every status: above) is accepted.
+#[test]
+fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
+    use crate::mech::GapStatus;
+    let spec = ParallelArch {
+        contact: crate::mech::specimen::SpecimenContact::CurvedSupport,
+        ..ParallelArch::default()
+    };
+    let (u, log) = (
+        Unpacked::new("forgedcontacts", Source::ParallelArch(spec)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    let bytes = serialized_after_ramp(&fmu);
+    let guid = u.guid.to_str().unwrap();
+    let genuine = super::state::deserialize(&bytes, guid).unwrap();
+    let contacts = &genuine.analysis.as_ref().unwrap().contacts;
+    let model = spec.model().unwrap();
+    let support = &model.curved_supports[0];
+    let slipping = contacts.iter().position(|c| c.status == GapStatus::Slip);
+    let open = contacts.iter().position(|c| c.status == GapStatus::Open);
+    let (slipping, open) = (slipping.unwrap(), open.unwrap());
+    let name = |k: usize| {
+        format!(
+            "node {} on curved support '{}'",
+            support.nodes[k], support.name
+        )
+    };
+    type Forgery = Box<dyn Fn(&mut crate::mech::surface::ContactHistory)>;
+    let cases: Vec<(usize, Forgery, String)> = vec![
+        (
+            open,
+            Box::new(|c| c.status = GapStatus::Stick),
+            format!("status of {} is Stick", name(open)),
+        ),
+        (
+            slipping,
+            Box::new(|c| c.status = GapStatus::Open),
+            format!("status of {} is Open", name(slipping)),
+        ),
+        (
+            slipping,
+            Box::new(|c| c.anchor[0] += 1e-3),
+            "further slip".into(),
+        ),
+    ];
+    for (k, f, expected) in cases {
+        let forged = forge(&bytes, guid, |s| {
+            f(&mut s.analysis.as_mut().unwrap().contacts[k])
+        });
+        assert_deserialization_refused(&fmu, &forged, &expected);
+    }
+    assert_eq!(deserialize_status(&fmu, &bytes).0, 0, "{:?}", log.take());
+}
