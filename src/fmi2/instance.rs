@@ -61,13 +61,14 @@ use super::state::{self, Snapshot};
 use super::types::{
     FMI2_CO_SIMULATION, FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status,
 };
-use super::variables::{Binding, Causality, StepInputs, Value, VarType, Variable, step_inputs};
+use super::variables::{
+    Binding, Causality, StepInputs, Value, VarType, Variable, article, message_real, step_inputs,
+};
 use crate::mech::element::state_counts;
 use crate::mech::material::Wrinkling;
 use crate::mech::{
     Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SolverSettings,
     StepError, StepReport, check_results,
-    model::MAX_FRICTION,
     solver::{IncrementFailure, MAX_THREADS},
     summary::{model_warnings, result_warnings},
     vtk,
@@ -546,57 +547,38 @@ impl Instance {
         Ok(())
     }
 
+    /// Checks `values` for `vrs` ([`Variable::check_value`], after [`Self::settable`]) and
+    /// stores them; the first bad one refuses the whole call.
+    fn set_values(&mut self, vrs: &[u32], want: VarType, values: Vec<Value>) -> Outcome {
+        for (&vr, x) in vrs.iter().zip(&values) {
+            self.settable(vr, want)?
+                .check_value(x)
+                .map_err(Failure::error)?;
+        }
+        self.assign(vrs, values.into_iter());
+        Ok(())
+    }
+
     /// Copies the strings (the caller's may go away after the call).
     pub fn set_string(&mut self, vrs: &[u32], values: &[&str]) -> Outcome {
-        for (&vr, &x) in vrs.iter().zip(values) {
-            let v = self.settable(vr, VarType::String)?;
-            if v.binding == Binding::FrictionLaw && !x.is_empty() {
-                x.parse::<crate::mech::FrictionLaw>()
-                    .map_err(|e| Failure::error(format!("{}: {e}", v.name)))?;
-            }
-            if v.binding == Binding::VtkFormat {
-                x.parse::<vtk::Encoding>()
-                    .map_err(|e| Failure::error(format!("{}: {e}", v.name)))?;
-            }
-        }
-        self.assign(vrs, values.iter().map(|&x| Value::String(x.to_owned())));
-        Ok(())
+        let values = values.iter().map(|&x| Value::String(x.to_owned()));
+        self.set_values(vrs, VarType::String, values.collect())
     }
 
     pub fn set_real(&mut self, vrs: &[u32], values: &[f64]) -> Outcome {
-        for (&vr, &x) in vrs.iter().zip(values) {
-            let v = self.settable(vr, VarType::Real)?;
-            if !x.is_finite() {
-                return Err(Failure::error(format!(
-                    "{} = {x}: values must be finite",
-                    v.name
-                )));
-            }
-            if v.binding == Binding::Friction && !(0.0..=MAX_FRICTION).contains(&x) {
-                return Err(Failure::error(format!(
-                    "mu = {x}: the friction coefficient must be ≥ 0 and ≤ {MAX_FRICTION}"
-                )));
-            }
-        }
-        self.assign(vrs, values.iter().map(|&x| Value::Real(x)));
-        Ok(())
+        let values = values.iter().map(|&x| Value::Real(x));
+        self.set_values(vrs, VarType::Real, values.collect())
     }
 
     pub fn set_integer(&mut self, vrs: &[u32], values: &[i32]) -> Outcome {
-        for &vr in vrs {
-            self.settable(vr, VarType::Integer)?;
-        }
-        self.assign(vrs, values.iter().map(|&x| Value::Integer(x)));
-        Ok(())
+        let values = values.iter().map(|&x| Value::Integer(x));
+        self.set_values(vrs, VarType::Integer, values.collect())
     }
 
     /// Booleans as C ints (any non-zero is true).
     pub fn set_boolean(&mut self, vrs: &[u32], values: &[i32]) -> Outcome {
-        for &vr in vrs {
-            self.settable(vr, VarType::Boolean)?;
-        }
-        self.assign(vrs, values.iter().map(|&x| Value::Boolean(x != 0)));
-        Ok(())
+        let values = values.iter().map(|&x| Value::Boolean(x != 0));
+        self.set_values(vrs, VarType::Boolean, values.collect())
     }
 
     /// Whether `vr` may be set now (FMI 2.0 §4.2.4 conditions (1), (3), (6)).
@@ -669,7 +651,7 @@ impl Instance {
                     ..*spec
                 }
                 .model()
-                .map_err(|e| format!("archHeight = {arch_height}: {e}"))?
+                .map_err(|e| format!("archHeight = {}: {e}", message_real(arch_height)))?
             }
             Source::Model(m) => m.clone(),
         };
@@ -851,12 +833,15 @@ impl Instance {
     pub fn do_step(&mut self, t: f64, h: f64) -> Outcome {
         if !(t.is_finite() && h.is_finite()) {
             return Err(Failure::error(format!(
-                "currentCommunicationPoint = {t} and step size = {h} must be finite"
+                "currentCommunicationPoint = {} and step size = {} must be finite",
+                message_real(t),
+                message_real(h)
             )));
         }
         if h <= 0.0 {
             return Err(Failure::error(format!(
-                "communicationStepSize = {h} must be > 0"
+                "communicationStepSize = {} must be > 0",
+                message_real(h)
             )));
         }
         let tolerance = 1e-9 * t.abs().max(self.time.abs()).max(1.0);
@@ -872,8 +857,9 @@ impl Instance {
                 String::new()
             };
             return Err(Failure::error(format!(
-                "currentCommunicationPoint = {t} differs from the FMU's time {} (the last converged communication point){stale}",
-                self.time
+                "currentCommunicationPoint = {} differs from the FMU's time {} (the last converged communication point){stale}",
+                message_real(t),
+                message_real(self.time)
             )));
         }
         if let Some(stop) = self.stop_time
@@ -1127,14 +1113,8 @@ impl Instance {
             ));
         }
         for (v, x) in table.iter().zip(&s.values) {
-            let bad = match x {
-                Value::Real(r) => !r.is_finite(),
-                Value::String(text) => text.contains('\0'),
-                _ => false,
-            };
-            if x.var_type() != v.var_type || bad {
-                return Err(format!("the state's value of {} is {x:?}", v.name));
-            }
+            v.check_value(x)
+                .map_err(|e| format!("the state's value of {}: {e}", v.name))?;
         }
         let times = [s.time, s.start_time, s.stop_time.unwrap_or(0.0)];
         let file_times = s.vtk_steps.iter().map(|(t, _)| *t);
@@ -1362,10 +1342,6 @@ fn replace_file(path: &Path, text: &str) -> std::io::Result<()> {
     tmp.push(".tmp");
     std::fs::write(&tmp, text)?;
     std::fs::rename(&tmp, path)
-}
-
-fn article(t: VarType) -> &'static str {
-    if t == VarType::Integer { "n" } else { "" }
 }
 
 fn unavailable_status(kind: i32, function: &str) -> Failure {

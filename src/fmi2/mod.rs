@@ -24,7 +24,8 @@
 //! No global mutable state: everything lives in the [`Instance`](instance::Instance) behind
 //! `fmi2Component`; instances are independent and may run on different threads. The library
 //! keeps no thread: the assembly's threads (`solver.threads`) are scoped and joined before the
-//! FMI call that started them returns. It is linked with `-z nodelete` (see `fmu/build.rs`), so an
+//! FMI call that started them returns, on Linux until their tasks have left `/proc/self/task`
+//! (`tests/threads.rs`). It is linked with `-z nodelete` (see `fmu/build.rs`), so an
 //! importer's `dlclose` cannot unload code that is still referenced.
 
 pub mod description;

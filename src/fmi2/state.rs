@@ -31,7 +31,8 @@ use serde::{Deserialize, Serialize};
 use super::instance::Phase;
 use super::variables::Value;
 use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
-use crate::mech::{AnalysisState, GapStatus, Model};
+use crate::mech::surface::SurfaceContacts;
+use crate::mech::{AnalysisState, Model};
 
 /// Everything needed to continue an instance exactly.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -141,9 +142,10 @@ pub fn model_size(model: &Model) -> f64 {
 }
 
 /// Checks a (deserialized) analysis state against `model`: sizes, finite and bounded values,
-/// `μ ∈ [0, MAX_FRICTION]`, and each gap's stored status against the gap law re-evaluated at
-/// the stored displacements and slip history (open ⇔ the law finds it open; stick ⇒ the law
-/// finds it stuck; slip ⇒ closed with the trial force on the Coulomb limit `μN`).
+/// `μ ∈ [0, MAX_FRICTION]`, and each gap's stored status and slip history against the gap's
+/// own law ([`GapLaw::check_committed`](crate::mech::contact::GapLaw::check_committed), the
+/// law the solver evaluates, under either friction law), and each curved-support contact's
+/// status and anchor likewise ([`SurfaceContacts::check_committed`]).
 pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), String> {
     let (n, gaps, groups) = (model.dof_count(), model.gaps.len(), model.groups.len());
     let sizes = [
@@ -261,6 +263,21 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             model.gaps[g].name
         ));
     }
+    SurfaceContacts::new(model)
+        .check_committed(&state.displacement, &state.contacts, size)
+        .map_err(|(k, e)| {
+            let (support, node) = model
+                .curved_supports
+                .iter()
+                .flat_map(|s| s.nodes.iter().map(move |&v| (&s.name, v)))
+                .nth(k)
+                .expect("one contact per node of a curved support");
+            format!(
+                "the state's status of node {node} on curved support '{support}' is {:?} with \
+                 its stored displacements and anchor, but {e}",
+                state.contacts[k].status
+            )
+        })?;
     let at = |v: usize| Vector3::from_fn(|c, _| state.displacement[3 * v + c]);
     for (g, spec) in model.gaps.iter().enumerate() {
         let ub = match spec.support {
@@ -272,27 +289,22 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             friction: state.friction[g],
             ..spec.law()
         };
-        let r = law.evaluate(d, Vector2::from(state.plastic_slip[g]));
-        let limit = law.friction * r.normal_force;
-        let on_limit = (r.trial_magnitude - limit).abs()
-            <= 1e-6 * limit.max(law.tangential_stiffness * 1e-9 * size);
-        let consistent = match state.status[g] {
-            GapStatus::Open => r.status == GapStatus::Open,
-            GapStatus::Stick => r.status == GapStatus::Stick,
-            GapStatus::Slip => r.status != GapStatus::Open && on_limit,
-        };
-        if !consistent {
-            return Err(format!(
-                "the state's status of gap '{}' is {:?}, but its stored displacements give {:?} \
-                 (gap {:e} m, trial friction {:e} N, limit μN = {:e} N)",
-                spec.name,
-                state.status[g],
-                r.status,
-                spec.initial_gap + d.z,
-                r.trial_magnitude,
-                limit
-            ));
-        }
+        // 1e-6 of the Coulomb limit μN, or of the tangential force of 1e-9 of the model's size.
+        let coulomb = law.friction * law.normal_stiffness * (-(spec.initial_gap + d.z)).max(0.0);
+        let tolerance = 1e-6 * coulomb.max(law.tangential_stiffness * 1e-9 * size);
+        law.check_committed(
+            state.status[g],
+            d,
+            Vector2::from(state.plastic_slip[g]),
+            tolerance,
+        )
+        .map_err(|e| {
+            format!(
+                "the state's status of gap '{}' is {:?} with its stored displacements and slip \
+                 history, but {e}",
+                spec.name, state.status[g]
+            )
+        })?;
     }
     Ok(())
 }

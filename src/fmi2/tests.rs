@@ -696,16 +696,8 @@ fn saved_states_restore_and_continue_identically() {
     assert_eq!(fmu.all_values(), reference);
 
     // Serialize, and continue in a fresh instance with other parameters set.
-    let mut size = 0;
-    assert_eq!(
-        unsafe { fmi2_serialized_fmu_state_size(fmu.c, state, &mut size) },
-        0
-    );
-    let mut bytes = vec![0 as Fmi2Byte; size];
-    assert_eq!(
-        unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size) },
-        0
-    );
+    let mut bytes = serialized(&fmu, state);
+    let size = bytes.len();
     assert_eq!(
         unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size - 1) },
         Status::Error.raw()
@@ -1161,19 +1153,9 @@ fn forge(bytes: &[u8], guid: &str, f: impl FnOnce(&mut super::state::Snapshot)) 
 fn serialized_after_ramp(fmu: &Fmu) -> Vec<u8> {
     fmu.ramp(0, 4, 10);
     let mut state: Fmi2FmuState = std::ptr::null_mut();
-    let mut size = 0;
-    unsafe {
-        assert_eq!(fmi2_get_fmu_state(fmu.c, &mut state), 0);
-        assert_eq!(fmi2_serialized_fmu_state_size(fmu.c, state, &mut size), 0);
-    }
-    let mut bytes = vec![0 as Fmi2Byte; size];
-    unsafe {
-        assert_eq!(
-            fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size),
-            0
-        );
-        assert_eq!(fmi2_free_fmu_state(fmu.c, &mut state), 0);
-    }
+    assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+    let bytes = serialized(fmu, state);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
     bytes.iter().map(|&b| b as u8).collect()
 }
 
@@ -1182,6 +1164,19 @@ fn deserialize_status(fmu: &Fmu, bytes: &[u8]) -> (c_int, Fmi2FmuState) {
     let status =
         unsafe { fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr().cast(), bytes.len(), &mut s) };
     (status, s)
+}
+
+/// `fmi2DeSerializeFMUstate` of `bytes` returns fmi2Error, no state, and logs `expected`.
+fn assert_deserialization_refused(fmu: &Fmu, bytes: &[u8], expected: &str) {
+    let (status, s) = deserialize_status(fmu, bytes);
+    assert_eq!(status, Status::Error.raw(), "{expected}");
+    assert!(s.is_null());
+    assert!(
+        fmu.log.contains(Status::Error, expected),
+        "{expected}: {:?}",
+        fmu.log.take()
+    );
+    fmu.log.take();
 }
 
 /// Issue 12, item 3: forged states (scaled displacements with length and CRC recomputed, sizes
@@ -1242,16 +1237,7 @@ fn forged_states_are_refused_at_deserialization_with_a_message() {
         ),
     ];
     for (f, expected) in cases {
-        let forged = forge(&bytes, guid, f);
-        let (status, s) = deserialize_status(&fmu, &forged);
-        assert_eq!(status, Status::Error.raw(), "{expected}");
-        assert!(s.is_null());
-        assert!(
-            log.contains(Status::Error, expected),
-            "{expected}: {:?}",
-            log.take()
-        );
-        log.take();
+        assert_deserialization_refused(&fmu, &forge(&bytes, guid, f), expected);
     }
     // The instance is untouched and steps on.
     fmu.ramp(4, 5, 10);
@@ -1392,16 +1378,8 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
     assert_eq!(fmu.set_real("top.pressure", 100.0), 0);
     assert_eq!(fmu.step(0.5, 0.5), 0);
     assert_eq!(fmu.all_values(), reference);
-    let mut size = 0;
-    assert_eq!(
-        unsafe { fmi2_serialized_fmu_state_size(fmu.c, state, &mut size) },
-        0
-    );
-    let mut bytes = vec![0 as Fmi2Byte; size];
-    assert_eq!(
-        unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size) },
-        0
-    );
+    let bytes = serialized(&fmu, state);
+    let size = bytes.len();
     let other = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
     let mut restored: Fmi2FmuState = std::ptr::null_mut();
     assert_eq!(
@@ -1629,4 +1607,295 @@ fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
     assert_eq!(fmu.integer("G.status"), 1);
     assert!((fmu.real("G.frictionX") + 20.0).abs() < 1e-9);
     assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
+}
+
+// ---------------------------------------------------------------- issue 17: trust in the workflow
+
+/// Issue 17, defect 1 as reported: the specimen with the paper's law, `frame.dz` = −0.03, −0.06,
+/// −0.09, saved, one more step, restored: the restore must succeed.
+#[test]
+fn saved_state_restores_under_sliding_direction_law() {
+    let (u, log) = (Unpacked::specimen("slidingrestore"), Log::default());
+    let fmu = Fmu::new(&u, &log);
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(fmu.set_string("frictionLaw", "sliding-direction"), 0);
+    assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+    for (k, dz) in [-0.03, -0.06, -0.09].into_iter().enumerate() {
+        assert_eq!(fmu.set_real("frame.dz", dz), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+    }
+    let mut state: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+    assert_eq!(fmu.set_real("frame.dz", -0.12), 0);
+    assert_eq!(fmu.step(3.0, 1.0), 0, "{:?}", log.take());
+    assert_eq!(
+        unsafe { fmi2_set_fmu_state(fmu.c, state) },
+        0,
+        "{:?}",
+        log.take()
+    );
+}
+
+/// The state's serialized bytes (`fmi2SerializedFMUstateSize` + `fmi2SerializeFMUstate`).
+fn serialized(fmu: &Fmu, state: Fmi2FmuState) -> Vec<Fmi2Byte> {
+    let mut size = 0;
+    assert_eq!(
+        unsafe { fmi2_serialized_fmu_state_size(fmu.c, state, &mut size) },
+        0
+    );
+    let mut bytes = vec![0 as Fmi2Byte; size];
+    assert_eq!(
+        unsafe { fmi2_serialize_fmu_state(fmu.c, state, bytes.as_mut_ptr(), size) },
+        0
+    );
+    bytes
+}
+
+/// Steps the specimen (`contact`: its nine gaps or its curved support) under `law` along
+/// `path` (`frame.dz` as a fraction of its target and `mu`, one step each); before each step after the
+/// first saves the state (get, and serialized), steps, then restores the state by
+/// `fmi2SetFMUstate` and by `fmi2DeSerializeFMUstate` + `fmi2SetFMUstate` and repeats the step:
+/// every output must equal the one of the step that never restored, bit for bit. Returns the
+/// statuses (0 open, 1 stick, 2 slip) the contacts had at the saved states.
+fn round_trips_at_every_step(
+    contact: crate::mech::specimen::SpecimenContact,
+    law: &str,
+    path: &[(f64, f64)],
+) -> std::collections::BTreeSet<i32> {
+    let spec = ParallelArch {
+        contact,
+        ..ParallelArch::default()
+    };
+    let u = Unpacked::new(
+        &format!("roundtrip {contact:?} {law}"),
+        Source::ParallelArch(spec),
+    );
+    let log = Log::default();
+    let fmu = Fmu::new(&u, &log);
+    unsafe {
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
+    }
+    assert_eq!(fmu.set_string("frictionLaw", law), 0);
+    assert_eq!(fmu.set_integer("solver.incrementsPerStep", 2), 0);
+    assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+    let status_names: Vec<String> = u
+        .variables
+        .iter()
+        .filter(|v| v.name.ends_with(".status") && v.name != "solver.status")
+        .map(|v| v.name.clone())
+        .collect();
+    assert_eq!(status_names.len(), 9, "{status_names:?}");
+    let mut seen = std::collections::BTreeSet::new();
+    let target = spec.target()[2];
+    for (k, &(fraction, mu)) in path.iter().enumerate() {
+        let dz = target * fraction;
+        let t = k as f64;
+        if k == 0 {
+            assert_eq!(fmu.set_real("frame.dz", dz), 0);
+            assert_eq!(fmu.set_real("mu", mu), 0);
+            assert_eq!(fmu.step(t, 1.0), 0, "{law} step {k}: {:?}", log.take());
+            continue;
+        }
+        seen.extend(status_names.iter().map(|n| fmu.integer(n)));
+        let mut state: Fmi2FmuState = std::ptr::null_mut();
+        assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+        let bytes = serialized(&fmu, state);
+        let step = || {
+            assert_eq!(fmu.set_real("frame.dz", dz), 0);
+            assert_eq!(fmu.set_real("mu", mu), 0);
+            assert_eq!(fmu.step(t, 1.0), 0, "{law} step {k}: {:?}", log.take());
+            fmu.all_values()
+        };
+        let reference = step();
+        assert_eq!(
+            unsafe { fmi2_set_fmu_state(fmu.c, state) },
+            0,
+            "{contact:?} {law} step {k}: {:?}",
+            log.take()
+        );
+        assert_eq!(step(), reference, "{contact:?} {law} step {k}: restored");
+        let mut read: Fmi2FmuState = std::ptr::null_mut();
+        assert_eq!(
+            unsafe { fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr(), bytes.len(), &mut read) },
+            0,
+            "{contact:?} {law} step {k}: {:?}",
+            log.take()
+        );
+        assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, read) }, 0);
+        assert_eq!(
+            step(),
+            reference,
+            "{contact:?} {law} step {k}: deserialized"
+        );
+        unsafe {
+            assert_eq!(fmi2_free_fmu_state(fmu.c, &mut state), 0);
+            assert_eq!(fmi2_free_fmu_state(fmu.c, &mut read), 0);
+        }
+    }
+    seen
+}
+
+#[test]
+fn saved_states_round_trip_in_every_gap_and_contact_status_under_both_laws() {
+    // (frame.dz / target, μ): down, a little way back up (the sliding nodes stick under the
+    // isotropic law), with μ = 10 (they stick under the sliding-direction law, whose elastic
+    // y force is several μN at μ = 0.2), back up (nodes open), down again.
+    const PATH: [(f64, f64); 10] = [
+        (0.1, 0.2),
+        (0.2, 0.2),
+        (0.3, 0.2),
+        (0.4, 0.2),
+        (0.5, 0.2),
+        (0.4999, 0.2),
+        (0.499, 10.0),
+        (0.49, 0.2),
+        (0.3, 0.2),
+        (0.6, 0.2),
+    ];
+    use crate::mech::specimen::SpecimenContact;
+    for contact in [SpecimenContact::Gaps, SpecimenContact::CurvedSupport] {
+        for law in ["isotropic", "sliding-direction"] {
+            let seen = round_trips_at_every_step(contact, law, &PATH);
+            assert_eq!(
+                seen,
+                [0, 1, 2].into(),
+                "{contact:?} {law}: statuses at the saved states"
+            );
+        }
+    }
+}
+
+/// Issue 17, defect 2: a serialized state whose stored variable values `fmi2SetReal`/`SetString`
+/// would refuse (μ = 1e300 or 11, an unknown friction law or VTK encoding, a value of the wrong
+/// type; length and CRC recomputed) is refused by `fmi2DeSerializeFMUstate` with the same
+/// message, naming the variable; NaN cannot even be written in the payload (JSON has no NaN).
+#[test]
+fn forged_variable_values_are_refused_as_fmi2_set_would_naming_the_variable() {
+    use super::variables::Value;
+    let (u, log) = (Unpacked::specimen("forgedvalues"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[("mu", 0.2)], &[]);
+    let bytes = serialized_after_ramp(&fmu);
+    let guid = u.guid.to_str().unwrap();
+    let forged = |name: &str, value: Value| {
+        let at = u.vr(name) as usize;
+        forge(&bytes, guid, move |s| s.values[at] = value)
+    };
+    let cases = [
+        (
+            forged("mu", Value::Real(1e300)),
+            "the state's value of mu: mu = 1e300: the friction coefficient must be ≥ 0 and ≤ 10",
+        ),
+        (
+            forged("mu", Value::Real(11.0)),
+            "the state's value of mu: mu = 11: the friction coefficient",
+        ),
+        (
+            forged("mu", Value::Real(-0.5)),
+            "mu = -0.5: the friction coefficient",
+        ),
+        (forged("mu", Value::Real(f64::NAN)), "payload"),
+        (
+            forged("frictionLaw", Value::String("x-only".into())),
+            "the state's value of frictionLaw: frictionLaw: unknown friction law 'x-only'",
+        ),
+        (
+            forged("results.vtkFormat", Value::String("gzip".into())),
+            "the state's value of results.vtkFormat: results.vtkFormat:",
+        ),
+        (
+            forged("film.E", Value::Integer(7)),
+            "film.E is a Real, not an Integer",
+        ),
+    ];
+    for (forged, expected) in cases {
+        assert_deserialization_refused(&fmu, &forged, expected);
+    }
+    // The same values through fmi2SetReal/fmi2SetString: the same messages.
+    assert_eq!(fmu.set_real("mu", 1e300), Status::Error.raw());
+    assert!(log.contains(
+        Status::Error,
+        "mu = 1e300: the friction coefficient must be ≥ 0 and ≤ 10"
+    ));
+    assert_eq!(fmu.set_real("mu", 11.0), Status::Error.raw());
+    assert!(log.contains(Status::Error, "mu = 11: the friction coefficient"));
+    // Neither a huge nor a tiny number prints as hundreds of digits.
+    assert_eq!(fmu.step(0.4, -1e300), Status::Error.raw());
+    assert_eq!(fmu.step(1e300, 0.1), Status::Error.raw());
+    let messages = log.take();
+    assert!(
+        messages
+            .iter()
+            .any(|(_, _, m)| m.contains("communicationStepSize = -1e300 must be > 0"))
+            && messages
+                .iter()
+                .any(|(_, _, m)| m.contains("currentCommunicationPoint = 1e300 differs")),
+        "{messages:?}"
+    );
+    assert!(
+        messages.iter().all(|(_, _, m)| !m.contains("0000000000")),
+        "{messages:?}"
+    );
+    // The genuine state is still accepted.
+    assert_eq!(deserialize_status(&fmu, &bytes).0, 0);
+}
+
+/// Issue 17, defect 1 for curved supports: a forged curved-support contact status or anchor
+/// that the contact's own law contradicts is refused at deserialization, naming the node and
+/// the support; the genuine state (round trips in every status: above) is accepted.
+#[test]
+fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
+    use crate::mech::GapStatus;
+    let spec = ParallelArch {
+        contact: crate::mech::specimen::SpecimenContact::CurvedSupport,
+        ..ParallelArch::default()
+    };
+    let (u, log) = (
+        Unpacked::new("forgedcontacts", Source::ParallelArch(spec)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    let bytes = serialized_after_ramp(&fmu);
+    let guid = u.guid.to_str().unwrap();
+    let genuine = super::state::deserialize(&bytes, guid).unwrap();
+    let contacts = &genuine.analysis.as_ref().unwrap().contacts;
+    let model = spec.model().unwrap();
+    let support = &model.curved_supports[0];
+    let slipping = contacts.iter().position(|c| c.status == GapStatus::Slip);
+    let open = contacts.iter().position(|c| c.status == GapStatus::Open);
+    let (slipping, open) = (slipping.unwrap(), open.unwrap());
+    let name = |k: usize| {
+        format!(
+            "node {} on curved support '{}'",
+            support.nodes[k], support.name
+        )
+    };
+    type Forgery = Box<dyn Fn(&mut crate::mech::surface::ContactHistory)>;
+    let cases: Vec<(usize, Forgery, String)> = vec![
+        (
+            open,
+            Box::new(|c| c.status = GapStatus::Stick),
+            format!("status of {} is Stick", name(open)),
+        ),
+        (
+            slipping,
+            Box::new(|c| c.status = GapStatus::Open),
+            format!("status of {} is Open", name(slipping)),
+        ),
+        (
+            slipping,
+            Box::new(|c| c.anchor[0] += 1e-3),
+            "further slip".into(),
+        ),
+    ];
+    for (k, f, expected) in cases {
+        let forged = forge(&bytes, guid, |s| {
+            f(&mut s.analysis.as_mut().unwrap().contacts[k])
+        });
+        assert_deserialization_refused(&fmu, &forged, &expected);
+    }
+    assert_eq!(deserialize_status(&fmu, &bytes).0, 0, "{:?}", log.take());
 }

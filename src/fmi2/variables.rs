@@ -43,6 +43,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::mech::model::MAX_FRICTION;
 use crate::mech::{LoadLevels, Model, SolverSettings};
 
 /// What the FMU is built from, as far as the variable table is concerned.
@@ -147,6 +148,21 @@ impl Value {
 /// round-trip form; `1e-8` rather than `0.00000001`).
 pub fn format_real(v: f64) -> String {
     format!("{v:?}")
+}
+
+/// A real for a message: plain between 1e-4 and 1e15 in magnitude (`0.25`, `11`), else in
+/// `{:e}` form (`1e300`, `5e-324`), so that no huge or tiny value prints as hundreds of digits.
+pub fn message_real(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// "n" before a word starting with a vowel sound ("an Integer"), else "".
+pub fn article(t: VarType) -> &'static str {
+    if t == VarType::Integer { "n" } else { "" }
 }
 
 /// What a variable stands for: the instance reads and writes the core through this.
@@ -336,6 +352,49 @@ impl Variable {
             Causality::Parameter => Some("exact"),
             Causality::Output => Some("calculated"),
             Causality::Input | Causality::Independent => None,
+        }
+    }
+
+    /// Checks a value for this variable as `fmi2SetReal/Integer/Boolean/String` do (and
+    /// `fmi2DeSerializeFMUstate` for every stored value): its type, a finite Real, `mu` in
+    /// `[0, MAX_FRICTION]`, a String without NUL, a known friction law or VTK encoding. The
+    /// message names the variable.
+    pub fn check_value(&self, value: &Value) -> Result<(), String> {
+        if value.var_type() != self.var_type {
+            return Err(format!(
+                "{} is a{} {}, not a{} {}",
+                self.name,
+                article(self.var_type),
+                self.var_type.name(),
+                article(value.var_type()),
+                value.var_type().name()
+            ));
+        }
+        match (self.binding, value) {
+            (_, Value::Real(x)) if !x.is_finite() => Err(format!(
+                "{} = {}: values must be finite",
+                self.name,
+                message_real(*x)
+            )),
+            (Binding::Friction, Value::Real(x)) if !(0.0..=MAX_FRICTION).contains(x) => {
+                Err(format!(
+                    "{} = {}: the friction coefficient must be ≥ 0 and ≤ {MAX_FRICTION}",
+                    self.name,
+                    message_real(*x)
+                ))
+            }
+            (_, Value::String(text)) if text.contains('\0') => {
+                Err(format!("{} holds a NUL character", self.name))
+            }
+            (Binding::FrictionLaw, Value::String(name)) if !name.is_empty() => name
+                .parse::<crate::mech::FrictionLaw>()
+                .map(drop)
+                .map_err(|e| format!("{}: {e}", self.name)),
+            (Binding::VtkFormat, Value::String(name)) => name
+                .parse::<crate::mech::vtk::Encoding>()
+                .map(drop)
+                .map_err(|e| format!("{}: {e}", self.name)),
+            _ => Ok(()),
         }
     }
 
@@ -1190,6 +1249,26 @@ mod tests {
         let user = variables(&model, Kind::Model);
         assert!(user.iter().all(|v| v.name != "archHeight"));
         assert!(user.iter().any(|v| v.binding == Binding::ResultsDirectory));
+    }
+
+    #[test]
+    fn message_reals_are_short_for_every_magnitude() {
+        let cases = [
+            (1e300, "1e300"),
+            (-1e300, "-1e300"),
+            (11.0, "11"),
+            (0.25, "0.25"),
+            (0.0, "0"),
+            (123456.5, "123456.5"),
+            (1e15, "1e15"),
+            (2.5e-7, "2.5e-7"),
+            (5e-324, "5e-324"),
+            (f64::NAN, "NaN"),
+            (f64::NEG_INFINITY, "-inf"),
+        ];
+        for (v, text) in cases {
+            assert_eq!(message_real(v), text);
+        }
     }
 
     #[test]

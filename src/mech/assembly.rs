@@ -13,9 +13,10 @@
 //! DOF in its range (in element order) and adds only the entries it owns. A triangle across two
 //! ranges is computed by both (0.3–11 % of the triangles on the benchmarks' meshes); no two
 //! threads write the same entry, and each entry receives the same additions in the same order as
-//! in the serial loop: the result is bit-identical for every thread count. The threads are scoped:
-//! they end before [`System::assemble`] returns (no pool outlives a call, which an FMU unloaded by
-//! `dlclose` needs), and a panic in one reaches the caller.
+//! in the serial loop: the result is bit-identical for every thread count. The threads are scoped
+//! and joined one by one: they end before [`System::assemble`] returns, on Linux until the kernel
+//! no longer lists them in `/proc/self/task` (see `worker`; no pool outlives a call, which an FMU
+//! unloaded by `dlclose` needs), and a panic in one reaches the caller.
 
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
@@ -435,6 +436,7 @@ impl System {
         let mut forces = internal;
         let mut matrix = values;
         std::thread::scope(|scope| {
+            let mut workers = Vec::with_capacity(self.parts.len());
             for (t, part) in self.parts.iter().enumerate() {
                 let (mine, rest) = std::mem::take(&mut forces).split_at_mut(part.dofs.len());
                 forces = rest;
@@ -460,9 +462,22 @@ impl System {
                     }
                 };
                 if t + 1 < self.parts.len() {
-                    scope.spawn(work);
+                    let worker = std::thread::Builder::new()
+                        .name(format!("assembly {t}"))
+                        .spawn_scoped(scope, move || {
+                            work();
+                            worker::own_task()
+                        })
+                        .expect("the system gives a thread for the assembly");
+                    workers.push(worker);
                 } else {
                     work();
+                }
+            }
+            for worker in workers {
+                match worker.join() {
+                    Ok(task) => worker::wait_until_gone(task),
+                    Err(panic) => std::panic::resume_unwind(panic),
                 }
             }
         });
@@ -532,4 +547,50 @@ impl std::ops::Deref for GapDofs {
 /// Displacement of node `v` from the global vector.
 pub fn node_vector(u: &[f64], v: usize) -> Vector3<f64> {
     Vector3::new(u[3 * v], u[3 * v + 1], u[3 * v + 2])
+}
+
+/// Making "no thread outlives the call" hold to the operating system's eyes. `join` returns
+/// when the thread's code has ended (its pthread's tid is cleared), but the kernel lists the
+/// task until it has finished tearing it down: on Linux a joined worker was still in
+/// `/proc/self/task` after about 40 % of the FMU's calls on the shared 2-core machine
+/// (`tests/threads.rs`). So on Linux a worker reports its task id, and the caller waits, after
+/// the join, until that task is gone (a few microseconds; bounded).
+mod worker {
+    /// Longest wait for the kernel to remove a joined thread's task.
+    #[cfg(target_os = "linux")]
+    const LONGEST_WAIT: std::time::Duration = std::time::Duration::from_millis(200);
+
+    /// The calling thread's task id (`/proc/thread-self` → `<pid>/task/<tid>`), Linux only.
+    pub fn own_task() -> Option<std::ffi::OsString> {
+        #[cfg(target_os = "linux")]
+        {
+            std::fs::read_link("/proc/thread-self")
+                .ok()
+                .and_then(|p| p.file_name().map(|f| f.to_owned()))
+        }
+        #[cfg(not(target_os = "linux"))]
+        None
+    }
+
+    /// Waits until the joined thread's `task` has left `/proc/self/task` (at most
+    /// [`LONGEST_WAIT`]: beyond it the thread's code has ended anyway).
+    pub fn wait_until_gone(task: Option<std::ffi::OsString>) {
+        #[cfg(target_os = "linux")]
+        if let Some(task) = task {
+            let path = std::path::Path::new("/proc/self/task").join(task);
+            let start = std::time::Instant::now();
+            let mut round = 0u32;
+            while path.exists() && start.elapsed() < LONGEST_WAIT {
+                // Hand the core to the exiting thread first, then sleep a little.
+                if round < 16 {
+                    std::thread::yield_now();
+                } else {
+                    std::thread::sleep(std::time::Duration::from_micros(50));
+                }
+                round += 1;
+            }
+        }
+        #[cfg(not(target_os = "linux"))]
+        let _ = task;
+    }
 }

@@ -329,6 +329,54 @@ impl GapLaw {
         }
     }
 
+    /// Checks that `status` with the slip history `plastic_slip` is what [`GapLaw::evaluate`]
+    /// commits at `d` from some history before it (a converged state read back): open or stick
+    /// exactly as the law evaluates them; slip closed, with the trial force on or beyond (2.13)
+    /// and the law's own return map leaving the history where it is (a committed slip is the
+    /// fixed point of the return map: on the cone for the isotropic law, `|t_x| ≤ μN` for the
+    /// sliding-direction law, whose `t_y` is elastic), both to `tolerance` (N). Err: what differs.
+    pub fn check_committed(
+        &self,
+        status: GapStatus,
+        d: Vector3<f64>,
+        plastic_slip: Vector2<f64>,
+        tolerance: f64,
+    ) -> Result<(), String> {
+        let r = self.evaluate(d, plastic_slip);
+        let limit = self.friction * r.normal_force;
+        let moved = (r.plastic_slip - plastic_slip).norm() * self.tangential_stiffness;
+        let consistent = match status {
+            GapStatus::Open | GapStatus::Stick => r.status == status,
+            GapStatus::Slip => {
+                r.status != GapStatus::Open
+                    && r.trial_magnitude >= limit - tolerance
+                    && moved <= tolerance
+            }
+        };
+        if consistent {
+            return Ok(());
+        }
+        let trial = (Vector2::new(d.x, d.y) - plastic_slip) * self.tangential_stiffness;
+        Err(format!(
+            "the {} law gives {:?} there (gap {:e} m, trial friction ({:e}, {:e}) N, \
+             limit μN = {:e} N{})",
+            self.friction_law,
+            r.status,
+            self.initial_gap + d.z,
+            trial.x,
+            trial.y,
+            limit,
+            if moved > tolerance {
+                format!(
+                    ", a further slip of {:e} m",
+                    moved / self.tangential_stiffness
+                )
+            } else {
+                String::new()
+            }
+        ))
+    }
+
     /// Consistent tangent `∂r_A/∂d` of [`GapLaw::evaluate`] in the local frame.
     pub fn consistent_tangent(&self, response: &GapResponse) -> Matrix3<f64> {
         let (kn, ks) = (self.normal_stiffness, self.tangential_stiffness);
@@ -417,6 +465,43 @@ mod tests {
                     "{friction_law} {name}"
                 );
                 assert_tangent_matches_finite_difference(&law, d, HISTORY);
+            }
+        }
+    }
+
+    #[test]
+    fn committed_states_of_both_laws_pass_their_check_and_altered_ones_do_not() {
+        let tolerance = 1e-6 * 5e3;
+        for friction_law in FrictionLaw::ALL {
+            let law = law_of(friction_law);
+            for (name, d, status) in STATES {
+                let d = Vector3::from(d);
+                let r = law.evaluate(d, HISTORY);
+                let check = |status, slip| law.check_committed(status, d, slip, tolerance);
+                assert_eq!(
+                    check(status, r.plastic_slip),
+                    Ok(()),
+                    "{friction_law} {name}"
+                );
+                for other in [GapStatus::Open, GapStatus::Stick, GapStatus::Slip] {
+                    if other != status && !(status == GapStatus::Slip && other == GapStatus::Stick)
+                    {
+                        assert!(
+                            check(other, r.plastic_slip).is_err(),
+                            "{friction_law} {name} as {other:?}"
+                        );
+                    }
+                }
+                if status == GapStatus::Slip {
+                    // The history before the slip is not a committed slip (it would slide on),
+                    // except where (2.13) is reached through y under the paper's law (x holds).
+                    let through_y = friction_law == FrictionLaw::SlidingDirection && d.y > 1e-4;
+                    let err = check(GapStatus::Slip, HISTORY);
+                    assert_eq!(err.is_ok(), through_y, "{friction_law} {name}: {err:?}");
+                    if let Err(e) = err {
+                        assert!(e.contains("further slip"), "{e}");
+                    }
+                }
             }
         }
     }

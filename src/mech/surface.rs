@@ -883,6 +883,49 @@ impl SurfaceContact {
         }
     }
 
+    /// Checks a converged `history` read back, at node position `x`, against this contact's own
+    /// law ([`SurfaceContact::respond`], either friction law): open where the gap is not
+    /// negative; in contact (stick or slip) where it is not positive, with an anchor that the
+    /// law's return map leaves where it is (stick inside the limit, slip on it), and for slip
+    /// the trial force on or beyond the limit (`|f|` isotropic, `|f1|` sliding-direction). The
+    /// gap to `length_tolerance` (m), forces to `force_tolerance` (N). Err: what differs.
+    pub fn check_committed(
+        &self,
+        x: &Vector3<f64>,
+        history: &ContactHistory,
+        length_tolerance: f64,
+        force_tolerance: f64,
+    ) -> Result<(), String> {
+        let gap = self.project(x, history.angle).gap;
+        let r = self.respond(x, history);
+        let anchor = Vector2::from(history.anchor);
+        let moved = (r.next_anchor - anchor).norm() * self.ks;
+        let trial = -(r.xi - anchor) * self.ks;
+        let measure = match self.law {
+            FrictionLaw::Isotropic => trial.norm(),
+            FrictionLaw::SlidingDirection => trial.x.abs(),
+        };
+        let limit = history.friction * r.normal_force;
+        let in_contact = gap <= length_tolerance && moved <= force_tolerance;
+        let consistent = match history.status {
+            GapStatus::Open => gap >= -length_tolerance,
+            GapStatus::Stick => in_contact,
+            GapStatus::Slip => in_contact && measure >= limit - force_tolerance,
+        };
+        if consistent {
+            return Ok(());
+        }
+        Err(format!(
+            "the {} law gives {:?} there (gap {gap:e} m, trial friction ({:e}, {:e}) N, \
+             limit μN = {limit:e} N, a further slip of {:e} m)",
+            self.law,
+            r.status,
+            trial.x,
+            trial.y,
+            moved / self.ks
+        ))
+    }
+
     /// The history of the undeformed state at `x0` with friction `mu`.
     pub fn initial_history(&self, x0: &Vector3<f64>, mu: f64) -> ContactHistory {
         let p = self.project(x0, 0.0);
@@ -1050,6 +1093,24 @@ impl SurfaceContacts {
                 ..*h
             })
             .collect()
+    }
+
+    /// [`SurfaceContact::check_committed`] for every contact at `u`, with tolerances scaled by
+    /// `size` (m): Err names the first contact that fails by its position in the model.
+    pub fn check_committed(
+        &self,
+        u: &[f64],
+        histories: &[ContactHistory],
+        size: f64,
+    ) -> Result<(), (usize, String)> {
+        for (k, (c, h)) in self.contacts.iter().zip(histories).enumerate() {
+            let x = self.position(c, u);
+            let lambda = c.kn * (-c.project(&x, h.angle).gap).max(0.0);
+            let force = 1e-6 * (h.friction * lambda).max(c.ks * 1e-9 * size);
+            c.check_committed(&x, h, 1e-9 * size, force)
+                .map_err(|e| (k, e))?;
+        }
+        Ok(())
     }
 
     /// Results at `u` with the converged `histories`.

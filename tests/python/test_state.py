@@ -144,3 +144,33 @@ def test_models_differing_in_one_number_have_two_guids_and_refuse_each_others_st
         b.initialize()
         with pytest.raises(FmuError, match=re.escape(f"serialized by another FMU (GUID {a.md.guid}); this one is")):
             b.deserialize(data, time=1.0)
+
+
+@pytest.mark.parametrize("law", ["isotropic", "sliding-direction"])
+def test_film_restores_its_own_state_under_either_friction_law(fmu_path, law):
+    """Issue 17, defect 1: ``Film.run`` to ``frame.dz`` = −0.03, −0.06, −0.09, ``save()``, one more
+    step, ``restore()``: the FMU takes back the state it saved, also under the paper's
+    sliding-direction law (it refused it), and the step repeated from there (in place, and from
+    the serialized state in a fresh film) gives the same outputs bit for bit."""
+    from membrane_contact import Film
+
+    path = {"time": [1.0, 2.0, 3.0], "frame.dz": [-0.03, -0.06, -0.09]}
+    one_more = {"time": [4.0], "frame.dz": [-0.12]}
+    with Film(fmu_path) as film:
+        film.initialize(parameters={"frictionLaw": law})
+        film.run(path)
+        state = film.save()
+        data = film.serialize(state)
+        first = film.run(one_more)
+        assert 2 in first["G1.status"], "a gap slides in the step after the save"
+        film.restore(state)
+        again = film.run(one_more)
+        for name in film.outputs:
+            assert again[name].tobytes() == first[name].tobytes(), name
+    with Film(fmu_path) as fresh:
+        fresh.initialize()
+        fresh.restore(fresh.deserialize(data, time=3.0))
+        assert fresh.get("frictionLaw") == law
+        restored = fresh.run(one_more)
+        for name in fresh.outputs:
+            assert restored[name].tobytes() == first[name].tobytes(), name
