@@ -732,3 +732,103 @@ fn a_user_model_named_parallel_arch_does_not_replace_the_specimen_fmu() {
     assert!(!ok && err.contains("not both"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The four figures `correction C m (tolerance Ct m), residual R N (tolerance Rt N)` that follow
+/// `prefix` in `text`: (the figures as printed, [C, Ct, R, Rt], the words after them).
+fn quoted_iteration<'a>(text: &'a str, prefix: &str) -> (&'a str, [f64; 4], &'a str) {
+    let start = text
+        .find(prefix)
+        .unwrap_or_else(|| panic!("no '{prefix}' in {text}"))
+        + prefix.len();
+    let rest = &text[start..];
+    let end = rest
+        .find(" N), ")
+        .unwrap_or_else(|| panic!("no figures in {rest}"))
+        + 3;
+    let figures = &rest[..end];
+    let numbers: Vec<f64> = figures
+        .split([' ', '(', ')', ','])
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert_eq!(numbers.len(), 4, "{figures}");
+    let verdict = rest[end + 2..].split([';', ')']).next().unwrap();
+    (
+        figures,
+        [numbers[0], numbers[1], numbers[2], numbers[3]],
+        verdict,
+    )
+}
+
+/// TEST GOAL (issue 19, item 3): the figures of a stalled increment all come from one iteration.
+/// The stall (a correction tolerance below round-off) names the iteration k closest to
+/// convergence; the same run limited to k iterations stops at k and quotes the same correction,
+/// residual and tolerances. The criterion called met is within its tolerance, the other is not,
+/// and no cause the solver did not establish ("almost no stiffness") is asserted. Without line
+/// search nothing in the iterations depends on the limit.
+#[test]
+fn a_stalled_increment_quotes_the_figures_of_one_iteration() {
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "specimen",
+            "--height",
+            "200",
+            "--quiet",
+            "--steps",
+            "2",
+            "--increments",
+            "1",
+            "--no-line-search",
+            "--displacement-tolerance",
+            "1e-16",
+            "--max-cutbacks",
+            "0",
+        ];
+        args.extend_from_slice(extra);
+        let (ok, _, err) = cli(&args);
+        assert!(!ok, "the tolerance below round-off was met: {err}");
+        err
+    };
+    let stalled = run(&[]);
+    let head = "closest to convergence at iteration ";
+    let at = stalled.find(head).unwrap_or_else(|| panic!("{stalled}")) + head.len();
+    let k: String = stalled[at..]
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    let (figures, [c, ct, r, rt], verdict) = quoted_iteration(&stalled, &format!("{head}{k} of "));
+    let figures = figures.split_once(": ").unwrap().1;
+    assert_eq!(
+        verdict, "the residual met its tolerance, the correction did not",
+        "{stalled}"
+    );
+    assert!(r <= rt && c > ct, "{stalled}");
+    assert!(!stalled.contains("almost no stiffness"), "{stalled}");
+    assert!(stalled.contains("(raise --steps)"), "{stalled}");
+
+    let limited = run(&["--max-iterations", &k]);
+    let (same, _, _) = quoted_iteration(&limited, &format!("at iteration {k} (the last): "));
+    assert_eq!(same, figures, "{stalled}\n{limited}");
+}
+
+/// TEST GOAL (issue 19, item 3): the advice of a failed run names the option that makes its
+/// steps smaller: `--increments` on a `--path` run (where `--steps` does not apply), `--steps`
+/// otherwise.
+#[test]
+fn advice_of_a_failed_run_names_the_option_that_applies() {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-advice-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let jump = write_file(
+        &dir,
+        "jump.csv",
+        "time,frame.dz\n1,-0.005\n2,-0.01\n3,-0.1\n",
+    );
+    let strict = ["--max-cutbacks", "0", "--max-iterations", "2"];
+    let specimen = ["specimen", "--height", "200", "--quiet"];
+    let (ok, _, err) = cli(&[&specimen[..], &["--path", &jump], &strict].concat());
+    assert!(!ok && err.contains("(raise --increments)"), "{err}");
+    assert!(!err.contains("--steps"), "{err}");
+    let (ok, _, err) = cli(&[&specimen[..], &["--steps", "2"], &strict].concat());
+    assert!(!ok && err.contains("(raise --steps)"), "{err}");
+    assert!(!err.contains("--increments"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

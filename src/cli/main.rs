@@ -11,7 +11,7 @@ use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::specimen::{FramePath, OBSERVED_GAPS, table1};
 use membrane_contact::mech::vtk;
 use membrane_contact::mech::{
-    Analysis, FrictionLaw, LoadLevels, Model, ParallelArch, Results, SolverSettings,
+    Analysis, FrictionLaw, LoadLevels, Model, ParallelArch, Results, SettingNames, SolverSettings,
 };
 
 mod args;
@@ -115,6 +115,22 @@ fn load_path(
     Ok(StagedPath { times, steps: rows })
 }
 
+/// The options that a failed step's advice names. Each `--path` row is one step, split into
+/// `--increments` increments; without `--path`, `--steps` makes each step smaller.
+fn setting_names(o: &RunArgs) -> SettingNames {
+    SettingNames {
+        max_iterations: "--max-iterations",
+        finer_increments: if o.path.is_some() {
+            "raise --increments"
+        } else {
+            "raise --steps"
+        },
+        residual_tolerance: "--residual-tolerance",
+        displacement_tolerance: "--displacement-tolerance",
+        consistent_tangent: "--matrix consistent",
+    }
+}
+
 fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     let mut model = match &source {
         Source::Specimen { spec, .. } => spec.model()?,
@@ -204,7 +220,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
                 );
                 let results = analysis.results();
                 report(height_mm, &analysis, &results);
-                return Err(format!("step {step}/{count}: {e}"));
+                return Err(format!(
+                    "step {step}/{count}: {}",
+                    e.message(&setting_names(o))
+                ));
             }
         };
         cutbacks += report.cutbacks;

@@ -67,13 +67,22 @@ use super::variables::{
 use crate::mech::element::state_counts;
 use crate::mech::material::Wrinkling;
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SolverSettings,
-    StepError, StepReport, check_results,
+    Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SettingNames,
+    SolverSettings, StepError, StepReport, check_results,
     solver::{IncrementFailure, MAX_THREADS},
     summary::{model_warnings, result_warnings},
     vtk,
 };
 use serde::{Deserialize, Serialize};
+
+/// The FMU parameters that a refused step's advice names.
+const SETTING_NAMES: SettingNames = SettingNames {
+    max_iterations: "solver.maxIterations",
+    finer_increments: "raise solver.incrementsPerStep or take a smaller communication step",
+    residual_tolerance: "solver.residualTolerance",
+    displacement_tolerance: "solver.displacementTolerance",
+    consistent_tangent: "solver.useJuRowlands = false",
+};
 
 /// Why a call failed: the status to return and the message to log.
 #[derive(Clone, Debug, PartialEq)]
@@ -929,7 +938,11 @@ impl Instance {
                     built.analysis.set_state(before).map_err(Failure::error)?;
                 }
                 self.phase = Phase::StepFailed;
-                let message = format!("step from t = {t} to {}: {e}", t + h);
+                let message = format!(
+                    "step from t = {t} to {}: {}",
+                    t + h,
+                    e.message(&SETTING_NAMES)
+                );
                 Err(match e {
                     StepError::NotConverged { .. } => {
                         let inputs = self.input_values();

@@ -606,6 +606,15 @@ fn a_step_that_cannot_converge_is_discarded_and_can_be_retried() {
         "{:?}",
         log.take()
     );
+    // The advice names the FMU's parameters, not the command line's options.
+    assert!(
+        log.contains(
+            Status::Discard,
+            "(raise solver.incrementsPerStep or take a smaller communication step)"
+        ) && !log.contains(Status::Discard, "--"),
+        "{:?}",
+        log.take()
+    );
     let mut status = 0;
     assert_eq!(
         unsafe { fmi2_get_status(fmu.c, FMI2_DO_STEP_STATUS, &mut status) },

@@ -43,5 +43,7 @@ pub use finite::check_results;
 pub use load::LoadLevels;
 pub use material::{Material, Wrinkling, WrinklingState};
 pub use model::{Model, ModelError};
-pub use solver::{Analysis, AnalysisState, Results, SolverSettings, StepError, StepReport};
+pub use solver::{
+    Analysis, AnalysisState, Results, SettingNames, SolverSettings, StepError, StepReport,
+};
 pub use specimen::ParallelArch;

@@ -192,14 +192,92 @@ impl StepReport {
     }
 }
 
+/// The convergence figures of one Newton iteration: its residual and the correction that led to
+/// it, each with the tolerance it had to meet at that iteration (both tolerances scale with the
+/// iterate). A refusal quotes one such record, so its numbers never mix iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationRecord {
+    /// Iteration number (0 = the predictor, before any correction).
+    pub iteration: usize,
+    /// `‖R_free‖∞` at this iterate (N).
+    pub residual: f64,
+    /// The residual tolerance at this iterate (N).
+    pub residual_tolerance: f64,
+    /// `‖Δu‖∞` of the correction that led to this iterate (m; infinite at iteration 0).
+    pub correction: f64,
+    /// The correction tolerance at this iterate (m).
+    pub correction_tolerance: f64,
+}
+
+impl IterationRecord {
+    /// How far this iterate is from convergence: the larger of the residual's and the
+    /// correction's ratio to its tolerance (converged iterates have at most 1).
+    fn distance(&self) -> f64 {
+        (self.residual / self.residual_tolerance).max(self.correction / self.correction_tolerance)
+    }
+
+    /// Which of the two criteria this iterate failed, in words.
+    fn verdict(&self) -> &'static str {
+        match (
+            self.residual <= self.residual_tolerance,
+            self.correction <= self.correction_tolerance,
+        ) {
+            (true, false) => "the residual met its tolerance, the correction did not",
+            (false, true) => "the correction met its tolerance, the residual did not",
+            (false, false) => "neither met its tolerance",
+            (true, true) => "both met their tolerances",
+        }
+    }
+}
+
+impl fmt::Display for IterationRecord {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "correction {:.3e} m (tolerance {:.3e} m), residual {:.3e} N (tolerance {:.3e} N)",
+            self.correction, self.correction_tolerance, self.residual, self.residual_tolerance
+        )
+    }
+}
+
+/// What a front end calls the settings that failure advice points to: the core names no
+/// command-line option or FMU parameter, each front end passes its own names
+/// ([`SettingNames::CORE`] names the [`SolverSettings`] fields).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SettingNames {
+    /// The iteration limit per increment.
+    pub max_iterations: &'static str,
+    /// How to make each increment smaller (an imperative: "raise --increments").
+    pub finer_increments: &'static str,
+    /// The residual tolerance.
+    pub residual_tolerance: &'static str,
+    /// The displacement (correction) tolerance.
+    pub displacement_tolerance: &'static str,
+    /// How to choose the consistent tangent over the Ju–Rowlands matrix.
+    pub consistent_tangent: &'static str,
+}
+
+impl SettingNames {
+    /// The names of the [`SolverSettings`] fields.
+    pub const CORE: Self = Self {
+        max_iterations: "max_iterations",
+        finer_increments: "raise the increments per step",
+        residual_tolerance: "residual_tolerance",
+        displacement_tolerance: "displacement_tolerance",
+        consistent_tangent: "iteration_matrix = Consistent",
+    };
+}
+
 /// Why one increment failed.
 #[derive(Clone, Debug, PartialEq)]
 pub enum IncrementFailure {
     /// No convergence within the iteration limit (with the consistent tangent: while the
     /// residual was still decreasing, or the stall test would have stopped it earlier).
     MaxIterations {
-        /// `‖R_free‖∞` at the first and the last iteration (N).
-        residuals: (f64, f64),
+        /// `‖R_free‖∞` at iteration 0 (N).
+        first_residual: f64,
+        /// The last iteration (the limit).
+        last: IterationRecord,
         /// The iteration matrix that ran out of iterations.
         matrix: IterationMatrix,
         /// Gaps whose status changed in the last iterations.
@@ -208,17 +286,13 @@ pub enum IncrementFailure {
         /// last two iterates.
         flipping: Vec<usize>,
     },
-    /// The residual stopped decreasing (a cycle between states or a plateau).
+    /// Neither the residual nor the correction improved for a while (a cycle between states or
+    /// a plateau).
     Stalled {
         /// Iteration at which the stall was detected.
         iteration: usize,
-        /// Smallest `‖R_free‖∞` reached (N) and the tolerance it had to meet (N).
-        best: f64,
-        /// The residual tolerance (N).
-        tolerance: f64,
-        /// Smallest correction `‖Δu‖∞` reached (m) and the tolerance it had to meet (m): a
-        /// residual within its tolerance still needs the corrections to settle.
-        correction: (f64, f64),
+        /// The iteration closest to convergence (smallest [`IterationRecord::distance`]).
+        closest: IterationRecord,
         /// Gaps whose status changed in the last iterations.
         chattering: Vec<String>,
         /// Film elements whose tension-field state differs between the last two iterates.
@@ -246,51 +320,68 @@ fn name_list(names: &[String]) -> String {
 }
 
 impl IncrementFailure {
-    /// What a user can change to get past this failure.
-    pub fn advice(&self) -> String {
+    /// What a user can change to get past this failure, naming the settings as `names` does.
+    /// It states what was observed; a cause is named only where the solver established it.
+    pub fn advice(&self, names: &SettingNames) -> String {
+        let SettingNames {
+            max_iterations,
+            finer_increments: finer,
+            residual_tolerance,
+            displacement_tolerance,
+            consistent_tangent,
+        } = names;
         match self {
             Self::MaxIterations {
                 matrix: IterationMatrix::JuRowlands,
                 ..
-            } => "the Ju–Rowlands matrix converges linearly (hundreds to thousands of iterations per increment \
-                once a gap slips, docs/mechanics.md): use the consistent tangent (solver.useJuRowlands = false, \
-                --matrix consistent) or raise the iteration limit a lot (solver.maxIterations, --max-iterations)"
-                .into(),
+            } => format!(
+                "the Ju–Rowlands matrix converges linearly (hundreds to thousands of iterations per increment \
+                 once a gap slips, docs/mechanics.md): use the consistent tangent ({consistent_tangent}) or raise \
+                 the iteration limit a lot ({max_iterations})"
+            ),
             Self::MaxIterations {
-                residuals: (first, last),
+                first_residual,
+                last,
                 ..
-            } if last < first => "the residual was still falling: raise the iteration limit \
-                (solver.maxIterations in the FMU, --max-iterations on the command line) or move the inputs by less per step"
-                .into(),
-            Self::MaxIterations { .. } => "the residual did not fall below its start: move the inputs by less per \
-                step or raise solver.incrementsPerStep (--steps on the command line)"
-                .into(),
+            } if last.residual < *first_residual => format!(
+                "the residual was still falling: raise the iteration limit ({max_iterations}) or move the inputs \
+                 by less per step ({finer})"
+            ),
+            Self::MaxIterations { .. } => format!(
+                "the residual did not fall below its start: move the inputs by less per step ({finer})"
+            ),
             Self::Stalled { chattering, .. } if !chattering.is_empty() => format!(
                 "gaps {} kept changing status (open/closed or stick/slip) between iterations: move the inputs by \
-                 less per step or raise solver.incrementsPerStep (--steps on the command line)",
+                 less per step ({finer})",
                 name_list(chattering)
             ),
             Self::Stalled { flipping, .. } if !flipping.is_empty() => format!(
                 "{} film elements switched between taut, wrinkled and slack between the last iterations \
-                 (a region on the verge of wrinkling): move the inputs by less per step or raise \
-                 solver.incrementsPerStep; more prestress keeps a film taut",
+                 (a region on the verge of wrinkling): move the inputs by less per step ({finer}); more \
+                 prestress keeps a film taut",
                 flipping.len()
             ),
-            Self::Stalled {
-                best, tolerance, ..
-            } if best <= tolerance => "the forces balance but the film keeps moving along a direction with almost no \
-                stiffness (a part held by too little, a flat film without prestress across): hold it by supports or \
-                prestress, or loosen solver.displacementTolerance"
-                .into(),
-            Self::Stalled { .. } => "Newton stopped making progress: move the inputs by less per step, or loosen \
-                solver.residualTolerance if the residual reached is acceptable for your model"
-                .into(),
-            Self::Diverged { .. } => "the increment is too large for Newton's method here: move the inputs by less \
-                per step or raise solver.incrementsPerStep"
-                .into(),
-            Self::Singular { .. } => "the film has a direction with no stiffness in this state (a slack film without \
-                prestress, or a part held only by open gaps): add prestress, supports, or wrinkling-aware material"
-                .into(),
+            Self::Stalled { closest, .. } if closest.residual <= closest.residual_tolerance => {
+                format!(
+                    "the forces balanced but the corrections did not settle (seen both with increments too large \
+                 and with a part held by too little, such as a flat film without prestress): move the inputs \
+                 by less per step ({finer}); if that does not help, hold the film by supports or prestress, or \
+                 loosen {displacement_tolerance} if the corrections reached are acceptable for your model"
+                )
+            }
+            Self::Stalled { .. } => format!(
+                "Newton stopped making progress: move the inputs by less per step ({finer}), or loosen \
+                 {residual_tolerance} if the residual reached is acceptable for your model"
+            ),
+            Self::Diverged { .. } => format!(
+                "the residual ran away or became non-finite: move the inputs by less per step ({finer})"
+            ),
+            Self::Singular { .. } => format!(
+                "the Newton matrix of an iterate had a direction with no stiffness (a slack film without \
+                 prestress, a part held only by open gaps, or an iterate that a smaller increment does not \
+                 reach): add prestress, supports or wrinkling-aware material, or move the inputs by less per \
+                 step ({finer})"
+            ),
         }
     }
 }
@@ -313,38 +404,34 @@ impl fmt::Display for IncrementFailure {
         };
         match self {
             Self::MaxIterations {
-                residuals: (first, last),
+                first_residual,
+                last,
                 chattering,
                 flipping,
                 ..
             } => {
                 write!(
                     f,
-                    "no convergence within the iteration limit (residual {first:.3e} N → {last:.3e} N)"
+                    "no convergence within the iteration limit: at iteration {} (the last): {last}, {}; \
+                     the residual was {first_residual:.3e} N at iteration 0",
+                    last.iteration,
+                    last.verdict()
                 )?;
                 chatter(f, chattering, flipping)
             }
             Self::Stalled {
                 iteration,
-                best,
-                tolerance,
-                correction: (correction, correction_tolerance),
+                closest,
                 chattering,
                 flipping,
             } => {
-                if best <= tolerance {
-                    write!(
-                        f,
-                        "corrections stalled at {correction:.3e} m (tolerance {correction_tolerance:.3e} m) \
-                         by iteration {iteration}, with the residual {best:.3e} N within its tolerance \
-                         {tolerance:.3e} N: the film moves along a direction with almost no stiffness"
-                    )?;
-                } else {
-                    write!(
-                        f,
-                        "residual stalled at {best:.3e} N (tolerance {tolerance:.3e} N) by iteration {iteration}"
-                    )?;
-                }
+                write!(
+                    f,
+                    "no progress (stopped at iteration {iteration}); closest to convergence at iteration {} \
+                     of {iteration}: {closest}, {}",
+                    closest.iteration,
+                    closest.verdict()
+                )?;
                 chatter(f, chattering, flipping)
             }
             Self::Diverged { iteration } => {
@@ -371,22 +458,29 @@ pub enum StepError {
     },
 }
 
-impl fmt::Display for StepError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+impl StepError {
+    /// The message, its advice naming the settings as `names` does (`Display` uses
+    /// [`SettingNames::CORE`]).
+    pub fn message(&self, names: &SettingNames) -> String {
         match self {
-            Self::InvalidInput { message } => write!(f, "invalid step input: {message}"),
+            Self::InvalidInput { message } => format!("invalid step input: {message}"),
             Self::NotConverged {
                 fraction_done,
                 cutbacks,
                 last,
-            } => write!(
-                f,
+            } => format!(
                 "step did not converge after {cutbacks} cut-backs ({:.1}% of it reached; last increment: {last}); \
                  the last converged state is kept. What to change: {}",
                 100.0 * fraction_done,
-                last.advice()
+                last.advice(names)
             ),
         }
+    }
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message(&SettingNames::CORE))
     }
 }
 
@@ -1032,6 +1126,8 @@ impl Analysis {
         let mut previous: Vec<GapStatus> = start.status.clone();
         let mut changed_at: Vec<Option<usize>> = vec![None; previous.len()];
         let (mut best, mut best_correction, mut best_at) = (f64::INFINITY, f64::INFINITY, 0);
+        // The iterate closest to meeting both tolerances (quoted if the increment stalls).
+        let mut closest: Option<IterationRecord> = None;
         // Levenberg–Marquardt shift of the free diagonal, relative to its mean.
         let mut damping = 0.0_f64;
         // The watchdog of the line search: non-monotone excursions until one fails.
@@ -1061,8 +1157,15 @@ impl Analysis {
             let displacement_scale = moved.max(max_abs(&u)).max(1e-9 * self.length_scale);
             let force_scale = max_abs(&self.work.internal).max(self.force_floor);
             let tolerance = s.residual_tolerance * force_scale;
+            let record = IterationRecord {
+                iteration,
+                residual,
+                residual_tolerance: tolerance,
+                correction: correction_norm,
+                correction_tolerance: s.displacement_tolerance * displacement_scale,
+            };
             let converged = (iteration > 0 || self.system.free_count == 0)
-                && correction_norm <= s.displacement_tolerance * displacement_scale
+                && record.correction <= record.correction_tolerance
                 && residual <= tolerance;
             if converged {
                 let state = AnalysisState {
@@ -1103,9 +1206,13 @@ impl Analysis {
                     .map(|(g, _)| self.model.gaps[g].name.clone())
                     .collect()
             };
+            if iteration > 0 && closest.is_none_or(|c| record.distance() < c.distance()) {
+                closest = Some(record);
+            }
             if iteration == s.max_iterations {
                 return Err(IncrementFailure::MaxIterations {
-                    residuals: (residuals[0], residual),
+                    first_residual: residuals[0],
+                    last: record,
                     matrix: s.iteration_matrix,
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
@@ -1129,12 +1236,7 @@ impl Analysis {
             {
                 return Err(IncrementFailure::Stalled {
                     iteration,
-                    best,
-                    tolerance,
-                    correction: (
-                        best_correction,
-                        s.displacement_tolerance * displacement_scale,
-                    ),
+                    closest: closest.unwrap_or(record),
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
                 });
@@ -1701,44 +1803,63 @@ pub fn bounding_diagonal(nodes: &[[f64; 3]]) -> f64 {
 mod advice_tests {
     use super::*;
 
-    #[test]
-    fn a_stall_within_the_residual_tolerance_names_the_corrections_not_the_residual() {
-        let stall = |best: f64| IncrementFailure::Stalled {
-            iteration: 12,
-            best,
-            tolerance: 1.374e-4,
-            correction: (3.2e-6, 1.0e-8),
+    fn record(residual: f64, correction: f64) -> IterationRecord {
+        IterationRecord {
+            iteration: 9,
+            residual,
+            residual_tolerance: 1.374e-4,
+            correction,
+            correction_tolerance: 1.0e-8,
+        }
+    }
+
+    fn stall(closest: IterationRecord) -> IncrementFailure {
+        IncrementFailure::Stalled {
+            iteration: 17,
+            closest,
             chattering: vec![],
             flipping: vec![],
-        };
-        let within = stall(6.996e-5);
+        }
+    }
+
+    #[test]
+    fn a_stall_quotes_one_iteration_and_says_which_criterion_failed() {
+        let names = SettingNames::CORE;
+        let within = stall(record(6.996e-5, 3.2e-6));
         let text = within.to_string();
-        assert!(
-            text.starts_with("corrections stalled at 3.200e-6 m (tolerance 1.000e-8 m)"),
-            "{text}"
+        assert_eq!(
+            text,
+            "no progress (stopped at iteration 17); closest to convergence at iteration 9 of 17: \
+             correction 3.200e-6 m (tolerance 1.000e-8 m), residual 6.996e-5 N (tolerance 1.374e-4 N), \
+             the residual met its tolerance, the correction did not"
         );
-        assert!(
-            text.contains("residual 6.996e-5 N within its tolerance"),
-            "{text}"
-        );
-        assert!(within.advice().contains("solver.displacementTolerance"));
-        let above = stall(2.0e-4);
+        let advice = within.advice(&names);
+        assert!(advice.contains("displacement_tolerance"), "{advice}");
+        assert!(!advice.contains("almost no stiffness"), "{advice}");
+        let above = stall(record(2.0e-4, 1.0e-9));
         assert!(
             above
                 .to_string()
-                .starts_with("residual stalled at 2.000e-4 N")
+                .ends_with("the correction met its tolerance, the residual did not"),
+            "{above}"
         );
-        assert!(above.advice().contains("solver.residualTolerance"));
+        assert!(above.advice(&names).contains("residual_tolerance"));
+        assert!(
+            stall(record(2.0e-4, 3.2e-6))
+                .to_string()
+                .ends_with("neither met its tolerance")
+        );
     }
 
     fn out_of_iterations(first: f64, last: f64, matrix: IterationMatrix) -> String {
         IncrementFailure::MaxIterations {
-            residuals: (first, last),
+            first_residual: first,
+            last: record(last, 1.0),
             matrix,
             chattering: vec![],
             flipping: vec![],
         }
-        .advice()
+        .advice(&SettingNames::CORE)
     }
 
     #[test]
@@ -1752,5 +1873,16 @@ mod advice_tests {
         );
         let jr = out_of_iterations(4.9, 3.4, IterationMatrix::JuRowlands);
         assert!(jr.contains("consistent tangent"), "{jr}");
+    }
+
+    #[test]
+    fn advice_names_the_settings_of_the_front_end_that_asks() {
+        let cli = SettingNames {
+            finer_increments: "raise --increments",
+            ..SettingNames::CORE
+        };
+        let failure = stall(record(2.0e-4, 1.0e-9));
+        assert!(failure.advice(&cli).contains("(raise --increments)"));
+        assert!(!failure.advice(&SettingNames::CORE).contains("--"));
     }
 }
