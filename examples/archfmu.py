@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import os
 import subprocess
 import tempfile
 import sys
@@ -34,7 +35,8 @@ except ImportError:  # run from a checkout without the package installed (pip in
     from membrane_contact import Film, StepRefused
     from membrane_contact.film import DISCARD
 DEFAULT_FMU = ROOT / "target" / "fmu" / "ParallelArch.fmu"
-CLI = ROOT / "target" / "release" / "membrane-contact"
+# The core's CLI: $MEMBRANE_CONTACT_CLI (e.g. the wheel's membrane-contact), else this checkout's build.
+CLI = Path(os.environ.get("MEMBRANE_CONTACT_CLI") or ROOT / "target" / "release" / "membrane-contact")
 TABLE1 = ROOT / "data" / "table1_sliding.csv"
 BUILD_HINT = "cargo build --release && cargo run --release --bin fmu-pack"
 

@@ -18,6 +18,7 @@ echo "== pytest (fmpy, libcosim) =="
 .venv/bin/python -m pytest tests/python -q -p no:cacheprovider
 
 # --- The wheel (issue 17 item 10): the wheel fmu/prepare.sh built, installed into a clean venv
-# with no cargo on PATH, packs FMUs and runs the specimen (tests/wheel/).
+# with no cargo on PATH, packs FMUs and runs the specimen (tests/wheel/), then the whole Python
+# suite against it (tests/python/ with MEMBRANE_CONTACT_INSTALLED=1).
 echo "== wheel: pip install into a clean venv, no Rust toolchain =="
 bash tests/wheel/run.sh

@@ -39,11 +39,11 @@ import numpy as np
 if __package__ in (None, ""):  # run as a script: python path/to/mesh.py
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from membrane_contact.arches import ArchError, gaps_on_curve, make_curve  # noqa: E402
-    from membrane_contact.fmu import repository_root  # noqa: E402
+    from membrane_contact.fmu import installed_program, repository_root  # noqa: E402
     from membrane_contact.tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes  # noqa: E402
 else:
     from .arches import ArchError, gaps_on_curve, make_curve
-    from .fmu import repository_root
+    from .fmu import installed_program, repository_root
     from .tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes
 
 
@@ -747,8 +747,9 @@ def _towards(entry: dict, where: str) -> dict:
 
 
 SIDES = ("+x", "-x", "+y", "-y", "+z", "-z")
-#: The solver's command line, run by :func:`solver_check` (default: the checkout's
-#: ``target/release/membrane-contact``, else ``membrane-contact`` on the PATH).
+#: The solver's command line, run by :func:`solver_check` (default: the one installed with this
+#: package from the wheel, else the checkout's ``target/release/membrane-contact``, else
+#: ``membrane-contact`` on the PATH: the order in which ``build_fmu`` finds ``fmu-pack``).
 CLI_VARIABLE = "MEMBRANE_CONTACT_CLI"
 
 
@@ -770,7 +771,7 @@ def solver_check(model: dict) -> SolverCheck | None:
     import subprocess
     import tempfile
 
-    program = os.environ.get(CLI_VARIABLE)
+    program = os.environ.get(CLI_VARIABLE) or installed_program("membrane-contact")
     root = repository_root()
     if not program and root is not None and (root / "target" / "release" / "membrane-contact").is_file():
         program = str(root / "target" / "release" / "membrane-contact")

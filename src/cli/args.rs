@@ -39,7 +39,8 @@ pub enum Command {
     },
     /// Imports a mesh (gmsh 2.2/4.1 ASCII or binary, or any format meshio reads) with a mapping
     /// file into a model file, gaps generated along arches (python/README-import.md). Runs the
-    /// Python importer `membrane_contact.mesh` (meshio) of this checkout.
+    /// Python importer `membrane_contact.mesh` (meshio): the checkout's for the checkout's build,
+    /// the interpreter's (the wheel's) when installed.
     Import {
         /// The mesh file (.msh, or another format meshio reads).
         mesh: PathBuf,

@@ -681,9 +681,19 @@ fn beside_this_program() -> Option<std::path::PathBuf> {
     python.is_file().then_some(python)
 }
 
+/// True when this program is the checkout's own build (`target/<profile>/`), not a copy installed
+/// from the wheel (which may sit in a venv inside the checkout, e.g. `target/wheel-venv/bin`).
+fn built_in_checkout(root: &std::path::Path) -> bool {
+    std::env::current_exe()
+        .ok()
+        .and_then(|exe| Some(exe.parent()?.parent()? == root.join("target")))
+        .unwrap_or(false)
+}
+
 /// Runs the Python mesh importer (`python -m membrane_contact.mesh`): one implementation of
 /// the import, on meshio, which reads gmsh 2.2 and 4.1 (the Rust crate mshio reads 4.1 only).
-/// The package is taken from this checkout's `python/` directory when the interpreter lacks it.
+/// The checkout's build takes the package from the checkout's `python/` directory (ahead on
+/// PYTHONPATH); the program installed from the wheel takes the interpreter's (the wheel's).
 fn import(
     mesh: &std::path::Path,
     mapping: &std::path::Path,
@@ -708,13 +718,15 @@ fn import(
     if let Some(output) = output {
         command.arg("-o").arg(output);
     }
-    let pythonpath = std::env::var_os("PYTHONPATH").unwrap_or_default();
-    let mut paths = vec![root.join("python")];
-    paths.extend(std::env::split_paths(&pythonpath));
-    command.env(
-        "PYTHONPATH",
-        std::env::join_paths(paths).map_err(|e| e.to_string())?,
-    );
+    if built_in_checkout(root) {
+        let pythonpath = std::env::var_os("PYTHONPATH").unwrap_or_default();
+        let mut paths = vec![root.join("python")];
+        paths.extend(std::env::split_paths(&pythonpath));
+        command.env(
+            "PYTHONPATH",
+            std::env::join_paths(paths).map_err(|e| e.to_string())?,
+        );
+    }
     let status = command.status().map_err(|e| {
         format!(
             "cannot run {} ({e}): give --python, or create the environment with bash fmu/prepare.sh",

@@ -1,51 +1,121 @@
 """Fixtures of the FMU tests.
 
-Before any test, the session makes sure the release build (CLI and library) and
-``target/fmu/ParallelArch.fmu`` are newer than every source they are built from (the ``.rs``
-files of ``src/`` and ``fmu/``, ``Cargo.*``, ``modelDescription.xml.in``): when one is missing or
-older, it runs ``cargo build --release`` and ``fmu-pack`` (what ``fmu/prepare.sh`` runs), so
-that a pytest run outside ``tests/run.sh`` never compares stale copies.
+Two modes. From the checkout (``tests/run.sh``'s ``.venv``), the package is this checkout's
+``python/`` and the programs are the release build in ``target/release``; before any test, the
+session makes sure that build and ``target/fmu/ParallelArch.fmu`` are newer than every source they
+are built from (the ``.rs`` files of ``src/`` and ``fmu/``, ``Cargo.*``, ``modelDescription.xml.in``):
+when one is missing or older, it runs ``cargo build --release`` and ``fmu-pack`` (what
+``fmu/prepare.sh`` runs), so that a pytest run outside ``tests/run.sh`` never compares stale copies.
 
-* ``fmu_path``: ``target/fmu/ParallelArch.fmu``;
-* ``custom_fmu``: an FMU of a user model file, packed in the test session with
-  ``cargo run --release --bin fmu-pack -- custom.json``; the model is the 200 mm specimen as the
-  CLI exports it, renamed (model ``CustomArch``, group ``rim``, gaps ``S1``..``S9``) so that every
-  variable name must come from the model file;
-* ``cli``: runs the core's CLI (``target/release/membrane-contact``), the reference the FMU
-  results are compared with.
+Installed (``MEMBRANE_CONTACT_INSTALLED=1``, set by ``tests/wheel/run.sh``: the wheel in a clean
+venv, no cargo on PATH), the package is the venv's, the programs are the venv's
+``membrane-contact`` and ``fmu-pack``, the specimen FMU is packed by that ``fmu-pack`` into a
+temporary directory, and nothing is built. Running ``cargo`` or anything of ``target/`` outside
+the venv (the checkout's build) fails the test that tries.
+
+* ``fmu_path``: the ParallelArch specimen FMU (``target/fmu/ParallelArch.fmu``, or installed, the
+  one the wheel's ``fmu-pack`` packs);
+* ``custom_fmu``: an FMU of a user model file, packed in the test session with ``fmu-pack
+  custom.json`` (:func:`pack`); the model is the 200 mm specimen as the CLI exports it, renamed
+  (model ``CustomArch``, group ``rim``, gaps ``S1``..``S9``) so that every variable name must come
+  from the model file;
+* ``cli``: runs the core's CLI (:data:`CLI`), the reference the FMU results are compared with.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import os
 import subprocess
 import sys
+import sysconfig
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-# The tests use the package of this checkout (python/), installed or not; test_package.py checks
-# the installed copy separately.
-sys.path.insert(0, str(ROOT / "python"))
 TARGET = ROOT / "target"
-PARALLEL_ARCH_FMU = TARGET / "fmu" / "ParallelArch.fmu"
-CLI = TARGET / "release" / "membrane-contact"
+#: The suite runs against the installed wheel (tests/wheel/run.sh), not the checkout.
+INSTALLED = os.environ.get("MEMBRANE_CONTACT_INSTALLED") == "1"
+#: Why a test that needs the checkout (cargo, fmu/prepare.sh, .venv) is skipped when installed.
+NEEDS_CHECKOUT = "needs the checkout's cargo build (MEMBRANE_CONTACT_INSTALLED=1 tests the wheel)"
+if INSTALLED:
+    VENV = Path(sys.prefix).resolve()
+    CLI = Path(sysconfig.get_path("scripts")) / "membrane-contact"
+    FMU_PACK = Path(sysconfig.get_path("scripts")) / "fmu-pack"
+    PARALLEL_ARCH_FMU = None  # packed by the session (fmu_path)
+    os.environ.pop("MEMBRANE_CONTACT_ROOT", None)  # it would make build_fmu pack with cargo
+else:
+    # The tests use the package of this checkout (python/), installed or not; test_package.py
+    # checks the installed copy separately.
+    sys.path.insert(0, str(ROOT / "python"))
+    CLI = TARGET / "release" / "membrane-contact"
+    FMU_PACK = TARGET / "release" / "fmu-pack"
+    PARALLEL_ARCH_FMU = TARGET / "fmu" / "ParallelArch.fmu"
+
+
+def package_env() -> dict:
+    """The environment of a Python subprocess that must import the package under test: the
+    checkout's ``python/`` ahead on ``PYTHONPATH``, or installed, the venv's as it is."""
+    env = dict(os.environ)
+    if not INSTALLED:
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(ROOT / "python"), env.get("PYTHONPATH")]))
+    return env
 
 
 def cargo(*args, check=True):
     return subprocess.run(["cargo", *args], cwd=ROOT, capture_output=True, text=True, check=check)
 
 
+def fmu_pack(*args) -> subprocess.CompletedProcess:
+    """Runs the ``fmu-pack`` under test (the release build's, or the wheel's) with ``args``."""
+    return subprocess.run([str(FMU_PACK), *map(str, args)], capture_output=True, text=True)
+
+
 def pack(model_file, out_dir) -> Path:
     """Packs the FMU of ``model_file`` into ``out_dir`` with ``fmu-pack`` and returns its path
     (``<model name>.fmu``)."""
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(model_file), "--out", str(out_dir))
+    r = fmu_pack(model_file, "--out", out_dir)
+    assert r.returncode == 0, f"fmu-pack {model_file} failed: {r.stderr}"
     name = json.loads(Path(model_file).read_text())["name"]
     path = Path(out_dir) / f"{name}.fmu"
     assert path.exists(), path
     return path
+
+
+def _the_checkouts_build(word) -> bool:
+    """``word`` names cargo or a file of ``target/`` that is not in the wheel's venv."""
+    if not isinstance(word, (str, os.PathLike)):
+        return False
+    word = os.fspath(word)
+    if os.path.basename(word) in ("cargo", "rustc"):
+        return True
+    if os.sep not in word:  # a plain argument, not a path
+        return False
+    path = Path(os.path.abspath(word))
+    return path.is_relative_to(TARGET) and not path.is_relative_to(VENV)
+
+
+def _refuse_the_checkouts_build(event, args):
+    """Audit hook of the installed mode: the tests may not run cargo, nor run or open the
+    checkout's build (target/release, target/fmu) instead of the wheel's."""
+    if event == "open":
+        words = [args[0]]
+    elif event == "subprocess.Popen":
+        executable, argv = args[0], args[1]
+        words = [executable, *(argv.replace("'", " ").replace('"', " ").split() if isinstance(argv, str)
+                               else argv)]
+    else:
+        return
+    bad = [w for w in words if _the_checkouts_build(w)]
+    if bad:
+        raise RuntimeError(f"installed mode (MEMBRANE_CONTACT_INSTALLED=1): {os.fspath(bad[0])} is the "
+                           "checkout's build or toolchain, not the wheel's")
+
+
+if INSTALLED:
+    sys.addaudithook(_refuse_the_checkouts_build)
 
 
 def newest_source() -> float:
@@ -56,13 +126,20 @@ def newest_source() -> float:
 
 
 def stale_artefacts() -> list[Path]:
-    """The CLI and the ParallelArch FMU if missing or older than a source file."""
+    """The CLI, fmu-pack and the ParallelArch FMU if missing or older than a source file."""
     newest = newest_source()
-    return [p for p in (CLI, PARALLEL_ARCH_FMU) if not p.is_file() or p.stat().st_mtime < newest]
+    return [p for p in (CLI, FMU_PACK, PARALLEL_ARCH_FMU) if not p.is_file() or p.stat().st_mtime < newest]
 
 
 def pytest_sessionstart(session):
-    """Rebuilds the CLI and repacks the FMU when stale (cargo is quick when up to date)."""
+    """Rebuilds the CLI and repacks the FMU when stale (cargo is quick when up to date).
+    Installed: checks that the venv has the wheel's programs, builds nothing."""
+    if INSTALLED:
+        missing = [str(p) for p in (CLI, FMU_PACK) if not p.is_file()]
+        if missing:
+            pytest.exit(f"MEMBRANE_CONTACT_INSTALLED=1 but the venv has no {', '.join(missing)}: "
+                        "pip install the wheel (tests/wheel/run.sh)", returncode=1)
+        return
     stale = stale_artefacts()
     if not stale:
         return
@@ -75,8 +152,13 @@ def pytest_sessionstart(session):
 
 
 @pytest.fixture(scope="session")
-def fmu_path() -> Path:
-    return PARALLEL_ARCH_FMU
+def fmu_path(tmp_path_factory) -> Path:
+    if not INSTALLED:
+        return PARALLEL_ARCH_FMU
+    out = tmp_path_factory.mktemp("specimen")
+    r = fmu_pack("--out", out)
+    assert r.returncode == 0, f"the wheel's fmu-pack failed: {r.stderr}"
+    return out / "ParallelArch.fmu"
 
 
 class Cli:

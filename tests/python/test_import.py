@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import re
 import subprocess
 import sys
@@ -52,7 +53,7 @@ import warnings
 import meshio
 import numpy as np
 import pytest
-from conftest import CLI, ROOT, cargo
+from conftest import CLI, INSTALLED, ROOT, pack, package_env
 from fmu_helpers import OK, Slave
 
 try:
@@ -491,19 +492,19 @@ def test_an_unreadable_mesh_is_an_error_not_an_exit(tmp_path, capsys):
 
 def test_command_line(tmp_path):
     out = tmp_path / "model.json"
-    env_path = str(ROOT / "python")
+    env = package_env()
     run = subprocess.run([sys.executable, "-m", "membrane_contact.mesh", str(MSH41), str(MAPPING), "-o", str(out)],
-                         capture_output=True, text=True, cwd=env_path)
+                         capture_output=True, text=True, cwd=tmp_path, env=env)
     assert run.returncode == 0, run.stderr
     assert "26 gaps (S1 … N13)" in run.stderr
     assert json.loads(out.read_text())["name"] == "FilmOverTwoArches"
     to_stdout = subprocess.run([sys.executable, "-m", "membrane_contact.mesh", str(MSH41), str(MAPPING), "-q"],
-                               capture_output=True, text=True, cwd=env_path)
+                               capture_output=True, text=True, cwd=tmp_path, env=env)
     assert to_stdout.stdout.startswith("{") and json.loads(to_stdout.stdout) == json.loads(out.read_text())
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps({**mapping(), "physical_groups": {"arch_west": {"role": "ignore"}}}))
     run = subprocess.run([sys.executable, "-m", "membrane_contact.mesh", str(MSH22), str(bad)],
-                         capture_output=True, text=True, cwd=env_path)
+                         capture_output=True, text=True, cwd=tmp_path, env=env)
     assert run.returncode == 1 and run.stderr.startswith("error: mapping names physical group 'arch_west'")
 
 
@@ -553,10 +554,8 @@ def test_the_imported_model_runs_in_the_cli(model, cli_run):
 
 @pytest.fixture(scope="module")
 def fmu(model_file, tmp_path_factory):
-    out = tmp_path_factory.mktemp("fmu")
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(model_file), "--out", str(out))
-    path = out / "FilmOverTwoArches.fmu"
-    assert path.exists()
+    path = pack(model_file, tmp_path_factory.mktemp("fmu"))
+    assert path.name == "FilmOverTwoArches.fmu"
     return path
 
 
@@ -635,3 +634,18 @@ def test_the_cli_import_command_runs_the_same_importer(model, tmp_path):
     run = subprocess.run([str(CLI), "import", str(MSH22), str(tmp_path / "none.json"), "--python", sys.executable],
                          capture_output=True, text=True)
     assert run.returncode == 1 and "none.json" in run.stderr and "the import failed" in run.stderr
+
+
+def test_the_cli_import_command_runs_the_package_under_test(tmp_path):
+    """The checkout's build puts the checkout's python/ ahead on the importer's PYTHONPATH; the
+    program installed from the wheel (MEMBRANE_CONTACT_INSTALLED=1) does not, so that the
+    interpreter's package, the wheel's, runs even when the checkout it was built from exists."""
+    seen, python = tmp_path / "pythonpath", tmp_path / "python"
+    python.write_text(f'#!/bin/sh\nprintf "%s" "$PYTHONPATH" > "{seen}"\n')
+    python.chmod(0o755)
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    run = subprocess.run([str(CLI), "import", str(MSH22), str(MAPPING), "-o", str(tmp_path / "m.json"),
+                          "--python", str(python)], capture_output=True, text=True, env=env)
+    assert run.returncode == 0, run.stderr
+    paths = seen.read_text().split(os.pathsep)
+    assert (str(ROOT / "python") in paths) == (not INSTALLED), paths

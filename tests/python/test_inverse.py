@@ -20,7 +20,7 @@ import sys
 
 import numpy as np
 import pytest
-from conftest import ROOT
+from conftest import ROOT, package_env
 
 from membrane_contact.inverse import Unknown, _run, fit
 
@@ -91,7 +91,7 @@ def test_the_command_line_fits_a_users_csv(fmu_path, tmp_path):
                                "--measured", str(measured), "--path", str(path), "--unknown", "mu=0.1:0:1",
                                "--parameter", f"solver.displacementTolerance={TOLERANCE}",
                                "--parameter", f"solver.residualTolerance={TOLERANCE}"],
-                              capture_output=True, text=True, cwd=ROOT, env={"PYTHONPATH": str(ROOT / "python")})
+                              capture_output=True, text=True, cwd=ROOT, env=package_env())
 
     ok = run("# slips (m) and the frame's reaction (N) at the end of the path\noutput,value,scale\n"
              f"G2.slip,{float(generated[0])!r},1e-4\nG4.slip,{float(generated[1])!r},1e-4\n"

@@ -13,11 +13,10 @@ from __future__ import annotations
 
 import ctypes
 import json
-import subprocess
 import zipfile
 
 import pytest
-from conftest import ROOT, cargo
+from conftest import fmu_pack, pack
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
@@ -111,13 +110,13 @@ def test_model_wrinkling_setting_is_the_parameter_start(custom_model, tmp_path):
     model["material"]["wrinkling"] = "tension-field"
     path = tmp_path / "wrinkling.json"
     path.write_text(json.dumps(model))
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(path), "--out", str(tmp_path))
-    v = {x.name: x for x in read_model_description(str(tmp_path / "CustomArch.fmu")).modelVariables}
+    v = {x.name: x for x in read_model_description(str(pack(path, tmp_path))).modelVariables}
     assert v["film.wrinkling"].start == "true"
 
 
 def test_packing_is_deterministic(fmu_path, tmp_path):
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", "--out", str(tmp_path))
+    r = fmu_pack("--out", tmp_path)
+    assert r.returncode == 0, r.stderr
     again = tmp_path / "ParallelArch.fmu"
     with zipfile.ZipFile(fmu_path) as a, zipfile.ZipFile(again) as b:
         assert a.read("modelDescription.xml") == b.read("modelDescription.xml")
@@ -144,8 +143,7 @@ def test_fmu_pack_refuses_a_bad_model_and_writes_nothing(custom_model, tmp_path)
     for i, (content, expect) in enumerate(cases):
         path = tmp_path / f"bad{i}.json"
         path.write_text(content if isinstance(content, str) else json.dumps(content))
-        r = subprocess.run([str(ROOT / "target/release/fmu-pack"), str(path), "--out", str(out)],
-                           capture_output=True, text=True)
+        r = fmu_pack(path, "--out", out)
         assert r.returncode != 0, expect
         assert expect in r.stderr and str(path) in r.stderr, r.stderr
         assert not out.exists() or not any(out.iterdir()), "nothing written"

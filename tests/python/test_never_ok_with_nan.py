@@ -24,11 +24,10 @@ import subprocess
 import zlib
 from ctypes import byref, c_size_t, c_void_p, create_string_buffer
 
-from conftest import CLI, ROOT
+from conftest import CLI, fmu_pack
 from fmpy import read_model_description
 from fmu_helpers import DISCARD, ERROR, OK, Slave
 
-FMU_PACK = ROOT / "target" / "release" / "fmu-pack"
 RAMP = {"frame.dz": -0.15}
 
 
@@ -52,7 +51,7 @@ def pack(model: dict, tmp_path, name="m.json"):
     path = tmp_path / name
     path.write_text(json.dumps(model))
     out = tmp_path / "out"
-    r = subprocess.run([str(FMU_PACK), str(path), "--out", str(out)], capture_output=True, text=True)
+    r = fmu_pack(path, "--out", out)
     return r, out
 
 

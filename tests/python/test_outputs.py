@@ -15,7 +15,8 @@ from __future__ import annotations
 import json
 
 import pytest
-from conftest import ROOT, cargo
+from conftest import ROOT
+from conftest import pack as pack_file
 from fmu_helpers import OK, WARNING, Slave
 
 EXAMPLE = ROOT / "examples" / "circular_membrane.json"
@@ -24,8 +25,7 @@ EXAMPLE = ROOT / "examples" / "circular_membrane.json"
 def pack(tmp_path, model: dict, name: str):
     source = tmp_path / f"{name}.json"
     source.write_text(json.dumps(model))
-    cargo("run", "--quiet", "--release", "--bin", "fmu-pack", "--", str(source), "--out", str(tmp_path))
-    return tmp_path / f"{model['name']}.fmu"
+    return pack_file(source, tmp_path)
 
 
 def test_output_point_set_summary_and_total_reaction(tmp_path):

@@ -22,12 +22,13 @@ MODELS: the ParallelArch FMU (300 mm, frame lowered to −H/2) and the hinged pa
 from __future__ import annotations
 
 import subprocess
+from pathlib import Path
 import sys
 
 import numpy as np
 import pandas as pd  # a test requirement (tests/python/requirements.txt): required, never skipped
 import pytest
-from conftest import ROOT, pack
+from conftest import INSTALLED, ROOT, pack
 
 from membrane_contact import Film, FmuError, Results, StepRefused, build_fmu, find_fmu
 from membrane_contact.film import DISCARD, OK
@@ -44,6 +45,19 @@ def test_the_package_is_installed_in_the_venv_and_importable_from_anywhere(tmp_p
     r = subprocess.run([sys.executable, "-c", "import membrane_contact.mesh, membrane_contact.arches, "
                         "membrane_contact.plot"], cwd=tmp_path, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_the_tests_import_the_package_under_test():
+    """The checkout's python/ (tests/run.sh's .venv), or installed (MEMBRANE_CONTACT_INSTALLED=1,
+    tests/wheel/run.sh), the wheel's copy in the venv's site-packages, never the checkout's."""
+    import membrane_contact
+
+    package = Path(membrane_contact.__file__).resolve()
+    if INSTALLED:
+        assert package.is_relative_to(Path(sys.prefix).resolve()) and "site-packages" in package.parts, package
+        assert not package.is_relative_to(ROOT / "python"), package
+    else:
+        assert package == ROOT / "python" / "membrane_contact" / "__init__.py"
 
 
 def test_names_in_and_out_and_bad_values_refused_with_the_fmus_message(fmu_path):
@@ -275,14 +289,30 @@ def test_build_fmu_packs_a_model_file_or_dict_and_reports_a_refused_model(tmp_pa
     assert not (tmp_path / "c" / "PanelFromDict.fmu").exists()
 
 
-def test_find_fmu_says_how_to_make_one_when_there_is_none(monkeypatch):
+@pytest.fixture
+def repository(fmu_path, tmp_path, monkeypatch) -> Path:
+    """The repository find_fmu looks into: this checkout, or installed (no checkout around the
+    package), one made in a temporary directory holding the specimen FMU, the current directory."""
+    if not INSTALLED:
+        return ROOT
+    repo = tmp_path / "repository"
+    (repo / "fmu").mkdir(parents=True)
+    (repo / "Cargo.toml").write_text("")
+    (repo / "target" / "fmu").mkdir(parents=True)
+    (repo / "target" / "fmu" / "ParallelArch.fmu").write_bytes(fmu_path.read_bytes())
+    monkeypatch.chdir(repo)
+    return repo
+
+
+def test_find_fmu_says_how_to_make_one_when_there_is_none(repository, monkeypatch):
     monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
     assert find_fmu().name == "ParallelArch.fmu"
     with pytest.raises(FileNotFoundError, match="pack it with"):
         find_fmu(model="NoSuchModel")
 
 
-def test_find_fmu_takes_a_path_then_the_environment_then_the_repository(fmu_path, tmp_path, monkeypatch):
+def test_find_fmu_takes_a_path_then_the_environment_then_the_repository(fmu_path, repository, tmp_path,
+                                                                        monkeypatch):
     copy = tmp_path / "Copy.fmu"
     copy.write_bytes(fmu_path.read_bytes())
     monkeypatch.setenv("MEMBRANE_CONTACT_FMU", str(copy))
@@ -293,7 +323,7 @@ def test_find_fmu_takes_a_path_then_the_environment_then_the_repository(fmu_path
     with pytest.raises(FileNotFoundError, match="gone.fmu: no such FMU"):
         find_fmu()
     monkeypatch.delenv("MEMBRANE_CONTACT_FMU")
-    assert find_fmu() == ROOT / "target" / "fmu" / "ParallelArch.fmu"
+    assert find_fmu().resolve() == (repository / "target" / "fmu" / "ParallelArch.fmu").resolve()
 
 
 def test_the_readme_python_package_block_runs_as_written(fmu_path, monkeypatch):
@@ -304,7 +334,10 @@ def test_the_readme_python_package_block_runs_as_written(fmu_path, monkeypatch):
     section = text[text.index("## Python package"):]
     block = section[section.index("```python") + len("```python"):section.index("```\n\n")]
     monkeypatch.chdir(ROOT)
-    monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
+    if INSTALLED:  # the block's other source of the FMU: no target/fmu beside the wheel
+        monkeypatch.setenv("MEMBRANE_CONTACT_FMU", str(fmu_path))
+    else:
+        monkeypatch.delenv("MEMBRANE_CONTACT_FMU", raising=False)
     scope = {}
     exec(compile(block, "README.md", "exec"), scope)
     assert scope["names"] == [f"G{i}" for i in range(1, 10)] and scope["slips"].shape == (21, 9)

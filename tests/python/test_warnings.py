@@ -26,11 +26,10 @@ import warnings
 
 import numpy as np
 import pytest
-from conftest import CLI, ROOT, TARGET
+from conftest import CLI, ROOT, fmu_pack
 
 from membrane_contact import Film, SolverWarning, SolverWarningError
 
-PACK = TARGET / "release" / "fmu-pack"
 EXAMPLE = ROOT / "examples" / "film_over_two_arches"
 TABLE = {"time": [1.0, 2.0, 3.0], "frame.dz": [-0.01, -0.03, -0.05]}
 
@@ -47,7 +46,7 @@ def pack(model: dict, tmp_path, name: str):
     model["name"] = name
     path = tmp_path / f"{name}.json"
     path.write_text(json.dumps(model))
-    r = subprocess.run([str(PACK), str(path), "--out", str(tmp_path)], capture_output=True, text=True)
+    r = fmu_pack(path, "--out", tmp_path)
     assert r.returncode == 0, r.stderr
     return tmp_path / f"{name}.fmu", r.stderr
 

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The wheel without a Rust toolchain (issue 17 item 10): installs target/wheels/membrane_contact-*.whl
-# (made by fmu/prepare.sh) into a clean venv, target/wheel-venv, and runs tests/wheel/ there with
-# every directory holding cargo or rustc taken off PATH. Called at the end of tests/run.sh.
+# (made by fmu/prepare.sh) into a clean venv, target/wheel-venv, with the test requirements, and
+# runs tests/wheel/ and the whole Python suite tests/python/ there against it
+# (MEMBRANE_CONTACT_INSTALLED=1: the wheel's package, CLI and fmu-pack; see tests/python/conftest.py)
+# with every directory holding cargo or rustc taken off PATH. Called at the end of tests/run.sh.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
@@ -23,6 +25,9 @@ done
 venv=target/wheel-venv
 rm -rf "$venv"
 python3 -m venv "$venv"
-# The wheel with its importer extra (meshio), and pytest: nothing of the checkout's python/.
-PATH="$no_rust" "$venv/bin/pip" install --quiet --disable-pip-version-check "${wheels[0]}[mesh]" pytest
-PATH="$(pwd)/$venv/bin:$no_rust" "$venv/bin/python" -m pytest tests/wheel -q -p no:cacheprovider
+# The wheel with its importer extra (meshio), and what the tests use (pytest, libcosimpy, pandas,
+# matplotlib): nothing of the checkout's python/.
+PATH="$no_rust" "$venv/bin/pip" install --quiet --disable-pip-version-check "${wheels[0]}[mesh]" \
+  -r tests/python/requirements.txt
+PATH="$(pwd)/$venv/bin:$no_rust" MEMBRANE_CONTACT_INSTALLED=1 \
+  "$venv/bin/python" -m pytest tests/wheel tests/python -q -p no:cacheprovider
