@@ -287,7 +287,10 @@ fn edit_snapshot(s: &mut Snapshot, rng: &mut Rng) {
                 // A control character in a path below the temporary directory: a mutated
                 // `results.directory` must never write into the working tree.
                 Value::String(_) => Value::String(
-                    std::env::temp_dir().join("membrane-contact-fuzz\u{1}x").display().to_string(),
+                    std::env::temp_dir()
+                        .join("membrane-contact-fuzz\u{1}x")
+                        .display()
+                        .to_string(),
                 ),
             };
         }

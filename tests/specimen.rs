@@ -111,7 +111,10 @@ fn arch_circle_passes_through_the_crown_at_h_and_the_feet_at_z_zero() {
     assert!((radius(0.3) - 73.0 / 60.0).abs() < 1e-15);
     for h in HEIGHTS {
         let [cy, cz] = arch_point(h, 0.0);
-        assert!(cy.abs() < 1e-15 && (cz - h).abs() < 1e-15, "crown {cy} {cz}");
+        assert!(
+            cy.abs() < 1e-15 && (cz - h).abs() < 1e-15,
+            "crown {cy} {cz}"
+        );
         let [fy, fz] = arch_point(h, foot_angle(h));
         assert!(
             (fy - HALF_SPAN).abs() < 1e-14 && fz.abs() < 1e-14,
@@ -133,7 +136,12 @@ fn specimen_geometry_is_the_documented_one_worked_by_hand_at_every_height() {
         let mut cells = vec![];
         for j in 0..CELLS {
             for i in 0..CELLS {
-                let (a, b, c, d) = (grid(i, j), grid(i + 1, j), grid(i + 1, j + 1), grid(i, j + 1));
+                let (a, b, c, d) = (
+                    grid(i, j),
+                    grid(i + 1, j),
+                    grid(i + 1, j + 1),
+                    grid(i, j + 1),
+                );
                 cells.push(sorted(vec![a, b, c]));
                 cells.push(sorted(vec![a, c, d]));
             }
@@ -169,7 +177,12 @@ fn specimen_geometry_is_the_documented_one_worked_by_hand_at_every_height() {
         // Film material.
         let mat = &m.material;
         assert_eq!(
-            (mat.youngs_modulus, mat.poisson_ratio, mat.thickness, mat.prestress),
+            (
+                mat.youngs_modulus,
+                mat.poisson_ratio,
+                mat.thickness,
+                mat.prestress
+            ),
             (E, NU, T, [PRESTRESS, PRESTRESS, 0.0])
         );
         // The nine gaps: film node (0.4, 0.1 k, H); the arch centre is (0.4, 0, H − R), so the
@@ -186,7 +199,11 @@ fn specimen_geometry_is_the_documented_one_worked_by_hand_at_every_height() {
                 panic!("{}: fixed support point", g.name)
             };
             let expected = [ARCH_X, r * ny, h - r + r * nz];
-            assert!(close(&p, &expected, 1e-12), "H = {h}, {}: {p:?} vs {expected:?}", g.name);
+            assert!(
+                close(&p, &expected, 1e-12),
+                "H = {h}, {}: {p:?} vs {expected:?}",
+                g.name
+            );
             assert!(
                 close(&g.frame.z, &[0.0, ny, nz], 1e-12)
                     && close(&g.frame.x, &[0.0, nz, -ny], 1e-12)
@@ -195,7 +212,11 @@ fn specimen_geometry_is_the_documented_one_worked_by_hand_at_every_height() {
                 g.name,
                 g.frame
             );
-            assert!((g.initial_gap - (d - r)).abs() < 1e-12, "H = {h}, {}", g.name);
+            assert!(
+                (g.initial_gap - (d - r)).abs() < 1e-12,
+                "H = {h}, {}",
+                g.name
+            );
             assert_eq!(
                 (g.normal_stiffness, g.tangential_stiffness, g.friction),
                 (KN, KS, 0.2)
@@ -224,7 +245,10 @@ fn specimen_geometry_is_the_documented_one_worked_by_hand_at_every_height() {
         assert!(close(&centre, &[ARCH_X, 0.0, h - r], 1e-12), "{centre:?}");
         assert!((ring + PIPE - r).abs() < 1e-12 && support.tube_radius == PIPE);
         let [from, to] = angles.unwrap();
-        assert!(from < 0.0 && (to - 0.1 - foot_angle(h)).abs() < 1e-12, "{angles:?}");
+        assert!(
+            from < 0.0 && (to - 0.1 - foot_angle(h)).abs() < 1e-12,
+            "{angles:?}"
+        );
         let arch_nodes: Vec<usize> = m.gaps.iter().map(|g| g.film_node).collect();
         assert_eq!(support.nodes, arch_nodes);
     }
@@ -280,7 +304,11 @@ fn model_file(h: f64, mu: f64, wrapped: Option<f64>) -> String {
     let mut nodes = vec![];
     for i in 0..=n {
         for j in 0..=n {
-            nodes.push(format!("[{:e}, {:e}, {h:e}]", i as f64 * CELL, j as f64 * CELL));
+            nodes.push(format!(
+                "[{:e}, {:e}, {h:e}]",
+                i as f64 * CELL,
+                j as f64 * CELL
+            ));
         }
     }
     let mut triangles = vec![];
@@ -340,7 +368,11 @@ fn model_file(h: f64, mu: f64, wrapped: Option<f64>) -> String {
             })
             .collect(),
     };
-    let wrinkling = if wrapped.is_some() { "tension-field" } else { "none" };
+    let wrinkling = if wrapped.is_some() {
+        "tension-field"
+    } else {
+        "none"
+    };
     format!(
         "{{\"name\": \"ByHand\", \"description\": \"the 300 mm specimen from its documented dimensions\",\n\
          \"nodes\": [{}],\n\"triangles\": [{}],\n\
@@ -411,7 +443,11 @@ fn assert_same_slips(by_hand: &Results, program: &Results, bound: f64, what: &st
         assert_eq!(a.status, b.status, "{what}, G{}", k + 1);
     }
     // The slips are not all zero: the comparison has something to compare.
-    assert!(program.gaps[7].slip_x > 1e-3, "{what}: {:?}", program.gaps[7]);
+    assert!(
+        program.gaps[7].slip_x > 1e-3,
+        "{what}: {:?}",
+        program.gaps[7]
+    );
 }
 
 #[test]
@@ -424,11 +460,17 @@ fn specimen_300mm_slips_at_half_the_rise_equal_those_of_a_model_file_written_by_
     };
     let lowered = |m: &Model, t: f64| vec![m.groups[0].target.map(|v| v * t); m.groups.len()];
     let a = run(by_hand, steps, lowered);
-    let b = run(spec.model().unwrap(), steps, |m, t| spec.boundary_targets(m, t));
+    let b = run(spec.model().unwrap(), steps, |m, t| {
+        spec.boundary_targets(m, t)
+    });
     assert_same_slips(&a, &b, slip_bound(steps, h / 2.0), "lowered");
     // The frame reaction too, to the residual tolerance of the largest nodal force.
     let scale = b.reactions[0].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    assert!(close(&a.reactions[0], &b.reactions[0], 10.0 * TOLERANCE * scale));
+    assert!(close(
+        &a.reactions[0],
+        &b.reactions[0],
+        10.0 * TOLERANCE * scale
+    ));
 }
 
 #[test]
@@ -451,7 +493,9 @@ fn specimen_300mm_wrapped_slips_equal_those_of_a_model_file_written_by_hand() {
         ..ParallelArch::with_height(h)
     };
     let a = run(by_hand, steps, wrapped);
-    let b = run(spec.model().unwrap(), steps, |m, t| spec.boundary_targets(m, t));
+    let b = run(spec.model().unwrap(), steps, |m, t| {
+        spec.boundary_targets(m, t)
+    });
     // The largest boundary displacement: the foot corner, wound down by about H + 0.2.
     let u_max = h + (FRAME - HALF_SPAN) + eps * FRAME;
     assert_same_slips(&a, &b, slip_bound(steps, u_max), "wrapped");
