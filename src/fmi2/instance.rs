@@ -64,15 +64,16 @@ use super::types::{
 use super::variables::{
     Binding, Causality, StepInputs, Value, VarType, Variable, article, message_real, step_inputs,
 };
-use crate::mech::element::state_counts;
-use crate::mech::material::Wrinkling;
+use crate::mech::elements::material::Wrinkling;
+use crate::mech::elements::triangle::state_counts;
 use crate::mech::{
-    Analysis, GapStatus, IterationMatrix, LoadLevels, Model, ParallelArch, Results, SettingNames,
-    SolverSettings, StepError, StepReport, check_results,
-    solver::{IncrementFailure, MAX_THREADS},
-    summary::{model_warnings, result_warnings},
-    vtk,
+    Analysis, GapStatus, IterationMatrix, LoadLevels, Model, Results, SettingNames, SolverSettings,
+    StepError, StepReport, check_results,
+    results::vtk,
+    results::warnings::{model_warnings, result_warnings},
+    solve::{IncrementFailure, MAX_THREADS},
 };
+use crate::specimens::ParallelArch;
 use serde::{Deserialize, Serialize};
 
 /// The FMU parameters that a refused step's advice names.
@@ -218,7 +219,7 @@ struct Built {
     /// The results of the state `checked_step` has just reached, already checked finite: the
     /// outputs are made of them (taken by `refresh_outputs`, so never stale).
     checked: Option<Results>,
-    /// What the last outputs leave of the model's assumptions (`summary::result_warnings`).
+    /// What the last outputs leave of the model's assumptions (`warnings::result_warnings`).
     warnings: Vec<String>,
 }
 

@@ -26,7 +26,7 @@ use super::instance::allowed;
 use super::resources::{Source, file_uri};
 use super::types::*;
 use super::variables::Variable;
-use crate::mech::ParallelArch;
+use crate::specimens::ParallelArch;
 
 /// Messages received by the test logger: (status, category, message).
 #[derive(Default)]
@@ -1319,8 +1319,8 @@ fn singular_model_is_refused_before_any_step() {
 fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels() {
     use super::variables::{Causality, Value};
     use crate::mech::model::ForceSet;
-    use crate::mech::scenarios::CircularMembrane;
     use crate::mech::{Analysis, LoadLevels, SolverSettings};
+    use crate::specimens::scenarios::CircularMembrane;
 
     let membrane = CircularMembrane {
         radius: 1.0,
@@ -1438,8 +1438,8 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
 #[test]
 fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
     use super::variables::{Causality, SummaryQuantity};
-    use crate::mech::scenarios::CircularMembrane;
     use crate::mech::{Analysis, LoadLevels, SolverSettings};
+    use crate::specimens::scenarios::CircularMembrane;
 
     let membrane = CircularMembrane {
         radius: 1.0,
@@ -1670,7 +1670,7 @@ fn serialized(fmu: &Fmu, state: Fmi2FmuState) -> Vec<Fmi2Byte> {
 /// every output must equal the one of the step that never restored, bit for bit. Returns the
 /// statuses (0 open, 1 stick, 2 slip) the contacts had at the saved states.
 fn round_trips_at_every_step(
-    contact: crate::mech::specimen::SpecimenContact,
+    contact: crate::specimens::parallel_arch::SpecimenContact,
     law: &str,
     path: &[(f64, f64)],
 ) -> std::collections::BTreeSet<i32> {
@@ -1765,7 +1765,7 @@ fn saved_states_round_trip_in_every_gap_and_contact_status_under_both_laws() {
         (0.3, 0.2),
         (0.6, 0.2),
     ];
-    use crate::mech::specimen::SpecimenContact;
+    use crate::specimens::parallel_arch::SpecimenContact;
     for contact in [SpecimenContact::Gaps, SpecimenContact::CurvedSupport] {
         for law in ["isotropic", "sliding-direction"] {
             let seen = round_trips_at_every_step(contact, law, &PATH);
@@ -1859,7 +1859,7 @@ fn forged_variable_values_are_refused_as_fmi2_set_would_naming_the_variable() {
 fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
     use crate::mech::GapStatus;
     let spec = ParallelArch {
-        contact: crate::mech::specimen::SpecimenContact::CurvedSupport,
+        contact: crate::specimens::parallel_arch::SpecimenContact::CurvedSupport,
         ..ParallelArch::default()
     };
     let (u, log) = (
@@ -1882,7 +1882,7 @@ fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
             support.nodes[k], support.name
         )
     };
-    type Forgery = Box<dyn Fn(&mut crate::mech::surface::ContactHistory)>;
+    type Forgery = Box<dyn Fn(&mut crate::mech::elements::curved_contact::ContactHistory)>;
     let cases: Vec<(usize, Forgery, String)> = vec![
         (
             open,

@@ -266,7 +266,7 @@ pub enum Binding {
     },
 }
 
-/// The quantities of a [`crate::mech::summary::FieldSummary`], each an FMU output per element set.
+/// The quantities of a [`crate::mech::results::summary::FieldSummary`], each an FMU output per element set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SummaryQuantity {
     MaxPrincipalStress,
@@ -312,7 +312,7 @@ impl SummaryQuantity {
     ];
 
     /// This quantity of `summary`.
-    pub fn of(self, summary: &crate::mech::summary::FieldSummary) -> f64 {
+    pub fn of(self, summary: &crate::mech::results::summary::FieldSummary) -> f64 {
         match self {
             Self::MaxPrincipalStress => summary.max_principal_stress,
             Self::MinPrincipalStress => summary.min_principal_stress,
@@ -391,7 +391,7 @@ impl Variable {
                 .map(drop)
                 .map_err(|e| format!("{}: {e}", self.name)),
             (Binding::VtkFormat, Value::String(name)) => name
-                .parse::<crate::mech::vtk::Encoding>()
+                .parse::<crate::mech::results::vtk::Encoding>()
                 .map(drop)
                 .map_err(|e| format!("{}: {e}", self.name)),
             _ => Ok(()),
@@ -432,9 +432,8 @@ pub const RESERVED_NAMES: [&str; 9] = [
 ];
 
 /// Default of `solver.incrementsPerStep`: the core's
-/// [`crate::mech::solver::DEFAULT_INCREMENTS_PER_STEP`], the CLI's default too.
-pub const DEFAULT_INCREMENTS_PER_STEP: i32 =
-    crate::mech::solver::DEFAULT_INCREMENTS_PER_STEP as i32;
+/// [`crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP`], the CLI's default too.
+pub const DEFAULT_INCREMENTS_PER_STEP: i32 = crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP as i32;
 
 /// Checks that the model's gap, group, pressure-set and force-set names can prefix variable names.
 pub fn check_names(model: &Model) -> Result<(), String> {
@@ -808,7 +807,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     );
     table.parameter(
         "results.vtkFormat",
-        Value::String(crate::mech::vtk::Encoding::default().name().into()),
+        Value::String(crate::mech::results::vtk::Encoding::default().name().into()),
         None,
         "encoding of the VTK files: binary (raw appended data, about half the size) or ascii",
         Binding::VtkFormat,
@@ -1137,7 +1136,7 @@ impl TableBuilder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::ParallelArch;
+    use crate::specimens::ParallelArch;
     use std::collections::HashSet;
 
     fn specimen_table() -> (Model, Vec<Variable>) {
