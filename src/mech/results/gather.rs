@@ -2,12 +2,10 @@
 
 use nalgebra::Vector3;
 
-use crate::mech::elements::triangle::ElementVector;
-use crate::mech::results::GapResult;
 use crate::mech::results::Results;
-use crate::mech::results::summary::summarize;
-use crate::mech::solve::analysis::Analysis;
+use crate::mech::solve::Analysis;
 use crate::mech::solve::assembly::{Dof, node_vector};
+use crate::mech::solve::contributions::Evaluation;
 
 impl Analysis {
     /// The moment of each group's reaction about its hinge axis (see [`Results::moments`]).
@@ -33,27 +31,13 @@ impl Analysis {
 
     /// Gap results, group reactions and element stresses at the converged state.
     pub fn results(&mut self) -> Results {
-        let (laws, history) = self.laws_and_history(&self.state);
         let u = std::mem::take(&mut self.state.displacement);
         let levels = self.state.loads.clone();
-        self.assemble_at(&u, &laws, &history, &levels, None);
+        for c in self.parts.all_mut() {
+            c.at_converged(&self.state);
+        }
+        self.assemble_at(&u, &levels, None);
         self.state.displacement = u;
-        // The law at the converged point with the updated history gives the same forces; the
-        // status is the one found when the increment converged.
-        let gaps = self
-            .work
-            .responses
-            .iter()
-            .zip(&self.state.status)
-            .map(|(r, &status)| GapResult {
-                slip_x: r.relative.x,
-                slip_y: r.relative.y,
-                normal_force: r.normal_force,
-                friction_force: (r.force.x.powi(2) + r.force.y.powi(2)).sqrt(),
-                friction: [r.force.x, r.force.y],
-                status,
-            })
-            .collect();
         let mut reactions = vec![[0.0; 3]; self.model.groups.len()];
         let mut total_reaction = [0.0; 3];
         let mut node_reactions = vec![[0.0; 3]; self.model.nodes.len()];
@@ -83,52 +67,36 @@ impl Analysis {
             }
         }
         let u = &self.state.displacement;
-        let elements = self
-            .system
-            .triangles
-            .iter()
-            .map(|(nodes, tri)| {
-                let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
-                tri.stress_state(&self.system.material, &ue)
-            })
-            .collect::<Vec<_>>();
-        let outputs = &self.model.outputs;
-        let points = outputs
+        let points = self
+            .model
+            .outputs
             .points
             .iter()
             .map(|p| node_vector(u, p.node).into())
             .collect();
-        let summaries = if outputs.element_sets.is_empty() {
-            vec![]
-        } else {
-            let areas: Vec<f64> = self
-                .system
-                .triangles
-                .iter()
-                .map(|(_, t)| t.area())
-                .collect();
-            outputs
-                .element_sets
-                .iter()
-                .map(|set| {
-                    let triangles = self.model.selected_triangles(&set.elements);
-                    summarize(&elements, &areas, &triangles)
-                })
-                .collect()
-        };
-        let cables = self.cables.results(u);
-        Results {
-            gaps,
+        let mut results = Results {
+            gaps: vec![],
             reactions,
             moments,
-            cables,
-            surface_contacts: self.surfaces.results(u, &self.state.contacts),
+            cables: vec![],
+            surface_contacts: vec![],
             support_reactions,
             total_reaction,
             node_reactions,
-            elements,
+            elements: vec![],
             points,
-            sets: summaries,
+            sets: vec![],
+        };
+        let at = Evaluation {
+            system: &self.system,
+            u,
+            levels: &levels,
+            iteration: None,
+            matrix: self.settings.iteration_matrix,
+        };
+        for c in self.parts.all() {
+            c.results(&at, &self.state, &self.model, &mut results);
         }
+        results
     }
 }

@@ -12,64 +12,50 @@
 
 use nalgebra::{Vector2, Vector3};
 
-use crate::mech::elements::cable::Cables;
-use crate::mech::elements::curved_contact::{ContactHistory, ContactResponse, SurfaceContacts};
-use crate::mech::elements::gap::{GapLaw, GapResponse, IterationMatrix};
+use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::{LoadLevels, Loads};
-use crate::mech::model::bounding_diagonal;
-use crate::mech::model::{Hinge, Model};
+use crate::mech::model::{Model, bounding_diagonal};
 use crate::mech::solve::assembly::{System, node_vector};
+use crate::mech::solve::contributions::{Contributions, Evaluation};
 use crate::mech::solve::linear::{LinearSolver, SolveProfile, UnsymmetricMethod};
-use crate::mech::solve::report::SetupError;
-use crate::mech::solve::report::StepError;
-use crate::mech::solve::report::StepReport;
+use crate::mech::solve::report::{SetupError, StepError, StepReport};
 use crate::mech::solve::settings::SolverSettings;
 use crate::mech::solve::state::AnalysisState;
-use crate::mech::solve::state::GroupMotion;
 
-/// A model under analysis: the system, its factorization and the last converged state.
+/// A model under analysis: the system, its factorization, its contributions and the last
+/// converged state.
 #[derive(Clone, Debug)]
 pub struct Analysis {
-    pub(crate) model: Model,
-    pub(crate) system: System,
-    pub(crate) laws: Vec<GapLaw>,
-    pub(crate) settings: SolverSettings,
-    pub(crate) linear: LinearSolver,
-    pub(crate) loads: Loads,
-    /// Tension-only edge cables.
-    pub(crate) cables: Cables,
-    /// Node-to-surface contacts on curved supports.
-    pub(crate) surfaces: SurfaceContacts,
-    pub(crate) state: AnalysisState,
-    pub(crate) work: Workspace,
+    pub(in crate::mech) model: Model,
+    pub(in crate::mech) system: System,
+    pub(in crate::mech) settings: SolverSettings,
+    pub(super) linear: LinearSolver,
+    /// Everything that adds force and stiffness, in assembly order.
+    pub(in crate::mech) parts: Contributions,
+    pub(in crate::mech) state: AnalysisState,
+    pub(in crate::mech) work: Workspace,
 
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
     /// the input check.
-    pub(crate) length_scale: f64,
+    pub(super) length_scale: f64,
     /// `1e-6·E·t·L` (N): the force scale of an unloaded film.
-    pub(crate) force_floor: f64,
+    pub(super) force_floor: f64,
 }
 
 /// Buffers reused by every iteration.
 #[derive(Clone, Debug)]
-pub(crate) struct Workspace {
+pub(in crate::mech) struct Workspace {
     /// Whether the line search may keep full steps that raise the residual (its watchdog):
     /// until an increment of the step has been cut back.
-    pub(crate) watchdog: bool,
-    pub(crate) internal: Vec<f64>,
-    pub(crate) values: Vec<f64>,
-    pub(crate) rhs: Vec<f64>,
-    pub(crate) responses: Vec<GapResponse>,
-    /// Gaps latched in slip for the rest of the Newton loop (§3(f)) with their slip direction.
-    pub(crate) latched: Vec<Option<Vector2<f64>>>,
-    /// Gaps found closed at some iteration of the current Newton loop.
-    pub(crate) closed: Vec<bool>,
+    pub(super) watchdog: bool,
+    /// Residual `f_int − f_ext` of every DOF at the last evaluation.
+    pub(in crate::mech) internal: Vec<f64>,
+    /// Newton matrix values at the last evaluation with a tangent.
+    pub(super) values: Vec<f64>,
+    /// Right-hand side, then the Newton correction, over the free DOFs.
+    pub(super) rhs: Vec<f64>,
     /// Slot of each free DOF's diagonal entry in `values` (for the Levenberg–Marquardt shift).
-    pub(crate) diagonal: Vec<usize>,
-    /// Curved-support contact histories at the start of the increment, and the responses at
-    /// the last assembled iterate.
-    pub(crate) contact_start: Vec<ContactHistory>,
-    pub(crate) contact_responses: Vec<ContactResponse>,
+    pub(super) diagonal: Vec<usize>,
 }
 
 impl Analysis {
@@ -82,7 +68,8 @@ impl Analysis {
         system.set_threads(settings.threads);
         let linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
-        let laws: Vec<GapLaw> = model.gaps.iter().map(|g| g.law()).collect();
+        let parts = Contributions::new(&model, &system);
+        let laws = parts.gaps.laws();
         let state = AnalysisState {
             displacement: vec![0.0; model.dof_count()],
             plastic_slip: vec![[0.0; 2]; model.gaps.len()],
@@ -95,39 +82,23 @@ impl Analysis {
                 .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
                 .collect(),
             last_increment: Vec::new(),
-            contacts: Vec::new(),
+            contacts: parts.curved.initial_histories(&model),
         };
-        let surfaces = SurfaceContacts::new(&model);
-        let mut state = state;
-        state.contacts = surfaces.initial_histories(&model);
-        let idle = laws
-            .first()
-            .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()));
         let work = Workspace {
             internal: vec![0.0; model.dof_count()],
             values: vec![0.0; system.nonzeros()],
             rhs: vec![0.0; system.free_count],
-            responses: idle.map_or_else(Vec::new, |r| vec![r; laws.len()]),
-            latched: vec![None; laws.len()],
-            closed: vec![false; laws.len()],
             diagonal: diagonal_slots(&system),
-            contact_start: state.contacts.clone(),
-            contact_responses: Vec::new(),
             watchdog: true,
         };
-        let loads = Loads::new(&model, &system);
-        let cables = Cables::new(&model);
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * model.material.membrane_stiffness() * length_scale;
         Ok(Self {
             model,
             system,
-            laws,
             settings,
             linear,
-            loads,
-            cables,
-            surfaces,
+            parts,
             state,
             work,
             length_scale,
@@ -278,117 +249,9 @@ impl Analysis {
         self.step_to_motion(target, &angles, loads, increments)
     }
 
-    /// Refuses targets of the wrong length, non-finite or beyond
-    /// [`Self::MAX_TARGET_PER_SIZE`] times the model's size.
-    pub(crate) fn check_targets(&self, target: &[[f64; 3]]) -> Result<(), StepError> {
-        let invalid = |message| Err(StepError::InvalidInput { message });
-        if target.len() != self.state.boundary.len() {
-            return invalid(format!(
-                "{} group targets given, the model has {}",
-                target.len(),
-                self.state.boundary.len()
-            ));
-        }
-        let limit = Self::MAX_TARGET_PER_SIZE * self.length_scale;
-        for (g, t) in target.iter().enumerate() {
-            let name = &self.model.groups[g].name;
-            if t.iter().any(|v| !v.is_finite()) {
-                return invalid(format!(
-                    "the target of group '{name}' {t:?} is NaN or infinite"
-                ));
-            }
-            if let Some(v) = t.iter().find(|v| v.abs() > limit) {
-                return invalid(format!(
-                    "the target of group '{name}' ({v:e} m) is more than {} times the model's size ({:.4} m): \
-                     refused before solving",
-                    Self::MAX_TARGET_PER_SIZE,
-                    self.length_scale
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// Refuses angles of the wrong length, not finite, beyond [`Hinge::MAX_ANGLE`] or given to
-    /// a group without a hinge.
-    pub(crate) fn check_angles(&self, angles: &[f64]) -> Result<(), StepError> {
-        let invalid = |message| Err(StepError::InvalidInput { message });
-        if angles.len() != self.model.groups.len() {
-            return invalid(format!(
-                "{} group angles given, the model has {} groups",
-                angles.len(),
-                self.model.groups.len()
-            ));
-        }
-        for (g, &a) in self.model.groups.iter().zip(angles) {
-            if !a.is_finite() || a.abs() > Hinge::MAX_ANGLE {
-                return invalid(format!(
-                    "the angle of group '{}' ({a} rad) is not finite or beyond two full turns",
-                    g.name
-                ));
-            }
-            if g.hinge.is_none() && a != 0.0 {
-                return invalid(format!(
-                    "group '{}' has no hinge and cannot turn ({a} rad asked)",
-                    g.name
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// The prescribed value of global DOF `i` (node `i / 3`, component `component`) of group
-    /// `group` under `motion`: its translation plus the turn about its hinge.
-    pub(crate) fn prescribed_value(
-        &self,
-        i: usize,
-        group: usize,
-        component: usize,
-        motion: &GroupMotion,
-    ) -> f64 {
-        let turn = self.model.groups[group].hinge.as_ref().map_or(0.0, |h| {
-            h.displacement(self.model.nodes[i / 3], motion.angles[group])[component]
-        });
-        motion.translation[group][component] + turn
-    }
-
-    /// Refuses load targets of the wrong sizes or not finite.
-    pub(crate) fn check_loads(&self, loads: &LoadLevels) -> Result<(), StepError> {
-        let invalid = |message| Err(StepError::InvalidInput { message });
-        if !loads.fits(&self.model) {
-            return invalid(format!(
-                "{} pressures and {} nodal forces given, the model has {} pressure sets and {} force sets",
-                loads.pressure.len(),
-                loads.force.len(),
-                self.model.loads.pressures.len(),
-                self.model.loads.forces.len()
-            ));
-        }
-        for (p, set) in loads.pressure.iter().zip(&self.model.loads.pressures) {
-            if !p.is_finite() {
-                return invalid(format!(
-                    "the pressure of set '{}' ({p}) is NaN or infinite",
-                    set.name
-                ));
-            }
-        }
-        for (f, set) in loads.force.iter().zip(&self.model.loads.forces) {
-            if f.iter().any(|v| !v.is_finite()) {
-                return invalid(format!(
-                    "the force of set '{}' {f:?} is NaN or infinite",
-                    set.name
-                ));
-            }
-        }
-        if loads.gravity.iter().any(|v| !v.is_finite()) {
-            return invalid(format!("gravity {:?} is NaN or infinite", loads.gravity));
-        }
-        Ok(())
-    }
-
     /// The model's external loads.
     pub fn loads(&self) -> &Loads {
-        &self.loads
+        &self.parts.loads
     }
 
     /// The out-of-balance force of every DOF at displacements `u` (three per node; prescribed
@@ -399,12 +262,32 @@ impl Analysis {
     #[doc(hidden)]
     pub fn residual_and_matrix(&mut self, u: &[f64], levels: &LoadLevels) -> (Vec<f64>, Vec<f64>) {
         let start = self.state.clone();
-        let (laws, history) = self.laws_and_history(&start);
-        self.work.contact_start.clone_from(&start.contacts);
-        self.work.latched.iter_mut().for_each(|l| *l = None);
-        self.work.closed.iter_mut().for_each(|c| *c = false);
-        self.assemble_at(u, &laws, &history, levels, Some(1));
+        for c in self.parts.all_mut() {
+            c.restore(&start);
+        }
+        self.assemble_at(u, levels, Some(1));
         (self.work.internal.clone(), self.work.values.clone())
+    }
+
+    /// Evaluates every contribution at `u` with the loads at `levels`: the residual
+    /// `f_int − f_ext` over all DOFs, and the Newton matrix when `iteration` is given; returns
+    /// `‖R_free‖∞`.
+    pub(in crate::mech) fn assemble_at(
+        &mut self,
+        u: &[f64],
+        levels: &LoadLevels,
+        iteration: Option<usize>,
+    ) -> f64 {
+        let at = Evaluation {
+            system: &self.system,
+            u,
+            levels,
+            iteration,
+            matrix: self.settings.iteration_matrix,
+        };
+        let values = iteration.map(|_| self.work.values.as_mut_slice());
+        self.parts.assemble(&at, &mut self.work.internal, values);
+        self.free_norm_inf()
     }
 
     /// Displacement of node `v` (m).
@@ -414,7 +297,7 @@ impl Analysis {
 }
 
 /// Slot of each equation's diagonal entry in the value array (the pattern keeps them all).
-pub(crate) fn diagonal_slots(system: &System) -> Vec<usize> {
+fn diagonal_slots(system: &System) -> Vec<usize> {
     let pattern = system.pattern();
     let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
     (0..system.free_count)

@@ -365,12 +365,19 @@ impl System {
         u: &[f64],
         internal: &mut [f64],
         mut values: Option<&mut [f64]>,
-        mut gap: impl FnMut(usize, Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>),
+        gap: impl FnMut(usize, Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>),
     ) {
         internal.fill(0.0);
         if let Some(v) = values.as_deref_mut() {
             v.fill(0.0);
         }
+        self.add_triangles(u, internal, values.as_deref_mut());
+        self.add_gaps(u, internal, values, gap);
+    }
+
+    /// Adds the triangles' internal forces (eq. 2.6) into `internal` and, when `values` is
+    /// given, their tangents (eq. 2.7), in element order (on threads when set: same sums).
+    pub fn add_triangles(&self, u: &[f64], internal: &mut [f64], mut values: Option<&mut [f64]>) {
         if self.threads > 1 {
             self.assemble_triangles_owned(u, internal, values.as_deref_mut());
         } else {
@@ -385,6 +392,17 @@ impl System {
                 }
             }
         }
+    }
+
+    /// Adds the gaps' forces (eq. 2.8) and, when `values` is given, their iteration matrices
+    /// (eq. 2.9), in gap order; `gap(g, d)` as in [`Self::assemble`].
+    pub fn add_gaps(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        mut values: Option<&mut [f64]>,
+        mut gap: impl FnMut(usize, Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>),
+    ) {
         for (g, geometry) in self.gaps.iter().enumerate() {
             let (force, k_local) = gap(g, self.gap_relative(g, u));
             let rt = geometry.rotation.transpose();

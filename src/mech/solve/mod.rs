@@ -4,8 +4,10 @@
 //! | file | what |
 //! |---|---|
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
+//! | [`contributions`] | the [`Contribution`](contributions::Contribution) trait: residual, tangent and history of each kind (triangles, gaps, loads, cables, curved contacts) |
 //! | [`linear`] | sparse LDLᵀ / Woodbury / GMRES / LU with a reused symbolic analysis |
 //! | [`analysis`] | [`Analysis`]: setup, state, steps and their input checks |
+//! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
 //! | `increments` | the increment controller: cut-back, enlargement, predictor |
 //! | `newton` | Newton–Raphson for one increment |
 //! | `line_search` | backtracking line search with a watchdog |
@@ -15,7 +17,9 @@
 
 pub mod analysis;
 pub mod assembly;
+pub mod contributions;
 mod increments;
+mod inputs;
 mod line_search;
 pub mod linear;
 mod newton;

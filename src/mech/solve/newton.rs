@@ -1,15 +1,9 @@
 //! Newton–Raphson for one increment.
 
-use nalgebra::Vector2;
-
-use crate::mech::elements::curved_contact::SurfaceContacts;
-use crate::mech::elements::gap::{GapLaw, GapStatus, IterationMatrix};
-use crate::mech::elements::load::{ExternalLoad, LoadLevels};
-use crate::mech::elements::material::Wrinkling;
-use crate::mech::elements::triangle::ElementVector;
-use crate::mech::elements::triangle::MembraneTriangle;
-use crate::mech::solve::analysis::{Analysis, Workspace};
-use crate::mech::solve::assembly::{Dof, node_dofs};
+use crate::mech::elements::gap::IterationMatrix;
+use crate::mech::elements::load::LoadLevels;
+use crate::mech::solve::analysis::Analysis;
+use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::line_search::Watchdog;
 use crate::mech::solve::report::{IncrementFailure, IterationRecord};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
@@ -23,34 +17,11 @@ impl Analysis {
         motion: &GroupMotion,
         levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
-        let mut u = start.displacement.clone();
-        // Predictor: when the boundary keeps moving the same way, extrapolate the free DOFs
-        // along the last converged increment (fewer iterations, same converged answer).
-        let (mut dot, mut old, mut new) = (0.0, 0.0, 0.0);
-        for (i, d) in self.system.dofs.iter().enumerate() {
-            if let Dof::Prescribed { group, component } = d {
-                let value = self.prescribed_value(i, *group, *component, motion);
-                let step = value - start.displacement[i];
-                let last = start.last_increment.get(i).copied().unwrap_or(0.0);
-                (dot, old, new) = (dot + step * last, old + last * last, new + step * step);
-                u[i] = value;
-            }
+        let mut u = self.predict(start, motion);
+        // Trial history from the converged start (also after a cut-back or for an enlarged retry).
+        for c in self.parts.all_mut() {
+            c.restore(start);
         }
-        if old > 0.0 && dot > 0.99 * (old * new).sqrt() {
-            // Not beyond twice the last increment: an enlarged increment (see `step_to`) would
-            // otherwise extrapolate the film far outside the range where the last one tells
-            // anything (residuals of 1e11 N were measured at its first iterate).
-            let ratio = (dot / old).min(Self::PREDICTOR_LIMIT);
-            for (i, d) in self.system.dofs.iter().enumerate() {
-                if let Dof::Free(_) = d {
-                    u[i] += ratio * start.last_increment[i];
-                }
-            }
-        }
-        let (laws, history) = self.laws_and_history(start);
-        self.work.contact_start.clone_from(&start.contacts);
-        self.work.latched.iter_mut().for_each(|l| *l = None);
-        self.work.closed.iter_mut().for_each(|c| *c = false);
         // A model without free DOFs (every node prescribed or fixed: how single elements are
         // verified) has nothing to solve: the first assembly evaluates the forces, the gaps'
         // return mapping and the reactions at the prescribed configuration, and converges.
@@ -63,9 +34,6 @@ impl Analysis {
         let mut previous_u = u.clone();
         let mut residuals = Vec::new();
         let mut assembled = false;
-        // Status of every gap at the previous iteration and the last iteration it changed.
-        let mut previous: Vec<GapStatus> = start.status.clone();
-        let mut changed_at: Vec<Option<usize>> = vec![None; previous.len()];
         let (mut best, mut best_correction, mut best_at) = (f64::INFINITY, f64::INFINITY, 0);
         // The iterate closest to meeting both tolerances (quoted if the increment stalls).
         let mut closest: Option<IterationRecord> = None;
@@ -82,17 +50,14 @@ impl Analysis {
             let residual = if assembled {
                 self.free_norm_inf()
             } else {
-                self.assemble_at(&u, &laws, &history, levels, Some(iteration))
+                self.assemble_at(&u, levels, Some(iteration))
             };
             if !residual.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             residuals.push(residual);
-            for (g, r) in self.work.responses.iter().enumerate() {
-                if r.status != previous[g] {
-                    previous[g] = r.status;
-                    changed_at[g] = Some(iteration);
-                }
+            for c in self.parts.all_mut() {
+                c.note_iteration(iteration);
             }
             let moved = max_abs_difference(&u, &start.displacement);
             let displacement_scale = moved.max(max_abs(&u)).max(1e-9 * self.length_scale);
@@ -109,29 +74,22 @@ impl Analysis {
                 && record.correction <= record.correction_tolerance
                 && residual <= tolerance;
             if converged {
-                let state = AnalysisState {
-                    plastic_slip: self
-                        .work
-                        .responses
-                        .iter()
-                        .map(|r| r.plastic_slip.into())
-                        .collect(),
-                    contacts: SurfaceContacts::commit(
-                        &self.work.contact_responses,
-                        &start.contacts,
-                    ),
+                let mut state = AnalysisState {
                     boundary: motion.translation.clone(),
                     angles: motion.angles.clone(),
                     loads: levels.clone(),
-                    friction: start.friction.clone(),
-                    status: self.work.responses.iter().map(|r| r.status).collect(),
                     last_increment: u
                         .iter()
                         .zip(&start.displacement)
                         .map(|(a, b)| a - b)
                         .collect(),
                     displacement: u,
+                    ..start.clone()
                 };
+                // Commit: the trial history of the converged iterate becomes the state's.
+                for c in self.parts.all() {
+                    c.commit(start, &mut state);
+                }
                 if !state.is_finite() {
                     return Err(IncrementFailure::Diverged { iteration });
                 }
@@ -140,12 +98,11 @@ impl Analysis {
             // Gaps that changed status in the last few iterations: the usual cause of a stall.
             let recent = iteration.saturating_sub(Self::STALL_PATIENCE / 2);
             let chattering = || -> Vec<String> {
-                changed_at
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, c)| c.is_some_and(|c| c > 0 && c >= recent))
-                    .map(|(g, _)| self.model.gaps[g].name.clone())
-                    .collect()
+                let mut names = Vec::new();
+                for c in self.parts.all() {
+                    c.chattering(recent, &mut names);
+                }
+                names
             };
             if iteration > 0 && closest.is_none_or(|c| record.distance() < c.distance()) {
                 closest = Some(record);
@@ -182,35 +139,13 @@ impl Analysis {
                     flipping: self.flipping_elements(&previous_u, &u),
                 });
             }
-            for (i, d) in self.system.dofs.iter().enumerate() {
-                if let Dof::Free(eq) = d {
-                    self.work.rhs[*eq] = -self.work.internal[i];
-                }
-            }
-            if damping > 0.0 {
-                let values = &mut self.work.values;
-                let mean = self
-                    .work
-                    .diagonal
-                    .iter()
-                    .map(|&d| values[d].abs())
-                    .sum::<f64>()
-                    / self.work.diagonal.len() as f64;
-                for &d in &self.work.diagonal {
-                    values[d] += damping * mean;
-                }
-            }
-            let matrix = self.system.matrix(&self.work.values);
-            self.linear
-                .factorize_and_solve(matrix, &mut self.work.rhs)
-                .map_err(|e| IncrementFailure::Singular { message: e.0 })?;
-            correction_norm = max_abs(&self.work.rhs);
+            correction_norm = self.correction(damping)?;
             if !correction_norm.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             previous_u.clone_from(&u);
             let (step, with_tangent, decreased) =
-                self.line_search(&mut u, &laws, &history, levels, iteration + 1, &mut watch);
+                self.line_search(&mut u, levels, iteration + 1, &mut watch);
             assembled = with_tangent;
             if step.is_infinite() {
                 // The watchdog went back to where its excursion started: the iterations spent
@@ -218,24 +153,8 @@ impl Analysis {
                 best_at = iteration + 1;
             }
             correction_norm *= step;
-            // Levenberg–Marquardt: a direction that cannot lower the residual (a mechanism of an
-            // unstressed film, an indefinite compressed one) gets a diagonal shift, raised until
-            // steps succeed and lowered again after full ones. Only the iteration matrix changes,
-            // never the residual: the converged state is the same, and with the shift gone the
-            // last iterations are Newton's again.
             if s.iteration_matrix == IterationMatrix::Consistent {
-                damping = if !decreased {
-                    (4.0 * damping).max(Self::DAMPING_START)
-                } else if step == 1.0 && damping > 0.0 {
-                    let lower = damping / 4.0;
-                    if lower < Self::DAMPING_START / 64.0 {
-                        0.0
-                    } else {
-                        lower
-                    }
-                } else {
-                    damping
-                };
+                damping = next_damping(damping, step, decreased);
             }
         }
         unreachable!("the loop returns at max_iterations")
@@ -243,26 +162,13 @@ impl Analysis {
 
     /// Film elements whose tension-field state differs between the displacements `a` and `b`
     /// (none without wrinkling). Called once when an increment fails, never per iteration.
-    pub(crate) fn flipping_elements(&self, a: &[f64], b: &[f64]) -> Vec<usize> {
-        if self.system.material.wrinkling == Wrinkling::None {
-            return vec![];
+    fn flipping_elements(&self, a: &[f64], b: &[f64]) -> Vec<usize> {
+        let mut elements = Vec::new();
+        for c in self.parts.all() {
+            c.flipping(&self.system, a, b, &mut elements);
         }
-        let state = |u: &[f64], nodes: &[usize; 3], tri: &MembraneTriangle| {
-            let dofs = node_dofs(nodes);
-            let ue = ElementVector::from_fn(|i, _| u[dofs[i]]);
-            tri.stress_state(&self.system.material, &ue).state
-        };
-        self.system
-            .triangles
-            .iter()
-            .enumerate()
-            .filter(|(_, (nodes, tri))| state(a, nodes, tri) != state(b, nodes, tri))
-            .map(|(e, _)| e)
-            .collect()
+        elements
     }
-
-    /// Largest ratio of the predictor's extrapolation to the last converged increment.
-    pub(crate) const PREDICTOR_LIMIT: f64 = 2.0;
 
     /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).
     pub(crate) const DAMPING_START: f64 = 1e-4;
@@ -270,6 +176,35 @@ impl Analysis {
     pub(crate) const PROGRESS: f64 = 0.9;
     /// Iterations without progress before an increment is declared stalled and cut back.
     pub(crate) const STALL_PATIENCE: usize = 8;
+
+    /// The Newton correction `ΔU` of the free DOFs into `work.rhs` from the last assembly, with
+    /// the Levenberg–Marquardt shift `damping` (times the mean of the free diagonal's
+    /// magnitudes) added to the matrix's diagonal; returns `‖ΔU‖∞`.
+    fn correction(&mut self, damping: f64) -> Result<f64, IncrementFailure> {
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Free(eq) = d {
+                self.work.rhs[*eq] = -self.work.internal[i];
+            }
+        }
+        if damping > 0.0 {
+            let values = &mut self.work.values;
+            let mean = self
+                .work
+                .diagonal
+                .iter()
+                .map(|&d| values[d].abs())
+                .sum::<f64>()
+                / self.work.diagonal.len() as f64;
+            for &d in &self.work.diagonal {
+                values[d] += damping * mean;
+            }
+        }
+        let matrix = self.system.matrix(&self.work.values);
+        self.linear
+            .factorize_and_solve(matrix, &mut self.work.rhs)
+            .map_err(|e| IncrementFailure::Singular { message: e.0 })?;
+        Ok(max_abs(&self.work.rhs))
+    }
 
     /// `‖R_free‖∞` of the last assembly.
     pub(crate) fn free_norm_inf(&self) -> f64 {
@@ -294,98 +229,26 @@ impl Analysis {
             .sum::<f64>()
             .sqrt()
     }
+}
 
-    /// Assembles the residual `f_int − f_ext` over all DOFs (and the Newton matrix when
-    /// `iteration` is given) at `u` with the loads at `levels`; returns `‖R_free‖∞`. Gap
-    /// responses are left in the workspace.
-    pub(crate) fn assemble_at(
-        &mut self,
-        u: &[f64],
-        laws: &[GapLaw],
-        history: &[Vector2<f64>],
-        levels: &LoadLevels,
-        iteration: Option<usize>,
-    ) -> f64 {
-        let mode = self.settings.iteration_matrix;
-        let Workspace {
-            internal,
-            values,
-            responses,
-            latched,
-            closed,
-            contact_start,
-            contact_responses,
-            ..
-        } = &mut self.work;
-        let mut values = iteration.map(|_| values.as_mut_slice());
-        self.system
-            .assemble(u, internal, values.as_deref_mut(), |g, d| {
-                let law = &laws[g];
-                let response = law.evaluate(d, history[g]);
-                responses[g] = response;
-                let matrix = match mode {
-                    IterationMatrix::Consistent => law.consistent_tangent(&response),
-                    IterationMatrix::JuRowlands => {
-                        // §3(b): stick in the first iteration; §3(f): once slipping, the slip matrix is
-                        // kept, with the slip direction (and its sign) found when the gap started
-                        // slipping, until the loop ends.
-                        // A latched gap keeps the slip matrix even if the law finds it open, and a gap
-                        // that has closed in this loop keeps at least the stick matrix: both stop the
-                        // open ↔ closed chatter of a symmetric matrix that has no cone direction.
-                        closed[g] |= response.status != GapStatus::Open;
-                        if response.status == GapStatus::Slip
-                            && iteration != Some(0)
-                            && latched[g].is_none()
-                        {
-                            latched[g] = Some(response.direction);
-                        }
-                        match (latched[g], response.status, iteration) {
-                            (Some(direction), _, _) => {
-                                law.ju_rowlands_matrix(GapStatus::Slip, direction)
-                            }
-                            (None, GapStatus::Open, _) if !closed[g] => {
-                                law.ju_rowlands_matrix(GapStatus::Open, response.direction)
-                            }
-                            (None, _, _) => {
-                                law.ju_rowlands_matrix(GapStatus::Stick, response.direction)
-                            }
-                        }
-                    }
-                };
-                (response.force, matrix)
-            });
-        self.loads
-            .add_to(&self.system, levels, u, internal, values.as_deref_mut());
-        self.cables
-            .add_to(&self.system, levels, u, internal, values.as_deref_mut());
-        self.surfaces.add_to(
-            &self.system,
-            u,
-            contact_start,
-            internal,
-            values,
-            contact_responses,
-        );
-        self.free_norm_inf()
-    }
-
-    /// Gap laws with the friction coefficients of `state`, and its slip history.
-    pub(crate) fn laws_and_history(
-        &self,
-        state: &AnalysisState,
-    ) -> (Vec<GapLaw>, Vec<Vector2<f64>>) {
-        let laws = self
-            .laws
-            .iter()
-            .zip(&state.friction)
-            .map(|(l, &mu)| GapLaw { friction: mu, ..*l })
-            .collect();
-        let history = state
-            .plastic_slip
-            .iter()
-            .map(|s| Vector2::from(*s))
-            .collect();
-        (laws, history)
+/// The Levenberg–Marquardt shift after a line search that took `step` and `decreased` (or
+/// not) the merit: a direction that cannot lower the residual (a mechanism of an unstressed
+/// film, an indefinite compressed one) gets a diagonal shift, raised until steps succeed and
+/// lowered again after full ones, to 0 below [`Analysis::DAMPING_START`]`/64`. Only the
+/// iteration matrix changes, never the residual: the converged state is the same, and with the
+/// shift gone the last iterations are Newton's again.
+fn next_damping(damping: f64, step: f64, decreased: bool) -> f64 {
+    if !decreased {
+        (4.0 * damping).max(Analysis::DAMPING_START)
+    } else if step == 1.0 && damping > 0.0 {
+        let lower = damping / 4.0;
+        if lower < Analysis::DAMPING_START / 64.0 {
+            0.0
+        } else {
+            lower
+        }
+    } else {
+        damping
     }
 }
 
@@ -409,4 +272,41 @@ pub(crate) fn max_abs_difference(a: &[f64], b: &[f64]) -> f64 {
     a.iter()
         .zip(b)
         .fold(0.0, |m, (x, y)| nan_max(m, (x - y).abs()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A NaN anywhere makes the norm NaN (so it fails every `≤ tolerance` test); without NaN
+    /// it is the largest magnitude, signs ignored.
+    #[test]
+    fn a_nan_residual_never_measures_small() {
+        assert_eq!(max_abs(&[1.0, -3.0, 2.0]), 3.0);
+        assert!(max_abs(&[0.0, f64::NAN, 1.0]).is_nan());
+        assert!(max_abs(&[f64::NAN, 5.0]).is_nan());
+        assert!(max_abs_difference(&[1.0, 2.0], &[1.0, f64::NAN]).is_nan());
+        assert_eq!(max_abs_difference(&[1.0, -2.0], &[0.5, 1.0]), 3.0);
+        assert_eq!(max_abs(&[]), 0.0);
+    }
+
+    /// The shift starts at `DAMPING_START` when a step fails to decrease the merit, grows
+    /// fourfold while they keep failing, falls fourfold after each full step and vanishes
+    /// below `DAMPING_START / 64`; partial steps keep it.
+    #[test]
+    fn damping_grows_on_failures_and_vanishes_after_full_steps() {
+        let start = Analysis::DAMPING_START;
+        assert_eq!(next_damping(0.0, 1.0, false), start);
+        assert_eq!(next_damping(start, 0.1, false), 4.0 * start);
+        assert_eq!(next_damping(4.0 * start, 0.5, true), 4.0 * start);
+        let mut d = 4.0 * start;
+        let mut full_steps = 0;
+        while d > 0.0 {
+            d = next_damping(d, 1.0, true);
+            full_steps += 1;
+        }
+        // 4·s → s → s/4 → s/16 → s/64 → 0 (s/256 is below s/64).
+        assert_eq!(full_steps, 5);
+        assert_eq!(next_damping(0.0, 1.0, true), 0.0);
+    }
 }
