@@ -28,7 +28,7 @@
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::instance::Phase;
+use super::phase::Phase;
 use super::variables::Value;
 use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::surface::SurfaceContacts;

@@ -22,7 +22,7 @@ use std::sync::Mutex;
 
 use super::description::describe;
 use super::exports::*;
-use super::instance::allowed;
+use super::phase::allowed;
 use super::resources::{Source, file_uri};
 use super::types::*;
 use super::variables::Variable;
