@@ -16,9 +16,9 @@ use std::ffi::CString;
 use super::description::{Description, describe};
 use super::logger::Logger;
 use super::resources::{Source, resource_dir};
+use super::scalar_variable::{Binding, Value, VarType, Variable, message_real};
 use super::state::Snapshot;
 use super::types::{FMI2_CO_SIMULATION, Status};
-use super::variables::{Binding, Value, VarType, Variable, message_real};
 use crate::mech::{
     Analysis, IterationMatrix, Model, ParallelArch, Results, SolverSettings, Wrinkling,
     solver::MAX_THREADS,

@@ -15,6 +15,7 @@
 //! | [`guard`] | every raw pointer, `Box::into_raw`/`from_raw`, the panic barrier |
 //! | [`logger`] | the variadic C logger, called with `"%s"`; log categories |
 //! | [`variables`] | the variable table, derived from the model: the one source of the interface |
+//! | [`scalar_variable`] | one variable: type, causality, variability, value, binding, value check |
 //! | [`description`] | `modelDescription.xml` (from `modelDescription.xml.in`), GUID, documentation |
 //! | [`resources`] | what an FMU is built from, its `resources/` file, the resource URI parser |
 //! | [`phase`] | the state machine's phases, which call is allowed in which phase (masks), [`Failure`](phase::Failure) |
@@ -53,6 +54,7 @@ pub mod logger;
 mod outputs;
 pub mod phase;
 pub mod resources;
+pub mod scalar_variable;
 pub mod state;
 mod stepping;
 pub mod types;

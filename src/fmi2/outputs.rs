@@ -6,8 +6,8 @@
 
 use super::instance::Instance;
 use super::phase::{Failure, Outcome};
+use super::scalar_variable::{Binding, Value};
 use super::types::Status;
-use super::variables::{Binding, Value};
 use crate::mech::element::state_counts;
 use crate::mech::summary::result_warnings;
 use crate::mech::{GapStatus, StepReport, check_results};

@@ -29,7 +29,7 @@ use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::phase::Phase;
-use super::variables::Value;
+use super::scalar_variable::Value;
 use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::surface::SurfaceContacts;
 use crate::mech::{AnalysisState, Model};

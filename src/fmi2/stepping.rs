@@ -14,8 +14,9 @@
 use super::instance::{Built, Instance, RefusedStep};
 use super::logger::Logger;
 use super::phase::{Failure, Outcome, Phase};
+use super::scalar_variable::message_real;
 use super::types::{FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status};
-use super::variables::{StepInputs, message_real, step_inputs};
+use super::variables::{StepInputs, step_inputs};
 use crate::mech::solver::IncrementFailure;
 use crate::mech::{LoadLevels, SettingNames, StepError, StepReport, check_results};
 

@@ -9,7 +9,7 @@ use std::ffi::{CString, c_char};
 
 use super::instance::Instance;
 use super::phase::{Failure, Outcome, Phase};
-use super::variables::{Binding, Causality, Value, VarType, Variable, article};
+use super::scalar_variable::{Binding, Causality, Value, VarType, Variable, article};
 
 impl Instance {
     /// The variable with value reference `vr`, which must be of type `want`.

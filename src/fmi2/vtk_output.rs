@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 use super::instance::Instance;
 use super::phase::{Failure, Outcome};
-use super::variables::{Binding, Value};
+use super::scalar_variable::{Binding, Value};
 use crate::mech::vtk;
 
 impl Instance {
