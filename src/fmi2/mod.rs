@@ -28,7 +28,7 @@
 //! | `fmu_states` | the instance's saved FMU states: get, set, free, (de)serialize |
 //! | [`state`] | one FMU state: the snapshot, its serialized byte format and its checks |
 //! | [`exports`] | the 44 exported `fmi2*` functions (25 common, 9 CS, 10 ME error stubs) |
-//! | `tests` | tests through the exported functions, as an importer calls them |
+//! | `tests/` | tests through the exported functions, as an importer calls them, one file per duty |
 //! | `wiring_tests` | every FMU parameter and input against the core, from the variable table |
 //!
 //! The instance's files have no import (or call) circle: `phase` uses only `types`; `instance`
