@@ -19,14 +19,15 @@
 //! comment; `cargo test --release --test robustness -- --include-ignored` runs it.
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
-use membrane_contact::mech::contact::FrictionLaw;
+use membrane_contact::mech::elements::gap::FrictionLaw;
 use membrane_contact::mech::model::{GapSupport, LoadSpec};
-use membrane_contact::mech::scenarios::{
+use membrane_contact::mech::{Analysis, GapStatus, Results, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
+use membrane_contact::specimens::parallel_arch::{FramePath, SpecimenContact};
+use membrane_contact::specimens::scenarios::{
     ArchEdge, ArchPanel, CircularSupport, CylinderStrip, Family, GapConstants, PathShape, Scenario,
     SpecimenPath, StepOutcome, WrappedSpecimen, gaps_on_arc, grid_slice, robustness_grid,
 };
-use membrane_contact::mech::specimen::{FramePath, SpecimenContact};
-use membrane_contact::mech::{Analysis, GapStatus, ParallelArch, Results, SolverSettings};
 use nalgebra::{Vector2, Vector3};
 
 /// The FMU's default `solver.incrementsPerStep` (what `Instance::build` gives `step_to`).

@@ -347,7 +347,7 @@ A failed write returns <code>fmi2Warning</code>; the step is kept.</li>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::ParallelArch;
+    use crate::specimens::ParallelArch;
 
     fn specimen() -> Description {
         describe(&Source::ParallelArch(ParallelArch::default())).unwrap()

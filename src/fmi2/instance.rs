@@ -20,9 +20,9 @@ use super::scalar_variable::{Binding, Value, VarType, Variable, message_real};
 use super::state::Snapshot;
 use super::types::{FMI2_CO_SIMULATION, Status};
 use crate::mech::{
-    Analysis, IterationMatrix, Model, ParallelArch, Results, SolverSettings, Wrinkling,
-    solver::MAX_THREADS,
+    Analysis, IterationMatrix, Model, Results, SolverSettings, Wrinkling, solve::MAX_THREADS,
 };
+use crate::specimens::ParallelArch;
 
 /// The phases, masks and failures, also under their former path `fmi2::instance`.
 pub use super::phase::{Failure, Mask, Outcome, Phase, allowed};

@@ -4,7 +4,7 @@
 
 use super::instance::{Instance, start_values};
 use super::phase::{Failure, Outcome, Phase};
-use crate::mech::summary::model_warnings;
+use crate::mech::results::warnings::model_warnings;
 
 impl Instance {
     pub fn setup_experiment(&mut self, start_time: f64, stop_time: Option<f64>) -> Outcome {

@@ -8,8 +8,8 @@ use super::instance::Instance;
 use super::phase::{Failure, Outcome};
 use super::scalar_variable::{Binding, Value};
 use super::types::Status;
-use crate::mech::element::state_counts;
-use crate::mech::summary::result_warnings;
+use crate::mech::elements::triangle::state_counts;
+use crate::mech::results::warnings::result_warnings;
 use crate::mech::{GapStatus, StepReport, check_results};
 
 impl Instance {

@@ -217,7 +217,7 @@ pub enum Binding {
     },
 }
 
-/// The quantities of a [`crate::mech::summary::FieldSummary`], each an FMU output per element set.
+/// The quantities of a [`crate::mech::results::summary::FieldSummary`], each an FMU output per element set.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SummaryQuantity {
     MaxPrincipalStress,
@@ -263,7 +263,7 @@ impl SummaryQuantity {
     ];
 
     /// This quantity of `summary`.
-    pub fn of(self, summary: &crate::mech::summary::FieldSummary) -> f64 {
+    pub fn of(self, summary: &crate::mech::results::summary::FieldSummary) -> f64 {
         match self {
             Self::MaxPrincipalStress => summary.max_principal_stress,
             Self::MinPrincipalStress => summary.min_principal_stress,
@@ -342,7 +342,7 @@ impl Variable {
                 .map(drop)
                 .map_err(|e| format!("{}: {e}", self.name)),
             (Binding::VtkFormat, Value::String(name)) => name
-                .parse::<crate::mech::vtk::Encoding>()
+                .parse::<crate::mech::results::vtk::Encoding>()
                 .map(drop)
                 .map_err(|e| format!("{}: {e}", self.name)),
             _ => Ok(()),

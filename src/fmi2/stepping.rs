@@ -17,7 +17,7 @@ use super::phase::{Failure, Outcome, Phase};
 use super::scalar_variable::message_real;
 use super::types::{FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status};
 use super::variables::{StepInputs, step_inputs};
-use crate::mech::solver::IncrementFailure;
+use crate::mech::solve::IncrementFailure;
 use crate::mech::{LoadLevels, SettingNames, StepError, StepReport, check_results};
 
 /// The FMU parameters that a refused step's advice names.

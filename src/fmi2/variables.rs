@@ -92,9 +92,9 @@ pub const RESERVED_NAMES: [&str; 9] = [
 ];
 
 /// Default of `solver.incrementsPerStep`: the core's
-/// [`crate::mech::solver::DEFAULT_INCREMENTS_PER_STEP`], the CLI's default too.
+/// [`crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP`], the CLI's default too.
 pub const DEFAULT_INCREMENTS_PER_STEP: i32 =
-    crate::mech::solver::DEFAULT_INCREMENTS_PER_STEP as i32;
+    crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP as i32;
 
 /// Checks that the model's gap, group, pressure-set and force-set names can prefix variable names.
 pub fn check_names(model: &Model) -> Result<(), String> {
@@ -468,7 +468,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     );
     table.parameter(
         "results.vtkFormat",
-        Value::String(crate::mech::vtk::Encoding::default().name().into()),
+        Value::String(crate::mech::results::vtk::Encoding::default().name().into()),
         None,
         "encoding of the VTK files: binary (raw appended data, about half the size) or ascii",
         Binding::VtkFormat,
@@ -797,7 +797,7 @@ impl TableBuilder {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::ParallelArch;
+    use crate::specimens::ParallelArch;
     use std::collections::HashSet;
 
     fn specimen_table() -> (Model, Vec<Variable>) {

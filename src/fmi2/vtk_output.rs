@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 use super::instance::Instance;
 use super::phase::{Failure, Outcome};
 use super::scalar_variable::{Binding, Value};
-use crate::mech::vtk;
+use crate::mech::results::vtk;
 
 impl Instance {
     /// The value of `results.directory`, `None` when it is empty (no output).

@@ -33,10 +33,11 @@ use super::resources::Source;
 use super::tests::{Fmu, Log, Unpacked};
 use super::types::*;
 use super::variables::{Causality, Value, VarType, Variable};
-use crate::mech::element::state_counts;
+use crate::mech::elements::triangle::state_counts;
 use crate::mech::model::CableSpec;
-use crate::mech::specimen::SpecimenContact;
-use crate::mech::{Analysis, LoadLevels, Model, ParallelArch, Results, SolverSettings, StepReport};
+use crate::mech::{Analysis, LoadLevels, Model, Results, SolverSettings, StepReport};
+use crate::specimens::ParallelArch;
+use crate::specimens::parallel_arch::SpecimenContact;
 
 /// Variables whose change no output can show, and why (each is still set and the outputs
 /// still compared with the core's).

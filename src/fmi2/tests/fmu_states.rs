@@ -216,7 +216,7 @@ fn saved_state_restores_under_sliding_direction_law() {
 /// every output must equal the one of the step that never restored, bit for bit. Returns the
 /// statuses (0 open, 1 stick, 2 slip) the contacts had at the saved states.
 fn round_trips_at_every_step(
-    contact: crate::mech::specimen::SpecimenContact,
+    contact: crate::specimens::parallel_arch::SpecimenContact,
     law: &str,
     path: &[(f64, f64)],
 ) -> std::collections::BTreeSet<i32> {
@@ -311,7 +311,7 @@ fn saved_states_round_trip_in_every_gap_and_contact_status_under_both_laws() {
         (0.3, 0.2),
         (0.6, 0.2),
     ];
-    use crate::mech::specimen::SpecimenContact;
+    use crate::specimens::parallel_arch::SpecimenContact;
     for contact in [SpecimenContact::Gaps, SpecimenContact::CurvedSupport] {
         for law in ["isotropic", "sliding-direction"] {
             let seen = round_trips_at_every_step(contact, law, &PATH);
@@ -405,7 +405,7 @@ fn forged_variable_values_are_refused_as_fmi2_set_would_naming_the_variable() {
 fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
     use crate::mech::GapStatus;
     let spec = ParallelArch {
-        contact: crate::mech::specimen::SpecimenContact::CurvedSupport,
+        contact: crate::specimens::parallel_arch::SpecimenContact::CurvedSupport,
         ..ParallelArch::default()
     };
     let (u, log) = (
@@ -428,7 +428,7 @@ fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
             support.nodes[k], support.name
         )
     };
-    type Forgery = Box<dyn Fn(&mut crate::mech::surface::ContactHistory)>;
+    type Forgery = Box<dyn Fn(&mut crate::mech::elements::curved_contact::ContactHistory)>;
     let cases: Vec<(usize, Forgery, String)> = vec![
         (
             open,

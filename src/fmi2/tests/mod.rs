@@ -43,7 +43,7 @@ use super::phase::allowed;
 use super::resources::{Source, file_uri};
 use super::types::*;
 use super::variables::Variable;
-use crate::mech::ParallelArch;
+use crate::specimens::ParallelArch;
 
 /// Messages received by the test logger: (status, category, message).
 #[derive(Default)]

@@ -33,10 +33,10 @@
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
-use super::contact::{FrictionLaw, GapFrame};
-use super::material::{DEFAULT_WRINKLING_REGULARISATION, Material, Wrinkling};
-use super::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Symmetry};
-use super::surface::{Centreline, CurvedSupport};
+use crate::mech::elements::curved_contact::{Centreline, CurvedSupport};
+use crate::mech::elements::gap::{FrictionLaw, GapFrame};
+use crate::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Material, Wrinkling};
+use crate::mech::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Symmetry};
 
 /// Measured sliding along the arch at the final step (mm), the paper's Table 1 (points 1–5).
 pub const TABLE1_CSV: &str = include_str!("../../data/table1_sliding.csv");

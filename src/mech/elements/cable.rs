@@ -15,10 +15,10 @@
 use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::assembly::{System, node_vector};
-use super::element::ElementMatrix;
-use super::load::{ExternalLoad, LoadLevels};
-use super::model::Model;
+use crate::mech::elements::load::{ExternalLoad, LoadLevels};
+use crate::mech::elements::triangle::ElementMatrix;
+use crate::mech::model::Model;
+use crate::mech::solve::assembly::{System, node_vector};
 
 /// Nodal forces of a segment (`[f_a; f_b]`).
 pub type SegmentVector = SVector<f64, 6>;

@@ -54,9 +54,9 @@
 
 use nalgebra::{DMatrix, Matrix6, SymmetricEigen, Vector3, Vector6};
 
-use super::cable::segment_force_and_tangent;
-use super::element::{ElementVector, MembraneTriangle};
-use super::model::{GapSupport, Model, ModelError};
+use crate::mech::elements::cable::segment_force_and_tangent;
+use crate::mech::elements::triangle::{ElementVector, MembraneTriangle};
+use crate::mech::model::{GapSupport, Model, ModelError};
 
 /// How many node numbers a message lists before "…".
 const LISTED_NODES: usize = 6;
@@ -447,7 +447,7 @@ impl DisjointSets {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::ParallelArch;
+    use crate::specimens::ParallelArch;
 
     /// A 0.1 m square of two triangles (nodes 0..3 counter-clockwise from the origin) with the
     /// given supports and gaps (JSON fragments).

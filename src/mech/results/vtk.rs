@@ -8,7 +8,7 @@
 //! * **film** ([`Block::Film`]): points are the deformed node positions, cells the triangles
 //!   (VTK type 5). Point data `displacement`, `reaction` (N: the restraint force on a supported,
 //!   symmetry or group node) and `line_reaction` (N/m: reaction per unit length along the
-//!   boundary groups and support sets, [`super::lines`]; 0 off them). Cell data `von_mises`, `principal_1`,
+//!   boundary groups and support sets, [`crate::mech::results::lines`]; 0 off them). Cell data `von_mises`, `principal_1`,
 //!   `principal_2` (Pa), `stress` (σx, σy, τxy in the element frame), `strain` (Green–Lagrange
 //!   εx, εy, γxy in the element frame), `principal_strain_1`, `principal_strain_2`,
 //!   `wrinkling_state` (0 taut, 1 wrinkled, 2 slack) and `tension_direction` (unit vector along
@@ -39,8 +39,8 @@
 use std::fmt::Write;
 use std::str::FromStr;
 
-use super::model::{GapSupport, Model};
-use super::solver::Results;
+use crate::mech::model::{GapSupport, Model};
+use crate::mech::results::Results;
 
 /// How the values of the data arrays are stored.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -161,7 +161,7 @@ pub fn cable_grid(model: &Model, displacement: &[f64], encoding: Encoding) -> Ve
             ends.extend(b.iter());
             cable.push(c as i64);
             strain.push(((a - b).norm_squared() - l0 * l0) / (2.0 * l0 * l0));
-            force.push(super::cable::axial_force(
+            force.push(crate::mech::elements::cable::axial_force(
                 &a,
                 &b,
                 l0,
@@ -295,10 +295,10 @@ pub fn film_grid(
 }
 
 /// Reaction per unit length of each node (N/m, three per node): its line reaction along the
-/// boundary groups and support sets it belongs to ([`super::lines`]), summed; 0 elsewhere.
+/// boundary groups and support sets it belongs to ([`crate::mech::results::lines`]), summed; 0 elsewhere.
 pub fn line_reaction_field(model: &Model, results: &Results) -> Vec<f64> {
     let mut field = vec![0.0; 3 * model.nodes.len()];
-    for line in super::lines::reaction_lines(model).0 {
+    for line in crate::mech::results::lines::reaction_lines(model).0 {
         for r in line.reactions(results) {
             for (c, q) in r.per_length.iter().enumerate() {
                 field[3 * r.node + c] += q;

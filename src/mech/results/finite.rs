@@ -3,8 +3,8 @@
 //! results (the CLI, the FMU) check them once more, so that no path reports a wrong number
 //! as a success.
 
-use super::model::Model;
-use super::solver::Results;
+use crate::mech::model::Model;
+use crate::mech::results::Results;
 
 /// Whether every reported quantity of `results` (and the step's final residual) is finite; the
 /// error names the first that is not, by gap, group or triangle.
@@ -109,7 +109,8 @@ pub fn check_results(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::{Analysis, ParallelArch};
+    use crate::mech::Analysis;
+    use crate::specimens::ParallelArch;
 
     #[test]
     fn each_non_finite_result_is_named_and_finite_ones_pass() {

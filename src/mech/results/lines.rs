@@ -17,8 +17,8 @@
 
 use std::collections::HashMap;
 
-use super::model::Model;
-use super::solver::Results;
+use crate::mech::model::Model;
+use crate::mech::results::Results;
 
 /// What a reaction line belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

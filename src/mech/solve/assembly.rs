@@ -21,8 +21,8 @@
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
 
-use super::element::{ElementMatrix, ElementVector, Material, MembraneTriangle};
-use super::model::{GapSupport, Model};
+use crate::mech::elements::triangle::{ElementMatrix, ElementVector, Material, MembraneTriangle};
+use crate::mech::model::{GapSupport, Model};
 
 const NO_SLOT: u32 = u32::MAX;
 

@@ -24,7 +24,7 @@
 use nalgebra::{Matrix2, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-pub use super::material::{Material, Wrinkling, WrinklingState};
+pub use crate::mech::elements::material::{Material, Wrinkling, WrinklingState};
 
 /// Element vector on the nine nodal DOF.
 pub type ElementVector = SVector<f64, 9>;

@@ -73,14 +73,14 @@ use std::fmt;
 
 use nalgebra::Vector3;
 
-use super::contact::{FrictionLaw, GapFrame};
-use super::material::{Material, Wrinkling};
-use super::model::{
+use crate::mech::elements::gap::{FrictionLaw, GapFrame};
+use crate::mech::elements::material::{Material, Wrinkling};
+use crate::mech::model::{
     AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, GapSpec, GapSupport, LoadSpec,
     Model, OutputPoint, OutputSpec, PressureSet, Support, Symmetry,
 };
-use super::solver::{Analysis, SolverSettings, StepError};
-use super::specimen::{FramePath, ParallelArch, SpecimenContact};
+use crate::mech::solve::{Analysis, SolverSettings, StepError};
+use crate::specimens::parallel_arch::{FramePath, ParallelArch, SpecimenContact};
 
 // ------------------------------------------------------------------------------- load paths
 
@@ -102,7 +102,7 @@ pub struct LoadPath {
     pub stages: Vec<Stage>,
     /// Increments per communication step given to `step_to` (the FMU's
     /// `solver.incrementsPerStep` and the CLI's `--increments` default to
-    /// [`super::solver::DEFAULT_INCREMENTS_PER_STEP`]).
+    /// [`crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP`]).
     pub increments_per_step: usize,
 }
 
@@ -586,7 +586,7 @@ impl SpecimenPath {
 // ------------------------------------------------------------------------- wrapped specimen
 
 /// The specimen wound onto the arch from crown to foot and its boundary extended
-/// ([`FramePath::Wrapped`](super::specimen::FramePath)), one communication step per stage of
+/// ([`FramePath::Wrapped`](crate::specimens::parallel_arch::FramePath)), one communication step per stage of
 /// the frame path (the path is not linear between its stages).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WrappedSpecimen {

@@ -26,9 +26,9 @@
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::assembly::{System, node_dofs, node_vector};
-use super::element::{ElementMatrix, ElementVector};
-use super::model::{Model, PressureSet};
+use crate::mech::elements::triangle::{ElementMatrix, ElementVector};
+use crate::mech::model::{Model, PressureSet};
+use crate::mech::solve::assembly::{System, node_dofs, node_vector};
 
 /// The magnitudes of the model's loads at one instant (what a step ramps).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
