@@ -248,6 +248,37 @@ fn bad_calls_return_error_with_a_message_and_change_nothing() {
     );
 }
 
+/// After `fmi2Terminate` the state machine (FMI 2.0 §4.2.4, `phase::allowed`) refuses a step, a
+/// Set and a second Terminate, each with fmi2Error naming the call and the state, and time stays;
+/// Get still answers (for debugging), and Reset leads back to a new experiment.
+#[test]
+fn after_terminate_no_step_set_or_terminate_is_allowed() {
+    let (u, log) = (Unpacked::specimen("terminated"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    let err = Status::Error.raw();
+    unsafe {
+        assert_eq!(fmi2_do_step(fmu.c, 0.0, 0.05, 1), 0);
+        assert_eq!(fmi2_terminate(fmu.c), 0);
+        let refused = [
+            ("fmi2DoStep", fmi2_do_step(fmu.c, 0.05, 0.05, 1)),
+            ("fmi2SetReal", fmu.set_real("frame.dz", -0.01)),
+            ("fmi2Terminate", fmi2_terminate(fmu.c)),
+        ];
+        for (call, status) in refused {
+            assert_eq!(status, err, "{call}");
+            let message = format!("{call} must not be called in state Terminated");
+            assert!(
+                log.contains(Status::Error, &message),
+                "{call}: {:?}",
+                log.take()
+            );
+        }
+        assert_eq!(fmu.real("time"), 0.05);
+        assert_eq!(fmi2_reset(fmu.c), 0);
+        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
+    }
+}
+
 #[test]
 fn logging_follows_the_categories() {
     let (u, log) = (Unpacked::specimen("log"), Log::default());
