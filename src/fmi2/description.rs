@@ -26,7 +26,8 @@ use uuid::Uuid;
 
 use super::logger::CATEGORIES;
 use super::resources::Source;
-use super::variables::{Causality, Kind, UNITS, Value, Variable, check_names, variables};
+use super::scalar_variable::{Causality, Value, Variable};
+use super::variables::{Kind, UNITS, check_names, variables};
 use crate::mech::Model;
 
 /// The template (top-level `modelDescription.xml.in`).

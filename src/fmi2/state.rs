@@ -28,10 +28,10 @@
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::instance::Phase;
-use super::variables::Value;
-use crate::mech::elements::curved_contact::SurfaceContacts;
+use super::phase::Phase;
+use super::scalar_variable::Value;
 use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
+use crate::mech::elements::curved_contact::SurfaceContacts;
 use crate::mech::{AnalysisState, Model};
 
 /// Everything needed to continue an instance exactly.

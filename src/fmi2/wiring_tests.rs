@@ -19,7 +19,7 @@
 //! BOUNDARY CONDITIONS: the specimens' frame lowered by 50 mm under self-weight, the panel's
 //! rail turned by 0.1 rad, the membrane under its file's loads; two increments per step.
 //!
-//! SAFETY: the FMU is driven through the harness of `tests.rs` (its soundness comment holds);
+//! SAFETY: the FMU is driven through the harness of `tests/mod.rs` (its soundness comment holds);
 //! the `unsafe` calls here pass the harness's live instance and plain numbers.
 
 use std::path::Path;
@@ -52,7 +52,7 @@ const UNSEEN: [(&str, &str); 3] = [
     ),
     (
         "results.vtkFormat",
-        "not an analysis parameter: writes nothing without results.directory (tests.rs checks the ascii files)",
+        "not an analysis parameter: writes nothing without results.directory (tests/vtk_output.rs checks the ascii files)",
     ),
 ];
 
