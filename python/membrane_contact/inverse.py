@@ -36,6 +36,7 @@ from fmpy import read_model_description
 
 from .film import Film
 from .fmu import find_fmu
+from .study import apply_values
 
 
 @dataclass
@@ -150,21 +151,16 @@ def read_path(path) -> dict[str, list[float]]:
 
 def _run(fmu, path, parameters, unknowns, values, outputs):
     """The outputs at the end of ``path`` with the unknowns at ``values``."""
-    params = dict(parameters or {})
-    table = {k: np.asarray(v, dtype=float).copy() for k, v in path.items()}
     with Film(fmu, logging=False) as film:
-        for u, x in zip(unknowns, values):
+        causality = {**{n: "input" for n in film.inputs}, **{n: "parameter" for n in film.parameters}}
+        for u in unknowns:
             if u.name.startswith("scale:"):
-                column = u.name[len("scale:"):]
-                if column not in table:
-                    raise KeyError(f"'{u.name}': the path has no column '{column}'")
-                table[column] = table[column] * x
-            elif u.name in film.inputs:
-                table[u.name] = np.full(len(table["time"]), x)
-            elif u.name in film.parameters:
-                params[u.name] = x
-            else:
+                if u.name[len("scale:"):] not in path:
+                    raise KeyError(f"'{u.name}': the path has no column '{u.name[len('scale:'):]}'")
+            elif u.name not in causality:
                 raise KeyError(f"unknown '{u.name}' is neither an input, a parameter nor scale:<column>")
+        table, params = apply_values({u.name: x for u, x in zip(unknowns, values)}, path, parameters or {},
+                                     causality)
         film.initialize(parameters=params)
         film.run(table, outputs=[])
         return np.array([film[o] for o in outputs], dtype=float)

@@ -347,11 +347,10 @@ def check_variables(fmu, design: dict, path: dict, parameters: dict, outputs: li
 
     md = read_model_description(str(fmu))
     causality = {v.name: v.causality for v in md.modelVariables}
-    kinds = {n: k for n, k in causality.items()}
 
     def refuse(what, name, allowed):
         raise KeyError(f"{what} '{name}' is not {allowed} of {md.modelName} "
-                       f"({'a ' + kinds[name] if name in kinds else 'no such variable'})")
+                       f"({'a ' + causality[name] if name in causality else 'no such variable'})")
 
     if "time" not in path:
         raise KeyError("the load path needs a 'time' column")
@@ -444,6 +443,12 @@ def read_case(path: Path, outputs: list[str]) -> dict:
             if k.decode().startswith("study.")}
     meta["values"] = np.stack([table.column(o).to_numpy() for o in outputs], axis=1)
     return meta
+
+
+def stored_results(directory: Path, outputs: list[str]) -> dict[int, dict]:
+    """``{case: result}`` of every case file in ``directory``."""
+    return {int(p.stem.split("-")[1]): read_case(p, outputs)
+            for p in sorted((Path(directory) / "cases").glob("case-*.parquet"))}
 
 
 # ---------------------------------------------------------------------------- progress
@@ -627,8 +632,7 @@ class Study:
         """Every stored case's result (``values``, ``status``, ``message``, ``seconds``, …)."""
         if self.directory is None:
             return dict(getattr(self, "_results", {}))
-        return {int(p.stem.split("-")[1]): read_case(p, self.outputs)
-                for p in sorted((self.directory / "cases").glob("case-*.parquet"))}
+        return stored_results(self.directory, self.outputs)
 
     def dataset(self):
         """The results as an ``xarray.Dataset``: one variable per output over ``(case, step)``
@@ -672,9 +676,7 @@ def open_study(directory):
     so far), without the FMU."""
     directory = Path(directory)
     description = json.loads((directory / "study.json").read_text())
-    results = {int(p.stem.split("-")[1]): read_case(p, description["outputs"])
-               for p in sorted((directory / "cases").glob("case-*.parquet"))}
-    return _assemble(description, results)
+    return _assemble(description, stored_results(directory, description["outputs"]))
 
 
 # ---------------------------------------------------------------------------- spec files
@@ -767,7 +769,7 @@ def main(argv=None) -> int:
         unknown = sorted(set(spec) - known)
         if unknown:
             raise ValueError(f"{a.spec}: unknown keys {', '.join(unknown)}")
-        out = Path(a.out) if a.out else base / spec.get("out", Path(a.spec).stem)
+        out = (Path(a.out) if a.out else base / spec.get("out", Path(a.spec).stem)).resolve()
         out.mkdir(parents=True, exist_ok=True)
         study = Study(fmu_from_spec(spec, base, out), design_from_spec(spec.get("design") or {}, base),
                       path_from_spec(spec.get("path") or {}, base), spec.get("outputs"),
