@@ -61,6 +61,7 @@ def main(argv=None) -> int:
             write_case(study.directory, run_case(study.fmu, *study.case_arguments(k)), study.outputs, study.times)
         rows.append(("in-process, no Dask", time.perf_counter() - started, 0.0))
         reference = study.dataset()
+        cpus = []
         for workers in (1, 2):
             started = time.perf_counter()
             with cluster(workers=workers) as client:
@@ -71,6 +72,10 @@ def main(argv=None) -> int:
                 print(f"{workers} worker(s): the dataset differs from the in-process one", file=sys.stderr)
                 return 1
             rows.append((f"LocalCluster, {workers} worker{'s' if workers > 1 else ''}", total - up, up))
+            cpu = [r["cpu_seconds"] for r in Study(a.fmu, d, PATH, OUTPUTS, directory=Path(tmp) / f"w{workers}")
+                   .results().values()]
+            cpus.append(f"{workers} worker(s): {1000 * np.mean(cpu):.1f} ms CPU per case on the worker "
+                        f"(median {1000 * np.median(cpu):.1f})")
     assert (reference.status == "ok").all(), reference.status.values
     print(f"{n} cases, {len(PATH['time'])} steps each, {len(OUTPUTS)} outputs; load average before: "
           f"{load:.2f} on {os.cpu_count()} cores\n")
@@ -81,6 +86,7 @@ def main(argv=None) -> int:
         print(f"| {name} | {seconds:.2f} | {1000 * seconds / n:.1f} | "
               f"{base / seconds:.2f} | {up:.2f} |" if up else
               f"| {name} | {seconds:.2f} | {1000 * seconds / n:.1f} | {base / seconds:.2f} | — |")
+    print("\n" + "; ".join(cpus) + ".")
     print("\nThe datasets of the three runs are identical bit for bit (every float of every output).")
     return 0
 

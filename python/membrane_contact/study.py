@@ -378,10 +378,11 @@ def run_case(fmu_path, case: int, variables: dict, path: dict, parameters: dict,
     case's values, stepped row by row along the path. Returns ``{"case", "status" ("ok",
     "refused": a step refused after every halving, "error": the FMU refused the case, e.g. a
     parameter at initialization), "message", "values" (steps × outputs, step 0 the initial
-    state, NaN past a refusal), "halvings", "warnings", "seconds", "worker"}``."""
+    state, NaN past a refusal), "halvings", "warnings", "seconds" (wall), "cpu_seconds" (this
+    process's CPU time), "worker"}``."""
     from .film import Film, FmuError, StepRefused
 
-    started = _time.perf_counter()
+    started, cpu = _time.perf_counter(), _time.process_time()
     if run_log:
         with open(run_log, "a") as f:
             f.write(f"{case} start {socket.gethostname()}:{os.getpid()}\n")
@@ -408,6 +409,7 @@ def run_case(fmu_path, case: int, variables: dict, path: dict, parameters: dict,
     kinds = sorted({str(w.message) for w in caught or []})
     return {"case": case, "status": status, "message": message, "values": values, "halvings": halvings,
             "warnings": "\n".join(kinds), "seconds": _time.perf_counter() - started,
+            "cpu_seconds": _time.process_time() - cpu,
             "worker": f"{socket.gethostname()}:{os.getpid()}"}
 
 
@@ -427,7 +429,8 @@ def write_case(directory: Path, result: dict, outputs: list[str], times: np.ndar
     values = result["values"]
     columns = {"step": pa.array(np.arange(len(times), dtype=np.int64)), "time": pa.array(times)}
     columns.update({o: pa.array(values[:, j]) for j, o in enumerate(outputs)})
-    meta = {k: json.dumps(result[k]) for k in ("case", "status", "message", "halvings", "warnings", "seconds", "worker")}
+    meta = {k: json.dumps(result[k]) for k in ("case", "status", "message", "halvings", "warnings", "seconds",
+                                                "cpu_seconds", "worker")}
     table = pa.table(columns).replace_schema_metadata({f"study.{k}": v for k, v in meta.items()})
     path = _case_file(directory, result["case"])
     tmp = path.with_suffix(".part")
