@@ -315,9 +315,10 @@ def cluster(scheduler: str | None = None, workers: int | None = None):
         return
     import logging
 
-    n = workers or os.cpu_count() or 1
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    n = workers or cores or 1
     with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR) as local, Client(local) as client:
+                      silence_logs=logging.CRITICAL) as local, Client(local) as client:
         yield client
 
 
@@ -487,7 +488,7 @@ class Progress:
         if not self.enabled:
             return
         if self.tty:
-            print("\r" + self.line(), end="", file=self.stream, flush=True)
+            print("\r" + self.line() + "\033[K", end="", file=self.stream, flush=True)
         elif (self.done - self.already) % self._every == 0 or self.done == self.total:
             print(self.line(), file=self.stream, flush=True)
 
