@@ -763,6 +763,8 @@ def main(argv=None) -> int:
     p.add_argument("--out", help="the results directory (default: the spec's 'out')")
     p.add_argument("--scheduler", help="a Dask scheduler address or scheduler file (default: a LocalCluster)")
     p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: one per core)")
+    p.add_argument("--shared-fmu", action="store_true",
+                   help="workers read the FMU at its path (a shared filesystem) instead of receiving its bytes")
     p.add_argument("--no-progress", action="store_true", help="no progress lines")
     a = p.parse_args(argv)
     try:
@@ -781,7 +783,7 @@ def main(argv=None) -> int:
     except (KeyError, ValueError, FileNotFoundError, RuntimeError) as e:
         print(f"error: {e.args[0] if isinstance(e, KeyError) and e.args else e}", file=sys.stderr)
         return 2
-    ds = study.run(scheduler=a.scheduler, workers=a.workers, progress=not a.no_progress)
+    ds = study.run(scheduler=a.scheduler, workers=a.workers, progress=not a.no_progress, shared_fmu=a.shared_fmu)
     failed = int((ds.status != "ok").sum())
     print(f"{study.cases} cases in {out}: {study.cases - failed} ran through, {failed} refused")
     for k in np.flatnonzero(ds.status.values != "ok")[:10]:

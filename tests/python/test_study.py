@@ -85,8 +85,9 @@ def test_one_and_two_local_workers_give_bit_identical_datasets(fmu_path, one_wor
                    .results().values())) == 2  # both workers ran cases
     assert identical(ds1, ds2)
     assert identical(open_study(tmp_path / "two"), ds2)  # read back from the directory alone
-    # Without a directory, the results come back in memory: the same dataset.
-    ds0 = Study(fmu_path, DESIGN, PATH, OUTPUTS).run(two_workers, progress=False)
+    # Without a directory, the results come back in memory; workers reading the FMU at its path
+    # (a shared filesystem) instead of receiving its bytes: the same dataset.
+    ds0 = Study(fmu_path, DESIGN, PATH, OUTPUTS).run(two_workers, progress=False, shared_fmu=True)
     assert identical(ds1, ds0)
 
 
