@@ -20,7 +20,9 @@ residual is ``r = x̃ − x``. Schemes (``scheme=``):
 * ``"newton"``: interface Newton, ``(J_s J_f − I) Δx = −r``, with ``J_f = ∂y/∂x`` and
   ``J_s = ∂x̃/∂y`` from each FMU's ``fmi2GetDirectionalDerivative`` (one seed per interface
   variable, at the state the iteration reached); ``derivatives="finite-differences"`` takes
-  them from extra steps with rollback instead, for an FMU that does not provide them.
+  them from extra steps with rollback instead, for an FMU that does not provide them. A step
+  that does not lower ``‖r‖`` (it crossed a kink: the valve opening, a gap closing) is halved
+  back toward the last iterate, up to 10 times (damped Newton).
 
 Every iterated scheme reports, per step, the coupling iterations (film steps), the residual
 history (``‖r‖∞`` of each iteration), the rollbacks (restores of the pair) and why it stopped.
@@ -204,7 +206,8 @@ class CoupledSystem:
             x_pred = self._step_structure(self.y, h)
             structure.restore(s0)
             x = x_pred if x_pred is not None else self.x.copy()
-            r_prev = xt_prev = None
+            r_prev = xt_prev = x_prev = None
+            halvings = 0
             V, W = [], []
             omega_k = min(omega, self._omega if self._omega is not None else omega)
             r0 = None
@@ -234,6 +237,14 @@ class CoupledSystem:
                 if rec.iterations >= max_iterations:
                     rec.reason = f"not converged in {max_iterations} iterations"
                     break
+                if scheme == "newton" and r_prev is not None and norm >= (1 - 1e-4) * float(np.max(np.abs(r_prev))) \
+                        and halvings < 10:
+                    # No decrease: a full step across a kink (the valve opening, a gap closing)
+                    # overshot; halve it back toward the last iterate (damped Newton).
+                    halvings += 1
+                    x = x_prev + 0.5 * (x - x_prev)
+                    continue
+                halvings = 0
                 if scheme == "gauss-seidel":
                     x_next = x + omega * r
                 elif scheme == "aitken":
@@ -257,7 +268,7 @@ class CoupledSystem:
                     Jf, Js = self._jacobians(x, y, h, derivatives, fd_step, rec, restore)
                     A = Js @ Jf - np.eye(len(x))
                     x_next = x - np.linalg.solve(A, r)
-                r_prev, xt_prev, x = r, xt, x_next
+                r_prev, xt_prev, x_prev, x = r, xt, x, x_next
             rec.converged = False
             film.restore(f0)
             structure.restore(s0)
@@ -325,16 +336,20 @@ def erection_system(film_fmu=None, jack_fmu=None, film_parameters: dict | None =
     :func:`closing`."""
     from .ssp import FILM_PARAMETERS, JACK_PARAMETERS, pack_jack_fmu
 
+    packed = None
     if jack_fmu is None:
         import tempfile
         from pathlib import Path
 
-        jack_fmu = pack_jack_fmu(Path(tempfile.mkdtemp(prefix="jack_")) / "HydraulicJack.fmu")
+        packed = tempfile.mkdtemp(prefix="jack_")
+        jack_fmu = pack_jack_fmu(Path(packed) / "HydraulicJack.fmu")
     film = Film(film_fmu, name="film", logging=False, quiet=True)
     jack = Film(jack_fmu, name="jack", logging=False, quiet=True)
     film.initialize({**FILM_PARAMETERS, **(film_parameters or {})})
     jack.initialize({**JACK_PARAMETERS, **(jack_parameters or {})})
-    return CoupledSystem(film, jack, displacements=[("dz", f"{group}.dz")], forces=[(f"{group}.Rz", "force")])
+    system = CoupledSystem(film, jack, displacements=[("dz", f"{group}.dz")], forces=[(f"{group}.Rz", "force")])
+    system.packed = packed
+    return system
 
 
 class closing:
@@ -347,5 +362,9 @@ class closing:
         return self.system
 
     def __exit__(self, *exc):
+        import shutil
+
         self.system.film.close()
         self.system.structure.close()
+        if getattr(self.system, "packed", None):
+            shutil.rmtree(self.system.packed, ignore_errors=True)
