@@ -191,3 +191,14 @@ def test_interface_newton_halves_a_step_that_overshoots_the_valves_kink(fmu_path
     assert len(report.steps) == 4
     # some step's residual rose (the overshoot) before it converged
     assert any(any(b > a for a, b in zip(s.residuals, s.residuals[1:])) for s in report.steps)
+
+
+def test_staggered_exchange_hands_the_jacks_new_position_to_the_film_in_the_same_step(fmu_path, jack_fmu):
+    with closing(erection_system(fmu_path, jack_fmu)) as system:
+        report = system.run(30.0, 10.0, "staggered")
+        assert system.film["frame.dz"] == system.structure["dz"] != 0.0
+    assert [(s.iterations, s.rollbacks) for s in report.steps] == [(1, 0)] * 3
+    with closing(erection_system(fmu_path, jack_fmu)) as system:
+        system.run(30.0, 10.0, "jacobi")
+        # Jacobi: the film reached the jack's position of the step before
+        assert system.film["frame.dz"] != system.structure["dz"]
