@@ -4,12 +4,16 @@ master (membrane_contact.coupling) with rollback."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+import zipfile
+
 import numpy as np
 import pytest
 from fmpy.ssp.simulation import simulate_ssp
 from fmpy.validation import validate_fmu
 
-from conftest import INSTALLED, NEEDS_CHECKOUT
+from conftest import INSTALLED, NEEDS_CHECKOUT, ROOT, package_env
 from cosim_runner import run_ssp_with_libcosim, run_with_libcosim
 from membrane_contact import Film
 from membrane_contact.coupling import CouplingFailed, closing, erection_system
@@ -202,3 +206,22 @@ def test_staggered_exchange_hands_the_jacks_new_position_to_the_film_in_the_same
         system.run(30.0, 10.0, "jacobi")
         # Jacobi: the film reached the jack's position of the step before
         assert system.film["frame.dz"] != system.structure["dz"]
+
+
+def test_ssp_command_line_packs_both_fmus_with_the_values_set_and_refuses_a_bad_setting(fmu_path, jack_fmu, tmp_path):
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "membrane_contact.ssp", *args], cwd=ROOT,
+                              capture_output=True, text=True, env=package_env(), timeout=120)
+
+    out = tmp_path / "e.ssp"
+    r = run(str(out), "--film", str(fmu_path), "--jack", str(jack_fmu), "--set", "jack.stiffness=2e5",
+            "--set", "film.solver.incrementsPerStep=4", "--stop", "50", "--step", "2.5")
+    assert r.returncode == 0, r.stderr
+    with zipfile.ZipFile(out) as z:
+        assert sorted(z.namelist()) == ["SystemStructure.ssd", "resources/film.fmu", "resources/jack.fmu"]
+        assert z.read("resources/jack.fmu") == jack_fmu.read_bytes()
+    values = {p.name: p.value for p in fmpy_parameter_set(out).parameters}
+    assert values["jack.stiffness"] == "200000.0" and values["film.solver.incrementsPerStep"] == "4"
+    assert values["jack.relief"] == "600.0" and values["film.archHeight"] == "0.3"
+    r = run(str(tmp_path / "f.ssp"), "--set", "crane.stiffness=1")
+    assert r.returncode == 2 and "--set crane.stiffness=1: expected film.NAME=VALUE or jack.NAME=VALUE" in r.stderr
