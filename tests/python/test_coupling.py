@@ -142,16 +142,18 @@ def test_gauss_seidel_fails_where_aitken_iqn_ils_and_interface_newton_converge_t
     assert gs.failure is not None, gs.summary()
     assert "not converged" in gs.failure.reason or "diverged" in gs.failure.reason
     ends = {}
-    for scheme, options in [("aitken", {}), ("iqn-ils", {}), ("newton", {"derivatives": "finite-differences"})]:
+    for label, scheme, options in [("aitken", "aitken", {}), ("iqn-ils", "iqn-ils", {}),
+                                   ("iqn-ils reusing 2 steps", "iqn-ils", {"reuse": 2}),
+                                   ("newton", "newton", {"derivatives": "finite-differences"})]:
         report, rz, dz = soft_jack_run(fmu_path, jack_fmu, scheme, **options)
         assert report.failure is None, report.summary()
         assert len(report.steps) == 12
         for rec in report.steps:
             assert rec.converged and rec.residuals[-1] <= 1e-9 + 1e-7 * max(abs(v) for v in rec.x)
             assert len(rec.residuals) == rec.iterations and rec.rollbacks >= rec.iterations - 1
-        ends[scheme] = (rz, dz, report.iterations)
+        ends[label] = (rz, dz, report.iterations)
     # one answer (to the coupling tolerance, 1e-7 of |dz|)
-    for scheme in ("iqn-ils", "newton"):
+    for scheme in ("iqn-ils", "iqn-ils reusing 2 steps", "newton"):
         assert ends[scheme][1] == pytest.approx(ends["aitken"][1], rel=1e-6)
         assert ends[scheme][0] == pytest.approx(ends["aitken"][0], rel=1e-5)
     # where Gauss-Seidel failed, interface Newton needs few iterations (the first is the
