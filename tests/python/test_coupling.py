@@ -144,7 +144,7 @@ def test_gauss_seidel_fails_where_aitken_iqn_ils_and_interface_newton_converge_t
     ends = {}
     for label, scheme, options in [("aitken", "aitken", {}), ("iqn-ils", "iqn-ils", {}),
                                    ("iqn-ils reusing 2 steps", "iqn-ils", {"reuse": 2}),
-                                   ("newton", "newton", {"derivatives": "finite-differences"})]:
+                                   ("newton", "newton", {"derivatives": "fmu"})]:
         report, rz, dz = soft_jack_run(fmu_path, jack_fmu, scheme, **options)
         assert report.failure is None, report.summary()
         assert len(report.steps) == 12
