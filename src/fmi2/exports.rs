@@ -376,20 +376,28 @@ fn not_provided(what: &str) -> Failure {
 #[unsafe(export_name = "fmi2GetDirectionalDerivative")]
 pub unsafe extern "C" fn fmi2_get_directional_derivative(
     c: Fmi2Component,
-    _v_unknown_ref: *const Fmi2ValueReference,
-    _n_unknown: usize,
-    _v_known_ref: *const Fmi2ValueReference,
-    _n_known: usize,
-    _dv_known: *const Fmi2Real,
-    _dv_unknown: *mut Fmi2Real,
+    v_unknown_ref: *const Fmi2ValueReference,
+    n_unknown: usize,
+    v_known_ref: *const Fmi2ValueReference,
+    n_known: usize,
+    dv_known: *const Fmi2Real,
+    dv_unknown: *mut Fmi2Real,
 ) -> Fmi2Status {
-    // SAFETY: FMI 2.0 caller contract (module doc); the arrays are not touched.
+    // SAFETY: FMI 2.0 caller contract (module doc); `v_unknown_ref` and `dv_unknown` hold
+    // `n_unknown` elements, `v_known_ref` and `dv_known` `n_known`.
     unsafe {
         with_instance(
             c,
             "fmi2GetDirectionalDerivative",
             allowed::DIRECTIONAL_DERIVATIVE,
-            |_| Err(not_provided("providesDirectionalDerivative=\"false\"")),
+            |i| {
+                i.directional_derivative(
+                    input(v_unknown_ref, n_unknown, "vUnknown_ref")?,
+                    input(v_known_ref, n_known, "vKnown_ref")?,
+                    input(dv_known, n_known, "dvKnown")?,
+                    output(dv_unknown, n_unknown, "dvUnknown")?,
+                )
+            },
         )
     }
 }

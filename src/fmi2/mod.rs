@@ -25,6 +25,7 @@
 //! | `outputs` | the outputs from the converged state's results, checked finite; assumption warnings |
 //! | `stepping` | `fmi2DoStep` and what it drives (inputs, μ, the checked core step, retry); the status queries |
 //! | `vtk_output` | the results files: VTK `.vtu`/`.pvd` of every converged state (`results.directory`) |
+//! | `derivatives` | `fmi2GetDirectionalDerivative` from the core's linear response |
 //! | `fmu_states` | the instance's saved FMU states: get, set, free, (de)serialize |
 //! | [`state`] | one FMU state: the snapshot, its serialized byte format and its checks |
 //! | [`exports`] | the 44 exported `fmi2*` functions (25 common, 9 CS, 10 ME error stubs) |
@@ -44,6 +45,7 @@
 //! (`tests/threads.rs`). It is linked with `-z nodelete` (see `fmu/build.rs`), so an
 //! importer's `dlclose` cannot unload code that is still referenced.
 
+mod derivatives;
 pub mod description;
 pub mod exports;
 mod fmu_states;

@@ -10,7 +10,7 @@ use super::scalar_variable::{Binding, Value};
 use super::types::Status;
 use crate::mech::elements::triangle::state_counts;
 use crate::mech::results::warnings::result_warnings;
-use crate::mech::{GapStatus, StepReport, check_results};
+use crate::mech::{GapStatus, Results, StepReport, check_results};
 
 impl Instance {
     /// Builds the analysis if there is none (initialization) and computes the initial outputs.
@@ -47,7 +47,6 @@ impl Instance {
             }
         };
         built.warnings = result_warnings(built.analysis.model(), &results);
-        let max_stress = results.von_mises_range().1;
         let [_, wrinkled, slack] = state_counts(&results.elements);
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
@@ -57,50 +56,23 @@ impl Instance {
             .zip(self.values.iter_mut())
         {
             *x = match v.binding {
-                Binding::SlipX(g) => Value::Real(results.gaps[g].slip_x),
-                Binding::SlipY(g) => Value::Real(results.gaps[g].slip_y),
-                Binding::NormalForce(g) => Value::Real(results.gaps[g].normal_force),
-                Binding::FrictionForce(g) => Value::Real(results.gaps[g].friction_force),
-                // `GapResult::friction` is the force the film exerts on the support (the
-                // equilibrium of the film's Z forces shows it): the film feels the opposite.
-                Binding::GapFriction { gap, axis } => {
-                    Value::Real(-results.gaps[gap].friction[axis])
-                }
                 Binding::GapStatus(g) => Value::Integer(match results.gaps[g].status {
                     GapStatus::Open => 0,
                     GapStatus::Stick => 1,
                     GapStatus::Slip => 2,
                 }),
-                Binding::Reaction { group, axis } => Value::Real(results.reactions[group][axis]),
-                Binding::HingeMoment(group) => Value::Real(results.moments[group]),
                 Binding::Iterations => count(report.map_or(0, StepReport::total_iterations)),
                 Binding::Cutbacks => count(report.map_or(0, |r| r.cutbacks)),
                 Binding::Residual => Value::Real(report.map_or(0.0, |r| r.residual)),
-                Binding::MaxEquivalentStress => Value::Real(max_stress),
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
-                Binding::SupportReaction { set, axis } => {
-                    Value::Real(results.support_reactions[set][axis])
-                }
-                Binding::TotalReaction(axis) => Value::Real(results.total_reaction[axis]),
-                Binding::CableForce(c) => Value::Real(results.cables[c].max_force),
-                Binding::SurfaceSlip(c) => Value::Real(results.surface_contacts[c].slip),
-                Binding::SurfaceNormalForce(c) => {
-                    Value::Real(results.surface_contacts[c].normal_force)
-                }
-                Binding::SurfaceFrictionForce(c) => {
-                    Value::Real(results.surface_contacts[c].friction_force)
-                }
                 Binding::SurfaceStatus(c) => {
                     Value::Integer(results.surface_contacts[c].status as i32)
                 }
-                Binding::PointDisplacement { point, axis } => {
-                    Value::Real(results.points[point][axis])
-                }
-                Binding::SetSummary { set, quantity } => {
-                    Value::Real(quantity.of(&results.sets[set]))
-                }
-                _ => continue,
+                ref b => match state_result(b, &results) {
+                    Some(r) => Value::Real(r),
+                    None => continue,
+                },
             };
         }
         self.outputs_fresh = true;
@@ -128,4 +100,54 @@ impl Instance {
         }
         Err(Failure::warning(message))
     }
+}
+
+/// The Real output bound to `binding` that is a result of the film's state (the ones
+/// `fmi2GetDirectionalDerivative` differentiates), or None (inputs, parameters, statuses, the
+/// last step's statistics).
+pub(super) fn state_result(binding: &Binding, results: &Results) -> Option<f64> {
+    Some(match *binding {
+        Binding::SlipX(g) => results.gaps[g].slip_x,
+        Binding::SlipY(g) => results.gaps[g].slip_y,
+        Binding::NormalForce(g) => results.gaps[g].normal_force,
+        Binding::FrictionForce(g) => results.gaps[g].friction_force,
+        // `GapResult::friction` is the force the film exerts on the support (the equilibrium
+        // of the film's Z forces shows it): the film feels the opposite.
+        Binding::GapFriction { gap, axis } => -results.gaps[gap].friction[axis],
+        Binding::Reaction { group, axis } => results.reactions[group][axis],
+        Binding::HingeMoment(group) => results.moments[group],
+        Binding::MaxEquivalentStress => results.von_mises_range().1,
+        Binding::SupportReaction { set, axis } => results.support_reactions[set][axis],
+        Binding::TotalReaction(axis) => results.total_reaction[axis],
+        Binding::CableForce(c) => results.cables[c].max_force,
+        Binding::SurfaceSlip(c) => results.surface_contacts[c].slip,
+        Binding::SurfaceNormalForce(c) => results.surface_contacts[c].normal_force,
+        Binding::SurfaceFrictionForce(c) => results.surface_contacts[c].friction_force,
+        Binding::PointDisplacement { point, axis } => results.points[point][axis],
+        Binding::SetSummary { set, quantity } => quantity.of(&results.sets[set]),
+        _ => return None,
+    })
+}
+
+/// Whether `binding` is one of [`state_result`]'s.
+pub(super) fn is_state_result(binding: &Binding) -> bool {
+    matches!(
+        binding,
+        Binding::SlipX(_)
+            | Binding::SlipY(_)
+            | Binding::NormalForce(_)
+            | Binding::FrictionForce(_)
+            | Binding::GapFriction { .. }
+            | Binding::Reaction { .. }
+            | Binding::HingeMoment(_)
+            | Binding::MaxEquivalentStress
+            | Binding::SupportReaction { .. }
+            | Binding::TotalReaction(_)
+            | Binding::CableForce(_)
+            | Binding::SurfaceSlip(_)
+            | Binding::SurfaceNormalForce(_)
+            | Binding::SurfaceFrictionForce(_)
+            | Binding::PointDisplacement { .. }
+            | Binding::SetSummary { .. }
+    )
 }

@@ -21,4 +21,6 @@ pub use elements::material::{Material, Wrinkling, WrinklingState};
 pub use model::{Model, ModelError};
 pub use results::Results;
 pub use results::finite::check_results;
-pub use solve::{Analysis, AnalysisState, SettingNames, SolverSettings, StepError, StepReport};
+pub use solve::{
+    Analysis, AnalysisState, Response, Seed, SettingNames, SolverSettings, StepError, StepReport,
+};

@@ -120,7 +120,8 @@ if INSTALLED:
 
 def newest_source() -> float:
     """The latest modification time of the files the release build and the FMU are made from."""
-    files = [ROOT / "Cargo.toml", ROOT / "Cargo.lock", ROOT / "modelDescription.xml.in"]
+    files = [ROOT / "Cargo.toml", ROOT / "Cargo.lock", ROOT / "modelDescription.xml.in",
+             ROOT / "fmu" / "jack" / "modelDescription.xml"]
     files += [p for d in ("src", "fmu") for p in (ROOT / d).rglob("*.rs")]
     return max(p.stat().st_mtime for p in files if p.is_file())
 

@@ -114,3 +114,28 @@ def run_with_libcosim(
     # Terminate + FreeInstance happen when the execution is destroyed.
     del execution
     return result
+
+
+def run_ssp_with_libcosim(ssp_path: str, n_steps: int, outputs: dict[str, list[str]],
+                          log_level: CosimLogLevel = CosimLogLevel.WARNING) -> dict:
+    """Run an ``.ssp`` archive as it is (``CosimExecution.from_ssp_file``: its components,
+    connections, parameter values and the fixed step of its libcosim annotation) for
+    ``n_steps`` steps. ``outputs``: ``{component: [variable names]}`` to read after the last
+    step. Returns ``{"time": end time in s, component: {name: value}}``."""
+    from libcosimpy.CosimExecution import CosimExecution
+
+    log_output_level(log_level)
+    execution = CosimExecution.from_ssp_file(str(ssp_path))
+    observer = CosimObserver.create_last_value()
+    if not execution.add_observer(observer):
+        raise RuntimeError(get_last_error_message())
+    index = {i.name.decode(): i.index for i in execution.slave_infos()}
+    refs = {c: {v.name.decode(): v.reference for v in execution.slave_variables(index[c])} for c in outputs}
+    if not execution.step(n_steps):
+        raise RuntimeError(f"the SSP run failed: {get_last_error_message()}")
+    result: dict = {"time": execution.status().current_time / NANOS}
+    for c, names in outputs.items():
+        values = observer.last_real_values(index[c], [refs[c][n] for n in names])
+        result[c] = dict(zip(names, values))
+    del execution
+    return result

@@ -8,9 +8,10 @@ exist and are not empty, every number is finite, and the physics of §4.4:
   G1 < G2 < G3 < G4 (the gaps in contact at -H/2);
 * a larger mu gives less slip at the gaps in contact (Fig. 7);
 * a higher arch gives more slip at G2 and G4 (Fig. 8);
-* the erection master keeps the film's reaction at the jack's relief force and stays inside
-  the stroke; a step refused by the FMU (fmi2Discard) is retried in halves and reaches the
-  same answer as an unrefused path;
+* the erection system (film FMU + jack FMU, coupled to convergence) keeps the film's reaction
+  at the jack's relief force and stays inside the stroke, the frame where the jack holds it; a
+  step refused by the FMU (fmi2Discard) is retried in halves and reaches the same answer as an
+  unrefused path;
 * README's quick start (``run_specimen.sh``, ``run_specimen.py``) prints the slips, statuses and
   reaction the FMU gives on the same path, and Table 1 beside them;
 * Fig. 8 crown to foot (``fig8_wrapped.py``, the 300 mm specimen only): wrapped over the arch and
@@ -191,29 +192,35 @@ def test_read_vtu_mirror(tmp_path):
     assert {tuple(q[2][:2]) for q in quarters} == {(0, 1), (0, -1)}
 
 
+@pytest.mark.skipif(INSTALLED, reason=f"the jack FMU is built from fmu/jack: {NEEDS_CHECKOUT}")
 def test_erection_sequence(tmp_path, fmu_path):
-    relief, tol = 600.0, 40.0
-    run_example("erection_sequence.py", tmp_path, "--relief", str(relief),
-                "--max-force-change", str(tol), fmu=fmu_path)
+    relief, stiffness = 600.0, 1e5
+    run_example("erection_sequence.py", tmp_path, "--relief", str(relief), "--stiffness", str(stiffness),
+                fmu=fmu_path)
     assert_png(tmp_path / "erection_sequence.png")
     rows = read_csv(tmp_path / "erection_sequence.csv")
-    assert_finite(rows, ["time_s", "dz_mm", "Rz_N", "jack_speed_mm_s"]
+    assert_finite(rows, ["time_s", "dz_mm", "piston_mm", "Rz_N", "jack_speed_mm_s"]
                   + [f"G{i}_slip_mm" for i in range(1, 10)])
     t = [float(r["time_s"]) for r in rows]
     assert t[0] == 0 and all(a < b for a, b in zip(t, t[1:])) and t[-1] == pytest.approx(400)
     force = [abs(float(r["Rz_N"])) for r in rows]
     dz = [float(r["dz_mm"]) for r in rows]
     assert all(-150 - 1e-9 <= d <= 0 for d in dz)
-    assert max(force) <= relief + tol
-    # The jack stalls on the film: the end force is in the valve's band, the stroke not used up.
-    assert 0.85 * relief <= force[-1] <= relief + tol
+    # Converged coupling: the film's frame is where the jack holds it under the film's force
+    # (dz = piston - Rz / stiffness, to the master's 1e-7 relative tolerance).
+    for r in rows:
+        held = float(r["piston_mm"]) - float(r["Rz_N"]) / stiffness * 1e3
+        assert float(r["dz_mm"]) == pytest.approx(held, rel=1e-6, abs=1e-6)
+    # The jack stalls on the film: the end force in the valve's band, the stroke not used up.
+    assert max(force) <= relief * (1 + 1e-6)
+    assert 0.85 * relief <= force[-1] <= relief
     assert dz[-1] > -150 + 1
     assert rows[-1]["jack_phase"] == "relief valve open"
     last = rows[-1]
     slips = [float(last[f"G{i}_slip_mm"]) for i in range(1, 5)]
     assert abs(slips[0]) < 0.05 and slips == sorted(slips)
-    # Step refusals and rollbacks are counted (the coarse --steps forces the master to halve).
-    assert int(last["rollbacks"]) + int(last["discards"]) > 0
+    # Every step iterated (each iteration after the first rolled both FMUs back).
+    assert all(int(r["coupling_iterations"]) >= 2 and int(r["rollbacks"]) >= 1 for r in rows[1:])
 
 
 def test_discard_is_retried_in_halves(fmu_path, archfmu):

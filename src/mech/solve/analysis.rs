@@ -34,6 +34,9 @@ pub struct Analysis {
     pub(in crate::mech) parts: Contributions,
     pub(in crate::mech) state: AnalysisState,
     pub(in crate::mech) work: Workspace,
+    /// The state the last converged increment started from (None before the first step and
+    /// after [`Analysis::set_state`]): what its linear response holds (`sensitivity`).
+    pub(in crate::mech) increment_start: Option<AnalysisState>,
 
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
     /// the input check.
@@ -101,6 +104,7 @@ impl Analysis {
             parts,
             state,
             work,
+            increment_start: None,
             length_scale,
             force_floor,
         })
@@ -195,6 +199,7 @@ impl Analysis {
             return Err("state holds non-finite values or a negative friction coefficient".into());
         }
         self.state = state;
+        self.increment_start = None;
         Ok(())
     }
 

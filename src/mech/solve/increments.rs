@@ -31,6 +31,8 @@ impl Analysis {
         let base_angles = self.state.angles.clone();
         let base_loads = self.state.loads.clone();
         let mut current = self.state.clone();
+        // The start of the last converged increment (the linear response's, `sensitivity`).
+        let mut last_start = None;
         let mut report = StepReport::default();
         let largest = 1.0 / increments as f64;
         let smallest = largest / 2f64.powi(self.settings.max_cutbacks as i32);
@@ -79,7 +81,7 @@ impl Analysis {
             self.work.watchdog = report.cutbacks == 0;
             match self.solve_increment(&current, &at(next), &levels) {
                 Ok((state, history)) => {
-                    current = state;
+                    last_start = Some(std::mem::replace(&mut current, state));
                     done = next;
                     let iterations = history.len() - 1;
                     report.iterations.push(iterations);
@@ -119,7 +121,7 @@ impl Analysis {
                         });
                     };
                     report.enlarged += 1;
-                    current = state;
+                    last_start = Some(std::mem::replace(&mut current, state));
                     done = next;
                     report.iterations.push(history.len() - 1);
                     report.residual = *history.last().unwrap_or(&0.0);
@@ -129,6 +131,7 @@ impl Analysis {
             }
         }
         self.state = current;
+        self.increment_start = last_start;
         self.linear.set_fast(true);
         Ok(report)
     }

@@ -14,6 +14,7 @@
 //! | [`settings`] | [`SolverSettings`] |
 //! | [`state`] | [`AnalysisState`], the converged state an FMU state serializes |
 //! | [`report`] | [`StepReport`], [`IncrementFailure`] and its advice, [`StepError`], [`SetupError`] |
+//! | `sensitivity` | [`Analysis::linear_response`]: the converged state's linear response to a [`Seed`] (the FMU's directional derivatives) |
 
 pub mod analysis;
 pub mod assembly;
@@ -24,6 +25,7 @@ mod line_search;
 pub mod linear;
 mod newton;
 pub mod report;
+mod sensitivity;
 pub mod settings;
 pub mod state;
 
@@ -32,5 +34,6 @@ pub use newton::max_abs;
 pub use report::{
     IncrementFailure, IterationRecord, SettingNames, SetupError, StepError, StepReport,
 };
+pub use sensitivity::{Response, Seed};
 pub use settings::{DEFAULT_INCREMENTS_PER_STEP, MAX_THREADS, SolverSettings};
 pub use state::AnalysisState;

@@ -1,0 +1,310 @@
+//! A hydraulic jack (or winch) that carries the film's frame: the second FMU of the coupled
+//! erection system (issue 21, `membrane_contact.ssp` packs it next to the film).
+//!
+//! The model, quasi-static over pseudo-time, one backward-Euler step per communication step:
+//!
+//! * a pump lowers the piston at `rate` while the pull `T = -force` stays below the valve's
+//!   cracking force `crack · relief`; between it and `relief` the valve bypasses more and more
+//!   of the flow (the speed falls linearly to 0: the jack stalls at `relief`); above `relief` the
+//!   piston yields back, at most at `backRate`;
+//! * the piston stays within `[-stroke, 0]`;
+//! * a cylinder of `stiffness` links piston and frame: `dz = piston - force / stiffness`.
+//!
+//! With `force` reached at the end of the step, `piston₁ = clamp(piston₀ − h·v(T₁))`, so the
+//! outputs depend on the inputs of the same step (direct feedthrough): the directional
+//! derivatives ([`Jack::derivative`]) are those of the last step's end values with respect to
+//! that step's end inputs, the step's start held. They are what a coupling master needs to
+//! build the interface Jacobian. Where `v` has a kink (at `crack · relief`, `relief`, the
+//! `backRate` floor, the stroke ends) they are one-sided: the branch of the current state.
+//!
+//! The FMI 2.0 Co-Simulation interface is in [`fmi`]; all `unsafe` code lives there.
+
+pub mod fmi;
+
+/// Value references, in the order of `modelDescription.xml`.
+pub mod vr {
+    pub const FORCE: u32 = 0;
+    pub const STIFFNESS: u32 = 1;
+    pub const RELIEF: u32 = 2;
+    pub const CRACK: u32 = 3;
+    pub const RATE: u32 = 4;
+    pub const BACK_RATE: u32 = 5;
+    pub const STROKE: u32 = 6;
+    pub const DZ: u32 = 7;
+    pub const PISTON: u32 = 8;
+    pub const SPEED: u32 = 9;
+    /// Number of variables.
+    pub const COUNT: usize = 10;
+}
+
+/// Variable names by value reference (the model description's).
+pub const NAMES: [&str; vr::COUNT] = [
+    "force",
+    "stiffness",
+    "relief",
+    "crack",
+    "rate",
+    "backRate",
+    "stroke",
+    "dz",
+    "piston",
+    "speed",
+];
+
+/// The model description shipped in the FMU (the packer copies this very file).
+pub const MODEL_DESCRIPTION: &str = include_str!("../modelDescription.xml");
+
+/// The GUID of [`MODEL_DESCRIPTION`].
+pub const GUID: &str = "{6d1f4a52-3c0b-4e8e-9a57-2f1b8c4d7e21}";
+
+/// Default values (the model description's `start`), by value reference; outputs 0.
+pub const START: [f64; vr::COUNT] = [0.0, 1.0e5, 600.0, 0.85, 5.0e-4, 5.0e-4, 0.15, 0.0, 0.0, 0.0];
+
+/// The jack's whole state: every variable value, the piston at the start of the last step, the
+/// last step size and the time. `Copy`, so an FMU state is a copy of it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Jack {
+    /// Variable values by value reference.
+    pub values: [f64; vr::COUNT],
+    /// Piston position at the start of the last step (the state the step started from).
+    pub piston_start: f64,
+    /// Size of the last step (0 before the first).
+    pub last_step: f64,
+    /// Current time.
+    pub time: f64,
+}
+
+impl Default for Jack {
+    fn default() -> Self {
+        let mut j = Jack {
+            values: START,
+            piston_start: 0.0,
+            last_step: 0.0,
+            time: 0.0,
+        };
+        j.update_outputs();
+        j
+    }
+}
+
+/// Why a value was refused: the variable's name and the rule, ready for the log.
+pub fn check_value(vr: u32, value: f64) -> Result<(), String> {
+    let name = NAMES
+        .get(vr as usize)
+        .ok_or_else(|| format!("unknown value reference {vr}"))?;
+    if !value.is_finite() {
+        return Err(format!("{name} = {value}: values must be finite"));
+    }
+    let ok = match vr {
+        vr::STIFFNESS | vr::RELIEF => value > 0.0,
+        vr::CRACK => (0.0..1.0).contains(&value),
+        vr::RATE | vr::BACK_RATE | vr::STROKE => value >= 0.0,
+        _ => true,
+    };
+    if ok {
+        Ok(())
+    } else {
+        let rule = match vr {
+            vr::STIFFNESS | vr::RELIEF => "must be > 0",
+            vr::CRACK => "must lie in [0, 1)",
+            _ => "must be >= 0",
+        };
+        Err(format!("{name} = {value} {rule}"))
+    }
+}
+
+impl Jack {
+    fn v(&self, k: u32) -> f64 {
+        self.values[k as usize]
+    }
+
+    /// Lowering speed of the piston under the pull `pull` (> 0 lowering, < 0 yielding back)
+    /// and its derivatives with respect to the pull and to `relief` (the branch at a kink: the
+    /// one the pull lies in, lower bounds inclusive).
+    pub fn velocity(&self, pull: f64) -> (f64, f64, f64) {
+        let (rate, relief, crack, back) = (
+            self.v(vr::RATE),
+            self.v(vr::RELIEF),
+            self.v(vr::CRACK),
+            self.v(vr::BACK_RATE),
+        );
+        let band = relief * (1.0 - crack);
+        if pull <= crack * relief {
+            return (rate, 0.0, 0.0);
+        }
+        let v = rate * (relief - pull) / band;
+        if v < -back {
+            return (-back, 0.0, 0.0);
+        }
+        // d/dR [(R - T) / (R (1 - c))] = T / (R² (1 - c))
+        (v, -rate / band, rate * pull / (relief * band))
+    }
+
+    /// The piston reached from `piston_start` over `h` under the current inputs, and whether the
+    /// stroke's ends hold it (then it does not depend on the inputs).
+    fn piston_after(&self, h: f64) -> (f64, bool) {
+        let (v, _, _) = self.velocity(-self.v(vr::FORCE));
+        let trial = self.piston_start - h * v;
+        let stroke = self.v(vr::STROKE);
+        if trial > 0.0 {
+            (0.0, true)
+        } else if trial < -stroke {
+            (-stroke, true)
+        } else {
+            (trial, false)
+        }
+    }
+
+    fn update_outputs(&mut self) {
+        let h = self.last_step;
+        let (piston, _) = self.piston_after(h);
+        self.values[vr::PISTON as usize] = piston;
+        self.values[vr::DZ as usize] = piston - self.v(vr::FORCE) / self.v(vr::STIFFNESS);
+        self.values[vr::SPEED as usize] = if h > 0.0 {
+            (self.piston_start - piston) / h
+        } else {
+            0.0
+        };
+    }
+
+    /// Recomputes the outputs of the current time from the inputs (initialization: no step yet).
+    pub fn initialize(&mut self) {
+        self.piston_start = self.v(vr::PISTON);
+        self.last_step = 0.0;
+        self.update_outputs();
+    }
+
+    /// One communication step of size `h > 0` to the inputs as they are now.
+    pub fn step(&mut self, h: f64) {
+        self.piston_start = self.v(vr::PISTON);
+        self.last_step = h;
+        self.update_outputs();
+        self.time += h;
+    }
+
+    /// Derivative of output `unknown` with respect to input `known` at the end of the last
+    /// step (its start held), or `None` when `unknown` is not an output or `known` not an input.
+    pub fn derivative(&self, unknown: u32, known: u32) -> Option<f64> {
+        if !matches!(known, vr::FORCE | vr::STIFFNESS | vr::RELIEF) {
+            return None;
+        }
+        let h = self.last_step;
+        let (_, held) = self.piston_after(h);
+        let (_, dv_dpull, dv_drelief) = self.velocity(-self.v(vr::FORCE));
+        // piston = piston_start - h v(-force, relief)
+        let dpiston = if held {
+            0.0
+        } else {
+            match known {
+                vr::FORCE => h * dv_dpull,
+                vr::RELIEF => -h * dv_drelief,
+                _ => 0.0,
+            }
+        };
+        let k = self.v(vr::STIFFNESS);
+        match unknown {
+            vr::PISTON => Some(dpiston),
+            vr::SPEED => Some(if h > 0.0 { -dpiston / h } else { 0.0 }),
+            vr::DZ => Some(
+                dpiston
+                    + match known {
+                        vr::FORCE => -1.0 / k,
+                        vr::STIFFNESS => self.v(vr::FORCE) / (k * k),
+                        _ => 0.0,
+                    },
+            ),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stepped(force: f64, relief: f64, h: f64) -> Jack {
+        let mut j = Jack::default();
+        j.values[vr::PISTON as usize] = -0.05;
+        j.values[vr::FORCE as usize] = force;
+        j.values[vr::RELIEF as usize] = relief;
+        j.step(h);
+        j
+    }
+
+    #[test]
+    fn derivatives_match_central_differences_on_every_branch() {
+        // pumping, valve opening, yielding back at the floor, and the near-linear spring
+        for (force, relief) in [
+            (-100.0, 600.0),
+            (-550.0, 600.0),
+            (-2000.0, 600.0),
+            (-580.0, 600.0),
+        ] {
+            let j = stepped(force, relief, 5.0);
+            for known in [vr::FORCE, vr::STIFFNESS, vr::RELIEF] {
+                let x = j.values[known as usize];
+                let d = 1e-6 * x.abs().max(1.0);
+                let mut plus = stepped(force, relief, 5.0);
+                let mut minus = plus;
+                plus.values = {
+                    let mut v = j.values;
+                    v[known as usize] = x + d;
+                    v
+                };
+                minus.values[known as usize] = x - d;
+                for s in [&mut plus, &mut minus] {
+                    s.values[vr::PISTON as usize] = -0.05;
+                    s.step(5.0);
+                }
+                for unknown in [vr::DZ, vr::PISTON, vr::SPEED] {
+                    let fd = (plus.values[unknown as usize] - minus.values[unknown as usize])
+                        / (2.0 * d);
+                    let exact = j.derivative(unknown, known).unwrap();
+                    assert!(
+                        (fd - exact).abs() <= 1e-6 * exact.abs().max(1e-9) + 1e-12,
+                        "d{}/d{} at force {force}: exact {exact}, central difference {fd}",
+                        NAMES[unknown as usize],
+                        NAMES[known as usize]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn relief_valve_stalls_the_piston_at_the_relief_force() {
+        let j = stepped(-600.0, 600.0, 5.0);
+        assert_eq!(j.values[vr::SPEED as usize], 0.0);
+        assert_eq!(j.values[vr::PISTON as usize], -0.05);
+        let pumping = stepped(-100.0, 600.0, 5.0);
+        assert!((pumping.values[vr::SPEED as usize] - 5.0e-4).abs() < 1e-15);
+    }
+
+    #[test]
+    fn derivatives_refuse_what_is_not_an_output_or_not_an_input() {
+        let j = Jack::default();
+        assert_eq!(j.derivative(vr::FORCE, vr::FORCE), None);
+        assert_eq!(j.derivative(vr::DZ, vr::DZ), None);
+        assert_eq!(j.derivative(vr::DZ, vr::CRACK), None);
+    }
+
+    #[test]
+    fn model_description_lists_every_variable_with_its_reference_and_start() {
+        assert!(MODEL_DESCRIPTION.contains(&format!("guid=\"{GUID}\"")));
+        for (k, name) in NAMES.iter().enumerate() {
+            let tag = format!("name=\"{name}\" valueReference=\"{k}\"");
+            assert!(MODEL_DESCRIPTION.contains(&tag), "{tag} missing");
+            if k < vr::DZ as usize {
+                let rest = &MODEL_DESCRIPTION[MODEL_DESCRIPTION.find(&tag).unwrap()..];
+                let start = rest
+                    .split("start=\"")
+                    .nth(1)
+                    .unwrap()
+                    .split('"')
+                    .next()
+                    .unwrap();
+                assert_eq!(start.parse::<f64>().unwrap(), START[k], "start of {name}");
+            }
+        }
+    }
+}

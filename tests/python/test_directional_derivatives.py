@@ -1,0 +1,139 @@
+"""fmi2GetDirectionalDerivative of the film FMU (issue 21 item 1): the derivatives of the
+outputs with respect to the inputs agree with central differences of FMU steps (the state
+saved before the step and restored around each), through fmpy, to 1e-6 relative (1e-7
+absolute for outputs that are zero up to rounding):
+
+* the ParallelArch specimen at a state with gaps open, sticking and slipping (frame.dz; mu is
+  refused with a message);
+* the cushion under pressure (its pressure input);
+* the hinged panel (rail.angle).
+
+They are linear in the seed; an unknown reference, a known that is not an input, an unknown
+that is not a Real output, and a call before initialization are fmi2Error with a message; fmpy
+validate passes with the ModelStructure dependencies.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from fmpy.validation import validate_fmu
+
+from conftest import ROOT, pack
+from membrane_contact import Film
+from membrane_contact.film import FmuError
+
+#: One increment per step (the derivatives are the last increment's: module doc of the core's
+#: sensitivity; the steps checked are small enough not to be cut back), tight Newton
+#: tolerances so that the differences of steps are smooth.
+EXACT = {"solver.incrementsPerStep": 1,
+         "solver.displacementTolerance": 1e-12, "solver.residualTolerance": 1e-12}
+
+
+def real_outputs(film):
+    return [n for n in film.outputs if film.variables[n].type == "Real"
+            and not n.startswith("solver.")]
+
+
+def derivative(film, unknowns, known, seed=1.0):
+    vr = film.variables
+    return np.array(film._guard("fmi2GetDirectionalDerivative", lambda: film.fmu.getDirectionalDerivative(
+        [vr[n].valueReference for n in unknowns], [vr[known].valueReference], [seed])))
+
+
+def check_against_steps(film, start_inputs, end_inputs, known, delta, h=1.0):
+    """Steps from the current state to ``end_inputs``; compares the derivatives w.r.t.
+    ``known`` with central differences of the same step with ``known`` moved by ±delta."""
+    start = film.save()
+    film.set(end_inputs)
+    assert film.step(h) in (0, 1)
+    names = real_outputs(film)
+    exact = derivative(film, names, known)
+    twice = derivative(film, names, known, 2.0)
+    ends = []
+    for sign in (1, -1):
+        film.restore(start)
+        film.set({**end_inputs, known: end_inputs[known] + sign * delta})
+        assert film.step(h) in (0, 1)
+        ends.append(np.array([film[n] for n in names]))
+    film.restore(start)
+    film.free(start)
+    fd = (ends[0] - ends[1]) / (2 * delta)
+    # Relative to the output, or to the largest of its unit (a reaction that is zero by
+    # symmetry is compared with the others, not with its own rounding noise).
+    units = [film.variables[n].unit for n in names]
+    largest = {u: max(abs(f) for f, v in zip(fd, units) if v == u) for u in set(units)}
+    scale = np.array([max(abs(f), 1e-6 * largest[u]) for f, u in zip(fd, units)])
+    # 1e-7 absolute (SI units per unit seed): outputs that are zero up to rounding (the
+    # reactions of a closed cushion, a reaction zero by symmetry), whose differences of steps
+    # are the Newton tolerance's noise.
+    bad = [(n, e, f) for n, e, f, s in zip(names, exact, fd, scale) if abs(e - f) > 1e-6 * s + 1e-7]
+    assert not bad, (known, bad[:5])
+    assert np.array_equal(twice, 2 * exact)
+    return dict(zip(names, exact))
+
+
+def test_specimen_derivatives_agree_with_steps_with_gaps_open_sticking_and_slipping(fmu_path):
+    with Film(fmu_path, logging=True, quiet=True) as film:
+        # Lowered to dz = -0.13 m with mu = 0.2, then to -0.133 m with mu = 1: the crown gaps
+        # G1..G3 stick, G4 slips, G5..G9 are open; the step checked continues to -0.134 m in
+        # one increment.
+        film.initialize({"archHeight": 0.3, **EXACT}, {"mu": 0.2})
+        film.run({"time": np.arange(1.0, 14.0), "frame.dz": -0.01 * np.arange(1.0, 14.0)}, quiet=True)
+        film.set({"frame.dz": -0.133, "mu": 1.0})
+        assert film.step(1.0) == 0
+        end = {"frame.dz": -0.134, "mu": 1.0}
+        d = check_against_steps(film, {}, end, "frame.dz", 1e-5)
+        start = film.save()
+        film.set(end)
+        film.step(1.0)
+        statuses = [film[f"G{i}.status"] for i in range(1, 10)]
+        assert film["solver.cutbacks"] == 0
+        film.restore(start)
+        film.free(start)
+        assert set(statuses) == {0, 1, 2}, statuses
+        assert d["frame.Rz"] > 0 and d["G1.normalForce"] != 0 and d["G9.normalForce"] == 0
+        # mu is refused (its derivatives missed the differences of steps at a slipping gap)
+        with pytest.raises(FmuError, match="known mu .* derivatives with respect to the friction coefficient are not provided"):
+            derivative(film, ["frame.Rz"], "mu")
+
+
+def test_cushion_derivatives_with_respect_to_its_pressure_agree_with_steps(tmp_path):
+    fmu = pack(ROOT / "examples" / "cushion.json", tmp_path)
+    with Film(fmu, logging=True, quiet=True) as film:
+        film.initialize(EXACT)
+        pressure = [n for n in film.inputs if n.endswith(".pressure")][0]
+        film.set({pressure: 200.0})
+        film.step(1.0)
+        check_against_steps(film, {}, {pressure: 300.0}, pressure, 1e-2)
+
+
+def test_hinged_panel_derivatives_with_respect_to_the_angle_agree_with_steps(tmp_path):
+    fmu = pack(ROOT / "examples" / "hinged_panel.json", tmp_path)
+    with Film(fmu, logging=True, quiet=True) as film:
+        film.initialize(EXACT)
+        film.set({"rail.angle": 0.05})
+        film.step(1.0)
+        d = check_against_steps(film, {}, {"rail.angle": 0.1}, "rail.angle", 1e-5)
+        assert d["rail.moment"] != 0
+
+
+def test_bad_derivative_requests_are_refused_with_a_message(fmu_path):
+    with Film(fmu_path, logging=True, quiet=True) as film:
+        v = film.variables
+        with pytest.raises(FmuError, match="fmi2GetDirectionalDerivative"):
+            derivative(film, ["frame.Rz"], "frame.dz")  # before initialization
+        film.initialize({"archHeight": 0.3})
+        with pytest.raises(FmuError, match="unknown value reference 99999"):
+            film._guard("fmi2GetDirectionalDerivative",
+                        lambda: film.fmu.getDirectionalDerivative([99999], [v["frame.dz"].valueReference], [1.0]))
+        with pytest.raises(FmuError, match="archHeight .* is not an input"):
+            derivative(film, ["frame.Rz"], "archHeight")
+        with pytest.raises(FmuError, match="G1.status .* is not a Real output"):
+            derivative(film, ["G1.status"], "frame.dz")
+
+
+def test_fmpy_validate_passes_with_the_directional_derivatives(fmu_path):
+    assert validate_fmu(str(fmu_path)) == []
+    with Film(fmu_path) as film:
+        assert film.md.coSimulation.providesDirectionalDerivative
