@@ -101,7 +101,7 @@ def plot(rows, steps, path):
                  label="gap open at the end: film movement\nabove the arch, not sliding on it")
     axes[0].legend(fontsize=7, loc="upper left")
     fig.suptitle(f"Fig. 8: slip at the final step, frame lowered to dz = −H/2 in {steps} steps "
-                 "(assumed dimensions, src/mech/specimen.rs)", fontsize=9)
+                 "(assumed dimensions, src/specimens/parallel_arch.rs)", fontsize=9)
     fig.tight_layout()
     archfmu.save_png(fig, path)
     plt.close(fig)

@@ -67,7 +67,7 @@ def main(argv=None):
         print(f"{i + 1:<15} {g:<4}{s:>14.2f}  {m}   ({st})")
     print("\nGaps that are open at the end do not touch the arch: their 'slip' is film movement "
           "relative to the arch point. The specimen's dimensions are assumptions "
-          "(src/mech/specimen.rs), so the comparison is qualitative.")
+          "(src/specimens/parallel_arch.rs), so the comparison is qualitative.")
     return 0
 
 

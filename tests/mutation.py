@@ -71,7 +71,7 @@ MUTATIONS = [
     Mutation(
         "radius",
         "arch radius from the full span instead of the half span",
-        "src/mech/specimen.rs",
+        "src/specimens/parallel_arch.rs",
         [(
             "(self.arch_height.powi(2) + self.arch_half_span.powi(2)) / (2.0 * self.arch_height)",
             "(self.arch_height.powi(2) + (2.0 * self.arch_half_span).powi(2)) / (2.0 * self.arch_height)",
@@ -104,7 +104,7 @@ MUTATIONS = [
     Mutation(
         "cable",
         "cable axial force halved",
-        "src/mech/cable.rs",
+        "src/mech/elements/cable.rs",
         [("    (n0 + ea * strain).max(0.0)\n}", "    0.5 * (n0 + ea * strain).max(0.0)\n}")],
         first=["--test cables", "--lib cable::"],
         fmu=True,
@@ -112,7 +112,7 @@ MUTATIONS = [
     Mutation(
         "taut",
         "tension-field material point always taut (never wrinkled or slack)",
-        "src/mech/material.rs",
+        "src/mech/elements/material.rs",
         [
             ("        if e1 <= tol {", "        if false && e1 <= tol {"),
             ("        if e2 + nu * e1 > tol {", "        if true || e2 + nu * e1 > tol {"),
@@ -122,12 +122,12 @@ MUTATIONS = [
     Mutation(
         "curvature",
         "curved-support tangent without its curvature term −λN ∂n/∂x",
-        "src/mech/surface.rs",
+        "src/mech/elements/curved_contact/mod.rs",
         [(
             "let mut k = n * n.transpose() * self.kn - p.normal_derivative * lambda;",
             "let mut k = n * n.transpose() * self.kn;",
         )],
-        first=["--lib surface::", "--test surfaces"],
+        first=["--lib curved_contact::", "--test surfaces"],
     ),
 ]
 

@@ -8,7 +8,7 @@
 //! equal those of a model file written here from the documented dimensions alone, run through
 //! the public model API, for the lowered and the wrapped frame path.
 //!
-//! MODEL (the assumption table of `src/mech/specimen.rs`, the 1/4 model):
+//! MODEL (the assumption table of `src/specimens/parallel_arch.rs`, the 1/4 model):
 //!
 //! ```text
 //!   y ↑  frame edge y = 1 (held)                film flat at z = H, 10 × 10 cells of 0.1 m,

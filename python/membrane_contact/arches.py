@@ -6,8 +6,8 @@ treated as lying over it). For each selected film node ``A`` the importer
 
 1. projects ``A`` onto the curve's plane: ``A' = A - ((A - O)·n) n`` (``n`` the plane normal);
 2. finds the closest point ``P`` of the curve to ``A'`` and the unit tangent ``t`` there;
-3. builds the gap frame (Bui & Kawabata 2016, §4.3; ``src/mech/specimen.rs``, ``gaps_on_arc``
-   in ``src/mech/scenarios.rs``)::
+3. builds the gap frame (Bui & Kawabata 2016, §4.3; ``src/specimens/parallel_arch.rs``, ``gaps_on_arc``
+   in ``src/specimens/scenarios/arc.rs``)::
 
        x = t               the sliding direction, along the curve in its direction of travel
        y = n               the plane normal

@@ -149,7 +149,7 @@ def line_reactions(vtu_file, model: dict) -> dict[str, np.ndarray]:
     (``results.directory``) or the CLI (``--vtk``) wrote: ``{name: rows}``, one row per node of
     the group or set in the model's order, ``[node, x, y, z, qx, qy, qz]`` (reference
     coordinates). The core computes them (point data ``line_reaction``: each node's reaction over
-    its tributary length, half its film edges along the line; ``src/mech/lines.rs``); a node on
+    its tributary length, half its film edges along the line; ``src/mech/results/lines.rs``); a node on
     two lines carries their sum. Needs meshio."""
     import json
 

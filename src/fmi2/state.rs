@@ -30,8 +30,8 @@ use serde::{Deserialize, Serialize};
 
 use super::phase::Phase;
 use super::scalar_variable::Value;
-use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::elements::curved_contact::SurfaceContacts;
+use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::{AnalysisState, Model};
 
 /// Everything needed to continue an instance exactly.

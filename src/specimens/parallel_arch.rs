@@ -27,7 +27,7 @@
 //! | gaps `G1…G9` | film nodes on the arch line `x = 0.4`, `y = 0, 0.1, …, 0.8` (crown to foot); support = the fixed arch point on the radius through the node; `g0` = the initial distance | §4.2, §4.3 |
 //! | gap frame | `z` from the arch centre to the contact point, `x` = arch tangent towards the foot, `y = z × x` | §4.3 |
 //! | observed points 1–5 | `G1` (crown) and `G2, G4, G6, G8` | §4.4 maps points 2–5 to `G2, G4, G6, G8`; point 1 reads 0 at the crown |
-//! | contact model | the paper's fixed-frame gaps (default); `contact: curved-support` puts the same nine film nodes in node-to-surface contact with the arch itself (`surface.rs`): a ring of radius `R − r_p` about the arch's axis with a tube of radius `r_p`, so that its outer surface is the arch line the gaps use; slip is then the arc length along the arch | §4.3–4.4 and the conclusions name the fixed frames as the model's limit; issue 10 |
+//! | contact model | the paper's fixed-frame gaps (default); `contact: curved-support` puts the same nine film nodes in node-to-surface contact with the arch itself (`mech/elements/curved_contact`): a ring of radius `R − r_p` about the arch's axis with a tube of radius `r_p`, so that its outer surface is the arch line the gaps use; slip is then the arc length along the arch | §4.3–4.4 and the conclusions name the fixed frames as the model's limit; issue 10 |
 //! | pipe radius `r_p` | 24.3 mm | the arches are steel pipes of unknown size; 48.6 mm is the common Japanese structural/scaffold tube (JIS G 3444 STK400 φ48.6); only the curved-support model uses it (the gaps see the arch line) |
 
 use nalgebra::Vector3;
@@ -103,7 +103,7 @@ pub enum SpecimenContact {
     /// The paper's nine node-to-point gap elements with fixed frames (§4.2–4.3).
     #[default]
     Gaps,
-    /// The same nine film nodes in node-to-surface contact with the arch pipe (`surface.rs`).
+    /// The same nine film nodes in node-to-surface contact with the arch pipe (`mech/elements/curved_contact`).
     CurvedSupport,
 }
 

@@ -2,7 +2,7 @@
 
 SOURCE: hand geometry of ``examples/film_over_two_arches/`` (film_over_two_arches.geo, meshed
 by gmsh 4.15.2 from PyPI into the checked-in gmsh 2.2 ASCII and 4.1 binary files); the gap
-frames and initial gaps follow the paper's §4.3 as ``src/mech/specimen.rs`` builds them: z
+frames and initial gaps follow the paper's §4.3 as ``src/specimens/parallel_arch.rs`` builds them: z
 from the arch's centre of curvature through the contact point, x along the arch, y = z × x,
 ``g0 = |A − C| − R`` for a film node A in the arch's plane.
 
@@ -37,7 +37,7 @@ MESH (examples/film_over_two_arches, z = 0.3 everywhere, ~0.2 m triangles)::
 BOUNDARY CONDITIONS: frame lowered by dz = −0.15 m (half the rise) in 5 steps, dx = dy = 0.
 
 PARAMETERS: E = 1 GPa, ν = 0.43, t = 250 µm, σ0 = 0.5 MPa, k_n = 2.5e8 N/m, k_s = 2.5e7 N/m,
-μ = 0.2 (the specimen's values, src/mech/specimen.rs).
+μ = 0.2 (the specimen's values, src/specimens/parallel_arch.rs).
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ that ``report.line_reactions`` reads from the FMU's VTK film file equal the clos
 uniformly stretched strip at every node of both end edges (as tests/engineering.rs for the core),
 and Σ q · tributary is the group's FMU output pull.Rx.
 
-PARAMETERS: the specimen's (src/mech/specimen.rs), archHeight 0.3 m.
+PARAMETERS: the specimen's (src/specimens/parallel_arch.rs), archHeight 0.3 m.
 """
 
 from __future__ import annotations

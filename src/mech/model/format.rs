@@ -4,7 +4,7 @@
 //! Validation names the offending item: an unknown node index, a degenerate triangle, `E ≤ 0`,
 //! `ν` outside `[0, 0.5)`, `η` outside `[0, 1)`, `μ < 0`, a non-orthonormal gap frame, a duplicate
 //! name, a node that is both constrained and prescribed, a control character in text bound for
-//! modelDescription.xml, a rigid-body mode no restraint holds (`restraint.rs`). Nothing here
+//! modelDescription.xml, a rigid-body mode no restraint holds ([`super::restraint`], checked by `validate.rs`). Nothing here
 //! panics on user input.
 
 use std::fmt;
@@ -480,9 +480,9 @@ pub enum ModelError {
     Name { item: String, message: String },
     /// A DOF that is constrained and prescribed, or prescribed twice.
     Conflict { node: usize, message: String },
-    /// A node with free DOFs that belongs to no triangle (see `restraint.rs`).
+    /// A node with free DOFs that belongs to no triangle (see [`super::restraint`]).
     Unconnected { node: usize },
-    /// A film component with a rigid-body mode that no restraint holds (see `restraint.rs`).
+    /// A film component with a rigid-body mode that no restraint holds (see [`super::restraint`]).
     Unrestrained {
         /// The component's first nodes.
         nodes: Vec<usize>,

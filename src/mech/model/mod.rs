@@ -4,7 +4,7 @@
 //!
 //! | file | what |
 //! |---|---|
-//! | [`format`] | the model file's items (serde types), [`ModelError`], [`bounding_diagonal`] |
+//! | [`format`](mod@format) | the model file's items (serde types), [`ModelError`], [`bounding_diagonal`] |
 //! | `validate` | `Model::validate`: every item checked, the first problem named |
 //! | [`restraint`] | rigid-body modes no restraint holds (singular models), found at validation |
 

@@ -50,7 +50,7 @@
 //! a slipping gap does not hold the tangential direction; two components joined by a single
 //! node-to-node gap still rotate about it. A prestress that holds a mode at the start may be
 //! lost under load (a wrinkled or slack film). Those models pass validation and are caught at
-//! the first factorization, which reports the DOFs without stiffness by node (see `linear.rs`).
+//! the first factorization, which reports the DOFs without stiffness by node (see `solve/linear`).
 
 use nalgebra::{DMatrix, Matrix6, SymmetricEigen, Vector3, Vector6};
 

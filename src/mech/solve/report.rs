@@ -82,7 +82,7 @@ impl fmt::Display for IterationRecord {
 
 /// What a front end calls the settings that failure advice points to: the core names no
 /// command-line option or FMU parameter, each front end passes its own names
-/// ([`SettingNames::CORE`] names the [`SolverSettings`] fields).
+/// ([`SettingNames::CORE`] names the [`SolverSettings`](super::SolverSettings) fields).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SettingNames {
     /// The iteration limit per increment.
@@ -98,7 +98,7 @@ pub struct SettingNames {
 }
 
 impl SettingNames {
-    /// The names of the [`SolverSettings`] fields.
+    /// The names of the [`SolverSettings`](super::SolverSettings) fields.
     pub const CORE: Self = Self {
         max_iterations: "max_iterations",
         finer_increments: "raise the increments per step",

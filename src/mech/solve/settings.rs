@@ -26,14 +26,14 @@ pub struct SolverSettings {
     /// Relative tolerance of the out-of-balance force (see the type's doc).
     pub residual_tolerance: f64,
     /// Newton iterations per increment before the increment is cut back. A stalled or
-    /// diverging iteration is cut back earlier (see [`IncrementFailure`]).
+    /// diverging iteration is cut back earlier (see [`IncrementFailure`](super::IncrementFailure)).
     pub max_iterations: usize,
     /// How many times an increment may be halved before the step fails.
     pub max_cutbacks: usize,
     /// Backtracking on `‖R‖₂` along each Newton correction (see `Analysis::line_search`).
     pub line_search: bool,
     /// Factorize a consistent tangent that is symmetric (no slipping gap, no follower pressure)
-    /// by LDLᵀ instead of LU (`linear.rs`); false: always LU.
+    /// by LDLᵀ instead of LU (`solve/linear`); false: always LU.
     pub symmetric_factorization: bool,
     /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
     /// below [`crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results

@@ -47,6 +47,12 @@
 //! Source of the formulas: the project's note on node-to-curve contact (derived and
 //! FD-checked there), following Wriggers, *Computational Contact Mechanics* (2006), ch. 4
 //! (closest-point projection on a curve: `∇u`, the curvature terms).
+//!
+//! | file | what |
+//! |---|---|
+//! | `mod.rs` | the contact law: [`SurfaceContact`], [`SurfaceContacts`], histories, responses |
+//! | [`surface`] | the supports' geometry: centrelines, frames, closest-point projection |
+//! | `tests` | tangent against central differences, caps, corners, slip |
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};

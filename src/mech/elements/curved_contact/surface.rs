@@ -1,7 +1,7 @@
 //! Geometry of the rigid curved supports: the centreline shapes (line, circle/arc, parabola,
 //! polyline), their frames, and the closest-point projection of a point on the tube around them
 //! (distance, normal, surface coordinates `ξ` and their derivatives). The formulas are derived in
-//! [`super::curved_contact`]'s module doc; the contact law on top of them lives there.
+//! [the contact's](super) module doc; the contact law on top of them lives there.
 
 use nalgebra::{Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};

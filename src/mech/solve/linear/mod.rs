@@ -12,7 +12,7 @@
 //!     the Woodbury identity `A⁻¹b = y − W (I + K_CC W_C)⁻¹ K_CC y_C` with `[W y] = S⁻¹ [I_C b]`,
 //!     one solve with `|C| + 1` right-hand sides (the factor is read once for all of them);
 //!   - more (follower pressures, many slipping gaps), or a Woodbury solution that fails the
-//!     accuracy check: GMRES (no restart, at most [`KRYLOV_DIMENSION`] vectors, to
+//!     accuracy check: GMRES (no restart, at most [`KRYLOV_DIMENSION`](gmres::KRYLOV_DIMENSION) vectors, to
 //!     `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`) right-preconditioned by the same LDLᵀ;
 //!
 //!   so a Newton iteration costs one LDLᵀ and a block solve and keeps its quadratic convergence;
@@ -24,6 +24,15 @@
 //!
 //! Buffers (factor values, scratch) are allocated once and reused every iteration; where the
 //! time goes is summed in [`SolveProfile`].
+//!
+//! | file | what |
+//! |---|---|
+//! | `mod.rs` | [`LinearSolver`]: the choice of path, the accuracy check, counts and profile |
+//! | `ldlt` | LDLᵀ of the symmetric part and the dispatch of a solve on it |
+//! | `woodbury` | the Woodbury correction for a skew part on few DOFs |
+//! | `gmres` | GMRES right-preconditioned by that LDLᵀ |
+//! | `lu` | LU with partial pivoting, the checked fallback |
+//! | `tests` | the solver's tests |
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -299,7 +308,7 @@ impl LinearSolver {
     /// within [`WOODBURY_SMALL`] values, and at most [`WOODBURY_MOST`] DOFs. Measured: GMRES
     /// took 7 iterations on average (25 at most) on the 76 k-DOF specimen with its 5 skew DOFs,
     /// 4× the time of the Woodbury block solve; on the 38-gap strip (97 skew DOFs of 114) it
-    /// never converged within [`KRYLOV_DIMENSION`] iterations, where Woodbury does.
+    /// never converged within [`KRYLOV_DIMENSION`](gmres::KRYLOV_DIMENSION) iterations, where Woodbury does.
     pub fn woodbury_limit(&self) -> usize {
         let n = self.equation_dofs.len().max(1);
         let values = (self.factor_len() / 4).max(WOODBURY_SMALL);
