@@ -30,6 +30,7 @@ pub mod lines;
 pub mod load;
 pub mod material;
 pub mod model;
+pub mod plasticity;
 pub mod restraint;
 pub mod scenarios;
 pub mod solver;
