@@ -223,6 +223,26 @@ impl Hardening {
     }
 }
 
+/// Young's modulus of the ETFE data sheet the default curve is taken from (Pa).
+pub const ETFE_DATASHEET_YOUNGS_MODULUS: f64 = 1100e6;
+
+/// Nominal elongation at break of the same data sheet (450 %); its equivalent plastic strain
+/// is [`etfe_datasheet_hardening`]'s last row, the documented rupture strain.
+pub const ETFE_DATASHEET_ELONGATION_AT_BREAK: f64 = 4.5;
+
+/// Default ETFE hardening at 23 °C from the only tensile numbers we could verify (the etferoof
+/// data sheet: E = 1100 MPa, yield 21 MPa, tensile strength 50 MPa at 450 % elongation; sources
+/// and what this leaves out in `docs/mechanics.md` § "Plastic film"): bilinear in true stress
+/// against log plastic strain, from initial yield to the breaking point converted with
+/// `τ = σ_nom (1 + ε_nom)`, `ε̄p = ln(1 + ε_nom) − τ/E`.
+pub fn etfe_datasheet_hardening() -> Hardening {
+    let (yield_stress, strength) = (21e6, 50e6);
+    let stretch = 1.0 + ETFE_DATASHEET_ELONGATION_AT_BREAK;
+    let tau = strength * stretch;
+    let rupture = stretch.ln() - tau / ETFE_DATASHEET_YOUNGS_MODULUS;
+    Hardening::new(vec![[0.0, yield_stress], [rupture, tau]]).expect("a valid table")
+}
+
 /// Plastic history of one material point: what an increment starts from.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PlasticHistory {
@@ -1326,5 +1346,18 @@ mod tests {
         point.commit();
         assert_eq!(point.committed, point.trial);
         assert!(point.committed.equivalent_plastic_strain > h.equivalent_plastic_strain);
+    }
+
+    #[test]
+    fn datasheet_curve_gives_the_datasheet_strip_back() {
+        // A uniaxial strip of the default film: nominal stress = yield at first yield, and the
+        // data sheet's tensile strength at its elongation at break (closed form ln λ = τ/E + ε̄p).
+        let h = etfe_datasheet_hardening();
+        let e = ETFE_DATASHEET_YOUNGS_MODULUS;
+        let [_, [ep_break, tau_break]] = [h.rows()[0], h.rows()[1]];
+        let stretch = (tau_break / e + ep_break).exp();
+        assert!((stretch - 5.5).abs() < 1e-12);
+        assert!((tau_break / stretch - 50e6).abs() < 1e-6);
+        assert_eq!(h.initial_yield(), 21e6);
     }
 }
