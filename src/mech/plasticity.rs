@@ -42,13 +42,17 @@ use serde::{Deserialize, Serialize};
 
 use super::WrinklingState;
 
+/// Most rows a hardening table may have (stored inline, so that a material stays `Copy`).
+pub const MAX_HARDENING_ROWS: usize = 32;
+
 /// A piecewise-linear isotropic hardening curve: rows of (equivalent plastic strain, flow stress in
 /// Pa). The first row is initial yield at zero plastic strain; past the last row the last slope
 /// continues (a single row is perfect plasticity).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(try_from = "Vec<[f64; 2]>", into = "Vec<[f64; 2]>")]
 pub struct Hardening {
-    rows: Vec<[f64; 2]>,
+    table: [[f64; 2]; MAX_HARDENING_ROWS],
+    len: usize,
 }
 
 /// Why a hardening table is refused; `row` is the 0-based index in the table.
@@ -56,6 +60,11 @@ pub struct Hardening {
 pub enum HardeningError {
     /// The table has no rows.
     Empty,
+    /// The table has more than [`MAX_HARDENING_ROWS`] rows.
+    TooLong {
+        /// Rows given.
+        rows: usize,
+    },
     /// A value is NaN or infinite.
     NotFinite {
         /// Offending row.
@@ -97,6 +106,10 @@ impl fmt::Display for HardeningError {
             Self::Empty => write!(
                 f,
                 "hardening: the table is empty; give at least the initial yield row [0.0, σy]"
+            ),
+            Self::TooLong { rows } => write!(
+                f,
+                "hardening: {rows} rows; at most {MAX_HARDENING_ROWS} are supported"
             ),
             Self::NotFinite { row } => write!(f, "hardening[{row}]: values must be finite"),
             Self::FirstStrainNotZero { strain } => write!(
@@ -140,7 +153,7 @@ impl TryFrom<Vec<[f64; 2]>> for Hardening {
 
 impl From<Hardening> for Vec<[f64; 2]> {
     fn from(h: Hardening) -> Self {
-        h.rows
+        h.rows().to_vec()
     }
 }
 
@@ -148,6 +161,9 @@ impl Hardening {
     /// Validates and builds the table (errors name the bad row).
     pub fn new(rows: Vec<[f64; 2]>) -> Result<Self, HardeningError> {
         let first = rows.first().ok_or(HardeningError::Empty)?;
+        if rows.len() > MAX_HARDENING_ROWS {
+            return Err(HardeningError::TooLong { rows: rows.len() });
+        }
         if let Some(row) = rows.iter().position(|r| !r.iter().all(|v| v.is_finite())) {
             return Err(HardeningError::NotFinite { row });
         }
@@ -174,17 +190,22 @@ impl Hardening {
                 });
             }
         }
-        Ok(Self { rows })
+        let mut table = [[0.0; 2]; MAX_HARDENING_ROWS];
+        table[..rows.len()].copy_from_slice(&rows);
+        Ok(Self {
+            table,
+            len: rows.len(),
+        })
     }
 
     /// The rows (equivalent plastic strain, flow stress in Pa).
     pub fn rows(&self) -> &[[f64; 2]] {
-        &self.rows
+        &self.table[..self.len]
     }
 
     /// Initial yield stress (Pa): the first row.
     pub fn initial_yield(&self) -> f64 {
-        self.rows[0][1]
+        self.table[0][1]
     }
 
     /// Flow stress `σy(ε̄p)` (Pa) and slope `H = dσy/dε̄p` (right slope at a row).
@@ -195,7 +216,7 @@ impl Hardening {
 
     /// The row a strain lies after and the slope of its segment.
     fn segment(&self, plastic_strain: f64) -> ([f64; 2], f64) {
-        let rows = &self.rows;
+        let rows = self.rows();
         let i = rows
             .iter()
             .rposition(|r| r[0] <= plastic_strain)
@@ -211,9 +232,9 @@ impl Hardening {
 
     /// The same curve with every flow stress multiplied by `factor` (> 0).
     pub fn scaled(&self, factor: f64) -> Self {
-        Self {
-            rows: self.rows.iter().map(|r| [r[0], r[1] * factor]).collect(),
-        }
+        let mut scaled = *self;
+        scaled.table.iter_mut().for_each(|r| r[1] *= factor);
+        scaled
     }
 
     /// `σy` at a (possibly dual) plastic strain, the segment chosen from its value.
@@ -241,6 +262,14 @@ pub fn etfe_datasheet_hardening() -> Hardening {
     let tau = strength * stretch;
     let rupture = stretch.ln() - tau / ETFE_DATASHEET_YOUNGS_MODULUS;
     Hardening::new(vec![[0.0, yield_stress], [rupture, tau]]).expect("a valid table")
+}
+
+/// `material.plasticity` of a model: J2 plasticity with this hardening table.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Plasticity {
+    /// Rows (equivalent plastic strain, flow stress in Pa); the first is initial yield.
+    pub hardening: Hardening,
 }
 
 /// Plastic history of one material point: what an increment starts from.
@@ -289,7 +318,7 @@ impl PlasticPoint {
 }
 
 /// The elasto-plastic film law: Hencky elasticity, J2 plasticity, optional tension field.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PlasticFilm {
     /// Young's modulus `E` (Pa).
     pub youngs_modulus: f64,
@@ -1290,6 +1319,7 @@ mod tests {
     fn hardening_table_errors_name_the_bad_row() {
         let err = |rows: Vec<[f64; 2]>| Hardening::new(rows).unwrap_err().to_string();
         assert!(err(vec![]).contains("empty"));
+        assert!(err(vec![[0.0, 16e6]; 33]).contains("33 rows; at most 32"));
         assert!(err(vec![[0.01, 16e6]]).starts_with("hardening[0]:"));
         assert!(err(vec![[0.0, 0.0]]).starts_with("hardening[0]: initial yield"));
         assert!(err(vec![[0.0, 16e6], [0.02, f64::NAN]]).starts_with("hardening[1]:"));
@@ -1298,8 +1328,17 @@ mod tests {
         assert!(err(swapped).starts_with("hardening[2]: plastic strain 0.02 is not above"));
         let softening = vec![[0.0, 16e6], [0.02, 19e6], [0.15, 18e6]];
         assert!(err(softening).starts_with("hardening[2]: flow stress"));
-        let from_json: Result<Hardening, _> = serde_json::from_str("[[0.0, 16e6], [0.0, 19e6]]");
-        assert!(from_json.unwrap_err().to_string().contains("hardening[1]"));
+        let from_json = |text: &str| serde_json::from_str::<Plasticity>(text);
+        let e = from_json(r#"{"hardening": [[0.0, 16e6], [0.0, 19e6]]}"#).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("hardening[1]: plastic strain 0 is not above"),
+            "{e}"
+        );
+        let e = from_json(r#"{"hardening": [[0.0, 16e6]], "kinematic": 1}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown field `kinematic`"), "{e}");
+        let ok = from_json(r#"{"hardening": [[0.0, 16e6], [0.02, 19e6]]}"#).unwrap();
+        assert_eq!(ok.hardening.rows(), &[[0.0, 16e6], [0.02, 19e6]]);
         assert_eq!(table().flow_stress(0.01), (17.5e6, 150e6));
         assert_eq!(table().flow_stress(2.0).0, 40e6 + 16e6 / 0.85 * 1.0);
     }
