@@ -25,6 +25,7 @@ use nalgebra::{Matrix2, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 pub use super::material::{Material, Wrinkling, WrinklingState};
+use super::plasticity::{PlasticFilm, PlasticHistory, PlasticResponse};
 
 /// Element vector on the nine nodal DOF.
 pub type ElementVector = SVector<f64, 9>;
@@ -186,6 +187,33 @@ impl MembraneTriangle {
         }
     }
 
+    /// Internal force, tangent (when `with_tangent`) and material response of an elasto-plastic
+    /// film (`plasticity.rs`) starting from the committed `history`: `S` and the algorithmic
+    /// `∂S/∂E` enter (2.6)–(2.7) in place of `σ` and `D`; wrinkled and slack points get `η D`
+    /// added to the Newton matrix, as the elastic tension field does.
+    pub fn force_and_tangent_plastic(
+        &self,
+        material: &Material,
+        film: &PlasticFilm,
+        history: &PlasticHistory,
+        u: &ElementVector,
+        with_tangent: bool,
+    ) -> (ElementVector, ElementMatrix, PlasticResponse) {
+        let f = self.deformation_gradient(u);
+        let strain = strain_from(&f);
+        let (response, c) = if with_tangent {
+            let (response, mut c) = film.response_and_tangent(history, &strain);
+            if response.state != WrinklingState::Taut {
+                c += material.elasticity() * material.wrinkling_regularisation;
+            }
+            (response, c)
+        } else {
+            (film.response(history, &strain), Matrix3::zeros())
+        };
+        let (r, k) = self.force_and_tangent_with(material, &f, response.stress, with_tangent, || c);
+        (r, k, response)
+    }
+
     /// Force and tangent from the stress `s` and the material tangent `tangent()`.
     #[allow(non_snake_case)]
     #[inline(always)]
@@ -341,5 +369,76 @@ mod tests {
     fn tangent_is_symmetric() {
         let k = skew_triangle().tangent_stiffness(&etfe(), &pseudo_random_displacement(0.1));
         assert!((k - k.transpose()).amax() < 1e-9 * k.amax());
+    }
+
+    #[test]
+    fn plastic_tangent_matches_finite_difference_in_every_state() {
+        use crate::mech::plasticity::{Hardening, PlasticFilm};
+        let tri = skew_triangle();
+        let hardening =
+            Hardening::new(vec![[0.0, 16e6], [0.02, 19e6], [0.15, 24e6], [1.0, 40e6]]).unwrap();
+        let spread =
+            |k: usize| ((k as f64 * 12.9898).sin() * 43758.5453).rem_euclid(1.0) * 2.0 - 1.0;
+        let mut seen = std::collections::HashSet::new();
+        for k in 0..300 {
+            let tension_field = k % 2 == 0;
+            let mat = Material {
+                wrinkling: if tension_field {
+                    Wrinkling::TensionField
+                } else {
+                    Wrinkling::None
+                },
+                wrinkling_regularisation: 0.0,
+                ..etfe()
+            };
+            let film = PlasticFilm {
+                youngs_modulus: mat.youngs_modulus,
+                poisson_ratio: mat.poisson_ratio,
+                hardening,
+                tension_field,
+            };
+            let fresh = film.initial_history(mat.prestress);
+            let pre = ElementVector::from_fn(|i, _| 0.1 * spread(40 * k + i));
+            let history = if k % 3 == 0 {
+                fresh
+            } else {
+                tri.force_and_tangent_plastic(&mat, &film, &fresh, &pre, false)
+                    .2
+                    .history
+            };
+            let u = pre + ElementVector::from_fn(|i, _| 0.04 * spread(40 * k + 20 + i));
+            let (_, kt, at) = tri.force_and_tangent_plastic(&mat, &film, &history, &u, true);
+            let h = 1e-7;
+            let mut fd = ElementMatrix::zeros();
+            let mut stable = true;
+            for j in 0..9 {
+                let (mut up, mut um) = (u, u);
+                up[j] += h;
+                um[j] -= h;
+                let (rp, _, ap) = tri.force_and_tangent_plastic(&mat, &film, &history, &up, false);
+                let (rm, _, am) = tri.force_and_tangent_plastic(&mat, &film, &history, &um, false);
+                let same = |a: &PlasticResponse| (a.state, a.yielding) == (at.state, at.yielding);
+                stable &= same(&ap) && same(&am);
+                fd.set_column(j, &((rp - rm) / (2.0 * h)));
+            }
+            if !stable {
+                continue;
+            }
+            let err = (fd - kt).amax();
+            assert!(
+                err < 1e-6 * kt.amax().max(1.0),
+                "{:?} yielding {} : {err:e} vs {:e}",
+                at.state,
+                at.yielding,
+                kt.amax()
+            );
+            seen.insert((
+                at.state as usize,
+                at.yielding,
+                history.equivalent_plastic_strain > 0.0,
+            ));
+        }
+        // Taut, wrinkled and slack; loading and unloading; virgin and yielded histories.
+        assert!(seen.len() >= 7, "states covered: {seen:?}");
     }
 }
