@@ -252,6 +252,7 @@ fn film(prestress: [f64; 3]) -> membrane_contact::mech::Material {
         wrinkling_regularisation:
             membrane_contact::mech::material::DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
+        plasticity: None,
     }
 }
 

@@ -301,6 +301,7 @@ mod tests {
             wrinkling: Wrinkling::None,
             wrinkling_regularisation: 1e-5,
             yield_stress: None,
+            plasticity: None,
         }
     }
 
