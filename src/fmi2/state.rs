@@ -30,8 +30,8 @@ use serde::{Deserialize, Serialize};
 
 use super::phase::Phase;
 use super::scalar_variable::Value;
-use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::elements::curved_contact::SurfaceContacts;
+use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
 use crate::mech::{AnalysisState, Model};
 
 /// Everything needed to continue an instance exactly.
@@ -57,7 +57,7 @@ pub struct Snapshot {
 }
 
 const MAGIC: &[u8; 8] = b"MCFMI2ST";
-const VERSION: u32 = 6;
+const VERSION: u32 = 7;
 
 /// The serialized bytes of `snapshot` for the FMU with `guid`.
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {

@@ -93,8 +93,7 @@ pub const RESERVED_NAMES: [&str; 9] = [
 
 /// Default of `solver.incrementsPerStep`: the core's
 /// [`crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP`], the CLI's default too.
-pub const DEFAULT_INCREMENTS_PER_STEP: i32 =
-    crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP as i32;
+pub const DEFAULT_INCREMENTS_PER_STEP: i32 = crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP as i32;
 
 /// Checks that the model's gap, group, pressure-set and force-set names can prefix variable names.
 pub fn check_names(model: &Model) -> Result<(), String> {

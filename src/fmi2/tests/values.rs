@@ -158,8 +158,8 @@ fn wrinkling_parameter_switches_the_film_and_counts_its_elements() {
 fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels() {
     use crate::fmi2::variables::{Causality, Value};
     use crate::mech::model::ForceSet;
-    use crate::specimens::scenarios::CircularMembrane;
     use crate::mech::{Analysis, LoadLevels, SolverSettings};
+    use crate::specimens::scenarios::CircularMembrane;
 
     let membrane = CircularMembrane {
         radius: 1.0,
@@ -277,8 +277,8 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
 #[test]
 fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
     use crate::fmi2::variables::{Causality, SummaryQuantity};
-    use crate::specimens::scenarios::CircularMembrane;
     use crate::mech::{Analysis, LoadLevels, SolverSettings};
+    use crate::specimens::scenarios::CircularMembrane;
 
     let membrane = CircularMembrane {
         radius: 1.0,

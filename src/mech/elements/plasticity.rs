@@ -251,6 +251,11 @@ pub const ETFE_DATASHEET_YOUNGS_MODULUS: f64 = 1100e6;
 /// is [`etfe_datasheet_hardening`]'s last row, the documented rupture strain.
 pub const ETFE_DATASHEET_ELONGATION_AT_BREAK: f64 = 4.5;
 
+/// Equivalent plastic strain at which ETFE tears: the data sheet's elongation at break (450 %)
+/// in uniaxial tension, `ln 5.5 − 275 MPa/1100 MPa` (the last row of
+/// [`etfe_datasheet_hardening`]); a converged state past it is reported with a warning.
+pub const ETFE_RUPTURE_PLASTIC_STRAIN: f64 = 1.454_748_092_238_425_3;
+
 /// Default ETFE hardening at 23 °C from the only tensile numbers we could verify (the etferoof
 /// data sheet: E = 1100 MPa, yield 21 MPa, tensile strength 50 MPa at 450 % elongation; sources
 /// and what this leaves out in `docs/mechanics.md` § "Plastic film"): bilinear in true stress
@@ -1398,5 +1403,6 @@ mod tests {
         assert!((stretch - 5.5).abs() < 1e-12);
         assert!((tau_break / stretch - 50e6).abs() < 1e-6);
         assert_eq!(h.initial_yield(), 21e6);
+        assert!((ep_break - ETFE_RUPTURE_PLASTIC_STRAIN).abs() < 1e-15);
     }
 }

@@ -57,7 +57,7 @@ pub struct ElementStress {
 }
 
 /// Plastic state of one element of an elasto-plastic film.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PlasticOutput {
     /// Equivalent plastic strain `ε̄p`.
     pub equivalent_plastic_strain: f64,

@@ -83,6 +83,11 @@ impl Analysis {
                 .collect(),
             last_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
+            plastic: model
+                .material
+                .plastic_film()
+                .map(|f| vec![f.initial_history(model.material.prestress); model.triangles.len()])
+                .unwrap_or_default(),
         };
         let work = Workspace {
             internal: vec![0.0; model.dof_count()],
