@@ -6,6 +6,7 @@
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
+use membrane_contact::mech::elements::plasticity::{Plasticity, etfe_datasheet_hardening};
 use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::results::vtk;
@@ -59,7 +60,7 @@ enum Source<'a> {
 
 fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArch, String> {
     let defaults = ParallelArch::default();
-    let spec = ParallelArch {
+    let mut spec = ParallelArch {
         refinement: args.refine as usize,
         friction_law: law.unwrap_or_default(),
         contact: args.contact,
@@ -73,6 +74,11 @@ fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArc
             }),
         ..ParallelArch::with_height(args.height / 1000.0)
     };
+    if args.plastic {
+        spec.material.plasticity = Some(Plasticity {
+            hardening: etfe_datasheet_hardening(),
+        });
+    }
     spec.check()?;
     Ok(spec)
 }

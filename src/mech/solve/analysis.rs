@@ -187,6 +187,14 @@ impl Analysis {
         {
             return Err("state does not match this model's sizes".into());
         }
+        if state.plastic.len() != s.plastic.len() {
+            return Err(format!(
+                "state holds the plastic history of {} triangles; this model's film needs {} \
+                 (a state of an elastic film does not fit a plastic one, nor the reverse)",
+                state.plastic.len(),
+                s.plastic.len()
+            ));
+        }
         let finite = state
             .displacement
             .iter()
@@ -195,7 +203,8 @@ impl Analysis {
             .chain(&state.angles)
             .chain(&state.friction)
             .all(|v| v.is_finite())
-            && state.loads.is_finite();
+            && state.loads.is_finite()
+            && state.is_finite();
         if !finite || state.friction.iter().any(|&m| m < 0.0) {
             return Err("state holds non-finite values or a negative friction coefficient".into());
         }
