@@ -47,6 +47,7 @@ fn film(prestress: f64) -> Material {
         wrinkling: Wrinkling::None,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
+        plasticity: None,
     }
 }
 
@@ -956,6 +957,7 @@ fn example_cushion() -> Model {
         poisson_ratio: 0.43,
         thickness: 250e-6,
         yield_stress: Some(15.0e6),
+        plasticity: None,
         ..film(0.0)
     };
     let top = disc(1.0, 8, material);

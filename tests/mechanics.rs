@@ -35,6 +35,7 @@ fn etfe() -> Material {
         wrinkling: Wrinkling::None,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
+        plasticity: None,
     }
 }
 
@@ -1298,6 +1299,7 @@ fn tension_field_film(eta: f64, prestress: f64) -> Material {
         density: 0.0,
         wrinkling: Wrinkling::TensionField,
         yield_stress: None,
+        plasticity: None,
         wrinkling_regularisation: eta,
     }
 }
@@ -1822,6 +1824,7 @@ fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
         prestress: [s0, s0, 0.0],
         density: 0.0,
         yield_stress: None,
+        plasticity: None,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     };

@@ -253,6 +253,7 @@ fn film(prestress: [f64; 3]) -> membrane_contact::mech::Material {
         wrinkling_regularisation:
             membrane_contact::mech::elements::material::DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
+        plasticity: None,
     }
 }
 

@@ -40,6 +40,7 @@ pub fn sheet(n: usize) -> Model {
             wrinkling: Wrinkling::None,
             wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
             yield_stress: None,
+            plasticity: None,
         },
         supports: edge
             .map(|node| Support {

@@ -109,6 +109,10 @@ pub struct SpecimenArgs {
     /// per frame node (the crown-to-foot reconstruction, docs/mechanics.md).
     #[arg(long, value_name = "EPS")]
     pub wrap: Option<f64>,
+    /// Give the film ETFE's elasto-plastic behaviour (finite-strain J2 with the documented
+    /// data-sheet curve at 23 °C, docs/mechanics.md "Plastic film") instead of the linear film.
+    #[arg(long)]
+    pub plastic: bool,
 }
 
 /// Newton iteration matrix.

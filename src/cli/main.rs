@@ -6,6 +6,7 @@
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
+use membrane_contact::mech::elements::plasticity::{Plasticity, etfe_datasheet_hardening};
 use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::results::vtk;
@@ -49,6 +50,7 @@ fn print_line(args: std::fmt::Arguments<'_>) {
 }
 
 /// Where the model comes from, and what the run compares with.
+#[allow(clippy::large_enum_variant)] // one per run; the specimen holds a material's inline hardening table
 enum Source<'a> {
     /// A parallel-arch specimen of height `height_mm` (compared with Table 1).
     Specimen { spec: ParallelArch, height_mm: f64 },
@@ -58,7 +60,7 @@ enum Source<'a> {
 
 fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArch, String> {
     let defaults = ParallelArch::default();
-    let spec = ParallelArch {
+    let mut spec = ParallelArch {
         refinement: args.refine as usize,
         friction_law: law.unwrap_or_default(),
         contact: args.contact,
@@ -72,6 +74,11 @@ fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArc
             }),
         ..ParallelArch::with_height(args.height / 1000.0)
     };
+    if args.plastic {
+        spec.material.plasticity = Some(Plasticity {
+            hardening: etfe_datasheet_hardening(),
+        });
+    }
     spec.check()?;
     Ok(spec)
 }
@@ -173,7 +180,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
     }
-    let mut csv = CsvFiles::create(o)?;
+    let mut csv = CsvFiles::create(o, analysis.model().material.plasticity.is_some())?;
     let mut outputs = report::Outputs::create(
         analysis.model(),
         o.line_reactions.as_deref(),
@@ -330,7 +337,9 @@ struct CsvFiles {
 }
 
 impl CsvFiles {
-    fn create(o: &RunArgs) -> Result<Self, String> {
+    /// Opens the files; an elasto-plastic film's element rows get its plastic strain and
+    /// thickness as two more columns.
+    fn create(o: &RunArgs, plastic: bool) -> Result<Self, String> {
         let open = |path: &Option<std::path::PathBuf>, header: &str| -> Result<_, String> {
             let Some(path) = path else {
                 return Ok(None);
@@ -347,9 +356,16 @@ impl CsvFiles {
             )?,
             elements: open(
                 &o.elements_csv,
-                "step,time,element,node1,node2,node3,state,stress_x_Pa,stress_y_Pa,stress_xy_Pa,\
-                 principal_1_Pa,principal_2_Pa,von_mises_Pa,strain_x,strain_y,strain_xy,\
-                 principal_strain_1,principal_strain_2",
+                &format!(
+                    "step,time,element,node1,node2,node3,state,stress_x_Pa,stress_y_Pa,stress_xy_Pa,\
+                     principal_1_Pa,principal_2_Pa,von_mises_Pa,strain_x,strain_y,strain_xy,\
+                     principal_strain_1,principal_strain_2{}",
+                    if plastic {
+                        ",equivalent_plastic_strain,thickness_m"
+                    } else {
+                        ""
+                    }
+                ),
             )?,
         })
     }
@@ -383,7 +399,7 @@ impl CsvFiles {
         if let Some((f, name)) = self.elements.as_mut() {
             for (i, (t, e)) in model.triangles.iter().zip(&results.elements).enumerate() {
                 let [e1, e2] = vtk::principal_strain(e.strain);
-                writeln!(
+                write!(
                     f,
                     "{step},{time},{i},{},{},{},{:?},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e},{:e}",
                     t[0],
@@ -403,6 +419,11 @@ impl CsvFiles {
                     e2
                 )
                 .map_err(|e| format!("{name}: {e}"))?;
+                if let Some(p) = e.plastic {
+                    write!(f, ",{:e},{:e}", p.equivalent_plastic_strain, p.thickness)
+                        .map_err(|e| format!("{name}: {e}"))?;
+                }
+                writeln!(f).map_err(|e| format!("{name}: {e}"))?;
             }
         }
         Ok(())

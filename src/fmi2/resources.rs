@@ -27,6 +27,7 @@ pub const MODEL_FILE: &str = "model.json";
 
 /// What an FMU is built from.
 #[derive(Clone, Debug, PartialEq)]
+#[allow(clippy::large_enum_variant)] // one per instance; the specimen holds a material's inline hardening table
 pub enum Source {
     /// The paper's specimen generator; the model is regenerated at initialization from
     /// `archHeight` (and these parameters).

@@ -137,6 +137,7 @@ impl Default for ParallelArch {
                 wrinkling: Wrinkling::None,
                 wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
                 yield_stress: None,
+                plasticity: None,
             },
             normal_penalty_factor: 1000.0,
             tangential_penalty_ratio: 0.1,

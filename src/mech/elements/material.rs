@@ -25,6 +25,8 @@
 use nalgebra::{Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
+use super::plasticity::{PlasticFilm, Plasticity};
+
 /// Default `η` of [`Material::wrinkling_regularisation`].
 pub const DEFAULT_WRINKLING_REGULARISATION: f64 = 1e-5;
 
@@ -89,6 +91,10 @@ pub struct Material {
     /// reported with a warning (`summary::assumption_warnings`); none: no check.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yield_stress: Option<f64>,
+    /// Elasto-plastic film (issue 20): finite-strain J2 plasticity with this hardening table
+    /// (`plasticity.rs`); none (the default): the elastic law (2.3), bit for bit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plasticity: Option<Plasticity>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -118,6 +124,16 @@ pub struct MaterialResponse {
 }
 
 impl Material {
+    /// The elasto-plastic film law of this material, if it has `plasticity`.
+    pub fn plastic_film(&self) -> Option<PlasticFilm> {
+        self.plasticity.map(|p| PlasticFilm {
+            youngs_modulus: self.youngs_modulus,
+            poisson_ratio: self.poisson_ratio,
+            hardening: p.hardening,
+            tension_field: self.wrinkling == Wrinkling::TensionField,
+        })
+    }
+
     /// Plane-stress elasticity matrix `D` of eq. (2.3).
     pub fn elasticity(&self) -> Matrix3<f64> {
         let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
@@ -253,6 +269,7 @@ mod tests {
             wrinkling: Wrinkling::TensionField,
             wrinkling_regularisation: 0.0,
             yield_stress: None,
+            plasticity: None,
         }
     }
 

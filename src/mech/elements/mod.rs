@@ -10,10 +10,12 @@
 //! | [`gap`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
 //! | [`curved_contact`] | node-to-surface friction contact on rigid curved supports (and, in `surface`, their geometry) |
 //! | [`load`] | follower pressure, self-weight, nodal forces and their load stiffness |
+//! | [`plasticity`] | elasto-plastic film law: finite-strain plane-stress J2 with a hardening table (issue 20) |
 
 pub mod cable;
 pub mod curved_contact;
 pub mod gap;
 pub mod load;
 pub mod material;
+pub mod plasticity;
 pub mod triangle;

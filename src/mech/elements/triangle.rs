@@ -25,6 +25,7 @@ use nalgebra::{Matrix2, Matrix3, Matrix3x2, SMatrix, SVector, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 pub use crate::mech::elements::material::{Material, Wrinkling, WrinklingState};
+use crate::mech::elements::plasticity::{PlasticFilm, PlasticHistory, PlasticResponse};
 
 /// Element vector on the nine nodal DOF.
 pub type ElementVector = SVector<f64, 9>;
@@ -50,6 +51,18 @@ pub struct ElementStress {
     /// (the wrinkles run along it); zero otherwise.
     #[serde(default)]
     pub tension_direction: [f64; 3],
+    /// Plastic state of an elasto-plastic film; none for the elastic film.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plastic: Option<PlasticOutput>,
+}
+
+/// Plastic state of one element of an elasto-plastic film.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct PlasticOutput {
+    /// Equivalent plastic strain `ε̄p`.
+    pub equivalent_plastic_strain: f64,
+    /// Current film thickness (m).
+    pub thickness: f64,
 }
 
 /// How many elements are taut, wrinkled and slack (indexed by [`WrinklingState`] as `usize`).
@@ -186,6 +199,33 @@ impl MembraneTriangle {
         }
     }
 
+    /// Internal force, tangent (when `with_tangent`) and material response of an elasto-plastic
+    /// film (`plasticity.rs`) starting from the committed `history`: `S` and the algorithmic
+    /// `∂S/∂E` enter (2.6)–(2.7) in place of `σ` and `D`; wrinkled and slack points get `η D`
+    /// added to the Newton matrix, as the elastic tension field does.
+    pub fn force_and_tangent_plastic(
+        &self,
+        material: &Material,
+        film: &PlasticFilm,
+        history: &PlasticHistory,
+        u: &ElementVector,
+        with_tangent: bool,
+    ) -> (ElementVector, ElementMatrix, PlasticResponse) {
+        let f = self.deformation_gradient(u);
+        let strain = strain_from(&f);
+        let (response, c) = if with_tangent {
+            let (response, mut c) = film.response_and_tangent(history, &strain);
+            if response.state != WrinklingState::Taut {
+                c += material.elasticity() * material.wrinkling_regularisation;
+            }
+            (response, c)
+        } else {
+            (film.response(history, &strain), Matrix3::zeros())
+        };
+        let (r, k) = self.force_and_tangent_with(material, &f, response.stress, with_tangent, || c);
+        (r, k, response)
+    }
+
     /// Force and tangent from the stress `s` and the material tangent `tangent()`.
     #[allow(non_snake_case)]
     #[inline(always)]
@@ -249,6 +289,50 @@ impl MembraneTriangle {
             von_mises: (s1 * s1 - s1 * s2 + s2 * s2).sqrt(),
             state: response.state,
             tension_direction,
+            plastic: None,
+        }
+    }
+
+    /// [`MembraneTriangle::stress_state`] of an elasto-plastic film from `history` (the
+    /// converged history at a converged `u`). `stress` is `S`; the principal and von Mises
+    /// stresses are Cauchy's in the material, `τ/J` with the elastic volume ratio
+    /// `J = exp((1 − 2ν)(τ1 + τ2)/E)` (plastic flow is isochoric, wrinkles are no material strain).
+    pub fn stress_state_plastic(
+        &self,
+        material: &Material,
+        film: &PlasticFilm,
+        history: &PlasticHistory,
+        u: &ElementVector,
+    ) -> ElementStress {
+        let f = self.deformation_gradient(u);
+        let strain = strain_from(&f);
+        let r = film.response(history, &strain);
+        let [t1, t2] = r.principal_kirchhoff;
+        let j = ((1.0 - 2.0 * film.poisson_ratio) * (t1 + t2) / film.youngs_modulus).exp();
+        // Wrinkled: S = s v vᵀ, v along the tension direction (reference); F v on the film.
+        let s = Matrix2::new(r.stress.x, r.stress.z, r.stress.z, r.stress.y);
+        let v = if s.column(0).norm() >= s.column(1).norm() {
+            s.column(0).into_owned()
+        } else {
+            s.column(1).into_owned()
+        };
+        let tension = f * v;
+        let tension_direction = if r.state == WrinklingState::Wrinkled {
+            (tension / tension.norm()).into()
+        } else {
+            [0.0; 3]
+        };
+        ElementStress {
+            strain: strain.into(),
+            stress: r.stress.into(),
+            principal: [t1 / j, t2 / j],
+            von_mises: r.equivalent_stress / j,
+            state: r.state,
+            tension_direction,
+            plastic: Some(PlasticOutput {
+                equivalent_plastic_strain: r.history.equivalent_plastic_strain,
+                thickness: material.thickness * r.thickness_ratio,
+            }),
         }
     }
 }
@@ -273,6 +357,7 @@ mod tests {
             wrinkling: Wrinkling::None,
             wrinkling_regularisation: 1e-5,
             yield_stress: None,
+            plasticity: None,
         }
     }
 
@@ -341,5 +426,125 @@ mod tests {
     fn tangent_is_symmetric() {
         let k = skew_triangle().tangent_stiffness(&etfe(), &pseudo_random_displacement(0.1));
         assert!((k - k.transpose()).amax() < 1e-9 * k.amax());
+    }
+
+    #[test]
+    fn plastic_tangent_matches_finite_difference_in_every_state() {
+        use crate::mech::elements::plasticity::{Hardening, PlasticFilm};
+        let tri = skew_triangle();
+        let hardening =
+            Hardening::new(vec![[0.0, 16e6], [0.02, 19e6], [0.15, 24e6], [1.0, 40e6]]).unwrap();
+        let spread =
+            |k: usize| ((k as f64 * 12.9898).sin() * 43758.5453).rem_euclid(1.0) * 2.0 - 1.0;
+        let mut seen = std::collections::HashSet::new();
+        for k in 0..300 {
+            let tension_field = k % 2 == 0;
+            let mat = Material {
+                wrinkling: if tension_field {
+                    Wrinkling::TensionField
+                } else {
+                    Wrinkling::None
+                },
+                wrinkling_regularisation: 0.0,
+                ..etfe()
+            };
+            let film = PlasticFilm {
+                youngs_modulus: mat.youngs_modulus,
+                poisson_ratio: mat.poisson_ratio,
+                hardening,
+                tension_field,
+            };
+            let fresh = film.initial_history(mat.prestress);
+            let pre = ElementVector::from_fn(|i, _| 0.1 * spread(40 * k + i));
+            let history = if k % 3 == 0 {
+                fresh
+            } else {
+                tri.force_and_tangent_plastic(&mat, &film, &fresh, &pre, false)
+                    .2
+                    .history
+            };
+            let u = pre + ElementVector::from_fn(|i, _| 0.04 * spread(40 * k + 20 + i));
+            let (_, kt, at) = tri.force_and_tangent_plastic(&mat, &film, &history, &u, true);
+            let h = 1e-7;
+            let mut fd = ElementMatrix::zeros();
+            let mut stable = true;
+            for j in 0..9 {
+                let (mut up, mut um) = (u, u);
+                up[j] += h;
+                um[j] -= h;
+                let (rp, _, ap) = tri.force_and_tangent_plastic(&mat, &film, &history, &up, false);
+                let (rm, _, am) = tri.force_and_tangent_plastic(&mat, &film, &history, &um, false);
+                let same = |a: &PlasticResponse| (a.state, a.yielding) == (at.state, at.yielding);
+                stable &= same(&ap) && same(&am);
+                fd.set_column(j, &((rp - rm) / (2.0 * h)));
+            }
+            if !stable {
+                continue;
+            }
+            let err = (fd - kt).amax();
+            assert!(
+                err < 1e-6 * kt.amax().max(1.0),
+                "{:?} yielding {} : {err:e} vs {:e}",
+                at.state,
+                at.yielding,
+                kt.amax()
+            );
+            seen.insert((
+                at.state as usize,
+                at.yielding,
+                history.equivalent_plastic_strain > 0.0,
+            ));
+        }
+        // Taut, wrinkled and slack; loading and unloading; virgin and yielded histories.
+        assert!(seen.len() >= 7, "states covered: {seen:?}");
+    }
+
+    #[test]
+    fn plastic_stress_state_reports_cauchy_stress_thickness_and_tension_direction() {
+        use crate::mech::elements::plasticity::{Hardening, PlasticFilm};
+        // A flat triangle stretched by 1.3 along X and held at 0.7 along Y: a wrinkled bar.
+        let tri = MembraneTriangle::new([
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.3, 0.8, 0.0),
+        ])
+        .unwrap();
+        let mat = Material {
+            wrinkling: Wrinkling::TensionField,
+            prestress: [0.0; 3],
+            ..etfe()
+        };
+        let film = PlasticFilm {
+            hardening: Hardening::new(vec![[0.0, 16e6], [1.0, 40e6]]).unwrap(),
+            youngs_modulus: mat.youngs_modulus,
+            poisson_ratio: mat.poisson_ratio,
+            tension_field: true,
+        };
+        let nodes = [[0.0, 0.0], [1.0, 0.0], [0.3, 0.8]];
+        let stretched = |lx: f64, ly: f64| {
+            let u = ElementVector::from_fn(|i, _| match i % 3 {
+                0 => (lx - 1.0) * nodes[i / 3][0],
+                1 => (ly - 1.0) * nodes[i / 3][1],
+                _ => 0.0,
+            });
+            tri.stress_state_plastic(&mat, &film, &film.initial_history([0.0; 3]), &u)
+        };
+        // Taut, equibiaxial: Cauchy σ = τ/J with τ = λ² S and J = λ² t/t0.
+        let l = 1.2f64;
+        let out = stretched(l, l);
+        let plastic = out.plastic.unwrap();
+        let sigma = out.stress[0] * l * l / (l * l * plastic.thickness / mat.thickness);
+        assert_eq!(out.state, WrinklingState::Taut);
+        for s in [out.principal[0], out.principal[1], out.von_mises] {
+            assert!((s - sigma).abs() < 1e-9 * sigma, "{s} vs {sigma}");
+        }
+        // Wrinkled bar along X: tension direction X, no stress across.
+        let out = stretched(1.3, 0.7);
+        let plastic = out.plastic.unwrap();
+        assert_eq!(out.state, WrinklingState::Wrinkled);
+        let along = Vector3::from(out.tension_direction) - Vector3::x();
+        assert!(along.norm() < 1e-12, "{:?}", out.tension_direction);
+        assert!(out.principal[1].abs() < 1e-9 * out.principal[0]);
+        assert!(plastic.equivalent_plastic_strain > 0.2 && plastic.thickness < mat.thickness);
     }
 }

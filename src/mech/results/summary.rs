@@ -99,6 +99,7 @@ mod tests {
             von_mises: (s1 * s1 - s1 * s2 + s2 * s2).sqrt(),
             state,
             tension_direction: [0.0; 3],
+            plastic: None,
         }
     }
 

@@ -12,7 +12,8 @@
 //!   `principal_2` (Pa), `stress` (σx, σy, τxy in the element frame), `strain` (Green–Lagrange
 //!   εx, εy, γxy in the element frame), `principal_strain_1`, `principal_strain_2`,
 //!   `wrinkling_state` (0 taut, 1 wrinkled, 2 slack) and `tension_direction` (unit vector along
-//!   the tension rays of a wrinkled triangle, global axes, deformed film; zero when taut or slack).
+//!   the tension rays of a wrinkled triangle, global axes, deformed film; zero when taut or slack);
+//!   an elasto-plastic film adds `equivalent_plastic_strain` and `thickness` (m).
 //! * **gaps** ([`Block::Gaps`]): points are the deformed positions of the gaps' film nodes
 //!   (point `k` for gap `k`) followed by their support points (point `G + k`), cells one line
 //!   (VTK type 3) per gap from film node to support. Cell data `film_node` (index of the gap's
@@ -242,7 +243,7 @@ pub fn film_grid(
     let cell = |f: &dyn Fn(usize) -> f64| Values::F64((0..tris).map(f).collect());
     let cell3 = |f: &dyn Fn(usize) -> [f64; 3]| Values::F64((0..tris).flat_map(f).collect());
     let principal_strains: Vec<[f64; 2]> = el.iter().map(|e| principal_strain(e.strain)).collect();
-    let piece = Piece {
+    let mut piece = Piece {
         points: deformed(model, displacement),
         connectivity: model
             .triangles
@@ -291,6 +292,19 @@ pub fn film_grid(
         point_vectors: Some("displacement"),
         cell_scalars: Some("von_mises"),
     };
+    // An elasto-plastic film adds its plastic strain and thickness (an elastic one writes
+    // exactly what it did).
+    if el.iter().any(|e| e.plastic.is_some()) {
+        let plastic = |e: usize| el[e].plastic.unwrap_or_default();
+        piece.cell_data.push((
+            "equivalent_plastic_strain",
+            1,
+            cell(&|e| plastic(e).equivalent_plastic_strain),
+        ));
+        piece
+            .cell_data
+            .push(("thickness", 1, cell(&|e| plastic(e).thickness)));
+    }
     piece.encode(encoding)
 }
 

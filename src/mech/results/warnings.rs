@@ -1,6 +1,7 @@
 //! Warnings about a model that validates but looks wrong, and about results outside the
 //! model's assumptions (large strain).
 
+use crate::mech::elements::plasticity::ETFE_RUPTURE_PLASTIC_STRAIN;
 use crate::mech::elements::triangle::ElementStress;
 use crate::mech::model::{GapSupport, Model};
 use crate::mech::results::Results;
@@ -62,8 +63,9 @@ pub fn model_warnings(model: &Model) -> Vec<String> {
 }
 
 /// Warnings about a converged state outside the model's assumptions: a von Mises stress above
-/// the material's `yield_stress`, a principal strain above [`SMALL_STRAIN_LIMIT`]. One line per
-/// kind, naming the worst element.
+/// the material's `yield_stress`, a principal strain above [`SMALL_STRAIN_LIMIT`] (an elastic
+/// film), an equivalent plastic strain past [`ETFE_RUPTURE_PLASTIC_STRAIN`] (a plastic film).
+/// One line per kind, naming the worst element.
 pub fn result_warnings(model: &Model, results: &Results) -> Vec<String> {
     let mut warnings = vec![];
     let worst = |f: &dyn Fn(&ElementStress) -> f64| {
@@ -92,6 +94,18 @@ pub fn result_warnings(model: &Model, results: &Results) -> Vec<String> {
                 limit / 1e6
             ));
         }
+    }
+    if model.material.plasticity.is_some() {
+        // The finite-strain plastic film holds at large strains; it tears past rupture.
+        let (e, ep) = worst(&|e| e.plastic.map_or(0.0, |p| p.equivalent_plastic_strain));
+        if ep > ETFE_RUPTURE_PLASTIC_STRAIN {
+            warnings.push(format!(
+                "equivalent plastic strain {ep:.3} in triangle {e} is past ETFE's rupture strain \
+                 {ETFE_RUPTURE_PLASTIC_STRAIN:.3} (elongation at break 450 %, docs/mechanics.md): \
+                 the film would have torn there"
+            ));
+        }
+        return warnings;
     }
     let (e, strain) = worst(&|e| major_principal(e.strain, 0.5));
     if strain > SMALL_STRAIN_LIMIT {

@@ -86,6 +86,11 @@ impl Analysis {
                 .collect(),
             last_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
+            plastic: model
+                .material
+                .plastic_film()
+                .map(|f| vec![f.initial_history(model.material.prestress); model.triangles.len()])
+                .unwrap_or_default(),
         };
         let work = Workspace {
             internal: vec![0.0; model.dof_count()],
@@ -186,6 +191,14 @@ impl Analysis {
         {
             return Err("state does not match this model's sizes".into());
         }
+        if state.plastic.len() != s.plastic.len() {
+            return Err(format!(
+                "state holds the plastic history of {} triangles; this model's film needs {} \
+                 (a state of an elastic film does not fit a plastic one, nor the reverse)",
+                state.plastic.len(),
+                s.plastic.len()
+            ));
+        }
         let finite = state
             .displacement
             .iter()
@@ -194,7 +207,8 @@ impl Analysis {
             .chain(&state.angles)
             .chain(&state.friction)
             .all(|v| v.is_finite())
-            && state.loads.is_finite();
+            && state.loads.is_finite()
+            && state.is_finite();
         if !finite || state.friction.iter().any(|&m| m < 0.0) {
             return Err("state holds non-finite values or a negative friction coefficient".into());
         }

@@ -381,15 +381,36 @@ impl System {
         if self.threads > 1 {
             self.assemble_triangles_owned(u, internal, values.as_deref_mut());
         } else {
-            let with_tangent = values.is_some();
-            for e in 0..self.triangles.len() {
-                let (r, k) = self.element(e, u, with_tangent);
-                for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
-                    internal[gi] += r[i];
-                }
-                if let Some(v) = values.as_deref_mut() {
-                    self.add_element_matrix(e, &k, v);
-                }
+            self.add_triangles_with(u, internal, values, |e, _, _, with_tangent| {
+                self.element(e, u, with_tangent)
+            });
+        }
+    }
+
+    /// Adds every triangle's force and, when `values` is given, its matrix, serially in
+    /// triangle order; `element(e, triangle, u_e, with_tangent)` computes them.
+    pub fn add_triangles_with(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        mut values: Option<&mut [f64]>,
+        mut element: impl FnMut(
+            usize,
+            &MembraneTriangle,
+            &ElementVector,
+            bool,
+        ) -> (ElementVector, ElementMatrix),
+    ) {
+        let with_tangent = values.is_some();
+        for (e, (nodes, tri)) in self.triangles.iter().enumerate() {
+            let global = node_dofs(nodes);
+            let ue = ElementVector::from_fn(|i, _| u[global[i]]);
+            let (r, k) = element(e, tri, &ue, with_tangent);
+            for (i, &gi) in global.iter().enumerate() {
+                internal[gi] += r[i];
+            }
+            if let Some(v) = values.as_deref_mut() {
+                self.add_element_matrix(e, &k, v);
             }
         }
     }

@@ -4,6 +4,7 @@
 use crate::mech::elements::curved_contact::ContactHistory;
 use crate::mech::elements::gap::GapStatus;
 use crate::mech::elements::load::LoadLevels;
+use crate::mech::elements::plasticity::PlasticHistory;
 use serde::{Deserialize, Serialize};
 
 /// Where the boundary groups are at one point of a step: translation and hinge angle of each.
@@ -38,6 +39,10 @@ pub struct AnalysisState {
     /// predictor of the next increment when the boundary keeps moving the same way.
     #[serde(default)]
     pub last_increment: Vec<f64>,
+    /// Plastic history of each triangle of an elasto-plastic film, committed only when an
+    /// increment converges (empty for the elastic film).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub plastic: Vec<PlasticHistory>,
 }
 
 impl AnalysisState {
@@ -50,6 +55,22 @@ impl AnalysisState {
             .chain(&self.angles)
             .chain(&self.friction)
             .chain(&self.last_increment)
+            .chain(
+                self.plastic
+                    .iter()
+                    .flat_map(|h| {
+                        let [a, b, c] = h.inverse_plastic_metric;
+                        [
+                            a,
+                            b,
+                            c,
+                            h.equivalent_plastic_strain,
+                            h.unloaded_thickness_strain,
+                        ]
+                    })
+                    .collect::<Vec<_>>()
+                    .iter(),
+            )
             .all(|v| v.is_finite())
             && self.contacts.iter().all(|c| {
                 [c.anchor[0], c.anchor[1], c.angle, c.origin, c.friction]

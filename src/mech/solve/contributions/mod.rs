@@ -119,7 +119,7 @@ impl Contributions {
     /// The contributions of `model` on `system`.
     pub fn new(model: &Model, system: &System) -> Self {
         Self {
-            triangles: Triangles,
+            triangles: Triangles::default(),
             gaps: Gaps::new(model),
             loads: Loads::new(model, system),
             cables: Cables::new(model),

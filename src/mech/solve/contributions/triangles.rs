@@ -3,20 +3,57 @@
 
 use super::{Contribution, Evaluation};
 use crate::mech::elements::material::Wrinkling;
-use crate::mech::elements::triangle::{ElementVector, MembraneTriangle};
+use crate::mech::elements::plasticity::PlasticHistory;
+use crate::mech::elements::triangle::{ElementStress, ElementVector};
 use crate::mech::model::Model;
 use crate::mech::results::Results;
 use crate::mech::results::summary::summarize;
 use crate::mech::solve::assembly::{System, node_dofs};
 use crate::mech::solve::state::AnalysisState;
 
-/// The membrane triangles (their geometry and material live in the [`System`]); no history yet.
-#[derive(Clone, Debug)]
-pub struct Triangles;
+/// The membrane triangles (their geometry and material live in the [`System`]) and, for an
+/// elasto-plastic film, the plastic history of each.
+#[derive(Clone, Debug, Default)]
+pub struct Triangles {
+    /// Converged plastic history the increment starts from (empty: elastic film).
+    start: Vec<PlasticHistory>,
+    /// Plastic history of the last evaluation (the trial).
+    trial: Vec<PlasticHistory>,
+}
 
 impl Contribution for Triangles {
+    fn restore(&mut self, start: &AnalysisState) {
+        self.start.clone_from(&start.plastic);
+        self.trial.clone_from(&start.plastic);
+    }
+
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
-        at.system.add_triangles(at.u, residual, values);
+        match at.system.material.plastic_film() {
+            None => at.system.add_triangles(at.u, residual, values),
+            Some(film) => {
+                let (start, trial) = (&self.start, &mut self.trial);
+                at.system
+                    .add_triangles_with(at.u, residual, values, |e, tri, ue, tangent| {
+                        let (r, k, response) = tri.force_and_tangent_plastic(
+                            &at.system.material,
+                            &film,
+                            &start[e],
+                            ue,
+                            tangent,
+                        );
+                        trial[e] = response.history;
+                        (r, k)
+                    });
+            }
+        }
+    }
+
+    fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
+        state.plastic.clone_from(&self.trial);
+    }
+
+    fn at_converged(&mut self, state: &AnalysisState) {
+        self.restore(state);
     }
 
     /// Film elements whose tension-field state differs between `a` and `b` (none without
@@ -25,37 +62,21 @@ impl Contribution for Triangles {
         if system.material.wrinkling == Wrinkling::None {
             return;
         }
-        let state = |u: &[f64], nodes: &[usize; 3], tri: &MembraneTriangle| {
-            let dofs = node_dofs(nodes);
-            let ue = ElementVector::from_fn(|i, _| u[dofs[i]]);
-            tri.stress_state(&system.material, &ue).state
-        };
-        out.extend(
-            system
-                .triangles
-                .iter()
-                .enumerate()
-                .filter(|(_, (nodes, tri))| state(a, nodes, tri) != state(b, nodes, tri))
-                .map(|(e, _)| e),
-        );
+        let state = |u: &[f64], e: usize| stress_state(system, &self.start, e, u).state;
+        out.extend((0..system.triangles.len()).filter(|&e| state(a, e) != state(b, e)));
     }
 
     /// Element stresses and the summaries of the model's element sets.
     fn results(
         &self,
         at: &Evaluation<'_>,
-        _state: &AnalysisState,
+        state: &AnalysisState,
         model: &Model,
         out: &mut Results,
     ) {
         let (system, u) = (at.system, at.u);
-        let elements = system
-            .triangles
-            .iter()
-            .map(|(nodes, tri)| {
-                let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
-                tri.stress_state(&system.material, &ue)
-            })
+        let elements = (0..system.triangles.len())
+            .map(|e| stress_state(system, &state.plastic, e, u))
             .collect::<Vec<_>>();
         let outputs = &model.outputs;
         out.sets = if outputs.element_sets.is_empty() {
@@ -72,5 +93,17 @@ impl Contribution for Triangles {
                 .collect()
         };
         out.elements = elements;
+    }
+}
+
+/// Stresses of triangle `e` at `u`, from its plastic `history` (indexed by triangle) when the
+/// film is elasto-plastic.
+fn stress_state(system: &System, history: &[PlasticHistory], e: usize, u: &[f64]) -> ElementStress {
+    let (nodes, tri) = &system.triangles[e];
+    let dofs = node_dofs(nodes);
+    let ue = ElementVector::from_fn(|i, _| u[dofs[i]]);
+    match system.material.plastic_film() {
+        None => tri.stress_state(&system.material, &ue),
+        Some(film) => tri.stress_state_plastic(&system.material, &film, &history[e], &ue),
     }
 }

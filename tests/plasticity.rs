@@ -1,0 +1,214 @@
+//! The elasto-plastic film through the solver (issue 20): a strip pulled to 30 % log strain and
+//! back, against the closed form of its hardening table.
+//!
+//! ```text
+//!   strip L × w (nx × 1 cells), z fixed everywhere
+//!   left edge: x fixed (and y at one node)     right edge: group "pull", x prescribed
+//! ```
+
+use membrane_contact::mech::Analysis;
+use membrane_contact::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
+use membrane_contact::mech::elements::plasticity::{Hardening, Plasticity};
+use membrane_contact::mech::elements::triangle::Material;
+use membrane_contact::mech::model::{Axis, BoundaryGroup, Model, Support};
+
+const E: f64 = 1.0e9;
+const NU: f64 = 0.43;
+const T0: f64 = 250e-6;
+const L: f64 = 0.1;
+const W: f64 = 0.02;
+/// Bilinear table: σy = 16 MPa + H ε̄p.
+const SY: f64 = 16e6;
+const H: f64 = 100e6;
+
+fn strip(nx: usize) -> Model {
+    let mut nodes = vec![];
+    for j in 0..=1 {
+        for i in 0..=nx {
+            nodes.push([L * i as f64 / nx as f64, W * j as f64, 0.0]);
+        }
+    }
+    let id = |i: usize, j: usize| j * (nx + 1) + i;
+    let mut triangles = vec![];
+    for i in 0..nx {
+        triangles.push([id(i, 0), id(i + 1, 0), id(i + 1, 1)]);
+        triangles.push([id(i, 0), id(i + 1, 1), id(i, 1)]);
+    }
+    let mut supports = vec![];
+    for j in 0..=1 {
+        for i in 0..nx {
+            let mut fixed = vec![Axis::Z];
+            if i == 0 {
+                fixed.push(Axis::X);
+                if j == 0 {
+                    fixed.push(Axis::Y);
+                }
+            }
+            supports.push(Support {
+                node: id(i, j),
+                fixed,
+                name: None,
+            });
+        }
+    }
+    supports.push(Support {
+        node: id(nx, 0),
+        fixed: vec![Axis::Z],
+        name: None,
+    });
+    supports.push(Support {
+        node: id(nx, 1),
+        fixed: vec![Axis::Z],
+        name: None,
+    });
+    Model {
+        loads: Default::default(),
+        outputs: Default::default(),
+        cables: vec![],
+        curved_supports: vec![],
+        name: "Strip".into(),
+        description: String::new(),
+        nodes,
+        triangles,
+        material: Material {
+            youngs_modulus: E,
+            poisson_ratio: NU,
+            thickness: T0,
+            prestress: [0.0; 3],
+            density: 0.0,
+            wrinkling: Wrinkling::None,
+            wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+            yield_stress: None,
+            plasticity: Some(Plasticity {
+                hardening: Hardening::new(vec![[0.0, SY], [1.0, SY + H]]).unwrap(),
+            }),
+        },
+        supports,
+        symmetry: vec![],
+        gaps: vec![],
+        groups: vec![BoundaryGroup {
+            name: "pull".into(),
+            nodes: vec![id(nx, 0), id(nx, 1)],
+            target: [0.0; 3],
+            components: Some(vec![Axis::X]),
+            hinge: None,
+        }],
+    }
+}
+
+/// Uniaxial closed form at log strain `eps` after the largest plastic strain `ep_max`:
+/// `(Kirchhoff τ, ε̄p)`; loading `ln λ = σy(ε̄p)/E + ε̄p`, unloading elastic.
+fn closed_form(eps: f64, ep_max: f64) -> (f64, f64) {
+    let loading = (E * eps - SY) / (E + H);
+    if loading > ep_max && E * eps > SY {
+        (SY + H * loading, loading)
+    } else if ep_max == 0.0 {
+        (E * eps, 0.0)
+    } else {
+        (E * (eps - ep_max), ep_max)
+    }
+}
+
+#[test]
+fn strip_to_30_percent_log_strain_and_back_follows_the_hardening_table() {
+    let model = strip(4);
+    let mut a = Analysis::new(model, Default::default()).unwrap();
+    let mut ep_max: f64 = 0.0;
+    let peak = 0.3;
+    let ep_peak = (E * peak - SY) / (E + H);
+    let path: Vec<f64> = (1..=6)
+        .map(|k| peak * k as f64 / 6.0)
+        .chain((1..=4).map(|k| peak + (ep_peak - peak) * k as f64 / 4.0))
+        .collect();
+    for eps in path {
+        let dx = L * (eps.exp() - 1.0);
+        a.step_to(&[[dx, 0.0, 0.0]], 5).unwrap();
+        let r = a.results();
+        let (tau, ep) = closed_form(eps, ep_max);
+        ep_max = ep_max.max(ep);
+        // Force on the pulled edge: nominal stress τ/λ on the initial section w t0.
+        let force = tau / eps.exp() * W * T0;
+        let fx = r.reactions[0][0];
+        assert!(
+            (fx - force).abs() < 1e-6 * (SY * W * T0),
+            "ε {eps}: F {fx} vs {force}"
+        );
+        let thickness = T0 * (-NU * tau / E - ep / 2.0).exp();
+        for e in &r.elements {
+            let p = e.plastic.unwrap();
+            assert!(
+                (p.equivalent_plastic_strain - ep).abs() < 1e-9,
+                "ε {eps}: ε̄p {p:?}"
+            );
+            assert!(
+                (p.thickness - thickness).abs() < 1e-6 * T0,
+                "ε {eps}: t {p:?} vs {thickness}"
+            );
+        }
+    }
+    // Back at ln λ = ε̄p: no force, the residual strain is the plastic strain.
+    assert!(a.results().reactions[0][0].abs() < 1e-6 * SY * W * T0);
+}
+
+#[test]
+fn strip_past_the_rupture_strain_is_reported_in_the_warnings() {
+    use membrane_contact::mech::elements::plasticity::ETFE_RUPTURE_PLASTIC_STRAIN;
+    use membrane_contact::mech::results::warnings::result_warnings;
+    let mut a = Analysis::new(strip(2), Default::default()).unwrap();
+    let mut warned = vec![];
+    for eps in [1.0, 1.4, 1.7] {
+        a.step_to(&[[L * (f64::exp(eps) - 1.0), 0.0, 0.0]], 20)
+            .unwrap();
+        let r = a.results();
+        let ep = r.elements[0].plastic.unwrap().equivalent_plastic_strain;
+        let w = result_warnings(a.model(), &r);
+        assert_eq!(
+            !w.is_empty(),
+            ep > ETFE_RUPTURE_PLASTIC_STRAIN,
+            "ε̄p {ep}: {w:?}"
+        );
+        warned.extend(w);
+    }
+    assert_eq!(warned.len(), 1);
+    assert!(
+        warned[0].contains("past ETFE's rupture strain 1.455"),
+        "{warned:?}"
+    );
+}
+
+#[test]
+fn saved_state_in_the_middle_of_plastic_loading_continues_bit_for_bit() {
+    let path = [0.05, 0.12, 0.2, 0.15, 0.25, 0.1];
+    let step = |a: &mut Analysis, eps: f64| {
+        a.step_to(&[[L * (eps.exp() - 1.0), 0.0, 0.0]], 3).unwrap();
+        a.results()
+    };
+    let mut straight = Analysis::new(strip(3), Default::default()).unwrap();
+    let mut resumed = Analysis::new(strip(3), Default::default()).unwrap();
+    for &eps in &path[..3] {
+        step(&mut straight, eps);
+        step(&mut resumed, eps);
+    }
+    // Save mid-loading (serialized as an FMU state is), restore into a fresh analysis.
+    let saved = serde_json::to_string(straight.state()).unwrap();
+    let mut restored = Analysis::new(strip(3), Default::default()).unwrap();
+    restored
+        .set_state(serde_json::from_str(&saved).unwrap())
+        .unwrap();
+    assert!(restored.state().plastic[0].equivalent_plastic_strain > 0.1);
+    for &eps in &path[3..] {
+        let (a, b) = (step(&mut straight, eps), step(&mut restored, eps));
+        assert_eq!(a.reactions, b.reactions, "ε {eps}");
+        assert_eq!(a.elements, b.elements, "ε {eps}");
+        assert_eq!(straight.state(), restored.state());
+    }
+    // A state of the elastic film does not fit the plastic one.
+    let mut elastic_model = strip(3);
+    elastic_model.material.plasticity = None;
+    let elastic = Analysis::new(elastic_model, Default::default()).unwrap();
+    let err = restored.set_state(elastic.state().clone()).unwrap_err();
+    assert!(
+        err.contains("plastic history of 0 triangles; this model's film needs 6"),
+        "{err}"
+    );
+}
