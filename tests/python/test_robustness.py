@@ -88,7 +88,15 @@ def test_bad_calls_return_error_and_log(fmu_path):
         assert s.step(0.0, -0.1) == ERROR and s.logged(ERROR, "must be > 0")
         assert f["fmi2ExitInitializationMode"](c) == ERROR
         assert f["fmi2CancelStep"](c) == ERROR
-        assert f["fmi2GetDirectionalDerivative"](c, None, 0, None, 0, None, None) == ERROR
+        # Directional derivatives are provided (issue 21): an empty request is answered, a NULL
+        # array with a count and an unknown reference are refused with a message.
+        assert f["fmi2GetDirectionalDerivative"](c, None, 0, None, 0, None, None) == OK
+        assert f["fmi2GetDirectionalDerivative"](c, None, 1, None, 0, None, None) == ERROR
+        assert s.logged(ERROR, "vUnknown_ref is NULL"), s.messages[-1]
+        unknown = (c_double * 1)(0.0)
+        assert f["fmi2GetDirectionalDerivative"](
+            c, vr_array(s.vr("G1.slip")), 1, vr_array(99999), 1, (c_double * 1)(1.0), unknown) == ERROR
+        assert s.logged(ERROR, "99999"), s.messages[-1]
         assert f["fmi2SetRealInputDerivatives"](c, None, 0, None, None) == ERROR
 
         # Unknown log category.
