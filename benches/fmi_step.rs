@@ -13,7 +13,8 @@ use membrane_contact::fmi2::description::describe;
 use membrane_contact::fmi2::exports::*;
 use membrane_contact::fmi2::resources::{Source, file_uri};
 use membrane_contact::fmi2::types::*;
-use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use membrane_contact::mech::{Analysis, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 
 const STEPS: usize = 20;
 const RUNS: usize = 25;

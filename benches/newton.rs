@@ -14,10 +14,11 @@
 
 use std::time::{Duration, Instant};
 
-use membrane_contact::mech::assembly::System;
-use membrane_contact::mech::contact::GapLaw;
-use membrane_contact::mech::linear::{LinearSolver, UnsymmetricMethod};
-use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use membrane_contact::mech::elements::gap::GapLaw;
+use membrane_contact::mech::solve::assembly::System;
+use membrane_contact::mech::solve::linear::{LinearSolver, UnsymmetricMethod};
+use membrane_contact::mech::{Analysis, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 use nalgebra::Vector2;
 
 /// Peak resident set size (bytes) from /proc (0 where unavailable).

@@ -11,9 +11,10 @@
 
 use std::time::{Duration, Instant};
 
-use membrane_contact::mech::assembly::System;
-use membrane_contact::mech::contact::GapLaw;
-use membrane_contact::mech::{Analysis, Model, ParallelArch, SolverSettings};
+use membrane_contact::mech::elements::gap::GapLaw;
+use membrane_contact::mech::solve::assembly::System;
+use membrane_contact::mech::{Analysis, Model, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 use nalgebra::Vector2;
 
 #[path = "common/sheet.rs"]

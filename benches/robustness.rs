@@ -20,7 +20,7 @@ use std::time::Instant;
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::SolverSettings;
-use membrane_contact::mech::scenarios::{
+use membrane_contact::specimens::scenarios::{
     Family, RunOutcome, Scenario, grid_slice, robustness_grid,
 };
 

@@ -10,10 +10,11 @@
 
 use std::time::{Duration, Instant};
 
-use membrane_contact::mech::assembly::System;
-use membrane_contact::mech::contact::GapLaw;
-use membrane_contact::mech::linear::LinearSolver;
-use membrane_contact::mech::{Analysis, IterationMatrix, ParallelArch, SolverSettings};
+use membrane_contact::mech::elements::gap::GapLaw;
+use membrane_contact::mech::solve::assembly::System;
+use membrane_contact::mech::solve::linear::LinearSolver;
+use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 use nalgebra::Vector2;
 
 fn median(mut v: Vec<Duration>) -> Duration {

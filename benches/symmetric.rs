@@ -40,7 +40,7 @@ fn solve(model: &Model, symmetric: bool) -> (Duration, usize, [usize; 4], f64) {
 /// iterations are unsymmetric (Woodbury or GMRES on the symmetric part's LDLᵀ when on, LU when
 /// off).
 fn specimen(r: usize, symmetric: bool) -> (Duration, usize, [usize; 4], Vec<f64>) {
-    use membrane_contact::mech::ParallelArch;
+    use membrane_contact::specimens::ParallelArch;
     let spec = ParallelArch {
         refinement: r,
         ..ParallelArch::with_height(0.3)

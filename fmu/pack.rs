@@ -38,8 +38,9 @@ use std::time::SystemTime;
 
 use membrane_contact::fmi2::description::{Description, describe, documentation_html};
 use membrane_contact::fmi2::resources::{SPECIMEN_FILE, Source};
-use membrane_contact::mech::specimen::MODEL_NAME;
-use membrane_contact::mech::{Model, ParallelArch};
+use membrane_contact::mech::Model;
+use membrane_contact::specimens::ParallelArch;
+use membrane_contact::specimens::parallel_arch::MODEL_NAME;
 use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
@@ -271,7 +272,7 @@ fn run(o: &Options) -> Result<(), String> {
     // What looks wrong in a model that validates (E in MPa, flipped pressure triangles, …): the
     // CLI's and the FMU's check, printed as the CLI prints it; the FMU is still packed.
     if let Source::Model(model) = &source {
-        for w in membrane_contact::mech::summary::model_warnings(model) {
+        for w in membrane_contact::mech::results::warnings::model_warnings(model) {
             eprintln!("warning: {w}");
         }
     }

@@ -10,9 +10,10 @@
 //! groups at both ends (the right one moved by δ), every node held in z, one corner in y, so
 //! the strip stretches homogeneously with free lateral contraction. Cables along both long edges.
 
-use membrane_contact::mech::cable::{axial_force, segment_force_and_tangent};
+use membrane_contact::mech::elements::cable::{axial_force, segment_force_and_tangent};
 use membrane_contact::mech::model::{Axis, BoundaryGroup, CableSpec, Model, Support};
-use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use membrane_contact::mech::{Analysis, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 use nalgebra::Vector3;
 
 const NX: usize = 8;
@@ -236,7 +237,7 @@ fn the_fmu_cable_force_is_the_cores_and_the_green_strain_closed_form() {
 /// the one the results report, and a strip without cables writes no cables block.
 #[test]
 fn cable_segments_are_written_to_vtk_with_their_axial_forces() {
-    use membrane_contact::mech::vtk::{self, Block, Encoding};
+    use membrane_contact::mech::results::vtk::{self, Block, Encoding};
     let model = strip(true, 200.0);
     let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
     analysis.step_to(&[[0.0; 3], [0.002, 0.0, 0.0]], 4).unwrap();

@@ -101,7 +101,7 @@ fn a_model_without_gaps_writes_film_files_only() {
     let root =
         std::env::temp_dir().join(format!("membrane-contact-cli-nogap-{}", std::process::id()));
     std::fs::create_dir_all(&root).unwrap();
-    let mut model = membrane_contact::mech::ParallelArch::with_height(0.2)
+    let mut model = membrane_contact::specimens::ParallelArch::with_height(0.2)
         .model()
         .unwrap();
     model.gaps.clear();
@@ -486,7 +486,7 @@ fn wrapped_specimen_runs_from_the_command_line_and_bad_wraps_are_refused() {
 fn cli_takes_the_fmus_default_increments_per_step() {
     use membrane_contact::fmi2::description::describe;
     use membrane_contact::fmi2::resources::Source;
-    use membrane_contact::mech::ParallelArch;
+    use membrane_contact::specimens::ParallelArch;
     let description = describe(&Source::ParallelArch(ParallelArch::default())).unwrap();
     let start = description
         .variables
@@ -497,7 +497,7 @@ fn cli_takes_the_fmus_default_increments_per_step() {
     let (ok, out, err) = specimen(&[]);
     assert!(ok, "{err}");
     let newton = out.lines().find(|l| l.starts_with("Newton:")).unwrap();
-    let per_step = membrane_contact::mech::solver::DEFAULT_INCREMENTS_PER_STEP;
+    let per_step = membrane_contact::mech::solve::DEFAULT_INCREMENTS_PER_STEP;
     assert!(
         start.contains(&format!("Integer({per_step})")),
         "FMU start value {start}"

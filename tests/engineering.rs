@@ -21,7 +21,7 @@
 
 use std::process::Command;
 
-use membrane_contact::mech::lines::{LineKind, reaction_lines};
+use membrane_contact::mech::results::lines::{LineKind, reaction_lines};
 use membrane_contact::mech::{Analysis, Model, SolverSettings};
 
 const XS: [f64; 4] = [0.0, 0.5, 1.0, 2.0];

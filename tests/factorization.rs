@@ -7,8 +7,9 @@
 //! LU throughout — its unsymmetric iterations solved by GMRES preconditioned with the LDLᵀ of
 //! the symmetric part (item 2); a follower pressure makes every iteration unsymmetric.
 
-use membrane_contact::mech::linear::UnsymmetricMethod;
-use membrane_contact::mech::{Analysis, LoadLevels, Model, ParallelArch, SolverSettings};
+use membrane_contact::mech::solve::linear::UnsymmetricMethod;
+use membrane_contact::mech::{Analysis, LoadLevels, Model, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 
 fn run(model: &Model, symmetric: bool, loads: &LoadLevels, angle: f64) -> (Vec<f64>, [usize; 4]) {
     let settings = SolverSettings {

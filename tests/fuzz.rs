@@ -27,7 +27,8 @@ use membrane_contact::fmi2::resources::Source;
 use membrane_contact::fmi2::state::{self, Snapshot};
 use membrane_contact::fmi2::types::{FMI2_LAST_SUCCESSFUL_TIME, Status};
 use membrane_contact::fmi2::variables::{Causality, Value, VarType};
-use membrane_contact::mech::{GapStatus, Model, ParallelArch};
+use membrane_contact::mech::{GapStatus, Model};
+use membrane_contact::specimens::ParallelArch;
 use serde_json::Value as Json;
 
 const STATE_CASES: usize = 1200;

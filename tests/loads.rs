@@ -5,19 +5,19 @@
 //! by shooting on its ODE (see [`hencky`]), which reproduces Hencky's (1915) series coefficient
 //! `b0 = 1.7244` and `w0/a = 0.6534 (qa/Et)^{1/3}` for ν = 0.3 (Fichter, NASA TP-3658, 1997).
 
-use membrane_contact::mech::assembly::{Dof, System};
-use membrane_contact::mech::element::{ElementVector, Material};
-use membrane_contact::mech::load::{
+use membrane_contact::mech::elements::load::{
     ExternalLoad, LoadLevels, Loads, orientation, pressure_force, pressure_signs,
     pressure_stiffness,
 };
-use membrane_contact::mech::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
+use membrane_contact::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
+use membrane_contact::mech::elements::triangle::{ElementVector, Material};
 use membrane_contact::mech::model::{
     AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, ForceSet, LoadSpec, Model,
     OutputPoint, OutputSpec, PressureSet, Side, Support, Towards,
 };
-use membrane_contact::mech::scenarios::CircularMembrane;
+use membrane_contact::mech::solve::assembly::{Dof, System};
 use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings, StepError};
+use membrane_contact::specimens::scenarios::CircularMembrane;
 use nalgebra::{DMatrix, Vector3};
 
 mod common;
@@ -668,7 +668,7 @@ fn oriented_pressure_deflects_a_disc_the_same_whatever_the_triangles_winding() {
 /// consistently wound disc there is no such warning. `orientation` reports the turned count.
 #[test]
 fn flipped_triangles_in_a_pressure_set_without_towards_are_warned_naming_how_many() {
-    use membrane_contact::mech::summary::model_warnings;
+    use membrane_contact::mech::results::warnings::model_warnings;
     let base = disc(1.0, 4, film(1e6));
     let flipped = half_flipped(&base);
     let count = base.triangles.len();

@@ -10,18 +10,19 @@
 //!   0 --- 1 --- 2
 //! ```
 
-use membrane_contact::mech::assembly::{Dof, System};
-use membrane_contact::mech::contact::{
+use membrane_contact::mech::elements::gap::{
     FrictionLaw, GapFrame, GapLaw, GapResponse, GapStatus, IterationMatrix,
 };
-use membrane_contact::mech::element::{ElementVector, Material, MembraneTriangle};
-use membrane_contact::mech::material::{
+use membrane_contact::mech::elements::material::{
     DEFAULT_WRINKLING_REGULARISATION, Wrinkling, WrinklingState,
 };
+use membrane_contact::mech::elements::triangle::{ElementVector, Material, MembraneTriangle};
 use membrane_contact::mech::model::{
     Axis, BoundaryGroup, GapSpec, GapSupport, Model, Support, Symmetry,
 };
-use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use membrane_contact::mech::solve::assembly::{Dof, System};
+use membrane_contact::mech::{Analysis, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 use nalgebra::{DMatrix, Matrix3, Rotation3, Vector2, Vector3};
 
 fn etfe() -> Material {
@@ -1035,7 +1036,7 @@ fn specimen_state() -> (Analysis, membrane_contact::mech::Results) {
 
 #[test]
 fn vtk_film_and_gap_files_are_complete_without_placeholders() {
-    use membrane_contact::mech::vtk::{self, Encoding};
+    use membrane_contact::mech::results::vtk::{self, Encoding};
     let (a, results) = specimen_state();
     let (model, u) = (a.model(), &a.state().displacement);
     for encoding in [Encoding::Ascii, Encoding::Binary] {
@@ -1105,7 +1106,7 @@ fn vtk_film_and_gap_files_are_complete_without_placeholders() {
 
 #[test]
 fn binary_vtu_round_trips_points_and_fields() {
-    use membrane_contact::mech::vtk::{self, Encoding};
+    use membrane_contact::mech::results::vtk::{self, Encoding};
     let (a, results) = specimen_state();
     let (model, u) = (a.model(), &a.state().displacement);
     let binary = vtk::film_grid(model, u, &results, Encoding::Binary);
@@ -1122,7 +1123,7 @@ fn binary_vtu_round_trips_points_and_fields() {
         .collect();
     assert_eq!(b.arrays["points"], points);
     assert_eq!(b.arrays["displacement"], u[..3 * model.nodes.len()]);
-    let field = |f: fn(&membrane_contact::mech::element::ElementStress) -> Vec<f64>| -> Vec<f64> {
+    let field = |f: fn(&membrane_contact::mech::elements::triangle::ElementStress) -> Vec<f64>| -> Vec<f64> {
         results.elements.iter().flat_map(f).collect()
     };
     assert_eq!(b.arrays["von_mises"], field(|e| vec![e.von_mises]));
@@ -1424,11 +1425,11 @@ fn over_contracted_stretch_is_uniaxial_tension() {
         let right = edge_reaction(a.model(), &results.reactions, |p| {
             (p[0] - 1.0).abs() < 1e-12
         });
-        let text = membrane_contact::mech::vtk::film_grid(
+        let text = membrane_contact::mech::results::vtk::film_grid(
             a.model(),
             &a.state().displacement,
             &results,
-            membrane_contact::mech::vtk::Encoding::Ascii,
+            membrane_contact::mech::results::vtk::Encoding::Ascii,
         );
         let text = String::from_utf8(text).unwrap();
         (results, right, text)
@@ -1572,7 +1573,7 @@ fn shear_panel(n: usize, material: Material) -> Model {
 }
 
 fn state_counts(results: &membrane_contact::mech::Results) -> [usize; 3] {
-    membrane_contact::mech::element::state_counts(&results.elements)
+    membrane_contact::mech::elements::triangle::state_counts(&results.elements)
 }
 
 #[test]
@@ -2009,9 +2010,9 @@ fn control_characters_in_the_description_are_refused_naming_the_field() {
 #[test]
 fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
     use membrane_contact::mech::LoadLevels;
-    use membrane_contact::mech::material::Wrinkling;
+    use membrane_contact::mech::elements::material::Wrinkling;
     use membrane_contact::mech::model::{AllElements, ElementSelection, PressureSet};
-    use membrane_contact::mech::specimen::SpecimenContact;
+    use membrane_contact::specimens::parallel_arch::SpecimenContact;
     let spec = ParallelArch {
         refinement: 3,
         ..ParallelArch::with_height(0.3)

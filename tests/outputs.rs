@@ -8,9 +8,10 @@
 //! by its pressure, with a point at the centre and a set of the inner rings.
 
 use membrane_contact::mech::model::{ElementSelection, ElementSet, OutputPoint};
-use membrane_contact::mech::scenarios::CircularMembrane;
-use membrane_contact::mech::summary;
-use membrane_contact::mech::{Analysis, LoadLevels, Material, Model, ParallelArch, SolverSettings};
+use membrane_contact::mech::results::warnings::{model_warnings, result_warnings};
+use membrane_contact::mech::{Analysis, LoadLevels, Material, Model, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
+use membrane_contact::specimens::scenarios::CircularMembrane;
 
 /// A 4-ring disc of radius 1 m, the specimen's ETFE film prestressed to 1 MPa, 100 Pa.
 fn disc(pressure: f64) -> CircularMembrane {
@@ -162,7 +163,7 @@ fn output_sections_name_the_bad_item() {
 fn the_specimen_gives_no_model_warning() {
     for h in [0.2, 0.3, 0.4] {
         let model = ParallelArch::with_height(h).model().unwrap();
-        assert_eq!(summary::model_warnings(&model), Vec::<String>::new());
+        assert_eq!(model_warnings(&model), Vec::<String>::new());
     }
 }
 
@@ -172,14 +173,14 @@ fn a_modulus_in_mpa_and_an_inconsistent_initial_gap_warn_naming_the_item() {
     model.material.youngs_modulus = 800.0;
     // 50 µm: within what validation accepts (1e-4 of the 2.9 m model), beyond what is exact.
     model.gaps[3].initial_gap += 5e-5;
-    let warnings = summary::model_warnings(&model);
+    let warnings = model_warnings(&model);
     assert_eq!(warnings.len(), 2, "{warnings:#?}");
     assert!(warnings[0].contains("looks like a value in MPa"));
     assert!(warnings[1].contains("gap 'G4'") && warnings[1].contains("farther"));
     // A gap consistent to well below a micrometre does not warn.
     let mut model = ParallelArch::default().model().unwrap();
     model.gaps[3].initial_gap += 1e-9;
-    assert!(summary::model_warnings(&model).is_empty());
+    assert!(model_warnings(&model).is_empty());
 }
 
 #[test]
@@ -214,11 +215,11 @@ fn stress_above_the_yield_stress_warns_and_below_does_not() {
         peak > 15e6,
         "the 300 mm specimen passes ETFE's first yield: {peak}"
     );
-    let warnings = summary::result_warnings(&model, &results);
+    let warnings = result_warnings(&model, &results);
     assert_eq!(warnings.len(), 1, "{warnings:#?}");
     assert!(warnings[0].contains("above the material's yield_stress 15.000 MPa"));
     model.material.yield_stress = Some(1.01 * peak);
-    assert!(summary::result_warnings(&model, &results).is_empty());
+    assert!(result_warnings(&model, &results).is_empty());
     model.material.yield_stress = None;
-    assert!(summary::result_warnings(&model, &results).is_empty());
+    assert!(result_warnings(&model, &results).is_empty());
 }

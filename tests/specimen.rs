@@ -26,10 +26,11 @@
 //! The model file numbers its nodes column by column and lists its triangles in another order
 //! than the program does, so the two runs agree to the solver's tolerance, not bit for bit.
 
+use membrane_contact::mech::elements::curved_contact::Centreline;
 use membrane_contact::mech::model::GapSupport;
-use membrane_contact::mech::specimen::{FramePath, SpecimenContact};
-use membrane_contact::mech::surface::Centreline;
-use membrane_contact::mech::{Analysis, Model, ParallelArch, Results, SolverSettings};
+use membrane_contact::mech::{Analysis, Model, Results, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
+use membrane_contact::specimens::parallel_arch::{FramePath, SpecimenContact};
 
 // The documented dimensions (assumption table), written as numbers, not read from the program.
 const HALF_SPAN: f64 = 0.8;

@@ -24,7 +24,8 @@
 use membrane_contact::fmi2::description::describe;
 use membrane_contact::fmi2::resources::Source;
 use membrane_contact::mech::model::{Axis, BoundaryGroup, Model, Support};
-use membrane_contact::mech::{Analysis, ParallelArch, SolverSettings};
+use membrane_contact::mech::{Analysis, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 
 mod common;
 
@@ -169,7 +170,7 @@ fn the_fmu_has_inputs_and_reactions_for_prescribed_components_only() {
 /// The ring-meshed disc of `scenarios::CircularMembrane` under 100 Pa, its rim held by
 /// supports instead of a group: the northern half named `north`, the southern `south`.
 fn disc_on_named_supports() -> (Model, f64) {
-    use membrane_contact::mech::scenarios::CircularMembrane;
+    use membrane_contact::specimens::scenarios::CircularMembrane;
     let disc = CircularMembrane {
         radius: 1.0,
         rings: 4,
@@ -250,7 +251,7 @@ fn film(prestress: [f64; 3]) -> membrane_contact::mech::Material {
         density: 0.0,
         wrinkling: Default::default(),
         wrinkling_regularisation:
-            membrane_contact::mech::material::DEFAULT_WRINKLING_REGULARISATION,
+            membrane_contact::mech::elements::material::DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
     }
 }
@@ -421,7 +422,7 @@ fn a_triangle_stretched_to_a_prescribed_shape_has_the_closed_form_stress_and_rea
 /// The prescribed triangle moved as one group `Drive`, with a gap `G` from node 0 to a point
 /// 1 mm below it: `k_n` = 1e5 N/m, `k_s` = 1e4 N/m, `μ` = 0.3.
 fn driven_gap(law: membrane_contact::mech::FrictionLaw) -> Model {
-    use membrane_contact::mech::contact::GapFrame;
+    use membrane_contact::mech::elements::gap::GapFrame;
     use membrane_contact::mech::model::{GapSpec, GapSupport};
     let mut model = prescribed_triangle([0.5e6, 0.5e6, 0.0]);
     model.name = "DrivenGap".into();

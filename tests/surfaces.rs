@@ -15,11 +15,14 @@
 //! stations on the half circle, vertical legs of 0.1 m, the left end held, the right end
 //! pulled down.
 
-use membrane_contact::mech::contact::GapFrame;
-use membrane_contact::mech::contact::{FrictionLaw, GapStatus};
+use membrane_contact::mech::elements::curved_contact::{
+    Centreline, CurvedSupport, SurfaceContactResult,
+};
+use membrane_contact::mech::elements::gap::GapFrame;
+use membrane_contact::mech::elements::gap::{FrictionLaw, GapStatus};
 use membrane_contact::mech::model::{BoundaryGroup, GapSpec, GapSupport, Hinge, Model};
-use membrane_contact::mech::surface::{Centreline, CurvedSupport, SurfaceContactResult};
-use membrane_contact::mech::{Analysis, LoadLevels, ParallelArch, SolverSettings};
+use membrane_contact::mech::{Analysis, LoadLevels, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
 use nalgebra::Vector3;
 
 mod common;
@@ -412,7 +415,7 @@ fn fmu_reports_each_contact_node_and_states_carry_the_contact_history() {
 /// larger than the travel, and zero at the open G8 while the gap's local x is not.
 #[test]
 fn specimen_on_curved_supports_agrees_with_the_gaps_where_the_film_touches_the_arch() {
-    use membrane_contact::mech::specimen::SpecimenContact;
+    use membrane_contact::specimens::parallel_arch::SpecimenContact;
     for h in [0.2, 0.3, 0.4] {
         let run = |contact| {
             let spec = ParallelArch {
@@ -466,8 +469,8 @@ fn specimen_on_curved_supports_agrees_with_the_gaps_where_the_film_touches_the_a
 /// residual, column by column over the contact nodes and their neighbours.
 #[test]
 fn assembled_tangent_with_sliding_curved_contacts_matches_finite_differences() {
-    use membrane_contact::mech::assembly::Dof;
-    use membrane_contact::mech::specimen::SpecimenContact;
+    use membrane_contact::mech::solve::assembly::Dof;
+    use membrane_contact::specimens::parallel_arch::SpecimenContact;
     let spec = ParallelArch {
         contact: SpecimenContact::CurvedSupport,
         target_dz_per_height: -0.8,

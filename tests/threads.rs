@@ -15,7 +15,7 @@
 use membrane_contact::fmi2::instance::Instance;
 use membrane_contact::fmi2::logger::Logger;
 use membrane_contact::fmi2::resources::Source;
-use membrane_contact::mech::ParallelArch;
+use membrane_contact::specimens::ParallelArch;
 
 fn tasks() -> usize {
     std::fs::read_dir("/proc/self/task")

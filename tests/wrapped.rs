@@ -13,10 +13,11 @@
 //!
 //! MODEL: the default specimen (`specimen.rs`) with `frame_path: wrapped`, 40 steps.
 
-use membrane_contact::mech::contact::GapStatus;
+use membrane_contact::mech::elements::gap::GapStatus;
 use membrane_contact::mech::model::OutputPoint;
-use membrane_contact::mech::specimen::{FramePath, SpecimenContact};
-use membrane_contact::mech::{Analysis, ParallelArch, Results, SolverSettings};
+use membrane_contact::mech::{Analysis, Results, SolverSettings};
+use membrane_contact::specimens::ParallelArch;
+use membrane_contact::specimens::parallel_arch::{FramePath, SpecimenContact};
 
 const STEPS: usize = 40;
 

@@ -1,6 +1,6 @@
 //! The sheet of issue 11's side-by-side benchmark, shared by the bench targets.
 
-use membrane_contact::mech::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
+use membrane_contact::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
 use membrane_contact::mech::model::{Axis, BoundaryGroup, Support};
 use membrane_contact::mech::{Material, Model};
 

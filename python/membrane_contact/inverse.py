@@ -25,6 +25,7 @@ The measured CSV has the columns ``output,value`` and optionally ``scale``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import csv
 import sys
 from dataclasses import dataclass, field
@@ -35,6 +36,7 @@ from fmpy import read_model_description
 
 from .film import Film
 from .fmu import find_fmu
+from .study import apply_values
 
 
 @dataclass
@@ -149,21 +151,16 @@ def read_path(path) -> dict[str, list[float]]:
 
 def _run(fmu, path, parameters, unknowns, values, outputs):
     """The outputs at the end of ``path`` with the unknowns at ``values``."""
-    params = dict(parameters or {})
-    table = {k: np.asarray(v, dtype=float).copy() for k, v in path.items()}
     with Film(fmu, logging=False) as film:
-        for u, x in zip(unknowns, values):
+        causality = {**{n: "input" for n in film.inputs}, **{n: "parameter" for n in film.parameters}}
+        for u in unknowns:
             if u.name.startswith("scale:"):
-                column = u.name[len("scale:"):]
-                if column not in table:
-                    raise KeyError(f"'{u.name}': the path has no column '{column}'")
-                table[column] = table[column] * x
-            elif u.name in film.inputs:
-                table[u.name] = np.full(len(table["time"]), x)
-            elif u.name in film.parameters:
-                params[u.name] = x
-            else:
+                if u.name[len("scale:"):] not in path:
+                    raise KeyError(f"'{u.name}': the path has no column '{u.name[len('scale:'):]}'")
+            elif u.name not in causality:
                 raise KeyError(f"unknown '{u.name}' is neither an input, a parameter nor scale:<column>")
+        table, params = apply_values({u.name: x for u, x in zip(unknowns, values)}, path, parameters or {},
+                                     causality)
         film.initialize(parameters=params)
         film.run(table, outputs=[])
         return np.array([film[o] for o in outputs], dtype=float)
@@ -171,10 +168,13 @@ def _run(fmu, path, parameters, unknowns, values, outputs):
 
 def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, parameters: dict | None = None,
         max_iterations: int = 30, tolerance: float = 1e-8, relative_step: float = 1e-4,
-        scales: dict[str, float] | None = None) -> FitResult:
+        scales: dict[str, float] | None = None, client=None) -> FitResult:
     """Levenberg–Marquardt on ``(model(unknowns) − measured) / scale`` over the outputs named in
     ``measured`` at the end of the staged ``path`` (a table for :meth:`Film.run`); ``scales``:
-    each output's measurement scale in its unit (see :func:`measurement_scales`)."""
+    each output's measurement scale in its unit (see :func:`measurement_scales`). ``client``: a
+    ``dask.distributed.Client``; the sensitivity runs of each Jacobian (two per unknown) then run
+    in parallel on its workers (:class:`membrane_contact.study.Runner`: the FMU travels to them),
+    each the same run as in series, so the fit is the same."""
     outputs = list(measured)
     scales = measurement_scales(fmu, outputs, scales)
     w = np.array([1.0 / scales[o] for o in outputs])
@@ -184,22 +184,38 @@ def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, pa
     hi = np.array([u.upper for u in unknowns])
     evaluations = 0
 
-    def model(v):
-        """The outputs divided by their scales."""
+    runner = None
+    if client is not None:
+        from .study import Runner
+
+        runner = Runner(client, find_fmu(fmu))
+
+    def models(points):
+        """The outputs divided by their scales at each of ``points``: in turn, or at once on the
+        cluster."""
         nonlocal evaluations
-        evaluations += 1
-        return w * _run(fmu, path, parameters, unknowns, v, outputs)
+        evaluations += len(points)
+        if runner is None:
+            runs = [_run(fmu, path, parameters, unknowns, v, outputs) for v in points]
+        else:
+            runs = runner.map(_run, [(path, parameters, unknowns, v, outputs) for v in points])
+        return [w * r for r in runs]
+
+    def model(v):
+        return models([v])[0]
 
     y = w * y
 
     def jacobian(v):
-        cols = []
+        pairs = []
         for j in range(len(v)):
             h = relative_step * max(abs(v[j]), 1e-3)
             plus, minus = v.copy(), v.copy()
             plus[j] = min(v[j] + h, hi[j])
             minus[j] = max(v[j] - h, lo[j])
-            cols.append((model(plus) - model(minus)) / (plus[j] - minus[j]))
+            pairs += [plus, minus]
+        runs = models(pairs)
+        cols = [(runs[2 * j] - runs[2 * j + 1]) / (pairs[2 * j][j] - pairs[2 * j + 1][j]) for j in range(len(v))]
         return np.stack(cols, axis=1)
 
     f = model(x) - y
@@ -250,14 +266,22 @@ def main(argv=None) -> int:
     p.add_argument("--path", required=True, help="load path CSV: time and input columns")
     p.add_argument("--unknown", action="append", required=True, help="name=start[:lower:upper], repeatable")
     p.add_argument("--parameter", action="append", default=[], help="name=value, set at initialization")
+    p.add_argument("--scheduler", help="run the sensitivity runs on this Dask scheduler (address or scheduler file)")
+    p.add_argument("--workers", type=int, help="run the sensitivity runs on a Dask LocalCluster of N processes")
     a = p.parse_args(argv)
     params = {}
     for text in a.parameter:
         k, _, v = text.partition("=")
         params[k] = float(v)
     try:
-        result = fit(a.fmu, read_measurements(a.measured), [Unknown.parse(u) for u in a.unknown],
-                     read_path(a.path), params, scales=read_scales(a.measured))
+        with contextlib.ExitStack() as stack:
+            client = None
+            if a.scheduler or a.workers:
+                from .study import cluster
+
+                client = stack.enter_context(cluster(a.scheduler, a.workers))
+            result = fit(a.fmu, read_measurements(a.measured), [Unknown.parse(u) for u in a.unknown],
+                         read_path(a.path), params, scales=read_scales(a.measured), client=client)
     except (KeyError, ValueError) as e:
         print(f"error: {e.args[0] if e.args else e}", file=sys.stderr)
         return 2

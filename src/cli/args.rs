@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use membrane_contact::mech::solver::DEFAULT_INCREMENTS_PER_STEP;
-use membrane_contact::mech::specimen::SpecimenContact;
-use membrane_contact::mech::vtk::Encoding;
+use membrane_contact::mech::results::vtk::Encoding;
+use membrane_contact::mech::solve::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::{FrictionLaw, IterationMatrix};
+use membrane_contact::specimens::parallel_arch::SpecimenContact;
 
 /// Geometrically nonlinear ETFE membrane analysis with friction gap elements (Bui & Kawabata's
 /// method): runs a parallel-arch specimen or a model file, stepping every boundary group to its

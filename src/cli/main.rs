@@ -6,13 +6,14 @@
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
-use membrane_contact::mech::element::state_counts;
+use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
-use membrane_contact::mech::specimen::{FramePath, OBSERVED_GAPS, table1};
-use membrane_contact::mech::vtk;
+use membrane_contact::mech::results::vtk;
 use membrane_contact::mech::{
-    Analysis, FrictionLaw, LoadLevels, Model, ParallelArch, Results, SettingNames, SolverSettings,
+    Analysis, FrictionLaw, LoadLevels, Model, Results, SettingNames, SolverSettings,
 };
+use membrane_contact::specimens::ParallelArch;
+use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, table1};
 
 mod args;
 mod path;
@@ -156,7 +157,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         threads: o.threads,
         ..defaults
     };
-    for w in membrane_contact::mech::summary::model_warnings(&model) {
+    for w in membrane_contact::mech::results::warnings::model_warnings(&model) {
         eprintln!("warning: {w}");
     }
     let spec = match &source {
@@ -256,7 +257,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         .map_err(|e| format!("the results are not finite ({e}): refused"))?;
     report(height_mm, &analysis, &results);
     outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
-    for w in membrane_contact::mech::summary::result_warnings(analysis.model(), &results) {
+    for w in membrane_contact::mech::results::warnings::result_warnings(analysis.model(), &results)
+    {
         eprintln!("warning: {w}");
     }
     let total: usize = iterations.iter().sum();
@@ -747,11 +749,11 @@ fn check(file: &std::path::Path) -> Result<(), String> {
     let name = file.display();
     let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
     let model = Model::from_json(&text).map_err(|e| format!("{name}: {e}"))?;
-    for w in membrane_contact::mech::summary::model_warnings(&model) {
+    for w in membrane_contact::mech::results::warnings::model_warnings(&model) {
         eprintln!("warning: {w}");
     }
     out!("{}", size_line(&model, ": valid,"));
-    for line in membrane_contact::mech::load::orientation_report(&model) {
+    for line in membrane_contact::mech::elements::load::orientation_report(&model) {
         out!("{line}");
     }
     Ok(())

@@ -152,7 +152,7 @@ fn column(table: &[Variable], name: &str, header: &[&str]) -> Result<usize, Stri
 #[cfg(test)]
 mod tests {
     use super::*;
-    use membrane_contact::mech::ParallelArch;
+    use membrane_contact::specimens::ParallelArch;
 
     fn specimen() -> Model {
         ParallelArch::default().model().unwrap()
@@ -177,7 +177,7 @@ mod tests {
 
     #[test]
     fn a_written_frame_path_reads_back_as_the_same_steps() {
-        use membrane_contact::mech::specimen::FramePath;
+        use membrane_contact::specimens::parallel_arch::FramePath;
         let spec = ParallelArch {
             frame_path: FramePath::Wrapped { extension: 0.02 },
             ..ParallelArch::default()

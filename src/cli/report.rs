@@ -1,5 +1,5 @@
 //! Engineering outputs of a run: reactions per unit length along boundary groups and support
-//! sets (`--line-reactions FILE`, CSV, every step; [`membrane_contact::mech::lines`]) and a run
+//! sets (`--line-reactions FILE`, CSV, every step; [`membrane_contact::mech::results::lines`]) and a run
 //! report (`--report FILE.md`, Markdown): the model, the load steps, the reactions of every step,
 //! the line reactions, extreme stresses, wrinkled and slack areas, the slips along every support,
 //! the warnings and the solver's statistics of the run.
@@ -9,8 +9,8 @@ use std::io::Write as _;
 use std::path::Path;
 
 use membrane_contact::fmi2::variables::StepInputs;
-use membrane_contact::mech::lines::{ReactionLine, reaction_lines};
-use membrane_contact::mech::summary::{model_warnings, result_warnings};
+use membrane_contact::mech::results::lines::{ReactionLine, reaction_lines};
+use membrane_contact::mech::results::warnings::{model_warnings, result_warnings};
 use membrane_contact::mech::{Analysis, Model, Results, StepReport, WrinklingState};
 
 /// The header of the `--line-reactions` CSV.
@@ -403,7 +403,7 @@ fn stress_section(s: &mut String, model: &Model, results: &Results) {
             }
         })
     };
-    let strain = |i: usize| membrane_contact::mech::vtk::principal_strain(el[i].strain)[0];
+    let strain = |i: usize| membrane_contact::mech::results::vtk::principal_strain(el[i].strain)[0];
     let rows: [Extreme; 4] = [
         (
             "largest major principal stress σ1",

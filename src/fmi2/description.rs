@@ -26,7 +26,8 @@ use uuid::Uuid;
 
 use super::logger::CATEGORIES;
 use super::resources::Source;
-use super::variables::{Causality, Kind, UNITS, Value, Variable, check_names, variables};
+use super::scalar_variable::{Causality, Value, Variable};
+use super::variables::{Kind, UNITS, check_names, variables};
 use crate::mech::Model;
 
 /// The template (top-level `modelDescription.xml.in`).
@@ -346,7 +347,7 @@ A failed write returns <code>fmi2Warning</code>; the step is kept.</li>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::ParallelArch;
+    use crate::specimens::ParallelArch;
 
     fn specimen() -> Description {
         describe(&Source::ParallelArch(ParallelArch::default())).unwrap()

@@ -15,7 +15,7 @@ use core::ffi::{c_char, c_int};
 use super::guard::{
     self, input, out_ref, output, state_handle, state_pointer, strings, with_instance,
 };
-use super::instance::{Failure, allowed};
+use super::phase::{Failure, allowed};
 use super::types::*;
 
 // ------------------------------------------------------------------ inquiry

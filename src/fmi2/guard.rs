@@ -13,8 +13,9 @@
 use std::ffi::CStr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use super::instance::{Failure, Instance, Mask, Outcome, Phase};
+use super::instance::Instance;
 use super::logger::Logger;
+use super::phase::{Failure, Mask, Outcome, Phase};
 use super::types::{
     Fmi2CallbackFunctions, Fmi2Component, Fmi2FmuState, Fmi2Status, Fmi2String, Status,
 };

@@ -5,7 +5,7 @@
 //! ```text
 //! importer ── fmi2DoStep(c, t, h, …)              exports.rs   #[unsafe(export_name)] extern "C", one line
 //!          └─ guard::with_instance(c, mask, …)    guard.rs     NULL/phase checks, catch_unwind, log, status
-//!             └─ Instance::do_step(t, h)          instance.rs  safe: state machine, values, FMU states
+//!             └─ Instance::do_step(t, h)          stepping.rs  safe: one file per duty of the instance
 //!                └─ mech::Analysis::step_to(…)    the mechanics core (knows nothing of FMI)
 //! ```
 //!
@@ -15,11 +15,27 @@
 //! | [`guard`] | every raw pointer, `Box::into_raw`/`from_raw`, the panic barrier |
 //! | [`logger`] | the variadic C logger, called with `"%s"`; log categories |
 //! | [`variables`] | the variable table, derived from the model: the one source of the interface |
+//! | [`scalar_variable`] | one variable: type, causality, variability, value, binding, value check |
 //! | [`description`] | `modelDescription.xml` (from `modelDescription.xml.in`), GUID, documentation |
 //! | [`resources`] | what an FMU is built from, its `resources/` file, the resource URI parser |
-//! | [`instance`] | the instance: state machine, get/set, DoStep, FMU states |
-//! | [`state`] | the FMU state snapshot and its serialized byte format |
+//! | [`phase`] | the state machine's phases, which call is allowed in which phase (masks), [`Failure`](phase::Failure) |
+//! | [`instance`] | the instance: its fields, instantiation, the model and analysis its parameters build |
+//! | `lifecycle` | the transitions: setup, enter/exit initialization, terminate, reset, debug logging |
+//! | `values` | `fmi2Get*`/`fmi2Set*` by value reference, and which variable may be set when |
+//! | `outputs` | the outputs from the converged state's results, checked finite; assumption warnings |
+//! | `stepping` | `fmi2DoStep` and what it drives (inputs, μ, the checked core step, retry); the status queries |
+//! | `vtk_output` | the results files: VTK `.vtu`/`.pvd` of every converged state (`results.directory`) |
+//! | `fmu_states` | the instance's saved FMU states: get, set, free, (de)serialize |
+//! | [`state`] | one FMU state: the snapshot, its serialized byte format and its checks |
 //! | [`exports`] | the 44 exported `fmi2*` functions (25 common, 9 CS, 10 ME error stubs) |
+//! | `tests/` | tests through the exported functions, as an importer calls them, one file per duty |
+//! | `wiring_tests` | every FMU parameter and input against the core, from the variable table |
+//!
+//! The instance's files have no import (or call) circle: `phase` uses only `types`; `instance`
+//! uses `phase` and `state` (for the `Snapshot` type) and none of its duty files; `outputs` and
+//! `vtk_output` use `instance`; `values` uses `outputs`; `stepping` uses `values`, `outputs`
+//! and `vtk_output`; `lifecycle` uses `outputs` and `vtk_output`; `fmu_states` uses `instance`
+//! and `state`; `state` takes `Phase` from `phase`.
 //!
 //! No global mutable state: everything lives in the [`Instance`](instance::Instance) behind
 //! `fmi2Component`; instances are independent and may run on different threads. The library
@@ -30,13 +46,21 @@
 
 pub mod description;
 pub mod exports;
+mod fmu_states;
 pub mod guard;
 pub mod instance;
+mod lifecycle;
 pub mod logger;
+mod outputs;
+pub mod phase;
 pub mod resources;
+pub mod scalar_variable;
 pub mod state;
+mod stepping;
 pub mod types;
+mod values;
 pub mod variables;
+mod vtk_output;
 
 #[cfg(test)]
 mod tests;

@@ -17,7 +17,8 @@ use std::ffi::OsString;
 use std::os::unix::ffi::OsStringExt;
 use std::path::{Path, PathBuf};
 
-use crate::mech::{Model, ParallelArch};
+use crate::mech::Model;
+use crate::specimens::ParallelArch;
 
 /// File name of a ParallelArch specification in `resources/`.
 pub const SPECIMEN_FILE: &str = "parallel_arch.json";

@@ -28,10 +28,10 @@
 use nalgebra::{Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
-use super::instance::Phase;
-use super::variables::Value;
+use super::phase::Phase;
+use super::scalar_variable::Value;
 use crate::mech::model::{GapSupport, Hinge, MAX_FRICTION};
-use crate::mech::surface::SurfaceContacts;
+use crate::mech::elements::curved_contact::SurfaceContacts;
 use crate::mech::{AnalysisState, Model};
 
 /// Everything needed to continue an instance exactly.
@@ -143,7 +143,7 @@ pub fn model_size(model: &Model) -> f64 {
 
 /// Checks a (deserialized) analysis state against `model`: sizes, finite and bounded values,
 /// `μ ∈ [0, MAX_FRICTION]`, and each gap's stored status and slip history against the gap's
-/// own law ([`GapLaw::check_committed`](crate::mech::contact::GapLaw::check_committed), the
+/// own law ([`GapLaw::check_committed`](crate::mech::elements::gap::GapLaw::check_committed), the
 /// law the solver evaluates, under either friction law), and each curved-support contact's
 /// status and anchor likewise ([`SurfaceContacts::check_committed`]).
 pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), String> {
@@ -285,7 +285,7 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             GapSupport::Point(_) => Vector3::zeros(),
         };
         let d = spec.frame.rotation() * (at(spec.film_node) - ub);
-        let law = crate::mech::contact::GapLaw {
+        let law = crate::mech::elements::gap::GapLaw {
             friction: state.friction[g],
             ..spec.law()
         };
@@ -340,7 +340,8 @@ impl<'a> Reader<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::{Analysis, ParallelArch};
+    use crate::mech::Analysis;
+    use crate::specimens::ParallelArch;
 
     /// A real converged state (one step of the specimen), whatever fields it has.
     fn converged_state() -> AnalysisState {

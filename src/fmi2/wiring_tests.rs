@@ -19,7 +19,7 @@
 //! BOUNDARY CONDITIONS: the specimens' frame lowered by 50 mm under self-weight, the panel's
 //! rail turned by 0.1 rad, the membrane under its file's loads; two increments per step.
 //!
-//! SAFETY: the FMU is driven through the harness of `tests.rs` (its soundness comment holds);
+//! SAFETY: the FMU is driven through the harness of `tests/mod.rs` (its soundness comment holds);
 //! the `unsafe` calls here pass the harness's live instance and plain numbers.
 
 use std::path::Path;
@@ -33,10 +33,11 @@ use super::resources::Source;
 use super::tests::{Fmu, Log, Unpacked};
 use super::types::*;
 use super::variables::{Causality, Value, VarType, Variable};
-use crate::mech::element::state_counts;
+use crate::mech::elements::triangle::state_counts;
 use crate::mech::model::CableSpec;
-use crate::mech::specimen::SpecimenContact;
-use crate::mech::{Analysis, LoadLevels, Model, ParallelArch, Results, SolverSettings, StepReport};
+use crate::mech::{Analysis, LoadLevels, Model, Results, SolverSettings, StepReport};
+use crate::specimens::ParallelArch;
+use crate::specimens::parallel_arch::SpecimenContact;
 
 /// Variables whose change no output can show, and why (each is still set and the outputs
 /// still compared with the core's).
@@ -51,7 +52,7 @@ const UNSEEN: [(&str, &str); 3] = [
     ),
     (
         "results.vtkFormat",
-        "not an analysis parameter: writes nothing without results.directory (tests.rs checks the ascii files)",
+        "not an analysis parameter: writes nothing without results.directory (tests/vtk_output.rs checks the ascii files)",
     ),
 ];
 

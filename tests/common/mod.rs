@@ -1,7 +1,8 @@
 //! Helpers shared by the integration tests (each test crate uses some of them).
 #![allow(dead_code)]
 
-use membrane_contact::mech::{Model, ParallelArch};
+use membrane_contact::mech::Model;
+use membrane_contact::specimens::ParallelArch;
 
 /// A model of just a film (the specimen's ETFE, no supports, groups, gaps or loads).
 pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model {

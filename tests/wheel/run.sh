@@ -25,9 +25,10 @@ done
 venv=target/wheel-venv
 rm -rf "$venv"
 python3 -m venv "$venv"
-# The wheel with its importer extra (meshio), and what the tests use (pytest, libcosimpy, pandas,
-# matplotlib): nothing of the checkout's python/.
-PATH="$no_rust" "$venv/bin/pip" install --quiet --disable-pip-version-check "${wheels[0]}[mesh]" \
+# The wheel with its importer and study extras (meshio; dask, distributed, xarray, pyarrow,
+# pyyaml), and what the tests use (pytest, libcosimpy, pandas, matplotlib, the pinned study
+# packages): nothing of the checkout's python/.
+PATH="$no_rust" "$venv/bin/pip" install --quiet --disable-pip-version-check "${wheels[0]}[mesh,study]" \
   -r tests/python/requirements.txt
 PATH="$(pwd)/$venv/bin:$no_rust" MEMBRANE_CONTACT_INSTALLED=1 \
   "$venv/bin/python" -m pytest tests/wheel tests/python -q -p no:cacheprovider

@@ -1,0 +1,805 @@
+"""Studies: many FMU runs of one model over a design of inputs and parameters, on a Dask cluster
+(issue 22).
+
+A study is a base FMU, a load path (a table for :meth:`membrane_contact.Film.run`), a design
+(one row of values per case, :func:`factorial`, :func:`latin_hypercube`, :func:`monte_carlo`,
+:func:`read_table`) and the outputs to keep. Each case is one FMU instance on a worker of a
+``dask.distributed`` cluster: a ``LocalCluster`` with one single-threaded worker process per
+core by default, or any scheduler (an address or a scheduler file). The FMU travels as bytes
+(or a path every worker can read): a worker needs this package and fmpy, no cargo and no
+repository.
+
+Each design variable names an FMU variable, whatever the model: a parameter (set before the
+initialization, ``film.E``, ``archHeight``), an input (held over the whole path, ``mu``), or
+``scale:<column>`` (the load path's column multiplied, ``scale:frame.dz``).
+
+Results go to a directory as they come, one Parquet file per case (written whole, then renamed:
+a killed study leaves no half file); run again on the same directory, a study runs only the
+cases that have no file and refuses a directory that holds another study. A case the FMU refuses
+(a step refused after every halving, a parameter refused at initialization) is stored with the
+FMU's message and the study goes on. :meth:`Study.run` returns an ``xarray.Dataset`` (one
+variable per output over ``case × step``, the design as coordinates, ``status`` and ``message``
+per case)::
+
+    python -m membrane_contact.study examples/study_mu_prestress.toml
+
+The spec file (TOML or YAML) is described in python/README.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import csv
+import hashlib
+import itertools
+import json
+import math
+import os
+import socket
+import sys
+import tempfile
+import time as _time
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from statistics import NormalDist
+
+import numpy as np
+
+#: FMU parameter holding the solver's thread count: each case runs single-threaded (one worker
+#: per core does the parallel work), unless the study's parameters say otherwise.
+THREADS_PARAMETER = "solver.threads"
+#: Prefix of a design variable that multiplies a column of the load path.
+SCALE = "scale:"
+
+# ---------------------------------------------------------------------------- distributions
+
+
+@dataclass(frozen=True)
+class Distribution:
+    """A named distribution of one design variable, sampled through its inverse CDF
+    (:meth:`ppf`) so that Monte-Carlo and Latin-hypercube designs share it:
+
+    * ``uniform(low, high)``, ``loguniform(low, high)``;
+    * ``normal(mean, sd)``;
+    * ``lognormal(median, sigma)``: ``ln X`` normal with mean ``ln median`` and standard
+      deviation ``sigma``;
+    * ``triangular(low, mode, high)``."""
+
+    kind: str
+    args: tuple
+
+    KINDS = {"uniform": ("low", "high"), "loguniform": ("low", "high"), "normal": ("mean", "sd"),
+             "lognormal": ("median", "sigma"), "triangular": ("low", "mode", "high")}
+
+    @classmethod
+    def parse(cls, name: str, spec) -> "Distribution":
+        """From ``{"dist": "lognormal", "median": 0.2, "sigma": 0.3}`` (or ``"distribution"``),
+        or ``[low, high]`` for a uniform one; errors name the variable ``name``."""
+        if isinstance(spec, Distribution):
+            return spec
+        if isinstance(spec, (list, tuple)) and len(spec) == 2:
+            spec = {"dist": "uniform", "low": spec[0], "high": spec[1]}
+        if not isinstance(spec, dict):
+            raise ValueError(f"design variable '{name}': give a distribution as {{dist = ..., ...}} or [low, high], "
+                             f"not {spec!r}")
+        spec = dict(spec)
+        kind = spec.pop("dist", spec.pop("distribution", None))
+        if kind not in cls.KINDS:
+            raise ValueError(f"design variable '{name}': distribution {kind!r} is not one of "
+                             f"{', '.join(cls.KINDS)}")
+        names = cls.KINDS[kind]
+        if set(spec) != set(names):
+            raise ValueError(f"design variable '{name}': a {kind} distribution takes {', '.join(names)}; "
+                             f"given {', '.join(sorted(spec)) or 'nothing'}")
+        args = tuple(float(spec[k]) for k in names)
+        if not all(math.isfinite(a) for a in args):
+            raise ValueError(f"design variable '{name}': {kind} parameters must be finite: {args}")
+        ok = {"uniform": lambda lo, hi: lo < hi, "loguniform": lambda lo, hi: 0 < lo < hi,
+              "normal": lambda m, s: s > 0, "lognormal": lambda m, s: m > 0 and s > 0,
+              "triangular": lambda lo, mo, hi: lo <= mo <= hi and lo < hi}[kind]
+        if not ok(*args):
+            raise ValueError(f"design variable '{name}': invalid {kind} parameters "
+                             f"{dict(zip(names, args))}")
+        return cls(kind, args)
+
+    def ppf(self, u: np.ndarray) -> np.ndarray:
+        """The values at the probabilities ``u`` (0 < u < 1)."""
+        u = np.asarray(u, dtype=float)
+        a = self.args
+        if self.kind == "uniform":
+            return a[0] + u * (a[1] - a[0])
+        if self.kind == "loguniform":
+            return np.exp(np.log(a[0]) + u * (np.log(a[1]) - np.log(a[0])))
+        z = np.array([NormalDist().inv_cdf(float(p)) for p in u.ravel()]).reshape(u.shape)
+        if self.kind == "normal":
+            return a[0] + a[1] * z
+        if self.kind == "lognormal":
+            return a[0] * np.exp(a[1] * z)
+        lo, mode, hi = a
+        c = (mode - lo) / (hi - lo)
+        return np.where(u < c, lo + np.sqrt(u * (hi - lo) * (mode - lo)),
+                        hi - np.sqrt((1 - u) * (hi - lo) * (hi - mode)))
+
+
+# ---------------------------------------------------------------------------- designs
+
+
+def _column(name: str, values) -> np.ndarray:
+    """A design column: float64 when numeric, else strings (``frictionLaw``)."""
+    array = np.asarray(list(values))
+    if array.dtype.kind in "iufb":
+        return array.astype(float)
+    return array.astype(str)
+
+
+def factorial(factors: dict) -> dict[str, np.ndarray]:
+    """Every combination of the factors' levels (``{"mu": [0.15, 0.3], "film.E": [...]}``), the
+    last factor varying fastest."""
+    if not factors:
+        raise ValueError("a factorial design needs at least one factor")
+    for name, levels in factors.items():
+        if isinstance(levels, (str, bytes)) or not hasattr(levels, "__len__") or len(levels) == 0:
+            raise ValueError(f"factor '{name}': give a non-empty list of levels")
+    rows = list(itertools.product(*factors.values()))
+    return {name: _column(name, [r[k] for r in rows]) for k, name in enumerate(factors)}
+
+
+def _probabilities(n: int, k: int, rng, strata: bool) -> np.ndarray:
+    if strata:  # one point in each of n equal strata per variable, strata shuffled per variable
+        u = (np.arange(n)[:, None] + rng.random((n, k))) / n
+        for j in range(k):
+            u[:, j] = u[rng.permutation(n), j]
+        return u
+    return rng.random((n, k))
+
+
+def _sampled(variables: dict, cases: int, seed: int, strata: bool) -> dict[str, np.ndarray]:
+    if not variables:
+        raise ValueError("a sampled design needs at least one variable")
+    if not (isinstance(cases, int) and cases > 0):
+        raise ValueError(f"cases = {cases!r}: give a positive number of cases")
+    dists = {n: Distribution.parse(n, s) for n, s in variables.items()}
+    rng = np.random.default_rng(seed)
+    u = _probabilities(cases, len(dists), rng, strata)
+    # Keep u strictly inside (0, 1): the inverse CDFs of normal laws are infinite at the ends.
+    u = np.clip(u, np.finfo(float).tiny, 1 - np.finfo(float).eps)
+    return {n: d.ppf(u[:, j]) for j, (n, d) in enumerate(dists.items())}
+
+
+def latin_hypercube(variables: dict, cases: int, seed: int = 0) -> dict[str, np.ndarray]:
+    """A Latin-hypercube sample of ``cases`` rows: each variable (a :class:`Distribution` spec or
+    ``[low, high]``) has one value in each of ``cases`` equally probable strata; ``seed``
+    makes it reproducible (numpy's PCG64)."""
+    return _sampled(variables, cases, seed, True)
+
+
+def monte_carlo(variables: dict, cases: int, seed: int = 0) -> dict[str, np.ndarray]:
+    """``cases`` independent draws of each variable (a :class:`Distribution` spec or
+    ``[low, high]``); ``seed`` makes it reproducible (numpy's PCG64)."""
+    return _sampled(variables, cases, seed, False)
+
+
+def read_table(path) -> dict[str, np.ndarray]:
+    """A user's design table: a CSV with one column per design variable, one row per case
+    (``#`` lines are comments)."""
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(line for line in f if not line.lstrip().startswith("#")))
+    if not rows:
+        raise ValueError(f"{path}: the design table has no rows")
+    columns = {}
+    for name in rows[0]:
+        texts = [r[name].strip() for r in rows]
+        try:
+            columns[name.strip()] = np.array([float(t) for t in texts])
+        except ValueError:
+            columns[name.strip()] = np.array(texts, dtype=str)
+    return columns
+
+
+def design_from_spec(spec: dict, base: Path = Path(".")) -> dict[str, np.ndarray]:
+    """A design from the ``[design]`` table of a study spec: ``kind`` = ``factorial``
+    (``factors``), ``lhs`` or ``montecarlo`` (``variables``, ``cases``, ``seed``) or ``table``
+    (``csv``); ``same`` = ``{"film.prestressY": "film.prestressX"}`` gives a variable another's
+    value in every case."""
+    spec = dict(spec)
+    kind = spec.pop("kind", None)
+    same = spec.pop("same", {}) or {}
+    if kind == "factorial":
+        design = factorial(spec.pop("factors", {}))
+    elif kind in ("lhs", "latin_hypercube", "montecarlo", "monte_carlo"):
+        sample = latin_hypercube if kind in ("lhs", "latin_hypercube") else monte_carlo
+        design = sample(spec.pop("variables", {}), spec.pop("cases", None), spec.pop("seed", 0))
+    elif kind == "table":
+        design = read_table(base / spec.pop("csv"))
+    else:
+        raise ValueError(f"design kind {kind!r}: use factorial, lhs, montecarlo or table")
+    if spec:
+        raise ValueError(f"design ({kind}): unknown keys {', '.join(sorted(spec))}")
+    for target, source in same.items():
+        if source not in design:
+            raise ValueError(f"design: same.{target} = '{source}', which is not a design variable")
+        design[target] = design[source].copy()
+    return design
+
+
+# ---------------------------------------------------------------------------- the FMU on workers
+
+
+@dataclass(frozen=True)
+class FmuRef:
+    """Which FMU a worker runs: its content hash, its file name and, for a shared filesystem, a
+    path every worker reads (else the bytes travel with the tasks, sent once per worker)."""
+
+    sha256: str
+    name: str
+    shared_path: str | None = None
+
+    @classmethod
+    def of(cls, path, shared: bool = False) -> tuple["FmuRef", bytes]:
+        data = Path(path).read_bytes()
+        ref = cls(hashlib.sha256(data).hexdigest(), Path(path).name, str(Path(path).resolve()) if shared else None)
+        return ref, data
+
+
+_LOCAL_FMUS: dict[str, Path] = {}
+
+
+def local_fmu(ref: FmuRef, data: bytes | None) -> Path:
+    """The FMU on this machine: the shared path, or the bytes written once per process into the
+    temporary directory (``membrane-contact-fmus/<sha256>/``, checked against the hash)."""
+    if ref.shared_path is not None:
+        return Path(ref.shared_path)
+    path = _LOCAL_FMUS.get(ref.sha256)
+    if path is not None and path.is_file():
+        return path
+    if data is None:
+        raise RuntimeError(f"no bytes of the FMU {ref.name} reached this worker")
+    if hashlib.sha256(data).hexdigest() != ref.sha256:
+        raise RuntimeError(f"the bytes of the FMU {ref.name} reached this worker damaged (hash differs)")
+    folder = Path(tempfile.gettempdir()) / "membrane-contact-fmus" / ref.sha256
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / ref.name
+    if not path.is_file():
+        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".part")
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    _LOCAL_FMUS[ref.sha256] = path
+    return path
+
+
+def call_with_fmu(ref: FmuRef, data, function, *args):
+    """Runs ``function(fmu_path, *args)`` on a worker with the FMU at a local path."""
+    return function(local_fmu(ref, data), *args)
+
+
+class Runner:
+    """Runs functions of an FMU path on a Dask cluster: the machinery shared by :class:`Study`
+    and :func:`membrane_contact.inverse.fit`. The FMU's bytes are scattered once to every
+    worker (or, with ``shared=True``, its path is given to them)."""
+
+    def __init__(self, client, fmu, shared: bool = False):
+        self.client = client
+        self.fmu = Path(fmu)
+        self.ref, data = FmuRef.of(fmu, shared)
+        self._data = None if shared else client.scatter(data, broadcast=True, hash=False)
+
+    def submit(self, function, *args, key: str | None = None):
+        """A future of ``function(fmu_path, *args)`` on a worker."""
+        kwargs = {"pure": False}
+        if key is not None:
+            kwargs["key"] = key
+        return self.client.submit(call_with_fmu, self.ref, self._data, function, *args, **kwargs)
+
+    def map(self, function, arguments: list[tuple]) -> list:
+        """``[function(fmu_path, *a) for a in arguments]``, run in parallel, in order."""
+        futures = [self.submit(function, *a) for a in arguments]
+        return self.client.gather(futures)
+
+
+@contextlib.contextmanager
+def cluster(scheduler: str | None = None, workers: int | None = None):
+    """A ``dask.distributed.Client``: to ``scheduler`` (an address ``tcp://host:8786`` or the
+    path of a scheduler file), else to a new ``LocalCluster`` with ``workers`` worker processes
+    (default: one per core), one thread each. The local cluster ends with the block."""
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        client = Client(scheduler_file=scheduler) if Path(scheduler).is_file() else Client(scheduler)
+        try:
+            yield client
+        finally:
+            client.close()
+        return
+    import logging
+
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    n = workers or cores or 1
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.CRITICAL) as local, Client(local) as client:
+        yield client
+
+
+# ---------------------------------------------------------------------------- one case
+
+
+def apply_values(variables: dict, path: dict, parameters: dict, names: dict[str, str]):
+    """Where each design value goes: the table ``path`` (an input held over the path, or a
+    column scaled by ``scale:<column>``) or the ``parameters``. ``names``: variable → causality."""
+    table = {k: np.asarray(v, dtype=float).copy() for k, v in path.items()}
+    params = dict(parameters)
+    for name, value in variables.items():
+        if name.startswith(SCALE):
+            table[name[len(SCALE):]] = table[name[len(SCALE):]] * float(value)
+        elif names.get(name) == "input":
+            table[name] = np.full(len(table["time"]), float(value))
+        else:
+            params[name] = value
+    return table, params
+
+
+def check_variables(fmu, design: dict, path: dict, parameters: dict, outputs: list[str]) -> dict[str, str]:
+    """Refuses names the FMU does not have, naming them: design variables (a parameter, an
+    input or ``scale:<column of the path>``), parameters, path columns (inputs) and outputs.
+    Returns ``{variable: causality}``."""
+    from fmpy import read_model_description
+
+    md = read_model_description(str(fmu))
+    causality = {v.name: v.causality for v in md.modelVariables}
+
+    def refuse(what, name, allowed):
+        raise KeyError(f"{what} '{name}' is not {allowed} of {md.modelName} "
+                       f"({'a ' + causality[name] if name in causality else 'no such variable'})")
+
+    if "time" not in path:
+        raise KeyError("the load path needs a 'time' column")
+    for name in path:
+        if name != "time" and causality.get(name) != "input":
+            refuse("path column", name, "an input")
+    for name in design:
+        if name.startswith(SCALE):
+            if name[len(SCALE):] not in path:
+                raise KeyError(f"design variable '{name}': the load path has no column '{name[len(SCALE):]}'")
+        elif causality.get(name) not in ("parameter", "input"):
+            refuse("design variable", name, "a parameter or an input")
+    for name in parameters:
+        if causality.get(name) != "parameter":
+            refuse("parameter", name, "a parameter")
+    for name in outputs:
+        if causality.get(name) != "output":
+            refuse("output", name, "an output")
+    return causality
+
+
+def run_case(fmu_path, case: int, variables: dict, path: dict, parameters: dict, outputs: list[str],
+             causality: dict, max_halvings: int = 6, dt: float | None = None, run_log: str | None = None) -> dict:
+    """One case on a worker: a fresh FMU instance initialized with the parameters and the
+    case's values, stepped row by row along the path. Returns ``{"case", "status" ("ok",
+    "refused": a step refused after every halving, "error": the FMU refused the case, e.g. a
+    parameter at initialization), "message", "values" (steps × outputs, step 0 the initial
+    state, NaN past a refusal), "halvings", "warnings", "seconds" (wall), "cpu_seconds" (this
+    process's CPU time), "worker"}``."""
+    from .film import Film, FmuError, StepRefused
+
+    started, cpu = _time.perf_counter(), _time.process_time()
+    if run_log:
+        with open(run_log, "a") as f:
+            f.write(f"{case} start {socket.gethostname()}:{os.getpid()}\n")
+    table, params = apply_values(variables, path, parameters, causality)
+    times = table.pop("time")
+    values = np.full((len(times) + 1, len(outputs)), np.nan)
+    status, message, halvings, caught = "ok", "", 0, []
+    try:
+        with warnings.catch_warnings(record=True) as caught, Film(fmu_path, logging=False, quiet=True) as film:
+            warnings.simplefilter("always")
+            film.initialize(parameters=params)
+            values[0] = [float(film.get(o)) for o in outputs]
+            for k, t in enumerate(times):
+                row = {"time": [t], **{n: [c[k]] for n, c in table.items()}}
+                results = film.run(row, outputs=outputs, max_halvings=max_halvings, dt=dt)
+                halvings += results.halvings
+                values[k + 1] = [results[o][-1] for o in outputs]
+    except StepRefused as e:
+        status, message = "refused", str(e)
+    except FmuError as e:
+        status, message = "error", str(e)
+    except (ValueError, RuntimeError) as e:
+        status, message = "error", f"{type(e).__name__}: {e}"
+    kinds = sorted({str(w.message) for w in caught or []})
+    return {"case": case, "status": status, "message": message, "values": values, "halvings": halvings,
+            "warnings": "\n".join(kinds), "seconds": _time.perf_counter() - started,
+            "cpu_seconds": _time.process_time() - cpu,
+            "worker": f"{socket.gethostname()}:{os.getpid()}"}
+
+
+# ---------------------------------------------------------------------------- storage
+
+
+def _case_file(directory: Path, case: int) -> Path:
+    return directory / "cases" / f"case-{case:06d}.parquet"
+
+
+def write_case(directory: Path, result: dict, outputs: list[str], times: np.ndarray):
+    """Writes one case's result as a Parquet file (step, time and one column per output; the
+    status, message and timing in the file's metadata), whole or not at all (rename)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    values = result["values"]
+    columns = {"step": pa.array(np.arange(len(times), dtype=np.int64)), "time": pa.array(times)}
+    columns.update({o: pa.array(values[:, j]) for j, o in enumerate(outputs)})
+    meta = {k: json.dumps(result[k]) for k in ("case", "status", "message", "halvings", "warnings", "seconds",
+                                                "cpu_seconds", "worker")}
+    table = pa.table(columns).replace_schema_metadata({f"study.{k}": v for k, v in meta.items()})
+    path = _case_file(directory, result["case"])
+    tmp = path.with_suffix(".part")
+    pq.write_table(table, tmp)
+    os.replace(tmp, path)
+
+
+def read_case(path: Path, outputs: list[str]) -> dict:
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path)
+    meta = {k.decode()[len("study."):]: json.loads(v) for k, v in table.schema.metadata.items()
+            if k.decode().startswith("study.")}
+    meta["values"] = np.stack([table.column(o).to_numpy() for o in outputs], axis=1)
+    return meta
+
+
+def stored_results(directory: Path, outputs: list[str]) -> dict[int, dict]:
+    """``{case: result}`` of every case file in ``directory``."""
+    return {int(p.stem.split("-")[1]): read_case(p, outputs)
+            for p in sorted((Path(directory) / "cases").glob("case-*.parquet"))}
+
+
+# ---------------------------------------------------------------------------- progress
+
+
+class Progress:
+    """Cases done, failed and the time left, on stderr: one line rewritten in place on a
+    terminal, else a plain line every tenth of the cases (and at the end)."""
+
+    def __init__(self, total: int, already: int, stream=None, enabled: bool = True):
+        self.total, self.already = total, already
+        self.done = already
+        self.failed = 0
+        self.stream = stream or sys.stderr
+        self.enabled = enabled
+        self.tty = enabled and hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.started = _time.monotonic()
+        self._every = max(1, (total - already) // 10)
+        if enabled and already:
+            print(f"study: {already} of {total} cases already stored, resuming", file=self.stream)
+
+    def line(self) -> str:
+        ran = self.done - self.already
+        elapsed = _time.monotonic() - self.started
+        left = self.total - self.done
+        eta = f"{_clock(elapsed / ran * left)} left" if ran else "time left unknown"
+        return (f"study: {self.done}/{self.total} cases done, {self.failed} failed, "
+                f"{_clock(elapsed)} elapsed, {eta}")
+
+    def update(self, ok: bool):
+        self.done += 1
+        self.failed += 0 if ok else 1
+        if not self.enabled:
+            return
+        if self.tty:
+            print("\r" + self.line() + "\033[K", end="", file=self.stream, flush=True)
+        elif (self.done - self.already) % self._every == 0 or self.done == self.total:
+            print(self.line(), file=self.stream, flush=True)
+
+    def close(self):
+        if self.enabled and self.tty:
+            print(file=self.stream)
+
+
+def _clock(seconds: float) -> str:
+    seconds = int(round(seconds))
+    return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
+
+
+# ---------------------------------------------------------------------------- the study
+
+
+def _plain(value):
+    """A design value for JSON (exact floats, strings)."""
+    if isinstance(value, np.ndarray):
+        return [_plain(v) for v in value.tolist()]
+    if isinstance(value, (np.floating, np.integer)):
+        return value.item()
+    return value
+
+
+class Study:
+    """A study of ``fmu`` (a path) over ``design`` (``{variable: values}``, one value per case),
+    each case stepped along ``path`` (``{"time": [...], input: [...]}``) with the fixed
+    ``parameters``, keeping ``outputs`` (default: every output) at each row of the path, in
+    ``directory`` (one Parquet file per case; see the module's doc). ``max_halvings`` and ``dt``
+    go to :meth:`Film.run`. The FMU's ``solver.threads`` is set to 1 unless ``parameters`` set
+    it. ``run_log``: a file each worker appends ``<case> start <host>:<pid>`` to when it starts
+    a case (a shared filesystem only; an audit of which case ran where)."""
+
+    def __init__(self, fmu, design: dict, path: dict, outputs: list[str] | None = None,
+                 parameters: dict | None = None, directory=None, max_halvings: int = 6,
+                 dt: float | None = None, run_log=None):
+        from fmpy import read_model_description
+
+        from .fmu import find_fmu
+
+        self.fmu = Path(find_fmu(fmu))
+        self.design = {str(k): _column(k, v) for k, v in design.items()}
+        lengths = {len(v) for v in self.design.values()}
+        if len(lengths) != 1 or 0 in lengths:
+            raise ValueError(f"the design's columns must have one value per case and the same length: "
+                             f"{ {k: len(v) for k, v in self.design.items()} }")
+        self.cases = lengths.pop()
+        self.path = {str(k): np.asarray(v, dtype=float).ravel() for k, v in path.items()}
+        times = self.path.get("time")
+        if times is None or len(times) == 0 or np.any(np.diff(times) <= 0):
+            raise ValueError("the load path needs a 'time' column of increasing values")
+        md = read_model_description(str(self.fmu))
+        self.outputs = list(outputs) if outputs else [v.name for v in md.modelVariables if v.causality == "output"]
+        self.parameters = dict(parameters or {})
+        self.causality = check_variables(self.fmu, self.design, self.path, self.parameters, self.outputs)
+        if THREADS_PARAMETER in self.causality and THREADS_PARAMETER not in self.parameters \
+                and THREADS_PARAMETER not in self.design:
+            self.parameters[THREADS_PARAMETER] = 1
+        self.max_halvings, self.dt = int(max_halvings), dt
+        self.directory = Path(directory) if directory is not None else None
+        self.run_log = str(run_log) if run_log else None
+        self.times = np.concatenate([[0.0], self.path["time"]])
+
+    # -- identity, for resuming
+
+    def description(self) -> dict:
+        """What defines the study's results: a directory holding another one is refused."""
+        return {"fmu_sha256": FmuRef.of(self.fmu)[0].sha256, "fmu": self.fmu.name,
+                "design": {k: _plain(v) for k, v in self.design.items()},
+                "path": {k: _plain(v) for k, v in self.path.items()},
+                "parameters": {k: _plain(v) for k, v in self.parameters.items()},
+                "outputs": self.outputs, "max_halvings": self.max_halvings, "dt": self.dt}
+
+    def _prepare_directory(self) -> set[int]:
+        """Creates the directory or checks it holds this study; returns the cases stored."""
+        d = self.directory
+        (d / "cases").mkdir(parents=True, exist_ok=True)
+        described = d / "study.json"
+        mine = self.description()
+        if described.is_file():
+            theirs = json.loads(described.read_text())
+            differ = [k for k in mine if theirs.get(k) != mine[k]]
+            if differ:
+                raise ValueError(f"{d} holds another study (its {', '.join(differ)} differ{'s' if len(differ) == 1 else ''}): "
+                                 "give another directory, or delete this one to start again")
+        else:
+            tmp = described.with_suffix(".part")
+            tmp.write_text(json.dumps(mine, indent=1))
+            os.replace(tmp, described)
+        for stale in (d / "cases").glob("*.part"):
+            stale.unlink()
+        return {int(p.stem.split("-")[1]) for p in (d / "cases").glob("case-*.parquet")}
+
+    # -- running
+
+    def case_arguments(self, case: int) -> tuple:
+        variables = {k: _plain(v[case]) for k, v in self.design.items()}
+        return (case, variables, self.path, self.parameters, self.outputs, self.causality, self.max_halvings,
+                self.dt, self.run_log)
+
+    def run(self, client=None, *, scheduler: str | None = None, workers: int | None = None,
+            progress: bool = True, shared_fmu: bool = False):
+        """Runs the cases not yet stored (all of them without a directory) and returns the
+        dataset of every case (:meth:`dataset`). ``client``: a ``dask.distributed.Client``;
+        else one to ``scheduler`` (an address or a scheduler file), else a ``LocalCluster`` of
+        ``workers`` single-threaded processes (default: one per core), closed at the end.
+        ``shared_fmu``: workers read the FMU at its path instead of receiving its bytes."""
+        from dask.distributed import as_completed
+
+        stored = self._prepare_directory() if self.directory is not None else set()
+        todo = [k for k in range(self.cases) if k not in stored]
+        if not todo:
+            if progress:
+                print(f"study: all {self.cases} cases already stored in {self.directory}", file=sys.stderr)
+            return self.dataset()
+        if client is None:
+            with cluster(scheduler, workers) as client:
+                return self.run(client, progress=progress, shared_fmu=shared_fmu)
+        self._results = {}
+        bar = Progress(self.cases, len(stored), enabled=progress)
+        runner = Runner(client, self.fmu, shared=shared_fmu)
+        futures = [runner.submit(run_case, *self.case_arguments(k)) for k in todo]
+        log = open(self.directory / "log.jsonl", "a") if self.directory is not None else None
+        try:
+            for future in as_completed(futures):
+                result = future.result()
+                if log is not None:
+                    write_case(self.directory, result, self.outputs, self.times)
+                    log.write(json.dumps({k: result[k] for k in ("case", "status", "seconds", "worker")}) + "\n")
+                    log.flush()
+                else:
+                    self._results[result["case"]] = result
+                bar.update(result["status"] == "ok")
+                future.release()
+        finally:
+            bar.close()
+            if log is not None:
+                log.close()
+        return self.dataset()
+
+    # -- results
+
+    def results(self) -> dict[int, dict]:
+        """Every stored case's result (``values``, ``status``, ``message``, ``seconds``, …)."""
+        if self.directory is None:
+            return dict(getattr(self, "_results", {}))
+        return stored_results(self.directory, self.outputs)
+
+    def dataset(self):
+        """The results as an ``xarray.Dataset``: one variable per output over ``(case, step)``
+        (step 0: the initialized state; step k: row k of the path; NaN where a refused case did
+        not get), the design's variables and ``time`` as coordinates, ``status`` ("ok",
+        "refused", "error", "" for a case not run yet), ``message`` (the FMU's reason) and
+        ``halvings`` per case. ``ds[outputs].to_array("output")`` gives one array
+        ``output × case × step``."""
+        return _assemble(self.description(), self.results())
+
+    def timings(self) -> dict[int, float]:
+        """Seconds each stored case took on its worker."""
+        return {k: r["seconds"] for k, r in self.results().items()}
+
+
+def _assemble(description: dict, results: dict[int, dict]):
+    """The dataset of a study (:meth:`Study.dataset`) from its description and results."""
+    import xarray as xr
+
+    design = {k: _column(k, v) for k, v in description["design"].items()}
+    outputs = description["outputs"]
+    times = np.concatenate([[0.0], np.asarray(description["path"]["time"], dtype=float)])
+    cases = len(next(iter(design.values())))
+    values = np.full((cases, len(times), len(outputs)), np.nan)
+    status = np.full(cases, "", dtype=object)
+    message = np.full(cases, "", dtype=object)
+    halvings = np.zeros(cases, dtype=np.int64)
+    for k, r in results.items():
+        values[k], status[k], message[k], halvings[k] = r["values"], r["status"], r["message"], r["halvings"]
+    data = {o: (("case", "step"), values[:, :, j]) for j, o in enumerate(outputs)}
+    data.update(status=("case", status.astype(str)), message=("case", message.astype(str)),
+                halvings=("case", halvings))
+    coords = {"case": np.arange(cases), "step": np.arange(len(times)), "time": ("step", times)}
+    coords.update({k: ("case", v) for k, v in design.items()})
+    return xr.Dataset(data, coords=coords, attrs={"fmu": description["fmu"],
+                                                  "parameters": json.dumps(description["parameters"])})
+
+
+def open_study(directory):
+    """The dataset of the study stored in ``directory`` (its ``study.json`` and the cases stored
+    so far), without the FMU."""
+    directory = Path(directory)
+    description = json.loads((directory / "study.json").read_text())
+    return _assemble(description, stored_results(directory, description["outputs"]))
+
+
+# ---------------------------------------------------------------------------- spec files
+
+
+def load_spec(path) -> dict:
+    """A study spec from a TOML (``.toml``) or YAML (``.yaml``/``.yml``) file."""
+    path = Path(path)
+    text = path.read_text()
+    if path.suffix in (".yaml", ".yml"):
+        import yaml
+
+        spec = yaml.safe_load(text)
+    else:
+        try:
+            import tomllib
+        except ImportError:  # Python < 3.11
+            import tomli as tomllib
+
+        spec = tomllib.loads(text)
+    if not isinstance(spec, dict):
+        raise ValueError(f"{path}: a study spec is a table of keys")
+    return spec
+
+
+def path_from_spec(spec: dict, base: Path) -> dict:
+    """The load path of a spec's ``[path]``: ``csv = "path.csv"``, or columns (``time = [...]``,
+    ``"frame.dz" = [...]``), or ``steps = N`` with ``to = {"frame.dz" = -0.15}`` (each input
+    ramped linearly from 0, time k/N)."""
+    spec = dict(spec)
+    if "csv" in spec:
+        from .inverse import read_path
+
+        return read_path(base / spec["csv"])
+    if "steps" in spec:
+        n = int(spec["steps"])
+        if n < 1:
+            raise ValueError(f"path.steps = {n}: give at least one step")
+        f = np.arange(1, n + 1) / n
+        return {"time": f, **{k: float(v) * f for k, v in (spec.get("to") or {}).items()}}
+    return spec
+
+
+def fmu_from_spec(spec: dict, base: Path, out: Path) -> Path:
+    """The spec's FMU: ``fmu`` (a path), or ``model`` (a model file packed with fmu-pack into
+    ``out``), or ``mesh`` + ``mapping`` (imported, then packed)."""
+    from .fmu import build_fmu, find_fmu
+
+    if "fmu" in spec:
+        return find_fmu(base / spec["fmu"])
+    if "model" in spec:
+        return build_fmu(base / spec["model"], out_dir=out / "fmu")
+    if "mesh" in spec:
+        from .mesh import import_mesh
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = import_mesh(base / spec["mesh"], base / spec["mapping"])
+        return build_fmu(model, out_dir=out / "fmu")
+    return find_fmu(None)
+
+
+def quantile_table(ds, outputs: list[str], quantiles: list[float], step: int = -1) -> str:
+    """Quantiles of ``outputs`` at ``step`` over the cases that ran through (status ok), as
+    Markdown rows."""
+    ok = ds.status == "ok"
+    lines = ["| output | " + " | ".join(f"{100 * q:g} %" for q in quantiles) + " | cases |",
+             "|---|" + "---|" * (len(quantiles) + 1)]
+    for o in outputs:
+        values = ds[o].isel(step=step).where(ok, drop=True).values
+        qs = np.quantile(values, quantiles) if len(values) else [np.nan] * len(quantiles)
+        lines.append(f"| {o} | " + " | ".join(f"{q:.6g}" for q in qs) + f" | {len(values)} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(prog="python -m membrane_contact.study",
+                                description="Runs a study (a design of FMU runs) on a Dask cluster.")
+    p.add_argument("spec", help="the study spec, TOML or YAML (python/README.md)")
+    p.add_argument("--out", help="the results directory (default: the spec's 'out')")
+    p.add_argument("--scheduler", help="a Dask scheduler address or scheduler file (default: a LocalCluster)")
+    p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: one per core)")
+    p.add_argument("--shared-fmu", action="store_true",
+                   help="workers read the FMU at its path (a shared filesystem) instead of receiving its bytes")
+    p.add_argument("--no-progress", action="store_true", help="no progress lines")
+    a = p.parse_args(argv)
+    try:
+        spec = load_spec(a.spec)
+        base = Path(a.spec).resolve().parent
+        known = {"fmu", "model", "mesh", "mapping", "out", "outputs", "parameters", "path", "design",
+                 "max_halvings", "dt", "report", "description"}
+        unknown = sorted(set(spec) - known)
+        if unknown:
+            raise ValueError(f"{a.spec}: unknown keys {', '.join(unknown)}")
+        out = (Path(a.out) if a.out else base / spec.get("out", Path(a.spec).stem)).resolve()
+        out.mkdir(parents=True, exist_ok=True)
+        study = Study(fmu_from_spec(spec, base, out), design_from_spec(spec.get("design") or {}, base),
+                      path_from_spec(spec.get("path") or {}, base), spec.get("outputs"),
+                      spec.get("parameters"), out, spec.get("max_halvings", 6), spec.get("dt"))
+    except (KeyError, ValueError, FileNotFoundError, RuntimeError) as e:
+        print(f"error: {e.args[0] if isinstance(e, KeyError) and e.args else e}", file=sys.stderr)
+        return 2
+    ds = study.run(scheduler=a.scheduler, workers=a.workers, progress=not a.no_progress, shared_fmu=a.shared_fmu)
+    failed = int((ds.status != "ok").sum())
+    print(f"{study.cases} cases in {out}: {study.cases - failed} ran through, {failed} refused")
+    for k in np.flatnonzero(ds.status.values != "ok")[:10]:
+        print(f"  case {k} ({', '.join(f'{n}={ds[n].values[k]}' for n in study.design)}): {ds.message.values[k]}")
+    report = spec.get("report")
+    if report:
+        table = quantile_table(ds, report.get("outputs", study.outputs), report.get("quantiles", [0.05, 0.5, 0.95]),
+                               report.get("step", -1))
+        (out / "quantiles.md").write_text(table + "\n")
+        print(table)
+    return 0
+
+
+if __name__ == "__main__":
+    # Run as a script, this file is __main__: the functions the workers run must be pickled as
+    # membrane_contact.study's, which they import.
+    from membrane_contact.study import main as _main
+
+    sys.exit(_main())

@@ -1,0 +1,131 @@
+//! The outputs: computed from the converged state's results (and the last step's statistics),
+//! checked finite, and the warnings when they leave the model's assumptions.
+//!
+//! * The initial outputs are those of the undeformed, prestressed film; inputs set during
+//!   initialization are reached by the first step.
+
+use super::instance::Instance;
+use super::phase::{Failure, Outcome};
+use super::scalar_variable::{Binding, Value};
+use super::types::Status;
+use crate::mech::elements::triangle::state_counts;
+use crate::mech::results::warnings::result_warnings;
+use crate::mech::{GapStatus, StepReport, check_results};
+
+impl Instance {
+    /// Builds the analysis if there is none (initialization) and computes the initial outputs.
+    pub(super) fn initial_outputs(&mut self) -> Outcome {
+        if self.analysis.is_none() {
+            let built = self
+                .build(&self.values)
+                .map_err(|e| Failure::error(format!("invalid parameters: {e}")))?;
+            self.analysis = Some(built);
+        }
+        if !self.outputs_fresh {
+            self.refresh_outputs(None)?;
+        }
+        Ok(())
+    }
+
+    /// Writes the results of the converged state (and the step's statistics) into the outputs;
+    /// refuses (fmi2Discard, outputs unchanged) when one of them would not be finite.
+    pub(super) fn refresh_outputs(&mut self, report: Option<&StepReport>) -> Outcome {
+        let Some(built) = self.analysis.as_mut() else {
+            return Ok(());
+        };
+        let results = match built.checked.take() {
+            Some(results) => results,
+            None => {
+                let results = built.analysis.results();
+                let residual = report.map(|r| r.residual);
+                check_results(built.analysis.model(), &results, residual).map_err(|e| {
+                    Failure::discard(format!(
+                        "{e}: the outputs are not updated (the state is not one the solver can reach)"
+                    ))
+                })?;
+                results
+            }
+        };
+        built.warnings = result_warnings(built.analysis.model(), &results);
+        let max_stress = results.von_mises_range().1;
+        let [_, wrinkled, slack] = state_counts(&results.elements);
+        let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
+        for (v, x) in self
+            .description
+            .variables
+            .iter()
+            .zip(self.values.iter_mut())
+        {
+            *x = match v.binding {
+                Binding::SlipX(g) => Value::Real(results.gaps[g].slip_x),
+                Binding::SlipY(g) => Value::Real(results.gaps[g].slip_y),
+                Binding::NormalForce(g) => Value::Real(results.gaps[g].normal_force),
+                Binding::FrictionForce(g) => Value::Real(results.gaps[g].friction_force),
+                // `GapResult::friction` is the force the film exerts on the support (the
+                // equilibrium of the film's Z forces shows it): the film feels the opposite.
+                Binding::GapFriction { gap, axis } => {
+                    Value::Real(-results.gaps[gap].friction[axis])
+                }
+                Binding::GapStatus(g) => Value::Integer(match results.gaps[g].status {
+                    GapStatus::Open => 0,
+                    GapStatus::Stick => 1,
+                    GapStatus::Slip => 2,
+                }),
+                Binding::Reaction { group, axis } => Value::Real(results.reactions[group][axis]),
+                Binding::HingeMoment(group) => Value::Real(results.moments[group]),
+                Binding::Iterations => count(report.map_or(0, StepReport::total_iterations)),
+                Binding::Cutbacks => count(report.map_or(0, |r| r.cutbacks)),
+                Binding::Residual => Value::Real(report.map_or(0.0, |r| r.residual)),
+                Binding::MaxEquivalentStress => Value::Real(max_stress),
+                Binding::WrinkledElements => count(wrinkled),
+                Binding::SlackElements => count(slack),
+                Binding::SupportReaction { set, axis } => {
+                    Value::Real(results.support_reactions[set][axis])
+                }
+                Binding::TotalReaction(axis) => Value::Real(results.total_reaction[axis]),
+                Binding::CableForce(c) => Value::Real(results.cables[c].max_force),
+                Binding::SurfaceSlip(c) => Value::Real(results.surface_contacts[c].slip),
+                Binding::SurfaceNormalForce(c) => {
+                    Value::Real(results.surface_contacts[c].normal_force)
+                }
+                Binding::SurfaceFrictionForce(c) => {
+                    Value::Real(results.surface_contacts[c].friction_force)
+                }
+                Binding::SurfaceStatus(c) => {
+                    Value::Integer(results.surface_contacts[c].status as i32)
+                }
+                Binding::PointDisplacement { point, axis } => {
+                    Value::Real(results.points[point][axis])
+                }
+                Binding::SetSummary { set, quantity } => {
+                    Value::Real(quantity.of(&results.sets[set]))
+                }
+                _ => continue,
+            };
+        }
+        self.outputs_fresh = true;
+        Ok(())
+    }
+
+    /// `outcome`, or `fmi2Warning` with the reasons when the current outputs leave the model's
+    /// assumptions (a stress above the yield stress, strains beyond the small-strain range):
+    /// the state and outputs stand, the importer is told once per step.
+    pub(super) fn warn_about_assumptions(&self, outcome: Outcome) -> Outcome {
+        let warnings = self.analysis.as_ref().map_or(&[][..], |b| &b.warnings[..]);
+        if warnings.is_empty() {
+            return outcome;
+        }
+        let mut message = format!(
+            "t = {}: the result is outside the model's assumptions: {}",
+            self.time,
+            warnings.join("; ")
+        );
+        if let Err(f) = outcome {
+            if f.status != Status::Warning {
+                return Err(f);
+            }
+            message = format!("{}; {message}", f.message);
+        }
+        Err(Failure::warning(message))
+    }
+}

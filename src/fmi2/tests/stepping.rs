@@ -1,0 +1,216 @@
+//! Stepping through the exported functions: a refused step (fmi2Discard) and its retry, the
+//! identical step repeated, inputs the solver cannot reach, results beyond the model's
+//! assumptions, and a model without a free DOF stepped through stick and slip.
+//!
+//! SAFETY of the `unsafe` blocks below: as in the harness (`tests/mod.rs`), each calls an
+//! exported function the way an importer does, with an instance from [`Fmu`] (freed only in its
+//! `Drop`), and pointers to live locals or NUL-terminated literals holding the announced number
+//! of elements; the deliberately bad arguments are NULL pointers, which the functions must
+//! reject without dereferencing.
+
+use super::*;
+
+#[test]
+fn a_step_that_cannot_converge_is_discarded_and_can_be_retried() {
+    let (u, log) = (Unpacked::specimen("discard"), Log::default());
+    // Small steps converge in fewer than 10 iterations; a jump to the target in one increment
+    // does not, and no cut-back may rescue it.
+    let settings = [
+        ("solver.maxCutbacks", 0),
+        ("solver.maxIterations", 10),
+        ("solver.incrementsPerStep", 1),
+    ];
+    let fmu = Fmu::initialized(&u, &log, &[], &settings);
+    fmu.ramp(0, 3, 40);
+    let before = fmu.all_values();
+    assert_eq!(fmu.set_real("frame.dz", -0.15), 0);
+    assert_eq!(fmu.step(0.075, 0.925), Status::Discard.raw());
+    assert!(
+        log.contains(Status::Discard, "did not converge"),
+        "{:?}",
+        log.take()
+    );
+    // The advice names the FMU's parameters, not the command line's options.
+    assert!(
+        log.contains(
+            Status::Discard,
+            "(raise solver.incrementsPerStep or take a smaller communication step)"
+        ) && !log.contains(Status::Discard, "--"),
+        "{:?}",
+        log.take()
+    );
+    let mut status = 0;
+    assert_eq!(
+        unsafe { fmi2_get_status(fmu.c, FMI2_DO_STEP_STATUS, &mut status) },
+        0
+    );
+    assert_eq!(status, Status::Discard.raw());
+    let mut last = f64::NAN;
+    assert_eq!(
+        unsafe { fmi2_get_real_status(fmu.c, FMI2_LAST_SUCCESSFUL_TIME, &mut last) },
+        0
+    );
+    assert!((last - 0.075).abs() < 1e-15, "{last}");
+    // Outputs and time are those of the last converged state (only the input changed).
+    let mut after = fmu.all_values();
+    let dz = u
+        .variables
+        .iter()
+        .filter(|v| v.var_type == crate::fmi2::variables::VarType::Real)
+        .position(|v| v.name == "frame.dz");
+    after.0[dz.unwrap()] = before.0[dz.unwrap()];
+    assert_eq!(after, before);
+    // Retry with a smaller change from the same time.
+    fmu.ramp(3, 4, 40);
+    assert!((fmu.real("time") - 0.1).abs() < 1e-15);
+    assert_eq!(
+        unsafe { fmi2_get_status(fmu.c, FMI2_DO_STEP_STATUS, &mut status) },
+        0
+    );
+    assert_eq!(status, 0);
+}
+
+#[test]
+fn repeating_a_refused_step_identically_reports_terminated() {
+    let (u, log) = (Unpacked::specimen("terminated"), Log::default());
+    let settings = [
+        ("solver.maxCutbacks", 0),
+        ("solver.maxIterations", 6),
+        ("solver.incrementsPerStep", 1),
+    ];
+    let fmu = Fmu::initialized(&u, &log, &[], &settings);
+    let terminated = || {
+        let mut value = -1;
+        assert_eq!(
+            unsafe { fmi2_get_boolean_status(fmu.c, FMI2_TERMINATED, &mut value) },
+            0
+        );
+        value
+    };
+    assert_eq!(terminated(), 0);
+    assert_eq!(fmu.set_real("frame.dz", -0.15), 0);
+    assert_eq!(fmu.step(0.0, 1.0), Status::Discard.raw());
+    // A first refusal leaves the retry open: what fmpy.simulate_fmu asks before repeating.
+    assert_eq!(terminated(), 0);
+    assert!(log.contains(Status::Discard, "asking the identical step again"));
+    // The identical step again (the step size does not matter for a pseudo-time): refused, and
+    // now the FMU asks the master to stop.
+    assert_eq!(fmu.step(0.0, 0.5), Status::Discard.raw());
+    assert_eq!(terminated(), 1);
+    assert!(log.contains(Status::Discard, "fmi2Terminated) is now true"));
+    // A master that ignores the Discard and goes on is refused with a message that the outputs
+    // are stale, at every call.
+    for _ in 0..2 {
+        assert_eq!(fmu.step(1.0, 1.0), Status::Error.raw());
+        assert!(log.contains(Status::Error, "its outputs are those of t = 0"));
+    }
+    // A smaller change still works and clears the flag.
+    assert_eq!(fmu.set_real("frame.dz", -0.0001), 0);
+    assert_eq!(fmu.step(0.0, 0.1), 0);
+    assert_eq!(terminated(), 0);
+}
+
+/// Issue 12, item 1: a huge but finite input never gives fmi2OK with NaN outputs: the step is
+/// refused (fmi2Error or fmi2Discard) and the outputs stay those of the last converged state.
+#[test]
+fn huge_finite_input_is_refused_never_ok_with_nan() {
+    let (u, log) = (Unpacked::specimen("huge"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[("mu", 0.2)], &[]);
+    fmu.ramp(0, 2, 20);
+    assert_eq!(fmu.set_real("frame.dz", -1e100), 0);
+    let before = fmu.all_values();
+    let status = fmu.step(0.1, 0.05);
+    assert!(
+        status == Status::Error.raw() || status == Status::Discard.raw(),
+        "status {status}: {:?}",
+        log.take()
+    );
+    assert_eq!(
+        fmu.all_values().0.iter().filter(|v| !v.is_finite()).count(),
+        0
+    );
+    assert_eq!(fmu.all_values(), before);
+}
+
+/// A step whose result leaves the model's assumptions (stress above `yield_stress`) returns
+/// fmi2Warning with the reason in the log, and keeps its state and outputs; a model that looks
+/// wrong (E in MPa) warns at fmi2ExitInitializationMode.
+#[test]
+fn result_beyond_the_yield_stress_is_a_warning_not_an_error() {
+    let mut model = ParallelArch::default().model().unwrap();
+    model.material.yield_stress = Some(15e6);
+    let (u, log) = (
+        Unpacked::new("yield", Source::Model(model.clone())),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    assert_eq!(fmu.set_real("frame.dz", -0.15), 0);
+    assert_eq!(fmu.step(0.0, 1.0), Status::Warning.raw());
+    assert!(
+        log.contains(
+            Status::Warning,
+            "above the material's yield_stress 15.000 MPa"
+        ),
+        "{:?}",
+        log.take()
+    );
+    assert!(fmu.real("film.maxEquivalentStress") > 15e6);
+    // The step stood: the next one continues from t = 1.
+    assert_eq!(fmu.set_real("frame.dz", -0.14), 0);
+    assert_ne!(fmu.step(1.0, 1.0), Status::Error.raw());
+}
+
+/// A model without a free DOF (issue 17: how single elements are verified) initializes and
+/// steps: `examples/driven_gap.json` driven down 2 mm and along x sticks at `k_s·dx`, slips at
+/// `μN` = 30 N beyond 3 mm and sticks again on the way back, as the core says
+/// (`tests/supports.rs`); the film feels the opposite of the gap's friction force and the drive
+/// carries both contact forces. Its FMU state round trip keeps the slip history.
+#[test]
+fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
+    let model =
+        crate::mech::Model::from_json(include_str!("../../../examples/driven_gap.json")).unwrap();
+    let (u, log) = (
+        Unpacked::new("prescribed", Source::Model(model)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    let path = [
+        (0.0, 1, 0.0),
+        (1e-3, 1, 10.0),
+        (2e-3, 1, 20.0),
+        (4e-3, 2, 30.0),
+        (6e-3, 2, 30.0),
+        (5e-3, 1, 20.0),
+    ];
+    let mut saved = None;
+    for (k, &(dx, status, friction)) in path.iter().enumerate() {
+        assert_eq!(fmu.set_real("Drive.dx", dx), 0);
+        assert_eq!(fmu.set_real("Drive.dz", -2e-3), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+        let at = format!("step {k}, dx = {dx}");
+        assert_eq!(fmu.integer("G.status"), status, "{at}");
+        assert!((fmu.real("G.normalForce") - 100.0).abs() < 1e-9, "{at}");
+        assert!((fmu.real("G.frictionX") + friction).abs() < 1e-9, "{at}");
+        assert!((fmu.real("Drive.Rx") - friction).abs() < 1e-9, "{at}");
+        assert!((fmu.real("Drive.Rz") + 100.0).abs() < 1e-9, "{at}");
+        assert_eq!(fmu.integer("solver.iterations"), 0, "{at}");
+        if k == 4 {
+            let mut state: Fmi2FmuState = std::ptr::null_mut();
+            assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+            saved = Some(state);
+        }
+    }
+    // Back to the slipped state at 6 mm (history 3 mm): 5 mm sticks at 20 N again.
+    let mut state = saved.unwrap();
+    assert_eq!(
+        unsafe { fmi2_set_fmu_state(fmu.c, state) },
+        0,
+        "{:?}",
+        log.take()
+    );
+    assert_eq!(fmu.set_real("Drive.dx", 5e-3), 0);
+    assert_eq!(fmu.step(5.0, 1.0), 0, "{:?}", log.take());
+    assert_eq!(fmu.integer("G.status"), 1);
+    assert!((fmu.real("G.frictionX") + 20.0).abs() < 1e-9);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
+}

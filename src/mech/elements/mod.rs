@@ -1,0 +1,19 @@
+//! What adds force and stiffness to the film: the membrane triangle and its film law, edge
+//! cables, friction gaps, node-to-surface contact on curved supports and external loads.
+//! A new material goes into [`material`] (its law) and [`triangle`] (its element).
+//!
+//! | file | what |
+//! |---|---|
+//! | [`triangle`] | CST membrane triangle, eqs. (2.2)–(2.7) |
+//! | [`material`] | film law, eq. (2.3), and its tension-field (wrinkling) option |
+//! | [`cable`] | tension-only edge cables (2-node truss segments along triangle edges) |
+//! | [`gap`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
+//! | [`curved_contact`] | node-to-surface friction contact on rigid curved supports (and, in `surface`, their geometry) |
+//! | [`load`] | follower pressure, self-weight, nodal forces and their load stiffness |
+
+pub mod cable;
+pub mod curved_contact;
+pub mod gap;
+pub mod load;
+pub mod material;
+pub mod triangle;

@@ -1,0 +1,581 @@
+//! Validation of a model: every item is checked before any analysis, and the first problem
+//! found is named (an unknown node index, a degenerate triangle, `E ≤ 0`, `ν` outside `[0, 0.5)`,
+//! `η` outside `[0, 1)`, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node both
+//! constrained and prescribed, a control character in text bound for modelDescription.xml, a
+//! rigid-body mode no restraint holds ([`crate::mech::model::restraint`]). Nothing here panics on user input.
+
+use std::collections::HashSet;
+
+use nalgebra::Vector3;
+
+use super::format::*;
+use crate::mech::elements::curved_contact::Centreline;
+use crate::mech::elements::curved_contact::SurfaceContact;
+use crate::mech::elements::triangle::MembraneTriangle;
+
+impl Model {
+    /// Checks every item; the first problem found is returned.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        let n = self.nodes.len();
+        let size = crate::mech::model::bounding_diagonal(&self.nodes);
+        if n == 0 || self.triangles.is_empty() {
+            return Err(ModelError::Empty {
+                message: "needs at least one node and one triangle".into(),
+            });
+        }
+        if !is_identifier(&self.name) {
+            return Err(ModelError::Name {
+                item: format!("model name '{}'", self.name),
+                message: "must be an identifier ([A-Za-z_][A-Za-z0-9_]*)".into(),
+            });
+        }
+        for (i, p) in self.nodes.iter().enumerate() {
+            if p.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NotFinite {
+                    item: format!("node {i}"),
+                });
+            }
+        }
+        let check_node = |item: &dyn Fn() -> String, node: usize| {
+            if node < n {
+                Ok(())
+            } else {
+                Err(ModelError::UnknownNode {
+                    item: item(),
+                    node,
+                    node_count: n,
+                })
+            }
+        };
+        let m = &self.material;
+        if !(m.youngs_modulus > 0.0 && m.youngs_modulus.is_finite()) {
+            return Err(ModelError::Material {
+                message: format!("E = {} must be > 0", m.youngs_modulus),
+            });
+        }
+        if !(m.poisson_ratio >= 0.0 && m.poisson_ratio < 0.5) {
+            return Err(ModelError::Material {
+                message: format!("ν = {} must lie in [0, 0.5)", m.poisson_ratio),
+            });
+        }
+        if !(m.thickness > 0.0 && m.thickness.is_finite()) {
+            return Err(ModelError::Material {
+                message: format!("thickness = {} must be > 0", m.thickness),
+            });
+        }
+        if m.prestress.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::Material {
+                message: "prestress must be finite".into(),
+            });
+        }
+        let eta = m.wrinkling_regularisation;
+        if !(0.0..1.0).contains(&eta) {
+            return Err(ModelError::Material {
+                message: format!("wrinkling_regularisation = {eta} must lie in [0, 1)"),
+            });
+        }
+        if !(m.density >= 0.0 && m.density.is_finite()) {
+            return Err(ModelError::Material {
+                message: format!("density = {} must be ≥ 0 (kg/m³)", m.density),
+            });
+        }
+        if let Some(y) = m.yield_stress
+            && !(y > 0.0 && y.is_finite())
+        {
+            return Err(ModelError::Material {
+                message: format!("yield_stress = {y} must be > 0 (Pa)"),
+            });
+        }
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for &v in tri {
+                check_node(&|| format!("triangle {t}"), v)?;
+            }
+            let x = tri.map(|v| Vector3::from(self.nodes[v]));
+            if tri[0] == tri[1]
+                || tri[1] == tri[2]
+                || tri[0] == tri[2]
+                || MembraneTriangle::new(x).is_err()
+            {
+                return Err(ModelError::DegenerateTriangle {
+                    triangle: t,
+                    nodes: *tri,
+                });
+            }
+        }
+        // Constrained DOFs: 0 free, 1 fixed (support or symmetry), 2 prescribed by a group.
+        let mut constrained = vec![[false; 3]; n];
+        let mut names = HashSet::new();
+        for name in self.support_sets() {
+            check_name(&mut names, "support set", &name)?;
+        }
+        for s in &self.supports {
+            check_node(&|| "support".to_string(), s.node)?;
+            for a in &s.fixed {
+                constrained[s.node][a.index()] = true;
+            }
+        }
+        for s in &self.symmetry {
+            for &v in &s.nodes {
+                check_node(&|| format!("symmetry plane '{}'", s.name), v)?;
+                constrained[v][s.normal.index()] = true;
+            }
+        }
+        let mut in_group = vec![None::<&str>; n];
+        for g in &self.groups {
+            check_name(&mut names, "boundary group", &g.name)?;
+            if g.nodes.is_empty() {
+                return Err(ModelError::Name {
+                    item: format!("boundary group '{}'", g.name),
+                    message: "has no nodes".into(),
+                });
+            }
+            if g.target.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NotFinite {
+                    item: format!("boundary group '{}' target", g.name),
+                });
+            }
+            if let Some(axes) = &g.components {
+                let listed = axes.len();
+                if listed == 0 || g.prescribes().iter().filter(|&&p| p).count() != listed {
+                    return Err(ModelError::Name {
+                        item: format!("boundary group '{}'", g.name),
+                        message: "components must list each of \"x\", \"y\", \"z\" at most once, and at least one"
+                            .into(),
+                    });
+                }
+            }
+            if let Some(h) = &g.hinge {
+                let item = || format!("boundary group '{}' hinge", g.name);
+                if h.point.iter().chain(&h.axis).any(|v| !v.is_finite())
+                    || !h.target_angle.is_finite()
+                {
+                    return Err(ModelError::NotFinite { item: item() });
+                }
+                if Vector3::from(h.axis).norm() == 0.0 {
+                    return Err(ModelError::Name {
+                        item: item(),
+                        message: "axis is the zero vector".into(),
+                    });
+                }
+                if h.target_angle.abs() > Hinge::MAX_ANGLE {
+                    return Err(ModelError::Name {
+                        item: item(),
+                        message: format!(
+                            "target_angle {} rad is beyond two full turns ({:.4} rad)",
+                            h.target_angle,
+                            Hinge::MAX_ANGLE
+                        ),
+                    });
+                }
+            }
+            let prescribed = g.prescribes();
+            for &v in &g.nodes {
+                check_node(&|| format!("boundary group '{}'", g.name), v)?;
+                if let Some(other) = in_group[v] {
+                    return Err(ModelError::Conflict {
+                        node: v,
+                        message: format!("is in boundary groups '{other}' and '{}'", g.name),
+                    });
+                }
+                if (0..3).any(|c| constrained[v][c] && prescribed[c]) {
+                    return Err(ModelError::Conflict {
+                        node: v,
+                        message: format!(
+                            "is prescribed by group '{}' and also fixed by a support or symmetry plane",
+                            g.name
+                        ),
+                    });
+                }
+                in_group[v] = Some(&g.name);
+            }
+        }
+        for gap in &self.gaps {
+            check_name(&mut names, "gap", &gap.name)?;
+            let bad = |message: String| ModelError::Gap {
+                gap: gap.name.clone(),
+                message,
+            };
+            check_node(&|| format!("gap '{}' film_node", gap.name), gap.film_node)?;
+            match &gap.support {
+                GapSupport::Node(b) => {
+                    check_node(&|| format!("gap '{}' support node", gap.name), *b)?;
+                    if *b == gap.film_node {
+                        return Err(bad("support node equals film node".into()));
+                    }
+                }
+                GapSupport::Point(p) => {
+                    if p.iter().any(|v| !v.is_finite()) {
+                        return Err(bad("support point is not finite".into()));
+                    }
+                }
+            }
+            let frame_values = gap.frame.x.iter().chain(&gap.frame.y).chain(&gap.frame.z);
+            if frame_values.clone().any(|v| !v.is_finite())
+                || gap.frame.orthonormality_error() > 1e-6
+            {
+                return Err(bad(format!(
+                    "frame is not orthonormal and right-handed with y = z × x (error {:.2e})",
+                    gap.frame.orthonormality_error()
+                )));
+            }
+            let positive = |v: f64| v > 0.0 && v.is_finite();
+            if !positive(gap.normal_stiffness) {
+                return Err(bad(format!(
+                    "normal_stiffness = {} must be > 0",
+                    gap.normal_stiffness
+                )));
+            }
+            if !positive(gap.tangential_stiffness) {
+                return Err(bad(format!(
+                    "tangential_stiffness = {} must be > 0",
+                    gap.tangential_stiffness
+                )));
+            }
+            if !(gap.friction >= 0.0 && gap.friction <= MAX_FRICTION) {
+                return Err(bad(format!(
+                    "friction μ = {} must lie in [0, {MAX_FRICTION}]",
+                    gap.friction
+                )));
+            }
+            if !(gap.initial_gap >= 0.0 && gap.initial_gap.is_finite()) {
+                return Err(bad(format!(
+                    "initial_gap = {} must be ≥ 0",
+                    gap.initial_gap
+                )));
+            }
+            let distance = gap.geometric_gap(&self.nodes);
+            let tolerance = GAP_GEOMETRY_TOLERANCE * size;
+            if (distance - gap.initial_gap).abs() > tolerance {
+                return Err(bad(format!(
+                    "initial_gap = {} m contradicts the geometry: the film node lies {distance:.6} m \
+                     from the support along the gap's z (the difference is beyond {tolerance:.2e} m, \
+                     {GAP_GEOMETRY_TOLERANCE} of the model's size{}); correct initial_gap, the \
+                     support or the frame",
+                    gap.initial_gap,
+                    if distance < 0.0 {
+                        ", and the node starts inside the support"
+                    } else {
+                        ""
+                    }
+                )));
+            }
+        }
+        self.validate_loads(&mut names)?;
+        self.validate_outputs(&mut names)?;
+        self.validate_cables(&mut names)?;
+        self.validate_curved_supports(&mut names)?;
+        check_xml_text("model description", &self.description)?;
+        for s in &self.symmetry {
+            check_xml_text(
+                &format!("symmetry plane name '{}'", s.name.escape_debug()),
+                &s.name,
+            )?;
+        }
+        crate::mech::model::restraint::check(self)
+    }
+
+    /// Checks an element selection: a non-empty list of existing triangles, each once.
+    fn check_selection(&self, selection: &ElementSelection) -> Result<(), String> {
+        let ElementSelection::List(list) = selection else {
+            return Ok(());
+        };
+        if list.is_empty() {
+            return Err("has no elements (write \"all\" for every triangle)".into());
+        }
+        let mut seen = HashSet::new();
+        for &e in list {
+            if e >= self.triangles.len() {
+                return Err(format!(
+                    "triangle {e} does not exist (the model has {} triangles, 0-based)",
+                    self.triangles.len()
+                ));
+            }
+            if !seen.insert(e) {
+                return Err(format!("lists triangle {e} twice"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the `outputs` section; its names join the gap and group namespace.
+    fn validate_outputs(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        for p in &self.outputs.points {
+            check_name(names, "output point", &p.name)?;
+            if p.node >= self.nodes.len() {
+                return Err(ModelError::UnknownNode {
+                    item: format!("output point '{}'", p.name),
+                    node: p.node,
+                    node_count: self.nodes.len(),
+                });
+            }
+        }
+        for set in &self.outputs.element_sets {
+            check_name(names, "element set", &set.name)?;
+            self.check_selection(&set.elements)
+                .map_err(|message| ModelError::Output {
+                    item: format!("element set '{}'", set.name),
+                    message,
+                })?;
+        }
+        Ok(())
+    }
+
+    /// Checks the `cables` section; cable names join the namespace.
+    fn validate_curved_supports(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        let mut in_triangle = vec![false; self.nodes.len()];
+        for t in &self.triangles {
+            for &v in t {
+                if let Some(x) = in_triangle.get_mut(v) {
+                    *x = true;
+                }
+            }
+        }
+        for s in &self.curved_supports {
+            check_name(names, "curved support", &s.name)?;
+            let bad = |message: String| ModelError::Gap {
+                gap: format!("curved support '{}'", s.name),
+                message,
+            };
+            let axis_line = match &s.centreline {
+                Centreline::Parabola { .. } | Centreline::Polyline { .. } => None,
+                Centreline::Line { point, axis } => Some((*point, *axis, None)),
+                Centreline::Circle {
+                    centre,
+                    axis,
+                    radius,
+                    angles,
+                    start_direction,
+                } => {
+                    if !(*radius > 0.0 && radius.is_finite()) {
+                        return Err(bad(format!("centreline radius = {radius} must be > 0")));
+                    }
+                    let finite = angles
+                        .iter()
+                        .flatten()
+                        .chain(start_direction.iter().flatten());
+                    if finite.clone().any(|v| !v.is_finite()) {
+                        return Err(bad("angles or start_direction not finite".into()));
+                    }
+                    if let Some([lo, hi]) = angles
+                        && lo >= hi
+                    {
+                        return Err(bad(format!("angles [{lo}, {hi}] must increase")));
+                    }
+                    if let Some(d) = start_direction {
+                        let (d, a) = (Vector3::from(*d), Vector3::from(*axis));
+                        if (d - a * (a.dot(&d) / a.norm_squared())).norm()
+                            < 1e-9 * d.norm().max(1.0)
+                        {
+                            return Err(bad("start_direction is parallel to the axis".into()));
+                        }
+                    }
+                    Some((*centre, *axis, Some(*radius)))
+                }
+            };
+            if let Some((point, axis, _)) = axis_line {
+                if point.iter().chain(&axis).any(|v| !v.is_finite()) {
+                    return Err(bad("centreline point or axis not finite".into()));
+                }
+                if Vector3::from(axis).norm() == 0.0 {
+                    return Err(bad("centreline axis is the zero vector".into()));
+                }
+            }
+            let positive = |v: f64| v > 0.0 && v.is_finite();
+            for (what, v) in [
+                ("tube_radius", s.tube_radius),
+                ("normal_stiffness", s.normal_stiffness),
+                ("tangential_stiffness", s.tangential_stiffness),
+            ] {
+                if !positive(v) {
+                    return Err(bad(format!("{what} = {v} must be > 0")));
+                }
+            }
+            if !(s.friction >= 0.0 && s.friction <= MAX_FRICTION) {
+                return Err(bad(format!(
+                    "friction μ = {} must lie in [0, {MAX_FRICTION}]",
+                    s.friction
+                )));
+            }
+            s.centreline.check(s.tube_radius).map_err(bad)?;
+            if s.nodes.is_empty() {
+                return Err(bad("lists no nodes".into()));
+            }
+            for &v in &s.nodes {
+                let Some(x) = self.nodes.get(v) else {
+                    return Err(ModelError::UnknownNode {
+                        item: format!("curved support '{}'", s.name),
+                        node: v,
+                        node_count: self.nodes.len(),
+                    });
+                };
+                if !in_triangle[v] {
+                    return Err(bad(format!("node {v} belongs to no triangle")));
+                }
+                let x = Vector3::from(*x);
+                if let Some((point, axis, ring)) = axis_line {
+                    let (rel, a) = (x - Vector3::from(point), Vector3::from(axis).normalize());
+                    let rho = (rel - a * a.dot(&rel)).norm();
+                    if rho < 1e-9 * ring.unwrap_or(s.tube_radius) {
+                        return Err(bad(format!(
+                            "node {v} lies on the centreline's axis: its closest point is \
+                             undefined"
+                        )));
+                    }
+                }
+                let distance = SurfaceContact::new(s, v).project(&x, 0.0).gap + s.tube_radius;
+                if distance.is_nan() || distance < 1e-9 * s.tube_radius {
+                    return Err(bad(format!(
+                        "node {v} lies on the centreline: its normal is undefined"
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_cables(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        if self.cables.is_empty() {
+            return Ok(());
+        }
+        let edges = self.edge_triangles();
+        for c in &self.cables {
+            check_name(names, "cable", &c.name)?;
+            let item = || format!("cable '{}'", c.name);
+            let bad = |message: String| ModelError::Output {
+                item: item(),
+                message,
+            };
+            if c.nodes.len() < 2 {
+                return Err(bad("needs at least two nodes".into()));
+            }
+            for &v in &c.nodes {
+                if v >= self.nodes.len() {
+                    return Err(ModelError::UnknownNode {
+                        item: item(),
+                        node: v,
+                        node_count: self.nodes.len(),
+                    });
+                }
+            }
+            for (what, v) in [("area", c.area), ("youngs_modulus", c.youngs_modulus)] {
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(bad(format!("{what} = {v} must be > 0")));
+                }
+            }
+            if !(c.prestress_force >= 0.0 && c.prestress_force.is_finite()) {
+                return Err(bad(format!(
+                    "prestress_force = {} must be ≥ 0 (N; a cable carries no compression)",
+                    c.prestress_force
+                )));
+            }
+            for pair in c.nodes.windows(2) {
+                if !edges.contains_key(&[pair[0], pair[1]]) {
+                    return Err(bad(format!(
+                        "nodes {} and {} are not an edge of one triangle: a cable runs along film edges",
+                        pair[0], pair[1]
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the `loads` section; set names join the gap and group namespace.
+    fn validate_loads(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        let l = &self.loads;
+        if l.gravity.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::NotFinite {
+                item: "loads gravity".into(),
+            });
+        }
+        for p in &l.pressures {
+            check_name(names, "pressure set", &p.name)?;
+            let item = || format!("pressure set '{}'", p.name);
+            if !p.pressure.is_finite() {
+                return Err(ModelError::NotFinite {
+                    item: format!("{} pressure", item()),
+                });
+            }
+            self.check_selection(&p.elements)
+                .map_err(|message| ModelError::Load {
+                    item: item(),
+                    message,
+                })?;
+            crate::mech::elements::load::check_towards(self, p).map_err(|message| {
+                ModelError::Load {
+                    item: item(),
+                    message,
+                }
+            })?;
+        }
+        for f in &l.forces {
+            check_name(names, "force set", &f.name)?;
+            let item = || format!("force set '{}'", f.name);
+            if f.force.iter().any(|v| !v.is_finite()) {
+                return Err(ModelError::NotFinite {
+                    item: format!("{} force", item()),
+                });
+            }
+            if f.nodes.is_empty() {
+                return Err(ModelError::Load {
+                    item: item(),
+                    message: "has no nodes".into(),
+                });
+            }
+            let mut seen = HashSet::new();
+            for &v in &f.nodes {
+                if v >= self.nodes.len() {
+                    return Err(ModelError::UnknownNode {
+                        item: item(),
+                        node: v,
+                        node_count: self.nodes.len(),
+                    });
+                }
+                if !seen.insert(v) {
+                    return Err(ModelError::Load {
+                        item: item(),
+                        message: format!("lists node {v} twice"),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Refuses text that modelDescription.xml could not carry: control characters (tab, line feed
+/// and carriage return excepted) and the non-characters U+FFFE, U+FFFF (XML 1.0 `Char`).
+pub fn check_xml_text(field: &str, text: &str) -> Result<(), ModelError> {
+    let bad = text.char_indices().find(|&(_, c)| {
+        (c.is_control() && !matches!(c, '\t' | '\n' | '\r')) || matches!(c, '\u{FFFE}' | '\u{FFFF}')
+    });
+    match bad {
+        None => Ok(()),
+        Some((at, c)) => Err(ModelError::Text {
+            field: field.to_string(),
+            message: format!(
+                "character U+{:04X} at byte {at} is a control character that modelDescription.xml cannot carry",
+                c as u32
+            ),
+        }),
+    }
+}
+
+fn check_name(names: &mut HashSet<String>, kind: &str, name: &str) -> Result<(), ModelError> {
+    let item = format!("{kind} '{name}'");
+    if !is_identifier(name) {
+        return Err(ModelError::Name {
+            item,
+            message: "name must be an identifier ([A-Za-z_][A-Za-z0-9_]*)".into(),
+        });
+    }
+    if !names.insert(name.to_string()) {
+        return Err(ModelError::Name {
+            item,
+            message:
+                "name is used twice (gap, group, load-set and output names share one namespace)"
+                    .into(),
+        });
+    }
+    Ok(())
+}

@@ -1,0 +1,78 @@
+//! The results of a converged state: gaps, reactions, hinge moments, cables, curved contacts,
+//! element stresses, output points and set summaries.
+
+use crate::mech::elements::cable::CableResult;
+use crate::mech::elements::curved_contact::SurfaceContactResult;
+use crate::mech::elements::gap::GapStatus;
+use crate::mech::elements::triangle::ElementStress;
+use crate::mech::results::summary::FieldSummary;
+use serde::{Deserialize, Serialize};
+
+/// Converged results of one gap.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GapResult {
+    /// Tangential displacement of A relative to B since the start, local x (m).
+    pub slip_x: f64,
+    /// … local y (m).
+    pub slip_y: f64,
+    /// Normal contact force `N ≥ 0` (N).
+    pub normal_force: f64,
+    /// Friction force magnitude `|t|` (N): `≤ μN` for the isotropic law; for the sliding-direction law only
+    /// `|t_x| ≤ μN`, the elastic `t_y` is not bounded.
+    pub friction_force: f64,
+    /// Friction force components (local x, y) of the gap's internal force on node A (eq. 2.8):
+    /// the force the film exerts on the support; the support acts on the film with the opposite (N).
+    pub friction: [f64; 2],
+    /// Status at convergence.
+    pub status: GapStatus,
+}
+
+/// Results of the current converged state.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Results {
+    /// One per gap.
+    pub gaps: Vec<GapResult>,
+    /// Total reaction of each boundary group (N), global axes: the force the group applies to the
+    /// film, `Σ (f_int − f_ext)` over its DOFs (it balances the loads on its nodes too).
+    pub reactions: Vec<[f64; 3]>,
+    /// Moment of each boundary group's reaction about its hinge axis, through the hinge's
+    /// current position (N·m, right-hand rule about the axis): the torque the drive of a
+    /// rotating frame side applies to the film; 0 for a group without a hinge.
+    pub moments: Vec<f64>,
+    /// Largest axial force and slack segments of each cable.
+    pub cables: Vec<CableResult>,
+    /// Slip along the support, forces and status of each curved-support contact (model order:
+    /// supports, then their nodes).
+    pub surface_contacts: Vec<SurfaceContactResult>,
+    /// Total reaction of each named support set (N), global axes, over its fixed components.
+    pub support_reactions: Vec<[f64; 3]>,
+    /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the
+    /// gaps' forces on their support points are reported per gap, not here).
+    pub total_reaction: [f64; 3],
+    /// Restraint force on each node (N), global axes: `f_int − f_ext` at its supported,
+    /// symmetry-fixed and prescribed components, 0 at its free ones (the nodal reactions that
+    /// [`crate::mech::results::lines`] spreads along groups and support sets).
+    #[serde(default)]
+    pub node_reactions: Vec<[f64; 3]>,
+    /// Stress state of each triangle.
+    pub elements: Vec<ElementStress>,
+    /// Displacement of each output point of the model (m).
+    pub points: Vec<[f64; 3]>,
+    /// Field summary of each element set of the model.
+    pub sets: Vec<FieldSummary>,
+}
+
+impl Results {
+    /// Range `(min, max)` of the element von Mises stress (Pa).
+    pub fn von_mises_range(&self) -> (f64, f64) {
+        self.elements
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), e| {
+                if e.von_mises.is_nan() || lo.is_nan() {
+                    (f64::NAN, f64::NAN)
+                } else {
+                    (lo.min(e.von_mises), hi.max(e.von_mises))
+                }
+            })
+    }
+}

@@ -1,0 +1,106 @@
+//! Warnings about a model that validates but looks wrong, and about results outside the
+//! model's assumptions (large strain).
+
+use crate::mech::elements::triangle::ElementStress;
+use crate::mech::model::{GapSupport, Model};
+use crate::mech::results::Results;
+use crate::mech::results::summary::major_principal;
+
+/// Major principal Green–Lagrange strain beyond which a result is outside the model's
+/// assumptions: the law (2.3) is linear elastic, and ETFE leaves its elastic range near 2–3 %
+/// strain (first yield ≈ 15 MPa at E ≈ 0.8 GPa is 2 %), so 5 % is far past it whatever the
+/// film's yield stress.
+pub const SMALL_STRAIN_LIMIT: f64 = 0.05;
+
+/// A Young's modulus below this (Pa) is almost surely given in MPa by mistake (ETFE: 0.6–1.1
+/// GPa; the softest architectural films and fabrics are far above 0.1 MPa · 1e6).
+pub const SUSPICIOUS_MODULUS: f64 = 1e5;
+
+/// Warnings about a model that validates but looks wrong (checked once, before any step): a
+/// Young's modulus that looks like MPa, pressure sets with triangles pushed against their
+/// neighbours ([`crate::mech::elements::load::orientation_warnings`]), and gaps whose `initial_gap` differs slightly (up to
+/// [`crate::mech::model::GAP_GEOMETRY_TOLERANCE`] of the size; beyond, validation refuses the model)
+/// from the distance along the gap's local z between film node and support (§4.3:
+/// `g0 = z · (X_A − X_B)`).
+pub fn model_warnings(model: &Model) -> Vec<String> {
+    let mut warnings = vec![];
+    let e = model.material.youngs_modulus;
+    if e < SUSPICIOUS_MODULUS {
+        warnings.push(format!(
+            "material youngs_modulus = {e} Pa looks like a value in MPa (ETFE: about 1e9 Pa); \
+             the model file takes Pa"
+        ));
+    }
+    warnings.extend(crate::mech::elements::load::orientation_warnings(model));
+    let size = crate::mech::model::bounding_diagonal(&model.nodes);
+    for gap in &model.gaps {
+        let n = model.nodes.len();
+        let support_exists = match gap.support {
+            GapSupport::Point(_) => true,
+            GapSupport::Node(b) => b < n,
+        };
+        if gap.film_node >= n || !support_exists {
+            continue;
+        }
+        let distance = gap.geometric_gap(&model.nodes);
+        if (distance - gap.initial_gap).abs() > 1e-6 * size {
+            warnings.push(format!(
+                "gap '{}': initial_gap = {} m, but its film node lies {distance} m from the support \
+                 point along the gap's z: the gap starts {} (check initial_gap, the support point \
+                 or the frame)",
+                gap.name,
+                gap.initial_gap,
+                if gap.initial_gap < distance {
+                    "closer than the geometry says"
+                } else {
+                    "farther than the geometry says"
+                }
+            ));
+        }
+    }
+    warnings
+}
+
+/// Warnings about a converged state outside the model's assumptions: a von Mises stress above
+/// the material's `yield_stress`, a principal strain above [`SMALL_STRAIN_LIMIT`]. One line per
+/// kind, naming the worst element.
+pub fn result_warnings(model: &Model, results: &Results) -> Vec<String> {
+    let mut warnings = vec![];
+    let worst = |f: &dyn Fn(&ElementStress) -> f64| {
+        results
+            .elements
+            .iter()
+            .map(f)
+            .enumerate()
+            .fold(
+                (0, f64::NEG_INFINITY),
+                |b, (i, v)| if v > b.1 { (i, v) } else { b },
+            )
+    };
+    if let Some(limit) = model.material.yield_stress {
+        let (e, s) = worst(&|e| e.von_mises);
+        if s > limit {
+            let over = results
+                .elements
+                .iter()
+                .filter(|e| e.von_mises > limit)
+                .count();
+            warnings.push(format!(
+                "equivalent stress {:.3} MPa in triangle {e} is above the material's yield_stress \
+                 {:.3} MPa ({over} triangles above it): the linear film law no longer holds there",
+                s / 1e6,
+                limit / 1e6
+            ));
+        }
+    }
+    let (e, strain) = worst(&|e| major_principal(e.strain, 0.5));
+    if strain > SMALL_STRAIN_LIMIT {
+        warnings.push(format!(
+            "principal strain {:.2} % in triangle {e} is beyond the small-strain range of the \
+             linear film law ({:.0} %)",
+            100.0 * strain,
+            100.0 * SMALL_STRAIN_LIMIT
+        ));
+    }
+    warnings
+}

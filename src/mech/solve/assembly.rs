@@ -1,0 +1,614 @@
+//! Global assembly: DOF numbering, the sparsity pattern (computed once per model), and the
+//! scatter of element and gap forces and matrices (the `K_m + K_g`, `R_m + R_g` of eq. 2.11).
+//!
+//! Prescribed DOFs (supports, symmetry planes, boundary groups) are eliminated: equations are
+//! numbered over free DOFs only. The pattern is built once from the triangles and the gaps
+//! (node-to-node gaps never change it); every entry of every element matrix gets a precomputed
+//! slot in the CSC value array, so an iteration only zeroes and adds values (top88's
+//! `iK/jK` vs `sK`). A symmetric pattern keeps the lower triangle only.
+//!
+//! With more than one thread ([`System::set_threads`]) the owner computes: the columns are cut
+//! into one range per thread of about equal nonzeros; each thread owns its columns' slots of
+//! `values` and the matching range of global DOFs of `internal`, computes every triangle with a
+//! DOF in its range (in element order) and adds only the entries it owns. A triangle across two
+//! ranges is computed by both (0.3–11 % of the triangles on the benchmarks' meshes); no two
+//! threads write the same entry, and each entry receives the same additions in the same order as
+//! in the serial loop: the result is bit-identical for every thread count. The threads are scoped
+//! and joined one by one: they end before [`System::assemble`] returns, on Linux until the kernel
+//! no longer lists them in `/proc/self/task` (see `worker`; no pool outlives a call, which an FMU
+//! unloaded by `dlclose` needs), and a panic in one reaches the caller.
+
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
+use nalgebra::{Matrix3, Vector3};
+
+use crate::mech::elements::triangle::{ElementMatrix, ElementVector, Material, MembraneTriangle};
+use crate::mech::model::{GapSupport, Model};
+
+const NO_SLOT: u32 = u32::MAX;
+
+/// Below this many triangles the automatic thread count is 1: on the shared 2-core machine a
+/// second thread lost time on every smaller mesh measured (docs/benchmarks.md, issue 11 item 3).
+pub const PARALLEL_MIN_TRIANGLES: usize = 100_000;
+
+/// Most threads the automatic thread count uses.
+pub const AUTOMATIC_MAX_THREADS: usize = 2;
+
+/// What a global DOF is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dof {
+    /// Unknown, with its equation number.
+    Free(usize),
+    /// Held at zero (support or symmetry plane).
+    Fixed,
+    /// Moved by boundary group `group` in component `component`.
+    Prescribed { group: usize, component: usize },
+}
+
+/// Geometry of a gap element as assembly needs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GapGeometry {
+    /// Film node A.
+    pub film_node: usize,
+    /// Support node B, or `None` for a fixed point.
+    pub support_node: Option<usize>,
+    /// Rotation local ← global (rows x, y, z).
+    pub rotation: Matrix3<f64>,
+}
+
+/// The discretized model: elements, gaps, DOF map and sparsity pattern.
+#[derive(Clone, Debug)]
+pub struct System {
+    /// DOF kind for each of the `3 × nodes` global DOFs.
+    pub dofs: Vec<Dof>,
+    /// Number of free DOFs (equations).
+    pub free_count: usize,
+    /// Triangles with their node indices.
+    pub triangles: Vec<([usize; 3], MembraneTriangle)>,
+    /// Gap elements.
+    pub gaps: Vec<GapGeometry>,
+    /// Film material.
+    pub material: Material,
+    /// CSC pattern of the free–free tangent.
+    symbolic: SymbolicSparseColMat<usize>,
+    /// Slot in the value array for each element-matrix entry, in assembly order.
+    slots: Vec<u32>,
+    /// Offset of each gap's entries in `slots`.
+    gap_offsets: Vec<usize>,
+    /// Whether only the lower triangle is stored.
+    lower_only: bool,
+    /// Threads of an assembly (at least 1).
+    threads: usize,
+    /// What each thread of a parallel assembly owns (empty when serial).
+    parts: Vec<Part>,
+}
+
+/// One thread's share of a parallel assembly: the global DOFs and slots it writes and
+/// the triangles with a DOF among them (ascending), computed by every thread they touch.
+#[derive(Clone, Debug)]
+struct Part {
+    dofs: std::ops::Range<usize>,
+    slots: std::ops::Range<usize>,
+    triangles: Vec<u32>,
+}
+
+/// Why a system cannot be built (only for sizes beyond the index type).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatternError(pub String);
+
+impl System {
+    /// Numbers the DOFs, builds the elements and the pattern. `model` must be validated.
+    pub fn new(model: &Model, lower_only: bool) -> Result<Self, PatternError> {
+        let n = model.nodes.len();
+        let mut dofs = vec![Dof::Free(0); 3 * n];
+        for s in &model.supports {
+            for a in &s.fixed {
+                dofs[3 * s.node + a.index()] = Dof::Fixed;
+            }
+        }
+        for s in &model.symmetry {
+            for &v in &s.nodes {
+                dofs[3 * v + s.normal.index()] = Dof::Fixed;
+            }
+        }
+        for (group, g) in model.groups.iter().enumerate() {
+            let prescribed = g.prescribes();
+            for &v in &g.nodes {
+                for component in (0..3).filter(|&c| prescribed[c]) {
+                    dofs[3 * v + component] = Dof::Prescribed { group, component };
+                }
+            }
+        }
+        let mut free_count = 0;
+        for d in dofs.iter_mut() {
+            if let Dof::Free(eq) = d {
+                *eq = free_count;
+                free_count += 1;
+            }
+        }
+        let triangles = model
+            .triangles
+            .iter()
+            .map(|t| {
+                let x = t.map(|v| Vector3::from(model.nodes[v]));
+                MembraneTriangle::new(x)
+                    .map(|e| (*t, e))
+                    .map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let gaps: Vec<GapGeometry> = model
+            .gaps
+            .iter()
+            .map(|g| GapGeometry {
+                film_node: g.film_node,
+                support_node: match g.support {
+                    GapSupport::Node(b) => Some(b),
+                    GapSupport::Point(_) => None,
+                },
+                rotation: g.frame.rotation(),
+            })
+            .collect();
+
+        // Pattern: one pair per element-matrix entry between free DOFs, in assembly order.
+        let mut pairs: Vec<Pair<usize, usize>> =
+            Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
+        let mut entry_rows: Vec<Option<(usize, usize)>> = Vec::with_capacity(pairs.capacity());
+        let mut push_block = |global: &[usize]| {
+            // Column-major, like nalgebra's storage of the element matrix.
+            for &gj in global {
+                for &gi in global {
+                    let entry = match (dofs[gi], dofs[gj]) {
+                        (Dof::Free(i), Dof::Free(j)) if !lower_only || i >= j => Some((i, j)),
+                        _ => None,
+                    };
+                    if let Some((i, j)) = entry {
+                        pairs.push(Pair::new(i, j));
+                    }
+                    entry_rows.push(entry);
+                }
+            }
+        };
+        for (t, _) in &triangles {
+            push_block(&node_dofs(t));
+        }
+        let mut gap_offsets = Vec::with_capacity(gaps.len());
+        let mut offset = 81 * triangles.len();
+        for g in &gaps {
+            gap_offsets.push(offset);
+            let block = gap_dofs(g);
+            offset += block.len() * block.len();
+            push_block(&block);
+        }
+        // Keep every diagonal entry so that a DOF whose stiffness vanishes stays in the pattern.
+        for i in 0..free_count {
+            pairs.push(Pair::new(i, i));
+        }
+        let (symbolic, _) =
+            SymbolicSparseColMat::try_new_from_indices(free_count, free_count, &pairs)
+                .map_err(|e| PatternError(format!("sparsity pattern: {e:?}")))?;
+        if symbolic.compute_nnz() >= NO_SLOT as usize {
+            return Err(PatternError("more than 2^32 nonzeros".into()));
+        }
+        let col_ptr = symbolic.col_ptr();
+        let row_idx = symbolic.row_idx();
+        let slots = entry_rows
+            .iter()
+            .map(|e| match e {
+                None => NO_SLOT,
+                Some((i, j)) => {
+                    let rows = &row_idx[col_ptr[*j]..col_ptr[*j + 1]];
+                    (col_ptr[*j] + rows.binary_search(i).expect("entry is in the pattern")) as u32
+                }
+            })
+            .collect();
+        Ok(Self {
+            dofs,
+            free_count,
+            triangles,
+            gaps,
+            material: model.material,
+            symbolic,
+            slots,
+            gap_offsets,
+            lower_only,
+            threads: 1,
+            parts: vec![],
+        })
+    }
+
+    /// Sets the threads of [`System::assemble`]: `requested` when positive, else the automatic
+    /// count (1 below [`PARALLEL_MIN_TRIANGLES`] triangles, else the available cores up to
+    /// [`AUTOMATIC_MAX_THREADS`]).
+    pub fn set_threads(&mut self, requested: usize) {
+        self.threads = match requested {
+            0 if self.triangles.len() < PARALLEL_MIN_TRIANGLES => 1,
+            0 => std::thread::available_parallelism()
+                .map_or(1, |n| n.get())
+                .min(AUTOMATIC_MAX_THREADS),
+            n => n,
+        };
+        self.parts = if self.threads > 1 {
+            self.partition(self.threads)
+        } else {
+            vec![]
+        };
+    }
+
+    /// Cuts the free DOFs into `threads` ranges of consecutive columns holding about equal
+    /// numbers of nonzeros; each part owns its columns' slots and the global DOFs from its
+    /// first column's DOF up to the next part's (constrained DOFs go with the free DOF before).
+    fn partition(&self, threads: usize) -> Vec<Part> {
+        let col_ptr = self.symbolic.col_ptr();
+        let nnz = self.nonzeros();
+        let global_of: Vec<usize> = self
+            .dofs
+            .iter()
+            .enumerate()
+            .filter(|(_, d)| matches!(d, Dof::Free(_)))
+            .map(|(g, _)| g)
+            .collect();
+        // Part t starts at column `first_column(t)` and at global DOF `first_dof(t)`.
+        let first_column = |t: usize| {
+            col_ptr
+                .partition_point(|&p| p < nnz * t / threads)
+                .min(self.free_count)
+        };
+        let first_dof = |t: usize| match first_column(t) {
+            _ if t == 0 => 0,
+            _ if t == threads => self.dofs.len(),
+            c if c == self.free_count => self.dofs.len(),
+            c => global_of[c],
+        };
+        let mut parts: Vec<Part> = (0..threads)
+            .map(|t| {
+                let (c0, c1) = (first_column(t), first_column(t + 1));
+                let c1 = if t + 1 == threads {
+                    self.free_count
+                } else {
+                    c1
+                };
+                Part {
+                    dofs: first_dof(t)..first_dof(t + 1),
+                    slots: col_ptr[c0]..col_ptr[c1],
+                    triangles: vec![],
+                }
+            })
+            .collect();
+        for (e, (nodes, _)) in self.triangles.iter().enumerate() {
+            for part in parts.iter_mut() {
+                if node_dofs(nodes).iter().any(|g| part.dofs.contains(g)) {
+                    part.triangles.push(e as u32);
+                }
+            }
+        }
+        parts
+    }
+
+    /// Triangles computed per assembly over all threads, relative to the triangle count (1 when
+    /// serial; above 1 by the triangles computed by two threads or more).
+    pub fn computed_share(&self) -> f64 {
+        if self.parts.is_empty() {
+            return 1.0;
+        }
+        let computed: usize = self.parts.iter().map(|p| p.triangles.len()).sum();
+        computed as f64 / self.triangles.len().max(1) as f64
+    }
+
+    /// Threads [`System::assemble`] uses.
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
+
+    /// The symbolic structure of the free–free tangent.
+    pub fn pattern(&self) -> SymbolicSparseColMatRef<'_, usize> {
+        self.symbolic.as_ref()
+    }
+
+    /// Number of stored nonzeros.
+    pub fn nonzeros(&self) -> usize {
+        self.symbolic.row_idx().len()
+    }
+
+    /// Bytes held by the pattern, the slot table and the element data (not the values).
+    pub fn memory_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let pattern =
+            (self.symbolic.col_ptr().len() + self.symbolic.row_idx().len()) * size_of::<usize>();
+        pattern
+            + self.slots.len() * size_of::<u32>()
+            + self.dofs.len() * size_of::<Dof>()
+            + self.triangles.len() * size_of::<([usize; 3], MembraneTriangle)>()
+            + self.gaps.len() * size_of::<GapGeometry>()
+            + self
+                .parts
+                .iter()
+                .map(|p| p.triangles.len() * size_of::<u32>())
+                .sum::<usize>()
+    }
+
+    /// Whether only the lower triangle is stored (symmetric iteration matrix).
+    pub fn is_lower_only(&self) -> bool {
+        self.lower_only
+    }
+
+    /// A matrix view over `values` (which must have [`System::nonzeros`] entries).
+    pub fn matrix<'a>(&'a self, values: &'a [f64]) -> SparseColMatRef<'a, usize, f64> {
+        SparseColMatRef::new(self.symbolic.as_ref(), values)
+    }
+
+    /// Adds a 9×9 matrix on the DOFs of triangle `e` (column-major, like the element tangent)
+    /// into `values` through the triangle's slots: entries on constrained DOFs, and above the
+    /// diagonal of a lower-only pattern, are dropped.
+    pub fn add_element_matrix(&self, e: usize, k: &ElementMatrix, values: &mut [f64]) {
+        let slots = &self.slots[81 * e..81 * (e + 1)];
+        for (s, kij) in slots.iter().zip(k.iter()) {
+            if *s != NO_SLOT {
+                values[*s as usize] += kij;
+            }
+        }
+    }
+
+    /// Relative displacement `d = R (u_A − u_B)` of gap `g` in its local frame.
+    pub fn gap_relative(&self, g: usize, u: &[f64]) -> Vector3<f64> {
+        let gap = &self.gaps[g];
+        let ua = node_vector(u, gap.film_node);
+        let ub = gap
+            .support_node
+            .map_or(Vector3::zeros(), |b| node_vector(u, b));
+        gap.rotation * (ua - ub)
+    }
+
+    /// Assembles the internal force over all DOFs (eqs. 2.6, 2.8) into `internal` and, when
+    /// `values` is given, the tangent (eqs. 2.7, 2.9) into it. `gap(g, d)` returns the local
+    /// force on node A and the local iteration matrix for gap `g` at relative displacement `d`.
+    pub fn assemble(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        mut values: Option<&mut [f64]>,
+        gap: impl FnMut(usize, Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>),
+    ) {
+        internal.fill(0.0);
+        if let Some(v) = values.as_deref_mut() {
+            v.fill(0.0);
+        }
+        self.add_triangles(u, internal, values.as_deref_mut());
+        self.add_gaps(u, internal, values, gap);
+    }
+
+    /// Adds the triangles' internal forces (eq. 2.6) into `internal` and, when `values` is
+    /// given, their tangents (eq. 2.7), in element order (on threads when set: same sums).
+    pub fn add_triangles(&self, u: &[f64], internal: &mut [f64], mut values: Option<&mut [f64]>) {
+        if self.threads > 1 {
+            self.assemble_triangles_owned(u, internal, values.as_deref_mut());
+        } else {
+            let with_tangent = values.is_some();
+            for e in 0..self.triangles.len() {
+                let (r, k) = self.element(e, u, with_tangent);
+                for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
+                    internal[gi] += r[i];
+                }
+                if let Some(v) = values.as_deref_mut() {
+                    self.add_element_matrix(e, &k, v);
+                }
+            }
+        }
+    }
+
+    /// Adds the gaps' forces (eq. 2.8) and, when `values` is given, their iteration matrices
+    /// (eq. 2.9), in gap order; `gap(g, d)` as in [`Self::assemble`].
+    pub fn add_gaps(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        mut values: Option<&mut [f64]>,
+        mut gap: impl FnMut(usize, Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>),
+    ) {
+        for (g, geometry) in self.gaps.iter().enumerate() {
+            let (force, k_local) = gap(g, self.gap_relative(g, u));
+            let rt = geometry.rotation.transpose();
+            let fa = rt * force;
+            let ka = rt * k_local * geometry.rotation;
+            let block = gap_dofs(geometry);
+            for c in 0..3 {
+                internal[block[c]] += fa[c];
+                if block.len() == 6 {
+                    internal[block[3 + c]] -= fa[c];
+                }
+            }
+            if let Some(v) = values.as_deref_mut() {
+                let m = block.len();
+                let slots = &self.slots[self.gap_offsets[g]..self.gap_offsets[g] + m * m];
+                for a in 0..m {
+                    for b in 0..m {
+                        let s = slots[b * m + a];
+                        if s != NO_SLOT {
+                            let sign = if (a < 3) == (b < 3) { 1.0 } else { -1.0 };
+                            v[s as usize] += sign * ka[(a % 3, b % 3)];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+impl System {
+    /// Force and tangent (zero unless `with_tangent`) of triangle `e` at `u`.
+    fn element(&self, e: usize, u: &[f64], with_tangent: bool) -> (ElementVector, ElementMatrix) {
+        let (nodes, tri) = &self.triangles[e];
+        let global = node_dofs(nodes);
+        let ue = ElementVector::from_fn(|i, _| u[global[i]]);
+        tri.force_and_tangent(&self.material, &ue, with_tangent)
+    }
+
+    /// The triangles' part of [`System::assemble`] on scoped threads, owner computes (see the
+    /// module doc): thread `t` computes every triangle of its part and adds the entries that
+    /// fall in its own DOFs and slots.
+    fn assemble_triangles_owned(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        values: Option<&mut [f64]>,
+    ) {
+        let with_tangent = values.is_some();
+        let mut forces = internal;
+        let mut matrix = values;
+        std::thread::scope(|scope| {
+            let mut workers = Vec::with_capacity(self.parts.len());
+            for (t, part) in self.parts.iter().enumerate() {
+                let (mine, rest) = std::mem::take(&mut forces).split_at_mut(part.dofs.len());
+                forces = rest;
+                let mine_values = match matrix.take() {
+                    Some(v) => {
+                        let (mine, rest) = v.split_at_mut(part.slots.len());
+                        matrix = Some(rest);
+                        Some((part.slots.start, mine))
+                    }
+                    None => None,
+                };
+                let work = move || {
+                    let mut mine_values = mine_values;
+                    for &e in &part.triangles {
+                        let e = e as usize;
+                        let (r, k) = self.element(e, u, with_tangent);
+                        self.scatter_part(
+                            e,
+                            (&r, &k),
+                            (part.dofs.start, &mut *mine),
+                            mine_values.as_mut().map(|(v0, v)| (*v0, &mut **v)),
+                        );
+                    }
+                };
+                if t + 1 < self.parts.len() {
+                    let worker = std::thread::Builder::new()
+                        .name(format!("assembly {t}"))
+                        .spawn_scoped(scope, move || {
+                            work();
+                            worker::own_task()
+                        })
+                        .expect("the system gives a thread for the assembly");
+                    workers.push(worker);
+                } else {
+                    work();
+                }
+            }
+            for worker in workers {
+                match worker.join() {
+                    Ok(task) => worker::wait_until_gone(task),
+                    Err(panic) => std::panic::resume_unwind(panic),
+                }
+            }
+        });
+    }
+
+    /// Adds triangle `e`'s force `r` and, when `matrix` is given, its tangent `k` to the parts of
+    /// `internal` and `values` that start at global DOF `d0` and slot `v0`.
+    fn scatter_part(
+        &self,
+        e: usize,
+        (r, k): (&ElementVector, &ElementMatrix),
+        (d0, forces): (usize, &mut [f64]),
+        matrix: Option<(usize, &mut [f64])>,
+    ) {
+        for (i, &gi) in node_dofs(&self.triangles[e].0).iter().enumerate() {
+            // Indices below d0 wrap to huge values: `get_mut` skips them like those past the end.
+            if let Some(x) = forces.get_mut(gi.wrapping_sub(d0)) {
+                *x += r[i];
+            }
+        }
+        if let Some((v0, values)) = matrix {
+            let slots = &self.slots[81 * e..81 * (e + 1)];
+            for (s, kij) in slots.iter().zip(k.iter()) {
+                // NO_SLOT lies past every part (nonzeros < NO_SLOT).
+                if let Some(x) = values.get_mut((*s as usize).wrapping_sub(v0)) {
+                    *x += kij;
+                }
+            }
+        }
+    }
+}
+
+/// The nine global DOFs of a triangle.
+pub fn node_dofs(nodes: &[usize; 3]) -> [usize; 9] {
+    std::array::from_fn(|i| 3 * nodes[i / 3] + i % 3)
+}
+
+/// The global DOFs of a gap: A's three, then B's three when B is a node (no allocation: it
+/// runs for every gap in every assembly).
+fn gap_dofs(g: &GapGeometry) -> GapDofs {
+    let a = 3 * g.film_node;
+    match g.support_node {
+        Some(b) => GapDofs {
+            dofs: [a, a + 1, a + 2, 3 * b, 3 * b + 1, 3 * b + 2],
+            len: 6,
+        },
+        None => GapDofs {
+            dofs: [a, a + 1, a + 2, 0, 0, 0],
+            len: 3,
+        },
+    }
+}
+
+/// The 3 or 6 global DOFs of a gap.
+struct GapDofs {
+    dofs: [usize; 6],
+    len: usize,
+}
+
+impl std::ops::Deref for GapDofs {
+    type Target = [usize];
+    fn deref(&self) -> &[usize] {
+        &self.dofs[..self.len]
+    }
+}
+
+/// Displacement of node `v` from the global vector.
+pub fn node_vector(u: &[f64], v: usize) -> Vector3<f64> {
+    Vector3::new(u[3 * v], u[3 * v + 1], u[3 * v + 2])
+}
+
+/// Making "no thread outlives the call" hold to the operating system's eyes. `join` returns
+/// when the thread's code has ended (its pthread's tid is cleared), but the kernel lists the
+/// task until it has finished tearing it down: on Linux a joined worker was still in
+/// `/proc/self/task` after about 40 % of the FMU's calls on the shared 2-core machine
+/// (`tests/threads.rs`). So on Linux a worker reports its task id, and the caller waits, after
+/// the join, until that task is gone (a few microseconds; bounded).
+mod worker {
+    /// Longest wait for the kernel to remove a joined thread's task.
+    #[cfg(target_os = "linux")]
+    const LONGEST_WAIT: std::time::Duration = std::time::Duration::from_millis(200);
+
+    /// The calling thread's task id (`/proc/thread-self` → `<pid>/task/<tid>`), Linux only.
+    pub fn own_task() -> Option<std::ffi::OsString> {
+        #[cfg(target_os = "linux")]
+        {
+            std::fs::read_link("/proc/thread-self")
+                .ok()
+                .and_then(|p| p.file_name().map(|f| f.to_owned()))
+        }
+        #[cfg(not(target_os = "linux"))]
+        None
+    }
+
+    /// Waits until the joined thread's `task` has left `/proc/self/task` (at most
+    /// [`LONGEST_WAIT`]: beyond it the thread's code has ended anyway).
+    pub fn wait_until_gone(task: Option<std::ffi::OsString>) {
+        #[cfg(target_os = "linux")]
+        if let Some(task) = task {
+            let path = std::path::Path::new("/proc/self/task").join(task);
+            let start = std::time::Instant::now();
+            let mut round = 0u32;
+            while path.exists() && start.elapsed() < LONGEST_WAIT {
+                // Hand the core to the exiting thread first, then sleep a little.
+                if round < 16 {
+                    std::thread::yield_now();
+                } else {
+                    std::thread::sleep(std::time::Duration::from_micros(50));
+                }
+                round += 1;
+            }
+        }
+        #[cfg(not(target_os = "linux"))]
+        let _ = task;
+    }
+}

@@ -1,0 +1,248 @@
+use super::*;
+use crate::mech::Model;
+
+/// A free 0.1 m square (two triangles, nodes 0..3) whose node 0 is fixed in x, y, z: nine
+/// equations, numbered node 1 (x, y, z), node 2, node 3.
+fn system(lower_only: bool) -> System {
+    let model = Model::from_json(
+        r#"{ "name": "Sq", "nodes": [[0,0,0], [0.1,0,0], [0.1,0.1,0], [0,0.1,0]],
+             "triangles": [[0,1,2], [0,2,3]],
+             "material": { "youngs_modulus": 1e9, "poisson_ratio": 0.43, "thickness": 250e-6,
+                           "prestress": [5e5, 5e5, 0] },
+             "supports": [{ "node": 0, "fixed": ["x", "y", "z"] }, { "node": 1, "fixed": ["y", "z"] },
+                          { "node": 3, "fixed": ["z"] }] }"#,
+    )
+    .unwrap();
+    System::new(&model, lower_only).unwrap()
+}
+
+/// Matrix values with `entries` (row, column, value) and zeros elsewhere.
+fn values(system: &System, entries: &[(usize, usize, f64)]) -> Vec<f64> {
+    let pattern = system.pattern();
+    let mut v = vec![0.0; system.nonzeros()];
+    for &(i, j, x) in entries {
+        let rows = pattern.row_idx_of_col_raw(j);
+        let k = rows
+            .iter()
+            .position(|&r| r == i)
+            .expect("entry in the pattern");
+        v[pattern.col_ptr()[j] + k] += x;
+    }
+    v
+}
+
+fn solve(lower_only: bool, entries: &[(usize, usize, f64)]) -> Result<Vec<f64>, String> {
+    let system = system(lower_only);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    let v = values(&system, entries);
+    let mut rhs = vec![1.0; system.free_count];
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .map(|()| rhs)
+        .map_err(|e| e.0)
+}
+
+fn diagonal_except(skip: &[usize]) -> Vec<(usize, usize, f64)> {
+    (0..6)
+        .filter(|i| !skip.contains(i))
+        .map(|i| (i, i, 2.0))
+        .collect()
+}
+
+#[test]
+fn regular_matrix_is_solved() {
+    for lower_only in [false, true] {
+        let x = solve(lower_only, &diagonal_except(&[])).unwrap();
+        assert!(x.iter().all(|&v| v == 0.5), "{x:?}");
+    }
+}
+
+#[test]
+fn dof_without_stiffness_is_named_by_node_and_axis() {
+    // Equations: 0 = node 1 x, 1 = node 2 x, 2 = node 2 y, 3 = node 2 z, 4 = node 3 x, 5 = node 3 y.
+    for lower_only in [false, true] {
+        let err = solve(lower_only, &diagonal_except(&[2, 3])).unwrap_err();
+        assert!(err.contains("no stiffness at node 2 (y, z)"), "{err}");
+    }
+}
+
+#[test]
+fn zero_pivot_is_an_error_naming_nodes_not_a_nan_solution() {
+    // Node 3's x and y are coupled by the singular block [[1, 1], [1, 1]].
+    let mut entries = diagonal_except(&[4, 5]);
+    entries.extend([(4, 4, 1.0), (5, 5, 1.0), (5, 4, 1.0), (4, 5, 1.0)]);
+    let err = solve(false, &entries).unwrap_err();
+    assert!(
+        err.contains("zero pivot") && err.contains("node 3"),
+        "{err}"
+    );
+}
+
+#[test]
+fn symmetric_values_take_the_ldlt_and_others_the_lu() {
+    let system = system(false);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    let mut entries = diagonal_except(&[]);
+    entries.extend([(4, 5, 0.5), (5, 4, 0.5)]);
+    let mut rhs = vec![1.0; system.free_count];
+    let v = values(&system, &entries);
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .unwrap();
+    assert_eq!(solver.counts(), [0, 1, 0, 0]);
+    assert!(
+        (rhs[4] - 0.4).abs() < 1e-14 && (rhs[0] - 0.5).abs() < 1e-14,
+        "{rhs:?}"
+    );
+    entries.push((4, 5, 0.25)); // unsymmetric now
+    let v = values(&system, &entries);
+    let mut rhs = vec![1.0; system.free_count];
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .unwrap();
+    assert_eq!(
+        solver.counts(),
+        [0, 1, 0, 1],
+        "GMRES on the unsymmetric one"
+    );
+}
+
+/// Node 3's x and y coupled as `[[0, 1], [1, 0]]` (symmetric, indefinite, zero diagonal),
+/// the identity elsewhere, and a right-hand side whose solution there is `(3, 1)`.
+fn indefinite_pair(system: &System) -> (Vec<f64>, Vec<f64>) {
+    let mut entries = diagonal_except(&[4, 5]);
+    entries.extend([(4, 5, 1.0), (5, 4, 1.0)]);
+    let mut rhs = vec![1.0; system.free_count];
+    rhs[5] = 3.0;
+    (values(system, &entries), rhs)
+}
+
+#[test]
+fn symmetric_matrix_the_ldlt_cannot_pivot_is_solved_by_the_lu() {
+    // Node 3's x and y: [[0, 1], [1, 0]] (symmetric, indefinite, zero diagonal).
+    let system = system(false);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    let (v, mut rhs) = indefinite_pair(&system);
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .unwrap();
+    assert_eq!(solver.counts(), [1, 0, 1, 0]);
+    assert_eq!((rhs[4], rhs[5]), (3.0, 1.0));
+}
+
+/// A diagonally dominant symmetric matrix on the six equations plus `skew` (row, column,
+/// value) added as `+v` at (row, column) and `−v` at (column, row).
+fn unsymmetric(skew: &[(usize, usize, f64)]) -> Vec<(usize, usize, f64)> {
+    let mut entries: Vec<(usize, usize, f64)> = (0..6).map(|i| (i, i, 4.0 + i as f64)).collect();
+    for (i, j) in [(1, 0), (2, 1), (3, 2), (4, 3), (5, 4), (5, 3)] {
+        entries.extend([(i, j, 0.7), (j, i, 0.7)]);
+    }
+    for &(i, j, v) in skew {
+        entries.extend([(i, j, v), (j, i, -v)]);
+    }
+    entries
+}
+
+/// Solves `entries` with `method` (or by LU when `None`); the solution and the solver.
+fn solve_with(
+    entries: &[(usize, usize, f64)],
+    method: Option<UnsymmetricMethod>,
+) -> (Vec<f64>, LinearSolver) {
+    let system = system(false);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    match method {
+        Some(m) => solver.set_method(m),
+        None => solver.set_fast(false),
+    }
+    let v = values(&system, entries);
+    let mut rhs: Vec<f64> = (0..system.free_count).map(|i| 1.0 + i as f64).collect();
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .unwrap();
+    (rhs, solver)
+}
+
+#[test]
+fn woodbury_and_gmres_solve_an_unsymmetric_matrix_like_lu_to_1e_10() {
+    // Skew entries on equations 1, 2 and 4 (as a slipping gap's μ k_n coupling would).
+    let entries = unsymmetric(&[(2, 1, 1.5), (4, 1, -0.9), (4, 2, 0.4)]);
+    let (lu, _) = solve_with(&entries, None);
+    let scale = lu.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+    for method in [UnsymmetricMethod::Woodbury, UnsymmetricMethod::Gmres] {
+        let (x, solver) = solve_with(&entries, Some(method));
+        let p = solver.profile();
+        let used = if method == UnsymmetricMethod::Woodbury {
+            (p.woodbury_count, p.woodbury_columns, p.gmres_count)
+        } else {
+            (p.gmres_count, 0, p.woodbury_count)
+        };
+        assert_eq!(
+            used,
+            (
+                1,
+                if method == UnsymmetricMethod::Woodbury {
+                    4
+                } else {
+                    0
+                },
+                0
+            ),
+            "{method:?}: {p:?}"
+        );
+        assert_eq!(solver.counts(), [0, 0, 0, 1], "{method:?}");
+        assert!(!solver.has_lu(), "{method:?}: the LU is never analysed");
+        let difference = max_difference(&x, &lu);
+        assert!(difference <= 1e-10 * scale, "{method:?}: {difference:e}");
+    }
+    // Auto takes Woodbury for three skew DOFs.
+    let (_, solver) = solve_with(&entries, Some(UnsymmetricMethod::Auto));
+    assert_eq!(solver.profile().woodbury_count, 1);
+}
+
+#[test]
+fn lu_is_analysed_only_when_a_fast_solution_fails_the_accuracy_check() {
+    let system = system(false);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    let mut rhs = vec![1.0; system.free_count];
+    let v = values(&system, &unsymmetric(&[]));
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .unwrap();
+    assert!(!solver.has_lu() && solver.counts() == [0, 1, 0, 0]);
+    // Node 3's x and y: [[0, 1], [1, 0]] — the unpivoted LDLᵀ fails, the LU is built.
+    let (v, mut rhs) = indefinite_pair(&system);
+    solver
+        .factorize_and_solve(system.matrix(&v), &mut rhs)
+        .unwrap();
+    assert!(solver.has_lu());
+    assert_eq!(solver.counts(), [1, 1, 1, 0]);
+    assert_eq!((rhs[4], rhs[5]), (3.0, 1.0));
+    // Its analysis is kept and shared by a clone.
+    assert!(solver.clone().has_lu());
+}
+
+#[test]
+fn rounding_sized_asymmetry_counts_as_symmetric() {
+    let mut entries = unsymmetric(&[]);
+    entries.push((2, 1, 1e-15)); // below 1e-12 of the largest entry (9)
+    let (_, solver) = solve_with(&entries, Some(UnsymmetricMethod::Auto));
+    assert_eq!(solver.counts(), [0, 1, 0, 0]);
+    entries.push((2, 1, 1e-10)); // above
+    let (_, solver) = solve_with(&entries, Some(UnsymmetricMethod::Auto));
+    assert_eq!(solver.counts(), [0, 0, 0, 1]);
+}
+
+fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn non_finite_entry_is_named() {
+    let mut entries = diagonal_except(&[]);
+    entries.push((0, 0, f64::NAN));
+    let err = solve(false, &entries).unwrap_err();
+    assert!(err.contains("non-finite entries at node 1 (x)"), "{err}");
+}

@@ -1,0 +1,36 @@
+//! Solving: the DOF map and assembly, the linear solvers, and the Newton–Raphson analysis with
+//! increments and cut-backs (eqs. 2.11–2.12, procedure §3).
+//!
+//! | file | what |
+//! |---|---|
+//! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
+//! | [`contributions`] | the [`Contribution`](contributions::Contribution) trait: residual, tangent and history of each kind (triangles, gaps, loads, cables, curved contacts) |
+//! | [`linear`] | sparse LDLᵀ / Woodbury / GMRES / LU with a reused symbolic analysis |
+//! | [`analysis`] | [`Analysis`]: setup, state, steps and their input checks |
+//! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
+//! | `increments` | the increment controller: cut-back, enlargement, predictor |
+//! | `newton` | Newton–Raphson for one increment |
+//! | `line_search` | backtracking line search with a watchdog |
+//! | [`settings`] | [`SolverSettings`] |
+//! | [`state`] | [`AnalysisState`], the converged state an FMU state serializes |
+//! | [`report`] | [`StepReport`], [`IncrementFailure`] and its advice, [`StepError`], [`SetupError`] |
+
+pub mod analysis;
+pub mod assembly;
+pub mod contributions;
+mod increments;
+mod inputs;
+mod line_search;
+pub mod linear;
+mod newton;
+pub mod report;
+pub mod settings;
+pub mod state;
+
+pub use analysis::Analysis;
+pub use newton::max_abs;
+pub use report::{
+    IncrementFailure, IterationRecord, SettingNames, SetupError, StepError, StepReport,
+};
+pub use settings::{DEFAULT_INCREMENTS_PER_STEP, MAX_THREADS, SolverSettings};
+pub use state::AnalysisState;

@@ -1,0 +1,444 @@
+//! What a step reports: Newton statistics, why an increment failed (with advice naming the
+//! front end's settings), and the errors of a step and of setting an analysis up.
+
+use std::fmt;
+
+use crate::mech::elements::gap::IterationMatrix;
+use crate::mech::model::ModelError;
+use crate::mech::solve::assembly::PatternError;
+use serde::{Deserialize, Serialize};
+
+/// Newton statistics of one step.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StepReport {
+    /// Newton iterations of each converged increment.
+    pub iterations: Vec<usize>,
+    /// Increments halved.
+    pub cutbacks: usize,
+    /// Increments made larger than `1/increments` of the step because every smaller one had
+    /// failed (see `Analysis::step_to`).
+    #[serde(default)]
+    pub enlarged: usize,
+    /// Final residual `‖R_free‖∞` (N).
+    pub residual: f64,
+    /// `‖R_free‖∞` at every iteration of the last converged increment (N).
+    pub residual_history: Vec<f64>,
+}
+
+impl StepReport {
+    /// Total Newton iterations (converged increments only).
+    pub fn total_iterations(&self) -> usize {
+        self.iterations.iter().sum()
+    }
+}
+
+/// The convergence figures of one Newton iteration: its residual and the correction that led to
+/// it, each with the tolerance it had to meet at that iteration (both tolerances scale with the
+/// iterate). A refusal quotes one such record, so its numbers never mix iterations.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IterationRecord {
+    /// Iteration number (0 = the predictor, before any correction).
+    pub iteration: usize,
+    /// `‖R_free‖∞` at this iterate (N).
+    pub residual: f64,
+    /// The residual tolerance at this iterate (N).
+    pub residual_tolerance: f64,
+    /// `‖Δu‖∞` of the correction that led to this iterate (m; infinite at iteration 0).
+    pub correction: f64,
+    /// The correction tolerance at this iterate (m).
+    pub correction_tolerance: f64,
+}
+
+impl IterationRecord {
+    /// How far this iterate is from convergence: the larger of the residual's and the
+    /// correction's ratio to its tolerance (converged iterates have at most 1).
+    pub(crate) fn distance(&self) -> f64 {
+        (self.residual / self.residual_tolerance).max(self.correction / self.correction_tolerance)
+    }
+
+    /// Which of the two criteria this iterate failed, in words.
+    fn verdict(&self) -> &'static str {
+        match (
+            self.residual <= self.residual_tolerance,
+            self.correction <= self.correction_tolerance,
+        ) {
+            (true, false) => "the residual met its tolerance, the correction did not",
+            (false, true) => "the correction met its tolerance, the residual did not",
+            (false, false) => "neither met its tolerance",
+            (true, true) => "both met their tolerances",
+        }
+    }
+}
+
+impl fmt::Display for IterationRecord {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "correction {:.3e} m (tolerance {:.3e} m), residual {:.3e} N (tolerance {:.3e} N)",
+            self.correction, self.correction_tolerance, self.residual, self.residual_tolerance
+        )
+    }
+}
+
+/// What a front end calls the settings that failure advice points to: the core names no
+/// command-line option or FMU parameter, each front end passes its own names
+/// ([`SettingNames::CORE`] names the [`SolverSettings`] fields).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SettingNames {
+    /// The iteration limit per increment.
+    pub max_iterations: &'static str,
+    /// How to make each increment smaller (an imperative: "raise --increments").
+    pub finer_increments: &'static str,
+    /// The residual tolerance.
+    pub residual_tolerance: &'static str,
+    /// The displacement (correction) tolerance.
+    pub displacement_tolerance: &'static str,
+    /// How to choose the consistent tangent over the Ju–Rowlands matrix.
+    pub consistent_tangent: &'static str,
+}
+
+impl SettingNames {
+    /// The names of the [`SolverSettings`] fields.
+    pub const CORE: Self = Self {
+        max_iterations: "max_iterations",
+        finer_increments: "raise the increments per step",
+        residual_tolerance: "residual_tolerance",
+        displacement_tolerance: "displacement_tolerance",
+        consistent_tangent: "iteration_matrix = Consistent",
+    };
+}
+
+/// Why one increment failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum IncrementFailure {
+    /// No convergence within the iteration limit (with the consistent tangent: while the
+    /// residual was still decreasing, or the stall test would have stopped it earlier).
+    MaxIterations {
+        /// `‖R_free‖∞` at iteration 0 (N).
+        first_residual: f64,
+        /// The last iteration (the limit).
+        last: IterationRecord,
+        /// The iteration matrix that ran out of iterations.
+        matrix: IterationMatrix,
+        /// Gaps whose status changed in the last iterations.
+        chattering: Vec<String>,
+        /// Film elements whose tension-field state (taut, wrinkled, slack) differs between the
+        /// last two iterates.
+        flipping: Vec<usize>,
+    },
+    /// Neither the residual nor the correction improved for a while (a cycle between states or
+    /// a plateau).
+    Stalled {
+        /// Iteration at which the stall was detected.
+        iteration: usize,
+        /// The iteration closest to convergence (smallest [`IterationRecord::distance`]).
+        closest: IterationRecord,
+        /// Gaps whose status changed in the last iterations.
+        chattering: Vec<String>,
+        /// Film elements whose tension-field state differs between the last two iterates.
+        flipping: Vec<usize>,
+    },
+    /// NaN/Inf or runaway corrections.
+    Diverged { iteration: usize },
+    /// The Newton matrix could not be factorized.
+    Singular { message: String },
+}
+
+/// `names` as a short list: the first few, then how many more.
+fn name_list(names: &[String]) -> String {
+    const SHOWN: usize = 6;
+    let mut text = names
+        .iter()
+        .take(SHOWN)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join(", ");
+    if names.len() > SHOWN {
+        text += &format!(" and {} more", names.len() - SHOWN);
+    }
+    text
+}
+
+impl IncrementFailure {
+    /// What a user can change to get past this failure, naming the settings as `names` does.
+    /// It states what was observed; a cause is named only where the solver established it.
+    pub fn advice(&self, names: &SettingNames) -> String {
+        let SettingNames {
+            max_iterations,
+            finer_increments: finer,
+            residual_tolerance,
+            displacement_tolerance,
+            consistent_tangent,
+        } = names;
+        match self {
+            Self::MaxIterations {
+                matrix: IterationMatrix::JuRowlands,
+                ..
+            } => format!(
+                "the Ju–Rowlands matrix converges linearly (hundreds to thousands of iterations per increment \
+                 once a gap slips, docs/mechanics.md): use the consistent tangent ({consistent_tangent}) or raise \
+                 the iteration limit a lot ({max_iterations})"
+            ),
+            Self::MaxIterations {
+                first_residual,
+                last,
+                ..
+            } if last.residual < *first_residual => format!(
+                "the residual was still falling: raise the iteration limit ({max_iterations}) or move the inputs \
+                 by less per step ({finer})"
+            ),
+            Self::MaxIterations { .. } => format!(
+                "the residual did not fall below its start: move the inputs by less per step ({finer})"
+            ),
+            Self::Stalled { chattering, .. } if !chattering.is_empty() => format!(
+                "gaps {} kept changing status (open/closed or stick/slip) between iterations: move the inputs by \
+                 less per step ({finer})",
+                name_list(chattering)
+            ),
+            Self::Stalled { flipping, .. } if !flipping.is_empty() => format!(
+                "{} film elements switched between taut, wrinkled and slack between the last iterations \
+                 (a region on the verge of wrinkling): move the inputs by less per step ({finer}); more \
+                 prestress keeps a film taut",
+                flipping.len()
+            ),
+            Self::Stalled { closest, .. } if closest.residual <= closest.residual_tolerance => {
+                format!(
+                    "the forces balanced but the corrections did not settle (seen both with increments too large \
+                 and with a part held by too little, such as a flat film without prestress): move the inputs \
+                 by less per step ({finer}); if that does not help, hold the film by supports or prestress, or \
+                 loosen {displacement_tolerance} if the corrections reached are acceptable for your model"
+                )
+            }
+            Self::Stalled { .. } => format!(
+                "Newton stopped making progress: move the inputs by less per step ({finer}), or loosen \
+                 {residual_tolerance} if the residual reached is acceptable for your model"
+            ),
+            Self::Diverged { .. } => format!(
+                "the residual ran away or became non-finite: move the inputs by less per step ({finer})"
+            ),
+            Self::Singular { .. } => format!(
+                "the Newton matrix of an iterate had a direction with no stiffness (a slack film without \
+                 prestress, a part held only by open gaps, or an iterate that a smaller increment does not \
+                 reach): add prestress, supports or wrinkling-aware material, or move the inputs by less per \
+                 step ({finer})"
+            ),
+        }
+    }
+}
+
+impl fmt::Display for IncrementFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let chatter = |f: &mut fmt::Formatter<'_>, names: &[String], elements: &[usize]| {
+            if !names.is_empty() {
+                write!(f, "; gaps changing status: {}", name_list(names))?;
+            }
+            if !elements.is_empty() {
+                let numbers: Vec<String> = elements.iter().map(|e| e.to_string()).collect();
+                write!(
+                    f,
+                    "; film elements changing wrinkling state: {}",
+                    name_list(&numbers)
+                )?;
+            }
+            Ok(())
+        };
+        match self {
+            Self::MaxIterations {
+                first_residual,
+                last,
+                chattering,
+                flipping,
+                ..
+            } => {
+                write!(
+                    f,
+                    "no convergence within the iteration limit: at iteration {} (the last): {last}, {}; \
+                     the residual was {first_residual:.3e} N at iteration 0",
+                    last.iteration,
+                    last.verdict()
+                )?;
+                chatter(f, chattering, flipping)
+            }
+            Self::Stalled {
+                iteration,
+                closest,
+                chattering,
+                flipping,
+            } => {
+                write!(
+                    f,
+                    "no progress (stopped at iteration {iteration}); closest to convergence at iteration {} \
+                     of {iteration}: {closest}, {}",
+                    closest.iteration,
+                    closest.verdict()
+                )?;
+                chatter(f, chattering, flipping)
+            }
+            Self::Diverged { iteration } => {
+                write!(
+                    f,
+                    "diverged (non-finite or runaway residual) at iteration {iteration}"
+                )
+            }
+            Self::Singular { message } => write!(f, "singular Newton matrix ({message})"),
+        }
+    }
+}
+
+/// Why a step failed. The analysis keeps its last converged state.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StepError {
+    /// A target that is not finite, has the wrong length or lies far outside the model's scale.
+    InvalidInput { message: String },
+    /// The increment could not converge even after the allowed cut-backs.
+    NotConverged {
+        fraction_done: f64,
+        cutbacks: usize,
+        last: IncrementFailure,
+    },
+}
+
+impl StepError {
+    /// The message, its advice naming the settings as `names` does (`Display` uses
+    /// [`SettingNames::CORE`]).
+    pub fn message(&self, names: &SettingNames) -> String {
+        match self {
+            Self::InvalidInput { message } => format!("invalid step input: {message}"),
+            Self::NotConverged {
+                fraction_done,
+                cutbacks,
+                last,
+            } => format!(
+                "step did not converge after {cutbacks} cut-backs ({:.1}% of it reached; last increment: {last}); \
+                 the last converged state is kept. What to change: {}",
+                100.0 * fraction_done,
+                last.advice(names)
+            ),
+        }
+    }
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.message(&SettingNames::CORE))
+    }
+}
+
+impl std::error::Error for StepError {}
+
+/// Why an analysis cannot be set up.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SetupError {
+    /// The model is invalid.
+    Model(ModelError),
+    /// The settings are invalid.
+    Settings(String),
+    /// The system could not be built or analysed.
+    System(String),
+}
+
+impl fmt::Display for SetupError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Model(e) => write!(f, "{e}"),
+            Self::Settings(m) => write!(f, "solver settings: {m}"),
+            Self::System(m) => write!(f, "{m}"),
+        }
+    }
+}
+
+impl std::error::Error for SetupError {}
+
+impl From<PatternError> for SetupError {
+    fn from(e: PatternError) -> Self {
+        Self::System(e.0)
+    }
+}
+
+#[cfg(test)]
+mod advice_tests {
+    use super::*;
+
+    fn record(residual: f64, correction: f64) -> IterationRecord {
+        IterationRecord {
+            iteration: 9,
+            residual,
+            residual_tolerance: 1.374e-4,
+            correction,
+            correction_tolerance: 1.0e-8,
+        }
+    }
+
+    fn stall(closest: IterationRecord) -> IncrementFailure {
+        IncrementFailure::Stalled {
+            iteration: 17,
+            closest,
+            chattering: vec![],
+            flipping: vec![],
+        }
+    }
+
+    #[test]
+    fn a_stall_quotes_one_iteration_and_says_which_criterion_failed() {
+        let names = SettingNames::CORE;
+        let within = stall(record(6.996e-5, 3.2e-6));
+        let text = within.to_string();
+        assert_eq!(
+            text,
+            "no progress (stopped at iteration 17); closest to convergence at iteration 9 of 17: \
+             correction 3.200e-6 m (tolerance 1.000e-8 m), residual 6.996e-5 N (tolerance 1.374e-4 N), \
+             the residual met its tolerance, the correction did not"
+        );
+        let advice = within.advice(&names);
+        assert!(advice.contains("displacement_tolerance"), "{advice}");
+        assert!(!advice.contains("almost no stiffness"), "{advice}");
+        let above = stall(record(2.0e-4, 1.0e-9));
+        assert!(
+            above
+                .to_string()
+                .ends_with("the correction met its tolerance, the residual did not"),
+            "{above}"
+        );
+        assert!(above.advice(&names).contains("residual_tolerance"));
+        assert!(
+            stall(record(2.0e-4, 3.2e-6))
+                .to_string()
+                .ends_with("neither met its tolerance")
+        );
+    }
+
+    fn out_of_iterations(first: f64, last: f64, matrix: IterationMatrix) -> String {
+        IncrementFailure::MaxIterations {
+            first_residual: first,
+            last: record(last, 1.0),
+            matrix,
+            chattering: vec![],
+            flipping: vec![],
+        }
+        .advice(&SettingNames::CORE)
+    }
+
+    #[test]
+    fn advice_to_raise_the_limit_only_while_the_residual_falls() {
+        let consistent = IterationMatrix::Consistent;
+        assert!(out_of_iterations(1.0, 1e-3, consistent).contains("still falling"));
+        let rose = out_of_iterations(9.4e-3, 2.9e-2, consistent);
+        assert!(
+            !rose.contains("still falling") && rose.contains("less per step"),
+            "{rose}"
+        );
+        let jr = out_of_iterations(4.9, 3.4, IterationMatrix::JuRowlands);
+        assert!(jr.contains("consistent tangent"), "{jr}");
+    }
+
+    #[test]
+    fn advice_names_the_settings_of_the_front_end_that_asks() {
+        let cli = SettingNames {
+            finer_increments: "raise --increments",
+            ..SettingNames::CORE
+        };
+        let failure = stall(record(2.0e-4, 1.0e-9));
+        assert!(failure.advice(&cli).contains("(raise --increments)"));
+        assert!(!failure.advice(&SettingNames::CORE).contains("--"));
+    }
+}

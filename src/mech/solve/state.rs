@@ -1,0 +1,61 @@
+//! The converged state of an analysis (what an FMU state serializes) and the boundary motion
+//! of a point of a step.
+
+use crate::mech::elements::curved_contact::ContactHistory;
+use crate::mech::elements::gap::GapStatus;
+use crate::mech::elements::load::LoadLevels;
+use serde::{Deserialize, Serialize};
+
+/// Where the boundary groups are at one point of a step: translation and hinge angle of each.
+#[derive(Clone, Debug)]
+pub(crate) struct GroupMotion {
+    pub(crate) translation: Vec<[f64; 3]>,
+    pub(crate) angles: Vec<f64>,
+}
+
+/// The converged state of an analysis: everything needed to continue it exactly.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AnalysisState {
+    /// Nodal displacements, three per node (m).
+    pub displacement: Vec<f64>,
+    /// Slip history `s_p` of each gap (local x, y) (m).
+    pub plastic_slip: Vec<[f64; 2]>,
+    /// Current imposed displacement of each boundary group (m).
+    pub boundary: Vec<[f64; 3]>,
+    /// Current hinge angle of each boundary group (rad; 0 for a group without a hinge).
+    #[serde(default)]
+    pub angles: Vec<f64>,
+    /// Current level of each load (pressures, nodal forces, gravity).
+    pub loads: LoadLevels,
+    /// Friction coefficient of each gap.
+    pub friction: Vec<f64>,
+    /// Status of each gap at convergence.
+    pub status: Vec<GapStatus>,
+    /// History of each curved-support contact ([`crate::mech::elements::curved_contact`]): anchor, angle, status, μ.
+    #[serde(default)]
+    pub contacts: Vec<ContactHistory>,
+    /// Displacement change of the last converged increment (empty before the first): the
+    /// predictor of the next increment when the boundary keeps moving the same way.
+    #[serde(default)]
+    pub last_increment: Vec<f64>,
+}
+
+impl AnalysisState {
+    /// Whether every number of the state is finite.
+    pub fn is_finite(&self) -> bool {
+        self.displacement
+            .iter()
+            .chain(self.plastic_slip.iter().flatten())
+            .chain(self.boundary.iter().flatten())
+            .chain(&self.angles)
+            .chain(&self.friction)
+            .chain(&self.last_increment)
+            .all(|v| v.is_finite())
+            && self.contacts.iter().all(|c| {
+                [c.anchor[0], c.anchor[1], c.angle, c.origin, c.friction]
+                    .iter()
+                    .all(|v| v.is_finite())
+            })
+            && self.loads.is_finite()
+    }
+}
