@@ -17,6 +17,7 @@
 
 pub mod analysis;
 pub mod assembly;
+mod continuation;
 pub mod contributions;
 mod increments;
 mod inputs;

@@ -23,9 +23,53 @@ pub struct StepReport {
     pub residual: f64,
     /// `‖R_free‖∞` at every iteration of the last converged increment (N).
     pub residual_history: Vec<f64>,
+    /// Increments solved by pseudo-transient continuation (`continuation.rs`).
+    #[serde(default)]
+    pub continued: usize,
+    /// Artificial energy left at the end of the step (J): over the increments solved by
+    /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
+    /// each (the pseudo-time force still acting when the increment was accepted).
+    #[serde(default)]
+    pub stabilization_energy: f64,
+    /// Work of the pseudo-time term over all the step's continuation iterations (J): what the
+    /// artificial damping took out on the way to the converged states (Abaqus' ALLSD).
+    #[serde(default)]
+    pub stabilization_dissipated: f64,
+    /// Elastic strain energy of the film at the end of the step (J), `Σ A t ½ (S − S0)·E`:
+    /// the scale of [`Self::stabilization_ratio`].
+    #[serde(default)]
+    pub strain_energy: f64,
 }
 
+/// Largest ratio of the artificial energy left at the end of a step
+/// ([`StepReport::stabilization_energy`]) to its strain energy that is reported as plain
+/// success: the dissipated-energy fraction of Abaqus' automatic stabilization, 2e-4.
+pub const STABILIZATION_BOUND: f64 = 2e-4;
+
 impl StepReport {
+    /// [`Self::stabilization_energy`] over [`Self::strain_energy`] (0 without continuation).
+    pub fn stabilization_ratio(&self) -> f64 {
+        if self.stabilization_energy == 0.0 {
+            0.0
+        } else {
+            self.stabilization_energy / self.strain_energy.abs().max(f64::MIN_POSITIVE)
+        }
+    }
+
+    /// The warning of a step whose continuation left more artificial energy than
+    /// [`STABILIZATION_BOUND`] of the strain energy (None: within it, or no continuation).
+    pub fn stabilization_warning(&self) -> Option<String> {
+        let ratio = self.stabilization_ratio();
+        (ratio > STABILIZATION_BOUND).then(|| {
+            format!(
+                "the pseudo-transient continuation left an artificial energy of {:.3e} J, {ratio:.2e} of the \
+                 strain energy {:.3e} J, above the bound {STABILIZATION_BOUND:.0e}: the step's equilibrium is \
+                 not reached to the model's accuracy",
+                self.stabilization_energy, self.strain_energy
+            )
+        })
+    }
+
     /// Total Newton iterations (converged increments only).
     pub fn total_iterations(&self) -> usize {
         self.iterations.iter().sum()
