@@ -2,6 +2,8 @@
 
 use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
+use crate::mech::elements::material::Wrinkling;
+use crate::mech::elements::triangle::ElementVector;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::continuation::{Continuation, Verdict};
@@ -121,6 +123,7 @@ impl Analysis {
                     matrix: s.iteration_matrix,
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
+                    compressed: self.compressed_elements(&u),
                 });
             }
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
@@ -150,6 +153,7 @@ impl Analysis {
                     closest: closest.unwrap_or(record),
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
+                    compressed: self.compressed_elements(&u),
                 });
             }
             correction_norm = match (self.correction(damping, ptc.as_mut()), ptc.as_mut()) {
@@ -218,6 +222,25 @@ impl Analysis {
             c.flipping(&self.system, a, b, &mut elements);
         }
         elements
+    }
+
+    /// Elements of a linear film (`wrinkling: "none"`) in compression (`σ2 < 0`) at `u` (none
+    /// with the tension-field film). Called once when an increment fails.
+    fn compressed_elements(&self, u: &[f64]) -> Vec<usize> {
+        let material = &self.system.material;
+        if material.wrinkling != Wrinkling::None {
+            return vec![];
+        }
+        self.system
+            .triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, (nodes, tri))| {
+                let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
+                tri.stress_state(material, &ue).principal[1] < 0.0
+            })
+            .map(|(e, _)| e)
+            .collect()
     }
 
     /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).

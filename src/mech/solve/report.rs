@@ -169,6 +169,9 @@ pub enum IncrementFailure {
         /// Film elements whose tension-field state (taut, wrinkled, slack) differs between the
         /// last two iterates.
         flipping: Vec<usize>,
+        /// Elements of a linear film (`wrinkling: "none"`) in compression (`σ2 < 0`) at the last
+        /// iterate.
+        compressed: Vec<usize>,
     },
     /// Neither the residual nor the correction improved for a while (a cycle between states or
     /// a plateau).
@@ -181,6 +184,8 @@ pub enum IncrementFailure {
         chattering: Vec<String>,
         /// Film elements whose tension-field state differs between the last two iterates.
         flipping: Vec<usize>,
+        /// Elements of a linear film in compression (`σ2 < 0`) at the last iterate.
+        compressed: Vec<usize>,
     },
     /// NaN/Inf or runaway corrections.
     Diverged { iteration: usize },
@@ -245,6 +250,12 @@ impl IncrementFailure {
                  prestress keeps a film taut",
                 flipping.len()
             ),
+            Self::Stalled { compressed, .. } if !compressed.is_empty() => format!(
+                "{} elements of the linear film were in compression (the film as given carries it, a real ETFE \
+                 film wrinkles): move the inputs by less per step ({finer}), or give the material \
+                 \"wrinkling\": \"tension-field\" if the film may wrinkle there",
+                compressed.len()
+            ),
             Self::Stalled { closest, .. } if closest.residual <= closest.residual_tolerance => {
                 format!(
                     "the forces balanced but the corrections did not settle (seen both with increments too large \
@@ -272,7 +283,18 @@ impl IncrementFailure {
 
 impl fmt::Display for IncrementFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let chatter = |f: &mut fmt::Formatter<'_>, names: &[String], elements: &[usize]| {
+        let chatter = |f: &mut fmt::Formatter<'_>,
+                       names: &[String],
+                       elements: &[usize],
+                       compressed: &[usize]| {
+            if !compressed.is_empty() {
+                let numbers: Vec<String> = compressed.iter().map(|e| e.to_string()).collect();
+                write!(
+                    f,
+                    "; linear-film elements in compression: {}",
+                    name_list(&numbers)
+                )?;
+            }
             if !names.is_empty() {
                 write!(f, "; gaps changing status: {}", name_list(names))?;
             }
@@ -292,6 +314,7 @@ impl fmt::Display for IncrementFailure {
                 last,
                 chattering,
                 flipping,
+                compressed,
                 ..
             } => {
                 write!(
@@ -301,13 +324,14 @@ impl fmt::Display for IncrementFailure {
                     last.iteration,
                     last.verdict()
                 )?;
-                chatter(f, chattering, flipping)
+                chatter(f, chattering, flipping, compressed)
             }
             Self::Stalled {
                 iteration,
                 closest,
                 chattering,
                 flipping,
+                compressed,
             } => {
                 write!(
                     f,
@@ -316,7 +340,7 @@ impl fmt::Display for IncrementFailure {
                     closest.iteration,
                     closest.verdict()
                 )?;
-                chatter(f, chattering, flipping)
+                chatter(f, chattering, flipping, compressed)
             }
             Self::Diverged { iteration } => {
                 write!(
@@ -403,6 +427,33 @@ impl From<PatternError> for SetupError {
 mod advice_tests {
     use super::*;
 
+    /// A stall of a linear film with elements in compression names them and points to the
+    /// tension-field film; without compressed elements the advice does not.
+    #[test]
+    fn a_stall_with_a_compressed_linear_film_names_the_elements_and_the_tension_field_film() {
+        let with = IncrementFailure::Stalled {
+            iteration: 17,
+            closest: record(2.0e-4, 3.2e-6),
+            chattering: vec![],
+            flipping: vec![],
+            compressed: vec![4, 5, 6],
+        };
+        assert!(
+            with.to_string()
+                .ends_with("; linear-film elements in compression: 4, 5, 6"),
+            "{with}"
+        );
+        let advice = with.advice(&SettingNames::CORE);
+        assert!(
+            advice.starts_with("3 elements of the linear film") && advice.contains("tension-field")
+        );
+        assert!(
+            !stall(record(2.0e-4, 3.2e-6))
+                .advice(&SettingNames::CORE)
+                .contains("tension-field")
+        );
+    }
+
     fn record(residual: f64, correction: f64) -> IterationRecord {
         IterationRecord {
             iteration: 9,
@@ -419,6 +470,7 @@ mod advice_tests {
             closest,
             chattering: vec![],
             flipping: vec![],
+            compressed: vec![],
         }
     }
 
@@ -458,6 +510,7 @@ mod advice_tests {
             matrix,
             chattering: vec![],
             flipping: vec![],
+            compressed: vec![],
         }
         .advice(&SettingNames::CORE)
     }
