@@ -51,7 +51,7 @@ def test_suction_lifts_the_panel_off_its_arches_and_its_removal_lays_it_back(cab
         assert max(res[n][-1] for n in normal) > 10.0
         # every step reports the artificial energy left by the continuation, within its bound
         ratio = res["solver.stabilizationRatio"]
-        assert np.all(ratio <= 0.05), ratio
+        assert np.all(ratio <= 2e-4), ratio  # the documented bound (StepReport::stabilization_warning)
 
 
 def test_a_flat_unstressed_disc_takes_its_own_weight(tmp_path):
