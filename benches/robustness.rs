@@ -24,52 +24,9 @@ use membrane_contact::specimens::scenarios::{
     Family, RunOutcome, Scenario, grid_slice, robustness_grid,
 };
 
-struct Options {
-    families: Vec<Family>,
-    quick: bool,
-    failures: bool,
-    check: bool,
-    threads: usize,
-}
-
-fn parse() -> Result<Options, String> {
-    let mut o = Options {
-        families: vec![],
-        quick: false,
-        failures: false,
-        check: false,
-        threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
-    let mut args = std::env::args().skip(1);
-    while let Some(a) = args.next() {
-        match a.as_str() {
-            "--bench" => {}
-            "--quick" => o.quick = true,
-            "--failures" => o.failures = true,
-            "--check" => o.check = true,
-            "--family" => {
-                let name = args.next().ok_or("--family needs a name")?;
-                let f = Family::ALL
-                    .into_iter()
-                    .find(|f| f.name() == name)
-                    .ok_or_else(|| format!("--family: unknown '{name}'"))?;
-                o.families.push(f);
-            }
-            "--threads" => {
-                o.threads = args
-                    .next()
-                    .and_then(|v| v.parse().ok())
-                    .filter(|&n| n > 0)
-                    .ok_or("--threads needs a positive integer")?
-            }
-            other => return Err(format!("unknown option {other}")),
-        }
-    }
-    if o.families.is_empty() {
-        o.families = Family::ALL.to_vec();
-    }
-    Ok(o)
-}
+#[path = "common/options.rs"]
+mod options;
+use options::PathOptions;
 
 /// Runs `paths` on `threads` worker threads; results in the order of `paths`.
 fn run_all(paths: &[Scenario], threads: usize) -> Vec<(RunOutcome, f64)> {
@@ -98,18 +55,19 @@ fn run_all(paths: &[Scenario], threads: usize) -> Vec<(RunOutcome, f64)> {
 }
 
 fn main() {
-    let o = match parse() {
-        Ok(o) => o,
-        Err(e) => {
-            eprintln!("{e}");
-            std::process::exit(2);
-        }
-    };
+    let names: Vec<&str> = Family::ALL.iter().map(|f| f.name()).collect();
+    let o = PathOptions::parse(&names, |_, _| Ok(false)).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2);
+    });
+    let families: Vec<Family> = Family::ALL
+        .into_iter()
+        .filter(|f| o.families.iter().any(|n| n == f.name()))
+        .collect();
     let increments = usize::try_from(DEFAULT_INCREMENTS_PER_STEP).unwrap();
     let grid = robustness_grid(increments).expect("the benchmark grid builds");
     let stride = if o.quick { 10 } else { 1 };
-    let paths: Vec<Scenario> = o
-        .families
+    let paths: Vec<Scenario> = families
         .iter()
         .flat_map(|family| grid_slice(&grid, *family, stride))
         .collect();
@@ -159,7 +117,7 @@ fn main() {
         (n, ok, iterations, incs, cut, cpu)
     };
     let pairs: Vec<(&Scenario, &(RunOutcome, f64))> = paths.iter().zip(&results).collect();
-    for family in &o.families {
+    for family in &families {
         let sel: Vec<_> = pairs
             .iter()
             .copied()
@@ -175,33 +133,9 @@ fn main() {
             total.5 + r.5,
         );
     }
-    println!(
-        "| **total** | {} | {} | {:.1} | {:.2} | | {} | | | {:.1} | |",
-        total.0,
-        total.1,
-        100.0 * total.1 as f64 / total.0.max(1) as f64,
-        total.2 as f64 / total.3.max(1) as f64,
-        total.4,
-        total.5
-    );
-    println!("\nwall time {wall:.1} s");
-    let failed = total.0 - total.1;
-    if o.failures || (o.check && failed > 0) {
-        println!("\n### failed paths\n");
-        for (s, (r, _)) in &pairs {
-            if let Some(m) = r.failure_message() {
-                println!("- {}: {m}", s.name);
-            }
-        }
-    }
-    if o.check {
-        if total.0 == 0 || failed > 0 {
-            eprintln!(
-                "robustness check failed: {} of {} load paths converge",
-                total.1, total.0
-            );
-            std::process::exit(1);
-        }
-        println!("\ncheck passed: all {} load paths converge", total.0);
-    }
+    let failed: Vec<(String, String)> = pairs
+        .iter()
+        .filter_map(|(s, (r, _))| r.failure_message().map(|m| (s.name.clone(), m.to_string())))
+        .collect();
+    o.finish(total, 2, wall, &failed);
 }

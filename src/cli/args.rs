@@ -177,6 +177,10 @@ pub struct RunArgs {
     /// no safeguard for a first step from a slack flat film.
     #[arg(long)]
     pub no_line_search: bool,
+    /// No pseudo-transient continuation: an increment plain Newton does not converge is halved
+    /// at once (the stabilization-free reference of a slack start; docs/mechanics.md)
+    #[arg(long)]
+    pub no_continuation: bool,
     /// Threads of the element assembly (0 = automatic: one below 100 000 triangles, else up to
     /// two; results are identical for every count).
     #[arg(long, value_name = "N", default_value_t = 0)]

@@ -161,6 +161,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             .unwrap_or(defaults.displacement_tolerance),
         residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
         line_search: !o.no_line_search,
+        continuation: !o.no_continuation,
         threads: o.threads,
         ..defaults
     };
@@ -206,6 +207,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         path.steps.len(),
     );
     let (mut iterations, mut cutbacks, mut enlarged, mut increments) = (Vec::new(), 0, 0, 0);
+    // Increments solved by continuation, and the step of the largest stabilization ratio.
+    let (mut continued, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
     let count = path.steps.len();
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
@@ -236,6 +239,21 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         };
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;
+        continued += report.continued;
+        if report.continued > 0 {
+            let ratio = report.stabilization_ratio();
+            if let Some(w) = report.stabilization_warning() {
+                eprintln!("warning: step {step}: {w}");
+            }
+            if stabilization.is_none_or(|(_, r, _, _)| ratio > r) {
+                stabilization = Some((
+                    step,
+                    ratio,
+                    report.stabilization_energy,
+                    report.stabilization_dissipated,
+                ));
+            }
+        }
         increments += report.iterations.len();
         iterations.push(report.total_iterations());
         let results =
@@ -276,6 +294,14 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         iterations,
         elapsed.as_secs_f64() * 1e3
     );
+    if let Some((step, ratio, energy, dissipated)) = stabilization {
+        out!(
+            "stabilization: {continued} increments by pseudo-transient continuation; largest artificial energy \
+             left {energy:.3e} J at step {step} ({ratio:.2e} of the strain energy; bound {:.0e}; {dissipated:.3e} J \
+             taken out on the way)",
+            membrane_contact::mech::solve::report::STABILIZATION_BOUND
+        );
+    }
     let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
     out!(
         "linear solves: {lu} LU, {ldlt} LDLᵀ, {gmres} GMRES on the symmetric part's LDLᵀ, \

@@ -47,6 +47,9 @@ impl Instance {
             }
         };
         built.warnings = result_warnings(built.analysis.model(), &results);
+        if let Some(w) = report.and_then(StepReport::stabilization_warning) {
+            built.warnings.push(w);
+        }
         let [_, wrinkled, slack] = state_counts(&results.elements);
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
@@ -64,6 +67,12 @@ impl Instance {
                 Binding::Iterations => count(report.map_or(0, StepReport::total_iterations)),
                 Binding::Cutbacks => count(report.map_or(0, |r| r.cutbacks)),
                 Binding::Residual => Value::Real(report.map_or(0.0, |r| r.residual)),
+                Binding::StabilizationEnergy => {
+                    Value::Real(report.map_or(0.0, |r| r.stabilization_energy))
+                }
+                Binding::StabilizationRatio => {
+                    Value::Real(report.map_or(0.0, |r| r.stabilization_ratio()))
+                }
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
                 Binding::SurfaceStatus(c) => {

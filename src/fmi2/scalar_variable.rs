@@ -187,6 +187,8 @@ pub enum Binding {
     Iterations,
     Cutbacks,
     Residual,
+    StabilizationEnergy,
+    StabilizationRatio,
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,

@@ -685,6 +685,19 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         Binding::Residual,
     );
     table.output(
+        "solver.stabilizationEnergy",
+        "N.m",
+        "artificial energy the pseudo-transient continuation left at the end of the last step (0 when no \
+         increment needed it)",
+        Binding::StabilizationEnergy,
+    );
+    table.output(
+        "solver.stabilizationRatio",
+        "1",
+        "solver.stabilizationEnergy over the film's elastic strain energy; above 2e-4 the step warns",
+        Binding::StabilizationRatio,
+    );
+    table.output(
         "film.maxEquivalentStress",
         "Pa",
         "largest von Mises stress of the film elements",
@@ -899,8 +912,8 @@ mod tests {
             .count();
         assert_eq!(
             outputs,
-            9 * 7 + 3 + 3 + 4 + 2,
-            "gaps, group and total reactions, statistics, film"
+            9 * 7 + 3 + 3 + 6 + 2,
+            "gaps, group and total reactions, statistics (with the stabilization energy and ratio), film"
         );
         assert_eq!(find("film.wrinkling").start, Some(Value::Boolean(false)));
         assert_eq!(find("film.slackElements").var_type, VarType::Integer);

@@ -321,6 +321,8 @@ fn expected(name: &str, model: &Model, r: &Results, report: &StepReport) -> Valu
             ("solver", "iterations") => Some(integer(report.total_iterations())),
             ("solver", "cutbacks") => Some(integer(report.cutbacks)),
             ("solver", "residual") => Some(Value::Real(report.residual)),
+            ("solver", "stabilizationEnergy") => Some(Value::Real(report.stabilization_energy)),
+            ("solver", "stabilizationRatio") => Some(Value::Real(report.stabilization_ratio())),
             ("film", "maxEquivalentStress") => Some(Value::Real(r.von_mises_range().1)),
             ("film", "wrinkledElements") => Some(integer(counts[1])),
             ("film", "slackElements") => Some(integer(counts[2])),

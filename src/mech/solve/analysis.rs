@@ -16,6 +16,7 @@ use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::{LoadLevels, Loads};
 use crate::mech::model::{Model, bounding_diagonal};
 use crate::mech::solve::assembly::{System, node_vector};
+use crate::mech::solve::continuation::pseudo_mass;
 use crate::mech::solve::contributions::{Contributions, Evaluation};
 use crate::mech::solve::linear::{LinearSolver, SolveProfile, UnsymmetricMethod};
 use crate::mech::solve::report::{SetupError, StepError, StepReport};
@@ -59,6 +60,16 @@ pub(in crate::mech) struct Workspace {
     pub(super) rhs: Vec<f64>,
     /// Slot of each free DOF's diagonal entry in `values` (for the Levenberg–Marquardt shift).
     pub(super) diagonal: Vec<usize>,
+    /// Whether the increment runs pseudo-transient continuation (`continuation.rs`).
+    pub(super) continuation: bool,
+    /// Pseudo-mass of each free equation (`continuation::pseudo_mass`).
+    pub(super) pseudo_mass: Vec<f64>,
+    /// Work of the pseudo-time term in the last correction of each increment solved by
+    /// continuation, and in all its corrections, over the current step (J).
+    pub(super) stabilization: f64,
+    pub(super) dissipated: f64,
+    /// The work of the current increment's last correction (J).
+    pub(super) last_work: f64,
 }
 
 impl Analysis {
@@ -98,6 +109,11 @@ impl Analysis {
             rhs: vec![0.0; system.free_count],
             diagonal: diagonal_slots(&system),
             watchdog: true,
+            continuation: false,
+            pseudo_mass: pseudo_mass(&system),
+            stabilization: 0.0,
+            dissipated: 0.0,
+            last_work: 0.0,
         };
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * model.material.membrane_stiffness() * length_scale;

@@ -18,6 +18,7 @@
 
 pub mod analysis;
 pub mod assembly;
+mod continuation;
 pub mod contributions;
 mod increments;
 mod inputs;

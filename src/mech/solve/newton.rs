@@ -2,8 +2,11 @@
 
 use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
+use crate::mech::elements::material::Wrinkling;
+use crate::mech::elements::triangle::ElementVector;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
+use crate::mech::solve::continuation::{Continuation, Verdict};
 use crate::mech::solve::line_search::Watchdog;
 use crate::mech::solve::report::{IncrementFailure, IterationRecord};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
@@ -45,6 +48,11 @@ impl Analysis {
         } else {
             Watchdog::Used
         };
+        // Pseudo-transient continuation instead of the line search and the shift
+        // (`continuation.rs`), and the artificial force of its last correction.
+        let mut ptc = self.work.continuation.then(Continuation::new);
+        let mut artificial = 0.0_f64;
+        self.work.last_work = 0.0;
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
             let residual = if assembled {
@@ -72,7 +80,8 @@ impl Analysis {
             };
             let converged = (iteration > 0 || self.system.free_count == 0)
                 && record.correction <= record.correction_tolerance
-                && residual <= tolerance;
+                && residual <= tolerance
+                && artificial <= tolerance;
             if converged {
                 let mut state = AnalysisState {
                     boundary: motion.translation.clone(),
@@ -114,6 +123,7 @@ impl Analysis {
                     matrix: s.iteration_matrix,
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
+                    compressed: self.compressed_elements(&u),
                 });
             }
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
@@ -130,20 +140,64 @@ impl Analysis {
                 best_correction = best_correction.min(correction_norm);
                 best_at = iteration;
             } else if s.iteration_matrix == IterationMatrix::Consistent
-                && iteration >= best_at + Self::STALL_PATIENCE
+                && iteration
+                    >= best_at
+                        + if ptc.is_some() {
+                            Continuation::PATIENCE
+                        } else {
+                            Self::STALL_PATIENCE
+                        }
             {
                 return Err(IncrementFailure::Stalled {
                     iteration,
                     closest: closest.unwrap_or(record),
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
+                    compressed: self.compressed_elements(&u),
                 });
             }
-            correction_norm = self.correction(damping)?;
+            correction_norm = match (self.correction(damping, ptc.as_mut()), ptc.as_mut()) {
+                (Ok(norm), _) => norm,
+                (Err(_), Some(p)) => {
+                    // A singular matrix: a shorter pseudo-time step from the same iterate.
+                    p.singular();
+                    assembled = false;
+                    continue;
+                }
+                (Err(e), None) => return Err(e),
+            };
             if !correction_norm.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             previous_u.clone_from(&u);
+            if let Some(p) = ptc.as_mut() {
+                // The full pseudo-time step; `c` follows the residual (SER), a step that
+                // raised it too far is taken back.
+                let (before, c) = (self.free_norm2(), p.c);
+                for (i, d) in self.system.dofs.iter().enumerate() {
+                    if let Dof::Free(eq) = d {
+                        u[i] += self.work.rhs[*eq];
+                    }
+                }
+                self.assemble_at(&u, levels, Some(iteration + 1));
+                assembled = true;
+                if p.judge(before, self.free_norm2()) == Verdict::Reject {
+                    u.clone_from(&previous_u);
+                    assembled = false;
+                    correction_norm = f64::INFINITY;
+                } else {
+                    let (work, force) = Continuation::work_and_force(
+                        c,
+                        p.scale,
+                        &self.work.rhs,
+                        &self.work.pseudo_mass,
+                    );
+                    self.work.dissipated += work;
+                    self.work.last_work = work;
+                    artificial = force;
+                }
+                continue;
+            }
             let (step, with_tangent, decreased) =
                 self.line_search(&mut u, levels, iteration + 1, &mut watch);
             assembled = with_tangent;
@@ -170,6 +224,25 @@ impl Analysis {
         elements
     }
 
+    /// Elements of a linear film (`wrinkling: "none"`) in compression (`σ2 < 0`) at `u` (none
+    /// with the tension-field film). Called once when an increment fails.
+    fn compressed_elements(&self, u: &[f64]) -> Vec<usize> {
+        let material = &self.system.material;
+        if material.wrinkling != Wrinkling::None {
+            return vec![];
+        }
+        self.system
+            .triangles
+            .iter()
+            .enumerate()
+            .filter(|(_, (nodes, tri))| {
+                let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
+                tri.stress_state(material, &ue).principal[1] < 0.0
+            })
+            .map(|(e, _)| e)
+            .collect()
+    }
+
     /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).
     pub(crate) const DAMPING_START: f64 = 1e-4;
     /// A residual below this fraction of the best so far counts as progress.
@@ -178,15 +251,25 @@ impl Analysis {
     pub(crate) const STALL_PATIENCE: usize = 8;
 
     /// The Newton correction `ΔU` of the free DOFs into `work.rhs` from the last assembly, with
-    /// the Levenberg–Marquardt shift `damping` (times the mean of the free diagonal's
-    /// magnitudes) added to the matrix's diagonal; returns `‖ΔU‖∞`.
-    fn correction(&mut self, damping: f64) -> Result<f64, IncrementFailure> {
+    /// the pseudo-time shift of `ptc` or else the Levenberg–Marquardt shift `damping` (times the
+    /// mean of the free diagonal's magnitudes) added to the matrix's diagonal; returns `‖ΔU‖∞`.
+    fn correction(
+        &mut self,
+        damping: f64,
+        ptc: Option<&mut Continuation>,
+    ) -> Result<f64, IncrementFailure> {
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Free(eq) = d {
                 self.work.rhs[*eq] = -self.work.internal[i];
             }
         }
-        if damping > 0.0 {
+        if let Some(p) = ptc {
+            p.shift(
+                &mut self.work.values,
+                &self.work.diagonal,
+                &self.work.pseudo_mass,
+            );
+        } else if damping > 0.0 {
             let values = &mut self.work.values;
             let mean = self
                 .work

@@ -23,9 +23,53 @@ pub struct StepReport {
     pub residual: f64,
     /// `‖R_free‖∞` at every iteration of the last converged increment (N).
     pub residual_history: Vec<f64>,
+    /// Increments solved by pseudo-transient continuation (`continuation.rs`).
+    #[serde(default)]
+    pub continued: usize,
+    /// Artificial energy left at the end of the step (J): over the increments solved by
+    /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
+    /// each (the pseudo-time force still acting when the increment was accepted).
+    #[serde(default)]
+    pub stabilization_energy: f64,
+    /// Work of the pseudo-time term over all the step's continuation iterations (J): what the
+    /// artificial damping took out on the way to the converged states (Abaqus' ALLSD).
+    #[serde(default)]
+    pub stabilization_dissipated: f64,
+    /// Elastic strain energy of the film at the end of the step (J), `Σ A t ½ (S − S0)·E`:
+    /// the scale of [`Self::stabilization_ratio`].
+    #[serde(default)]
+    pub strain_energy: f64,
 }
 
+/// Largest ratio of the artificial energy left at the end of a step
+/// ([`StepReport::stabilization_energy`]) to its strain energy that is reported as plain
+/// success: the dissipated-energy fraction of Abaqus' automatic stabilization, 2e-4.
+pub const STABILIZATION_BOUND: f64 = 2e-4;
+
 impl StepReport {
+    /// [`Self::stabilization_energy`] over [`Self::strain_energy`] (0 without continuation).
+    pub fn stabilization_ratio(&self) -> f64 {
+        if self.stabilization_energy == 0.0 {
+            0.0
+        } else {
+            self.stabilization_energy / self.strain_energy.abs().max(f64::MIN_POSITIVE)
+        }
+    }
+
+    /// The warning of a step whose continuation left more artificial energy than
+    /// [`STABILIZATION_BOUND`] of the strain energy (None: within it, or no continuation).
+    pub fn stabilization_warning(&self) -> Option<String> {
+        let ratio = self.stabilization_ratio();
+        (ratio > STABILIZATION_BOUND).then(|| {
+            format!(
+                "the pseudo-transient continuation left an artificial energy of {:.3e} J, {ratio:.2e} of the \
+                 strain energy {:.3e} J, above the bound {STABILIZATION_BOUND:.0e}: the step's equilibrium is \
+                 not reached to the model's accuracy",
+                self.stabilization_energy, self.strain_energy
+            )
+        })
+    }
+
     /// Total Newton iterations (converged increments only).
     pub fn total_iterations(&self) -> usize {
         self.iterations.iter().sum()
@@ -125,6 +169,9 @@ pub enum IncrementFailure {
         /// Film elements whose tension-field state (taut, wrinkled, slack) differs between the
         /// last two iterates.
         flipping: Vec<usize>,
+        /// Elements of a linear film (`wrinkling: "none"`) in compression (`σ2 < 0`) at the last
+        /// iterate.
+        compressed: Vec<usize>,
     },
     /// Neither the residual nor the correction improved for a while (a cycle between states or
     /// a plateau).
@@ -137,6 +184,8 @@ pub enum IncrementFailure {
         chattering: Vec<String>,
         /// Film elements whose tension-field state differs between the last two iterates.
         flipping: Vec<usize>,
+        /// Elements of a linear film in compression (`σ2 < 0`) at the last iterate.
+        compressed: Vec<usize>,
     },
     /// NaN/Inf or runaway corrections.
     Diverged { iteration: usize },
@@ -201,6 +250,12 @@ impl IncrementFailure {
                  prestress keeps a film taut",
                 flipping.len()
             ),
+            Self::Stalled { compressed, .. } if !compressed.is_empty() => format!(
+                "{} elements of the linear film were in compression (the film as given carries it, a real ETFE \
+                 film wrinkles): move the inputs by less per step ({finer}), or give the material \
+                 \"wrinkling\": \"tension-field\" if the film may wrinkle there",
+                compressed.len()
+            ),
             Self::Stalled { closest, .. } if closest.residual <= closest.residual_tolerance => {
                 format!(
                     "the forces balanced but the corrections did not settle (seen both with increments too large \
@@ -228,7 +283,18 @@ impl IncrementFailure {
 
 impl fmt::Display for IncrementFailure {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let chatter = |f: &mut fmt::Formatter<'_>, names: &[String], elements: &[usize]| {
+        let chatter = |f: &mut fmt::Formatter<'_>,
+                       names: &[String],
+                       elements: &[usize],
+                       compressed: &[usize]| {
+            if !compressed.is_empty() {
+                let numbers: Vec<String> = compressed.iter().map(|e| e.to_string()).collect();
+                write!(
+                    f,
+                    "; linear-film elements in compression: {}",
+                    name_list(&numbers)
+                )?;
+            }
             if !names.is_empty() {
                 write!(f, "; gaps changing status: {}", name_list(names))?;
             }
@@ -248,6 +314,7 @@ impl fmt::Display for IncrementFailure {
                 last,
                 chattering,
                 flipping,
+                compressed,
                 ..
             } => {
                 write!(
@@ -257,13 +324,14 @@ impl fmt::Display for IncrementFailure {
                     last.iteration,
                     last.verdict()
                 )?;
-                chatter(f, chattering, flipping)
+                chatter(f, chattering, flipping, compressed)
             }
             Self::Stalled {
                 iteration,
                 closest,
                 chattering,
                 flipping,
+                compressed,
             } => {
                 write!(
                     f,
@@ -272,7 +340,7 @@ impl fmt::Display for IncrementFailure {
                     closest.iteration,
                     closest.verdict()
                 )?;
-                chatter(f, chattering, flipping)
+                chatter(f, chattering, flipping, compressed)
             }
             Self::Diverged { iteration } => {
                 write!(
@@ -359,6 +427,33 @@ impl From<PatternError> for SetupError {
 mod advice_tests {
     use super::*;
 
+    /// A stall of a linear film with elements in compression names them and points to the
+    /// tension-field film; without compressed elements the advice does not.
+    #[test]
+    fn a_stall_with_a_compressed_linear_film_names_the_elements_and_the_tension_field_film() {
+        let with = IncrementFailure::Stalled {
+            iteration: 17,
+            closest: record(2.0e-4, 3.2e-6),
+            chattering: vec![],
+            flipping: vec![],
+            compressed: vec![4, 5, 6],
+        };
+        assert!(
+            with.to_string()
+                .ends_with("; linear-film elements in compression: 4, 5, 6"),
+            "{with}"
+        );
+        let advice = with.advice(&SettingNames::CORE);
+        assert!(
+            advice.starts_with("3 elements of the linear film") && advice.contains("tension-field")
+        );
+        assert!(
+            !stall(record(2.0e-4, 3.2e-6))
+                .advice(&SettingNames::CORE)
+                .contains("tension-field")
+        );
+    }
+
     fn record(residual: f64, correction: f64) -> IterationRecord {
         IterationRecord {
             iteration: 9,
@@ -375,6 +470,7 @@ mod advice_tests {
             closest,
             chattering: vec![],
             flipping: vec![],
+            compressed: vec![],
         }
     }
 
@@ -414,6 +510,7 @@ mod advice_tests {
             matrix,
             chattering: vec![],
             flipping: vec![],
+            compressed: vec![],
         }
         .advice(&SettingNames::CORE)
     }

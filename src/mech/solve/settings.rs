@@ -35,6 +35,10 @@ pub struct SolverSettings {
     /// Factorize a consistent tangent that is symmetric (no slipping gap, no follower pressure)
     /// by LDLᵀ instead of LU (`solve/linear`); false: always LU.
     pub symmetric_factorization: bool,
+    /// Pseudo-transient continuation (`continuation.rs`) for the increments plain Newton does
+    /// not converge, before they are halved; false: halving only (the stabilization-free
+    /// reference).
+    pub continuation: bool,
     /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
     /// below [`crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results
     /// are bit-identical for every count.
@@ -58,6 +62,7 @@ impl Default for SolverSettings {
             max_cutbacks: 12,
             line_search: true,
             symmetric_factorization: true,
+            continuation: true,
             threads: 0,
         }
     }
