@@ -92,7 +92,7 @@ pub struct Material {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub yield_stress: Option<f64>,
     /// Elasto-plastic film (issue 20): finite-strain J2 plasticity with this hardening table
-    /// (`plasticity.rs`); none (the default): the elastic law (2.3), bit for bit.
+    /// (`plasticity/`); none (the default): the elastic law (2.3), bit for bit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plasticity: Option<Plasticity>,
 }

@@ -200,7 +200,7 @@ impl MembraneTriangle {
     }
 
     /// Internal force, tangent (when `with_tangent`) and material response of an elasto-plastic
-    /// film (`plasticity.rs`) starting from the committed `history`: `S` and the algorithmic
+    /// film (`plasticity/`) starting from the committed `history`: `S` and the algorithmic
     /// `∂S/∂E` enter (2.6)–(2.7) in place of `σ` and `D`; wrinkled and slack points get `η D`
     /// added to the Newton matrix, as the elastic tension field does.
     pub fn force_and_tangent_plastic(
