@@ -682,6 +682,42 @@ fn every_parameter_and_input_of_the_circular_membrane_reaches_the_solver() {
     );
 }
 
+/// The circular membrane with an elasto-plastic film that yields everywhere under its pressure
+/// (initial yield 0.3 MPa): the plastic outputs (`film.yieldedElements`, `film.minThickness`,
+/// `disc.maxPlasticStrain`) equal the core's, and every film parameter reaches the plastic film.
+#[test]
+fn every_parameter_and_input_of_a_yielding_circular_membrane_reaches_the_solver() {
+    use crate::mech::elements::plasticity::{Hardening, Plasticity};
+    let mut model = example("circular_membrane.json");
+    model.material.yield_stress = None;
+    model.material.prestress = [1e5, 1e5, 0.0];
+    model.material.plasticity = Some(Plasticity {
+        hardening: Hardening::new(vec![[0.0, 3e5], [1.0, 3e7]]).unwrap(),
+    });
+    let u = Unpacked::new("plastic table", Source::Model(model.clone()));
+    for name in [
+        "film.yieldedElements",
+        "film.minThickness",
+        "disc.maxPlasticStrain",
+    ] {
+        assert!(u.variables.iter().any(|v| v.name == name), "{name} missing");
+    }
+    check_every_variable(
+        "plastic",
+        Source::Model(model),
+        &[("solver.incrementsPerStep", Value::Integer(2))],
+        &[
+            NOTHING_SLIDES,
+            NEVER_WRINKLES,
+            FULL_NEWTON_STEPS,
+            (
+                "solver.maxCutbacks",
+                "every increment converges within the 6 iterations that make the other runs cut back",
+            ),
+        ],
+    );
+}
+
 #[test]
 fn every_parameter_and_input_of_the_hinged_panel_reaches_the_solver() {
     check_every_variable(
