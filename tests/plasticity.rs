@@ -212,3 +212,48 @@ fn saved_state_in_the_middle_of_plastic_loading_continues_bit_for_bit() {
         "{err}"
     );
 }
+
+/// The CLI's summary of a plastic film (yielded elements, largest ε̄p, smallest thickness) is
+/// that of its own elements CSV at the last step; an elastic run prints no such line.
+#[test]
+fn cli_summary_of_the_plastic_film_matches_its_elements_csv() {
+    let csv = std::env::temp_dir().join(format!("mc plastic cli {}.csv", std::process::id()));
+    let run = |extra: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+            .args(["specimen", "--height", "300", "--steps", "10"])
+            .args(extra)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{out:?}");
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let elastic = run(&[]);
+    assert!(!elastic.contains("plastic film:"), "{elastic}");
+    let stdout = run(&["--plastic", "--elements-csv", csv.to_str().unwrap()]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::remove_file(&csv).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .map(|x| x.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    let last = rows.iter().map(|r| r[0]).fold(0.0, f64::max);
+    let last: Vec<_> = rows.iter().filter(|r| r[0] == last).collect();
+    let n = last[0].len();
+    let yielded = last.iter().filter(|r| r[n - 2] > 0.0).count();
+    let ep = last.iter().map(|r| r[n - 2]).fold(0.0, f64::max);
+    let thickness = last.iter().map(|r| r[n - 1]).fold(f64::INFINITY, f64::min);
+    assert!(yielded > 0 && thickness < T0, "{yielded} {thickness}");
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("plastic film:"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let expected = format!(
+        "plastic film: {yielded} yielded elements, equivalent plastic strain ≤ {ep:.6}, smallest thickness {thickness:.4e} m"
+    );
+    assert_eq!(line, expected);
+}

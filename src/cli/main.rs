@@ -668,6 +668,21 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             s.max_strain,
             s.compressed_area
         );
+        if model.material.plasticity.is_some() {
+            out!(
+                "element set {}: equivalent plastic strain ≤ {:.6}",
+                set.name,
+                s.max_plastic_strain
+            );
+        }
+    }
+    if let Some(p) = results.plastic_summary() {
+        out!(
+            "plastic film: {} yielded elements, equivalent plastic strain ≤ {:.6}, smallest thickness {:.4e} m",
+            p.yielded_elements,
+            p.max_plastic_strain,
+            p.min_thickness
+        );
     }
     if !model.material.wrinkling.is_none() {
         let [taut, wrinkled, slack] = state_counts(&results.elements);

@@ -51,6 +51,7 @@ impl Instance {
             built.warnings.push(w);
         }
         let [_, wrinkled, slack] = state_counts(&results.elements);
+        let plastic = results.plastic_summary();
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));
         for (v, x) in self
             .description
@@ -75,6 +76,11 @@ impl Instance {
                 }
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
+                Binding::YieldedElements => count(plastic.map_or(0, |p| p.yielded_elements)),
+                Binding::MinThickness => Value::Real(plastic.map_or(f64::NAN, |p| p.min_thickness)),
+                Binding::SetMaxPlasticStrain(set) => {
+                    Value::Real(results.sets[set].max_plastic_strain)
+                }
                 Binding::SurfaceStatus(c) => {
                     Value::Integer(results.surface_contacts[c].status as i32)
                 }

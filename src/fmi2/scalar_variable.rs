@@ -192,6 +192,11 @@ pub enum Binding {
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,
+    /// Elasto-plastic film only: the triangles that have yielded, the smallest thickness.
+    YieldedElements,
+    MinThickness,
+    /// Elasto-plastic film only: an element set's largest equivalent plastic strain.
+    SetMaxPlasticStrain(usize),
     /// Total reaction of a named support set along axis 0, 1, 2.
     SupportReaction {
         set: usize,

@@ -40,12 +40,17 @@
 //! | `solver.iterations/.cutbacks/.residual` | | output | | Newton statistics of the last step |
 //! | `film.maxEquivalentStress` | Real | output | Pa | largest element von Mises stress |
 //! | `film.wrinkledElements/.slackElements` | Integer | output | | element counts (0 without wrinkling) |
+//! | `film.yieldedElements` | Integer | output | | elasto-plastic film only: triangles with plastic strain |
+//! | `film.minThickness` | Real | output | m | elasto-plastic film only: smallest current thickness |
 //! | `<support set>.Rx/.Ry/.Rz` | Real | output | N | total reaction of a named support set |
 //! | `reactions.Rx/.Ry/.Rz` | Real | output | N | sum of all restraint forces (supports, symmetry, groups) |
 //! | `<cable>.maxForce` | Real | output | N | largest axial force of a tension-only cable |
 //! | `<support>.node<v>.slip/.normalForce/.frictionForce/.status` | Real, Integer | output | m, N | node-to-surface contact on a curved support: arc length slid along it, forces, status |
 //! | `<point>.ux/.uy/.uz` | Real | output | m | displacement of a named output point |
 //! | `<set>.maxPrincipalStress/.minPrincipalStress/.maxEquivalentStress/.maxStrain/.compressedArea` | Real | output | Pa, 1, m2 | field summary of a named element set |
+//! | `<set>.maxPlasticStrain` | Real | output | 1 | elasto-plastic film only: largest equivalent plastic strain of a named element set |
+//!
+//! The elasto-plastic film's outputs come last, so that an elastic model's table is unchanged.
 
 use crate::mech::{LoadLevels, Model, SolverSettings};
 
@@ -715,6 +720,31 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "number of slack film elements (no stress; 0 without wrinkling)",
         Binding::SlackElements,
     );
+    if model.material.plasticity.is_some() {
+        integer_output(
+            &mut table,
+            "film.yieldedElements",
+            "number of film elements with a positive equivalent plastic strain",
+            Binding::YieldedElements,
+        );
+        table.output(
+            "film.minThickness",
+            "m",
+            "smallest current thickness of the film elements (plastic flow is isochoric)",
+            Binding::MinThickness,
+        );
+        for (set, e) in model.outputs.element_sets.iter().enumerate() {
+            table.output(
+                &format!("{}.maxPlasticStrain", e.name),
+                "1",
+                &format!(
+                    "largest equivalent plastic strain of element set '{}'",
+                    e.name
+                ),
+                Binding::SetMaxPlasticStrain(set),
+            );
+        }
+    }
     table.0
 }
 

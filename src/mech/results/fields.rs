@@ -62,7 +62,37 @@ pub struct Results {
     pub sets: Vec<FieldSummary>,
 }
 
+/// The plastic state of an elasto-plastic film over all its triangles.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlasticSummary {
+    /// Triangles with a positive equivalent plastic strain.
+    pub yielded_elements: usize,
+    /// Largest equivalent plastic strain `ε̄p`.
+    pub max_plastic_strain: f64,
+    /// Smallest current film thickness (m).
+    pub min_thickness: f64,
+}
+
 impl Results {
+    /// The film's plastic summary; None for the elastic film (no triangle has a plastic state).
+    pub fn plastic_summary(&self) -> Option<PlasticSummary> {
+        let mut plastic = self.elements.iter().filter_map(|e| e.plastic).peekable();
+        plastic.peek()?;
+        Some(plastic.fold(
+            PlasticSummary {
+                yielded_elements: 0,
+                max_plastic_strain: 0.0,
+                min_thickness: f64::INFINITY,
+            },
+            |s, p| PlasticSummary {
+                yielded_elements: s.yielded_elements
+                    + usize::from(p.equivalent_plastic_strain > 0.0),
+                max_plastic_strain: nan_max(s.max_plastic_strain, p.equivalent_plastic_strain),
+                min_thickness: -nan_max(-s.min_thickness, -p.thickness),
+            },
+        ))
+    }
+
     /// Range `(min, max)` of the element von Mises stress (Pa).
     pub fn von_mises_range(&self) -> (f64, f64) {
         self.elements
@@ -74,5 +104,14 @@ impl Results {
                     (lo.min(e.von_mises), hi.max(e.von_mises))
                 }
             })
+    }
+}
+
+/// `a.max(b)`, NaN when either is (so that the finiteness check refuses a NaN field).
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
     }
 }

@@ -18,4 +18,4 @@ pub mod summary;
 pub mod vtk;
 pub mod warnings;
 
-pub use fields::{GapResult, Results};
+pub use fields::{GapResult, PlasticSummary, Results};

@@ -22,6 +22,9 @@ pub struct FieldSummary {
     /// Reference area of the triangles that would be compressed (m²): wrinkled or slack with the
     /// tension-field film, `σ2 < 0` without it.
     pub compressed_area: f64,
+    /// Largest equivalent plastic strain `ε̄p` (0 for the elastic film).
+    #[serde(default)]
+    pub max_plastic_strain: f64,
 }
 
 /// Major principal value of a Voigt tensor `[xx, yy, 2·xy]` (engineering shear, as strains)
@@ -49,6 +52,7 @@ pub fn summarize(elements: &[ElementStress], areas: &[f64], set: &[usize]) -> Fi
             max_equivalent_stress: 0.0,
             max_strain: 0.0,
             compressed_area: 0.0,
+            max_plastic_strain: 0.0,
         };
     }
     let mut s = FieldSummary {
@@ -57,6 +61,7 @@ pub fn summarize(elements: &[ElementStress], areas: &[f64], set: &[usize]) -> Fi
         max_equivalent_stress: f64::NEG_INFINITY,
         max_strain: f64::NEG_INFINITY,
         compressed_area: 0.0,
+        max_plastic_strain: 0.0,
     };
     // NaN-aware folds: a NaN field makes the summary NaN, which the finiteness check refuses.
     let max = |a: f64, b: f64| {
@@ -81,6 +86,9 @@ pub fn summarize(elements: &[ElementStress], areas: &[f64], set: &[usize]) -> Fi
         s.max_strain = max(s.max_strain, major_principal(e.strain, 0.5));
         if compressed(e) {
             s.compressed_area += areas[i];
+        }
+        if let Some(p) = e.plastic {
+            s.max_plastic_strain = max(s.max_plastic_strain, p.equivalent_plastic_strain);
         }
     }
     s
