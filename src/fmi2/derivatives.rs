@@ -1,6 +1,6 @@
 //! `fmi2GetDirectionalDerivative` (issue 21 item 1): derivatives of the Real outputs of the
 //! converged state with respect to the inputs (group displacements and angles, pressures,
-//! nodal forces; not `mu`), from the core's linear response (`Analysis::linear_response`: the last
+//! nodal forces, `mu`), from the core's linear response (`Analysis::linear_response`: the last
 //! increment's Newton equation linearized at its solution, the consistent tangent factorized
 //! once per call). One-sided where a gap sits on a switch; see the core's module doc.
 
@@ -56,15 +56,7 @@ impl Instance {
                 Binding::GroupAngle(g) => s.angles[g] += d,
                 Binding::Pressure(k) => s.pressure[k] += d,
                 Binding::NodalForce { set, axis } => s.force[set][axis] += d,
-                // The core's response to μ missed the differences of steps by 2e-3 at a
-                // slipping gap (issue 21): refused rather than wrong.
-                Binding::Friction => {
-                    return Err(Failure::error(format!(
-                        "known {} (value reference {r}): derivatives with respect to the friction \
-                         coefficient are not provided",
-                        v.name
-                    )));
-                }
+                Binding::Friction => s.friction += d,
                 _ => {
                     return Err(Failure::error(format!(
                         "known {} (value reference {r}) is not an input",

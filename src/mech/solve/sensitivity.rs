@@ -9,8 +9,9 @@
 //! converged point and factorized once for the seed, and the right-hand side the central
 //! difference of the assembled residual along the seed (step ε: a relative change of 1e-6 of
 //! the largest seeded quantity), free DOFs held. The results then move along
-//! `(du, dp, dλ, dμ)`: [`Response`] holds them at `±ε` along it, so that the derivative of any
-//! result is its central difference.
+//! `(du, dp, dλ, dμ)`: [`Response`] holds them at `±h, ±2h` along it (`h ≥ ε`, large enough
+//! that the rounding of the displacements does not swamp a small response), so that the
+//! derivative of any result is its fourth-order central difference.
 //!
 //! What the derivatives mean:
 //! * exact (to the central difference's ~1e-9) where the step was one increment, or the
@@ -29,6 +30,11 @@ use crate::mech::results::Results;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
+
+/// The largest displacement change of the outputs' central difference, as a fraction of the
+/// model's size (see `Analysis::linear_response`; 1e-7 and 1e-6 each missed the differences of
+/// steps by 2e-6 on the hinged panel's reaction, 3e-7 meets every check).
+const OUTPUT_STEP: f64 = 3e-7;
 
 /// The end values of a step's inputs moved along a seed: group motion, load levels, friction.
 type Moved = (GroupMotion, LoadLevels, Vec<f64>);
@@ -62,19 +68,21 @@ impl Seed {
     }
 }
 
-/// The results at the converged state moved by `±epsilon` along its linear response to a
-/// seed: `(plus − minus) / (2 epsilon)` of any result is its derivative along the seed.
+/// The results at the converged state moved by `−2ε, −ε, ε, 2ε` along its linear response
+/// to a seed: the derivative of any result is their fourth-order central difference.
 #[derive(Clone, Debug)]
 pub struct Response {
-    pub plus: Results,
-    pub minus: Results,
+    /// Results at `−2ε, −ε, ε, 2ε` along the response.
+    pub points: [Results; 4],
+    /// The step `ε` (per unit seed).
     pub epsilon: f64,
 }
 
 impl Response {
     /// The derivative of the result `of` along the seed.
     pub fn derivative(&self, of: impl Fn(&Results) -> f64) -> f64 {
-        (of(&self.plus) - of(&self.minus)) / (2.0 * self.epsilon)
+        let [m2, m1, p1, p2] = self.points.each_ref().map(&of);
+        (8.0 * (p1 - m1) - (p2 - m2)) / (12.0 * self.epsilon)
     }
 }
 
@@ -126,8 +134,7 @@ impl Analysis {
         if largest == 0.0 {
             let r = self.results();
             return Ok(Response {
-                plus: r.clone(),
-                minus: r,
+                points: [r.clone(), r.clone(), r.clone(), r],
                 epsilon: 1.0,
             });
         }
@@ -207,15 +214,29 @@ impl Analysis {
                 du[i] = rhs[f];
             }
         }
-        let (results_plus, _) =
-            self.results_from(&start, along(&end.displacement, &du, eps), &plus);
-        let (results_minus, _) =
-            self.results_from(&start, along(&end.displacement, &du, -eps), &minus);
+        // The outputs move along (du, seed) by a step of their own, at least ε: with ε alone, a
+        // response that is small against the displacements themselves (the normal
+        // displacement of a gap under a μ seed: 1e-14 m against 0.1 m) is lost to the
+        // rounding of `u + ε du`, and a stiff gap (k_n = 2.5e8 N/m) turned that rounding into
+        // 2e-3 of its normal force's derivative (issue 21: why μ was refused). The largest
+        // displacement moves by `OUTPUT_STEP` of the model's size (the input by at most 1e-3
+        // of itself); the fourth-order difference keeps the truncation (the slip direction
+        // turns over the slip) below 1e-6 at that step.
+        let du_max = du.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+        let eps_out = if du_max > 0.0 {
+            (OUTPUT_STEP * l / du_max).min(1e-3 / largest).max(eps)
+        } else {
+            eps
+        };
+        let points = [-2.0, -1.0, 1.0, 2.0].map(|k: f64| {
+            let at = moved(k * eps_out / eps);
+            self.results_from(&start, along(&end.displacement, &du, k * eps_out), &at)
+                .0
+        });
         self.state = end;
         Ok(Response {
-            plus: results_plus,
-            minus: results_minus,
-            epsilon: eps,
+            points,
+            epsilon: eps_out,
         })
     }
 
