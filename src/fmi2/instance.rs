@@ -269,6 +269,7 @@ impl Instance {
                     model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
                 }
                 (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
+                (Binding::Continuation, Value::Boolean(b)) => settings.continuation = b,
                 (Binding::Threads, Value::Integer(x)) => {
                     settings.threads = count(x, 0)?;
                     if settings.threads > MAX_THREADS {

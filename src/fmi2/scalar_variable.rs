@@ -159,6 +159,8 @@ pub enum Binding {
     UseJuRowlands,
     /// Backtracking line search on (true) or off.
     LineSearch,
+    /// Pseudo-transient continuation before halving (true) or halving only.
+    Continuation,
     /// Threads of the element assembly (0: automatic).
     Threads,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:

@@ -28,7 +28,7 @@
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
-//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch` | | parameter | | Newton settings |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation` | | parameter | | Newton settings |
 //! | `solver.threads` | Integer | parameter | | threads of the element assembly (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
@@ -399,7 +399,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          (the paper's: slides along the gap's local x, or along the support, only); empty: each keeps the model file's",
         Binding::FrictionLaw,
     );
-    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 8] = [
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 9] = [
         (
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
@@ -450,6 +450,15 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
              and closing); false: plain Newton steps, about half the iterations when each step starts near \
              its answer (a prestressed film under a gradually raised pressure)",
             Binding::LineSearch,
+        ),
+        (
+            "continuation",
+            Value::Boolean(solver.continuation),
+            None,
+            "true: an increment plain Newton does not converge is solved by pseudo-transient continuation \
+             before it is halved (slack films, contacts opening; its remaining artificial energy is \
+             solver.stabilizationEnergy); false: halving only",
+            Binding::Continuation,
         ),
         (
             "threads",
