@@ -17,12 +17,24 @@ residual is ``r = x̃ − x``. Schemes (``scheme=``):
 * ``"iqn-ils"``: interface quasi-Newton with an inverse Jacobian from least squares over the
   iteration's differences of residuals and of ``x̃`` (Degroote, Bathe & Vierendeels 2009,
   Computers & Structures 87, 793–801), optionally reusing ``reuse`` previous steps;
-* ``"newton"``: interface Newton, ``(J_s J_f − I) Δx = −r``, with ``J_f = ∂y/∂x`` and
-  ``J_s = ∂x̃/∂y`` from each FMU's ``fmi2GetDirectionalDerivative`` (one seed per interface
-  variable, at the state the iteration reached); ``derivatives="finite-differences"`` takes
-  them from extra steps with rollback instead, for an FMU that does not provide them. A step
-  that does not lower ``‖r‖`` (it crossed a kink: the valve opening, a gap closing) is halved
-  back toward the last iterate, up to 10 times (damped Newton).
+* ``"newton"``: interface Newton with both FMUs' ``fmi2GetDirectionalDerivative`` (one seed
+  per interface variable, at the state the iteration reached: the film's ``J_f = ∂y/∂x``, the
+  structure's ``J_s = ∂x̃/∂y``). Default ``structure_solve="exact"``: each iteration solves
+  ``x̃(ŷ(x)) = x`` with the structure stepped exactly (from the step's start, rolled back per
+  trial: it is the cheap FMU) and only the film replaced by its local model ``ŷ`` (tangent at
+  the iterate, through the other evaluated point: :func:`film_model`), by semi-smooth Newton
+  on the structure with its one-sided derivatives of the branch each trial lies on and Armijo
+  backtracking (nonlinear elimination of the structure). The predictor is the same solve with
+  the film's model at the step's start (the last converged state's derivative, curved through
+  the step before). Why: the jack's law is piecewise linear (its valve's band is far softer
+  than its cylinder), so the residual ``x̃ − x`` has slope ≈ −1 on the pumping and
+  yielding-back branches and ``−(1 + K_f h rate / ((1 − crack) relief))`` in the band; Newton
+  linearizing the jack on an outer branch jumps across the band to the other outer branch and
+  back (it cycled at ``h = 100 s``). ``structure_solve="linearized"``: plain interface Newton,
+  ``(J_s J_f − I) Δx = −r``, a step that does not lower ``‖r‖`` halved back toward the last
+  iterate up to 10 times (damped), with the explicit Gauss–Seidel predictor.
+  ``derivatives="finite-differences"`` takes the film's from extra steps with rollback instead,
+  for an FMU that does not provide them (the predictor reuses the last such Jacobian).
 
 Every iterated scheme reports, per step, the coupling iterations (film steps), the residual
 history (``‖r‖∞`` of each iteration), the rollbacks (restores of the pair) and why it stopped.
@@ -60,6 +72,9 @@ class StepRecord:
     rollbacks: int = 0
     #: Film steps spent on finite-difference derivatives.
     extra_steps: int = 0
+    #: Structure steps of Newton's exact structure solves (``structure_solve="exact"``), each
+    #: from the step's start; the structure steps of the iterations themselves not included.
+    structure_steps: int = 0
     converged: bool = True
     reason: str = ""
     #: The interface at the end of the step: film inputs, film outputs, the structure's outputs.
@@ -107,6 +122,36 @@ class CouplingReport:
         return text
 
 
+def film_model(x0, y0, jf, sample=None):
+    """The film's reactions near the iterate ``x0`` (reactions ``y0``, Jacobian ``jf``) as
+    ``x ↦ (y, ∂y/∂x)``: linear, or with ``sample = (x1, y1, j1)``, another point of the same
+    response (its Jacobian ``j1`` or None), a polynomial along ``p = x1 − x0``:
+    ``y0 + J_f s + a q² + b q³``, ``q = (p·s)/(p·p)``, through ``y1`` at ``q = 1`` and, with
+    ``j1``, with its slope ``j1 p`` there (Hermite; without ``j1``: ``b = 0``, the parabola)."""
+    x0, y0, jf = (np.asarray(v, dtype=float) for v in (x0, y0, jf))
+    a = b = p = None
+    if sample is not None and sample[0] is not None:
+        p = np.asarray(sample[0], dtype=float) - x0
+        pp = float(p @ p)
+        if pp > 0:
+            e = np.asarray(sample[1], dtype=float) - y0 - jf @ p
+            if sample[2] is None:
+                a, b = e, np.zeros_like(e)
+            else:
+                f = (np.asarray(sample[2], dtype=float) - jf) @ p
+                a, b = 3 * e - f, f - 2 * e
+            p = p / pp
+
+    def model(x):
+        s = np.asarray(x, dtype=float) - x0
+        if a is None:
+            return y0 + jf @ s, jf
+        q = float(p @ s)
+        return y0 + jf @ s + a * q * q + b * q ** 3, jf + np.outer(2 * q * a + 3 * q * q * b, p)
+
+    return model
+
+
 class CoupledSystem:
     """The film and the structure, both initialized FMU instances (:class:`~membrane_contact.Film`
     works for any FMI 2.0 co-simulation FMU), and their interface: ``displacements`` pairs
@@ -131,6 +176,10 @@ class CoupledSystem:
         self.y = np.asarray([film.get(a) for a, _ in self.forces], dtype=float)
         self._omega = None
         self._reuse: list = []
+        self._jf = None  # the film's last finite-difference Jacobian (Newton's predictor)
+        # the film's input of the last accepted step (self.x: the structure's output)
+        self._film_x = np.asarray([film.get(b) for _, b in self.displacements], dtype=float)
+        self._last_sample = None  # (film input, reactions) of the step before
 
     # -- one evaluation
 
@@ -166,14 +215,17 @@ class CoupledSystem:
 
     def step(self, h: float, scheme: str = "aitken", *, tolerance: float = 1e-9, rtol: float = 1e-7,
              max_iterations: int = 50, omega: float = 0.5, divergence: float = 1e3, reuse: int = 0,
-             derivatives: str = "fmu", fd_step: float = 1e-7) -> StepRecord:
+             derivatives: str = "fmu", fd_step: float = 1e-7, structure_solve: str = "exact") -> StepRecord:
         """One communication step of size ``h`` with ``scheme`` (:data:`SCHEMES`); converged when
-        ``‖r‖∞ ≤ tolerance + rtol ‖x‖∞``. Returns its record; raises :class:`CouplingFailed`
+        ``‖r‖∞ ≤ tolerance + rtol ‖x‖∞``. ``structure_solve`` (``"newton"`` only): ``"exact"``
+        or ``"linearized"`` (module doc). Returns its record; raises :class:`CouplingFailed`
         with both FMUs back at the step's start."""
         if scheme not in SCHEMES:
             raise ValueError(f"unknown scheme '{scheme}': one of {', '.join(SCHEMES)}")
         if derivatives not in ("fmu", "finite-differences"):
             raise ValueError(f"derivatives = '{derivatives}': 'fmu' or 'finite-differences'")
+        if structure_solve not in ("exact", "linearized"):
+            raise ValueError(f"structure_solve = '{structure_solve}': 'exact' or 'linearized'")
         film, structure = self.film, self.structure
         rec = StepRecord(time=film.time, step=h, scheme=scheme)
         if scheme == "jacobi":
@@ -206,7 +258,18 @@ class CoupledSystem:
             x_pred = self._step_structure(self.y, h)
             structure.restore(s0)
             x = x_pred if x_pred is not None else self.x.copy()
-            r_prev = xt_prev = x_prev = None
+            jf_start = None
+            if scheme == "newton" and structure_solve == "exact":
+                # Newton's predictor: the film linearized at the step's start (the last
+                # converged state), the structure solved exactly for it.
+                jf0 = (self._derivative(film, [a for a, _ in self.forces], [b for _, b in self.displacements])
+                       if derivatives == "fmu" else self._jf)
+                jf_start = jf0
+                if jf0 is not None and x_pred is not None:
+                    model = film_model(self._film_x, self.y, jf0, self._last_sample)
+                    x = self._solve_structure(model, self._film_x, None, None, h, s0, rec, tolerance, rtol)
+                    structure.restore(s0)
+            r_prev = xt_prev = x_prev = y_prev = jf_prev = None
             halvings = 0
             V, W = [], []
             omega_k = min(omega, self._omega if self._omega is not None else omega)
@@ -224,7 +287,8 @@ class CoupledSystem:
                     break
                 if norm <= tolerance + rtol * float(np.max(np.abs(x))):
                     rec.x, rec.y, rec.x_structure = list(x), list(y), list(xt)
-                    self.x, self.y = xt, y
+                    self._last_sample = (self._film_x, self.y, jf_start)
+                    self.x, self.y, self._film_x = xt, y, x
                     if scheme == "aitken":
                         self._omega = abs(omega_k)
                     if scheme == "iqn-ils" and reuse > 0:
@@ -266,9 +330,17 @@ class CoupledSystem:
                         x_next = x + omega_k * r
                 else:  # newton
                     Jf, Js = self._jacobians(x, y, h, derivatives, fd_step, rec, restore)
-                    A = Js @ Jf - np.eye(len(x))
-                    x_next = x - np.linalg.solve(A, r)
-                r_prev, xt_prev, x_prev, x = r, xt, x, x_next
+                    if structure_solve == "exact":
+                        # the film's other sample of this step: the last iterate, or the
+                        # step's start (a rate-independent film stepped back to its last
+                        # input gives its last reactions)
+                        sample = (x_prev, y_prev, jf_prev) if x_prev is not None else (self._film_x, self.y, jf_start)
+                        model = film_model(x, y, Jf, sample)
+                        x_next = self._solve_structure(model, x, r, Js, h, s0, rec, tolerance, rtol)
+                    else:
+                        x_next = x - np.linalg.solve(Js @ Jf - np.eye(len(x)), r)
+                    jf_prev = Jf
+                r_prev, xt_prev, x_prev, y_prev, x = r, xt, x, y, x_next
             rec.converged = False
             film.restore(f0)
             structure.restore(s0)
@@ -296,7 +368,51 @@ class CoupledSystem:
                 raise RuntimeError("the film refused a finite-difference step")
             cols.append((yp - y) / d)
         # Back to the iterate the derivatives belong to (the caller restores before the next).
-        return np.column_stack(cols), Js
+        self._jf = np.column_stack(cols)
+        return self._jf, Js
+
+    def _solve_structure(self, model, x0, r0, js0, h, s0, rec, tolerance, rtol):
+        """Newton's step with the structure solved exactly: the ``x`` with ``x̃(ŷ(x)) = x``,
+        ``ŷ = model`` the film's local model (:func:`film_model`) around ``x0``, the structure
+        stepped from the step's start ``s0`` for each trial. Semi-smooth Newton on the structure,
+        its derivatives at each trial (the branch of its piecewise law the trial lies on), with
+        Armijo backtracking on ``‖x̃(ŷ(x)) − x‖₂``. ``r0``, ``js0``: residual and structure
+        derivatives at ``x0`` when known (after a coupling iteration, where ``ŷ(x0)`` is the
+        film's own ``y``), else stepped here. Returns the best ``x`` found."""
+        structure = self.structure
+        unknowns, knowns = [a for a, _ in self.displacements], [b for _, b in self.forces]
+        eye = np.eye(len(x0))
+
+        def trial(x):
+            structure.restore(s0)
+            rec.structure_steps += 1
+            xs = self._step_structure(model(x)[0], h)
+            return None if xs is None else xs - x
+
+        x, g, js = np.asarray(x0, dtype=float), r0, js0
+        if g is None:
+            g = trial(x)
+            if g is None:
+                return x
+            js = self._derivative(structure, unknowns, knowns)
+        norm = float(np.linalg.norm(g))
+        target = 1e-3 * (tolerance + rtol * float(np.max(np.abs(x))))
+        for _ in range(50):
+            if norm <= target:
+                break
+            d = -np.linalg.solve(js @ model(x)[1] - eye, g)
+            t = 1.0
+            while True:
+                gt = trial(x + t * d)
+                if gt is not None and float(np.linalg.norm(gt)) <= (1 - 1e-4 * t) * norm:
+                    break
+                t *= 0.5
+                if t < 1e-10:
+                    return x
+            x, g = x + t * d, gt
+            norm = float(np.linalg.norm(g))
+            js = self._derivative(structure, unknowns, knowns)
+        return x
 
     def _explicit(self, rec, y, xt, x):
         rec.iterations = 1

@@ -119,8 +119,10 @@ impl Jack {
     }
 
     /// Lowering speed of the piston under the pull `pull` (> 0 lowering, < 0 yielding back)
-    /// and its derivatives with respect to the pull and to `relief` (the branch at a kink: the
-    /// one the pull lies in, lower bounds inclusive).
+    /// and its derivatives with respect to the pull and to `relief`. Branches: pumping for
+    /// `pull <= crack · relief`, the valve's band up to the `backRate` floor (included), the
+    /// floor beyond: at a kink, the derivatives of the branch of the smaller pull (one-sided:
+    /// from the side of the larger `force`).
     pub fn velocity(&self, pull: f64) -> (f64, f64, f64) {
         let (rate, relief, crack, back) = (
             self.v(vr::RATE),
@@ -268,6 +270,42 @@ mod tests {
                     );
                 }
             }
+        }
+    }
+
+    #[test]
+    fn derivative_at_a_valve_kink_is_the_one_sided_slope_from_the_larger_force() {
+        // binary-exact settings, so that the pulls below lie exactly on the kinks
+        let (h, relief, crack, rate) = (0.01, 600.0, 0.75, 0.5);
+        let band = relief * (1.0 - crack);
+        let piston = |force: f64| {
+            let mut j = Jack::default();
+            for (k, v) in [(vr::CRACK, crack), (vr::RATE, rate), (vr::BACK_RATE, rate)] {
+                j.values[k as usize] = v;
+            }
+            j.values[vr::PISTON as usize] = -0.05;
+            j.values[vr::FORCE as usize] = force;
+            j.step(h);
+            (
+                j.values[vr::PISTON as usize],
+                j.derivative(vr::PISTON, vr::FORCE).unwrap(),
+            )
+        };
+        // the valve cracking open (450 N), and the floor where the piston yields back at
+        // backRate (750 N)
+        for pull in [crack * relief, relief + band] {
+            let (at, exact) = piston(-pull);
+            let d = 1e-6;
+            let above = (piston(-pull + d).0 - at) / d;
+            let below = (at - piston(-pull - d).0) / d;
+            assert!(
+                (exact - above).abs() <= 1e-6 * above.abs().max(1e-9),
+                "pull {pull}: {exact} vs {above}"
+            );
+            assert!(
+                (exact - below).abs() > 0.5 * h * rate / band,
+                "pull {pull}: {exact} = {below}"
+            );
         }
     }
 
