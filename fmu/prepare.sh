@@ -2,7 +2,8 @@
 # Shared by the test runner and the example scripts: builds the crate, packs
 # target/fmu/ParallelArch.fmu, and creates/updates the Python environment .venv/ (fmpy,
 # libcosimpy, numpy, pytest, matplotlib, meshio, and this checkout's wheel, target/wheels/: the
-# package membrane_contact with the programs membrane-contact and fmu-pack).
+# package membrane_contact with the programs membrane-contact and fmu-pack, the FMU's library and
+# the hydraulic jack's, fmu/jack).
 # Idempotent; run from anywhere.
 set -euo pipefail
 cd "$(dirname "$0")/.."

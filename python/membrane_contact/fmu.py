@@ -47,6 +47,12 @@ def installed_program(name: str) -> Path | None:
     """The program ``name`` (``fmu-pack``, ``membrane-contact``) installed with this very package
     from the wheel (``PREFIX/bin``, found in the distribution's file list), or None: the package
     runs from a checkout, or was installed without the programs."""
+    return installed_file(name, "bin")
+
+
+def installed_file(name: str, folder: str) -> Path | None:
+    """The file ``name`` in the folder named ``folder`` (``bin``, ``membrane-contact`` for
+    ``PREFIX/lib/membrane-contact``) installed with this very package from the wheel, or None."""
     try:
         dist = importlib.metadata.distribution("membrane-contact")
     except importlib.metadata.PackageNotFoundError:
@@ -54,7 +60,7 @@ def installed_program(name: str) -> Path | None:
     if Path(dist.locate_file("membrane_contact/fmu.py")).resolve() != Path(__file__).resolve():
         return None  # another copy of the package (e.g. a checkout ahead of it on sys.path)
     for f in dist.files or []:
-        if f.name == name and f.parent.name == "bin":
+        if f.name == name and f.parent.name == folder:
             path = Path(dist.locate_file(f)).resolve()
             if path.is_file():
                 return path

@@ -4,7 +4,8 @@ in one ``.ssp`` file that fmpy and libcosim run as it is.
 
 * :func:`pack_jack_fmu` packs ``HydraulicJack.fmu`` from the jack's library
   (``target/release/libhydraulic_jack.so``, built by ``cargo build --release``) and its
-  ``fmu/jack/modelDescription.xml``;
+  ``fmu/jack/modelDescription.xml``; installed from the wheel, from the copies the wheel ships
+  (``PREFIX/lib/membrane-contact/``), no Rust toolchain needed;
 * :func:`write_ssp` writes ``SystemStructure.ssd`` and both FMUs (``resources/``) into the
   archive: the connections ``jack.dz → film.<group>.dz`` and ``film.<group>.Rz → jack.force``
   (the force the frame applies to the film is the force the jack applies to the frame), each
@@ -24,13 +25,14 @@ communication point), which is stable only where the jack is stiffer than the fi
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import tempfile
 import zipfile
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
-from .fmu import find_fmu, repository_root
+from .fmu import ROOT_VARIABLE, _own_checkout, find_fmu, installed_file, repository_root
 
 #: The jack's model identifier (its library's name in the FMU).
 JACK_IDENTIFIER = "hydraulic_jack"
@@ -46,11 +48,31 @@ SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
 
 
+#: The jack's library and model description as the wheel installs them (in
+#: ``PREFIX/lib/membrane-contact``; python/build_backend stages them).
+INSTALLED_JACK_LIBRARY, INSTALLED_JACK_DESCRIPTION = f"lib{JACK_IDENTIFIER}.so", "hydraulic_jack.xml"
+
+
+def _installed_jack() -> tuple[Path, Path] | None:
+    """The wheel's jack library and model description when this package is installed (not a
+    checkout's ``python/``, no ``$MEMBRANE_CONTACT_ROOT``), else None."""
+    if _own_checkout() is not None or os.environ.get(ROOT_VARIABLE):
+        return None
+    lib = installed_file(INSTALLED_JACK_LIBRARY, "membrane-contact")
+    md = installed_file(INSTALLED_JACK_DESCRIPTION, "membrane-contact")
+    return (lib, md) if lib is not None and md is not None else None
+
+
 def jack_library(root=None) -> Path:
-    """The jack's shared library of the repository, built with cargo when missing."""
+    """The jack's shared library: the repository's (``root``, ``$MEMBRANE_CONTACT_ROOT``, or the
+    checkout this package lives in), built with cargo when missing; installed from the wheel,
+    the wheel's copy; else the repository around the current directory's."""
+    if root is None and _installed_jack() is not None:
+        return _installed_jack()[0]
     root = Path(root) if root is not None else repository_root()
     if root is None:
-        raise RuntimeError("the jack FMU is built from the repository (fmu/jack): none found")
+        raise RuntimeError("the jack FMU is built from the repository (fmu/jack) or installed with the "
+                           "membrane-contact wheel: neither found")
     lib = root / "target" / "release" / f"lib{JACK_IDENTIFIER}.so"
     if not lib.is_file():
         r = subprocess.run(["cargo", "build", "--release", "-p", "hydraulic-jack-fmu"], cwd=root,
@@ -62,18 +84,27 @@ def jack_library(root=None) -> Path:
 
 def pack_jack_fmu(out=None, library=None, root=None) -> Path:
     """Packs ``HydraulicJack.fmu`` (``out``: a file name ending in ``.fmu`` or a directory;
-    default the repository's ``target/fmu``) from ``library`` (default :func:`jack_library`)
-    and the repository's ``fmu/jack/modelDescription.xml``. Returns its path."""
-    root = Path(root) if root is not None else repository_root()
-    if root is None:
-        raise RuntimeError("the jack FMU is packed from the repository (fmu/jack): none found")
-    library = Path(library) if library is not None else jack_library(root)
-    out = Path(out) if out is not None else root / "target" / "fmu"
+    default the repository's ``target/fmu``, installed the current directory) from ``library``
+    (default :func:`jack_library`) and the model description (the repository's
+    ``fmu/jack/modelDescription.xml``, or installed from the wheel, its copy). Returns its path."""
+    installed = _installed_jack() if root is None else None
+    if installed is not None:
+        description = installed[1]
+        library = Path(library) if library is not None else installed[0]
+        out = Path(out) if out is not None else Path.cwd()
+    else:
+        root = Path(root) if root is not None else repository_root()
+        if root is None:
+            raise RuntimeError("the jack FMU is packed from the repository (fmu/jack) or installed with the "
+                               "membrane-contact wheel: neither found")
+        description = root / "fmu" / "jack" / "modelDescription.xml"
+        library = Path(library) if library is not None else jack_library(root)
+        out = Path(out) if out is not None else root / "target" / "fmu"
     if out.suffix != ".fmu":
         out = out / "HydraulicJack.fmu"
     out.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
-        z.write(root / "fmu" / "jack" / "modelDescription.xml", "modelDescription.xml")
+        z.write(description, "modelDescription.xml")
         z.write(library, f"binaries/linux64/{JACK_IDENTIFIER}.so")
     return out
 

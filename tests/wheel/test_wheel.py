@@ -14,7 +14,10 @@ TEST GOAL:
   when installed) steps through ``Film`` to the slips, normal forces and statuses that the
   wheel's CLI computes for the same load path (the recipe of tests/python/test_core_agreement.py);
 * ``membrane-contact-import`` (a script of the wheel) turns the example gmsh mesh into a model
-  that the installed fmu-pack accepts.
+  that the installed fmu-pack accepts;
+* the hydraulic jack of the coupled erection system ships with the wheel: the installed
+  ``pack_jack_fmu`` packs ``HydraulicJack.fmu`` (into the current directory) from the wheel's
+  library and model description, and it steps (the coupling and SSP tests of tests/python use it).
 """
 
 from __future__ import annotations
@@ -123,3 +126,23 @@ def test_the_importer_script_makes_a_model_the_installed_fmu_pack_accepts(tmp_pa
     run = subprocess.run(["fmu-pack", str(model), "--out", str(tmp_path)], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     assert shipped_library(tmp_path / f"{name}.fmu") == LIBRARY.read_bytes()
+
+
+def test_the_wheel_ships_the_jack_and_packs_its_fmu_without_the_checkout(tmp_path, monkeypatch):
+    from fmpy.validation import validate_fmu
+
+    from membrane_contact import Film
+    from membrane_contact.ssp import pack_jack_fmu
+
+    monkeypatch.chdir(tmp_path)
+    fmu = pack_jack_fmu()
+    assert fmu == tmp_path / "HydraulicJack.fmu"
+    assert shipped_library(fmu) == (LIBRARY.parent / "libhydraulic_jack.so").read_bytes()
+    with zipfile.ZipFile(fmu) as z:
+        assert z.read("modelDescription.xml") == (ROOT / "fmu" / "jack" / "modelDescription.xml").read_bytes()
+    assert validate_fmu(str(fmu)) == []
+    with Film(fmu) as jack:
+        jack.initialize()
+        jack.set({"force": -100.0})
+        jack.step(5.0)
+        assert jack["piston"] == pytest.approx(-5.0 * 5e-4)  # pumping at its 0.5 mm/s
