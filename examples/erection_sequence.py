@@ -14,15 +14,18 @@ The coupled erection system (``membrane_contact.ssp``: the same two FMUs and par
 The master (``membrane_contact.coupling``, scheme ``--scheme``) steps the film to a frame
 position, the jack under the film's reaction, compares the jack's frame position with the one
 assumed, and repeats from the step's start (both FMUs rolled back with fmi2SetFMUstate) until
-they agree to 1e-7 (relative). Default: Aitken-relaxed Gauss–Seidel, the scheme that converged
-at every stiffness ratio and step size of the sweep in docs/benchmarks.md without derivatives
-(Gauss–Seidel alone fails once the valve's band makes the jack softer than the film; interface
-Newton needs fewer iterations where it has the film's exact derivatives).
+they agree to 1e-7 (relative). Default: interface Newton with both FMUs' directional
+derivatives, the film linearized and the jack solved exactly for it (its valve law is piecewise
+linear): in the sweep of docs/benchmarks.md it converged at every stiffness ratio and step size
+in at most 3 film steps per coupling step, fewest of all schemes (Gauss–Seidel alone fails once
+the valve's band makes the jack softer than the film; Aitken's relaxation converges everywhere
+too, without derivatives, at 3–14 film steps per coupling step: ``--scheme aitken`` for an FMU
+without fmi2GetDirectionalDerivative).
 
 Writes erection_sequence.png and erection_sequence.csv (one row per coupling step) into --out.
 
     .venv/bin/python examples/erection_sequence.py [--steps 40] [--out DIR] [--relief 600]
-        [--stiffness 1e5] [--scheme aitken|iqn-ils|newton|gauss-seidel]
+        [--stiffness 1e5] [--scheme newton|aitken|iqn-ils|gauss-seidel]
 """
 
 from __future__ import annotations
@@ -51,7 +54,7 @@ def phase(force: float, piston: float, relief: float, stroke: float) -> str:
     return "pumping"
 
 
-def simulate(duration: float, steps: int, fmu_path=None, scheme: str = "aitken", relief: float = 600.0,
+def simulate(duration: float, steps: int, fmu_path=None, scheme: str = "newton", relief: float = 600.0,
              stiffness: float = 1e5, rate: float = 0.5e-3, stroke: float = 0.15):
     """Run the coupled FMUs over ``duration`` seconds in ``steps`` steps; one record per step
     (the first: the initial state). The jack FMU is packed from the repository into a temporary
@@ -134,8 +137,8 @@ def main(argv=None):
     p.add_argument("--relief", type=float, default=600.0, help="relief force on the 1/4 frame, N (default 600)")
     p.add_argument("--stroke", type=float, default=150.0, help="jack stroke, mm (150)")
     p.add_argument("--stiffness", type=float, default=1e5, help="jack cylinder stiffness, N/m (1e5)")
-    p.add_argument("--scheme", default="aitken", choices=[s for s in SCHEMES if s not in ("jacobi", "staggered")],
-                   help="coupling scheme (default aitken)")
+    p.add_argument("--scheme", default="newton", choices=[s for s in SCHEMES if s not in ("jacobi", "staggered")],
+                   help="coupling scheme (default newton)")
     a = p.parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -15,8 +15,9 @@ in one ``.ssp`` file that fmpy and libcosim run as it is.
   argument; this reads them from the archive's bindings, named ``component.variable``.
 
 Both tools exchange explicitly (Jacobi: every FMU steps with the other's outputs of the last
-communication point), which is stable only where the jack is stiffer than the film
-(``membrane_contact.coupling`` iterates instead).
+communication point, whatever the components' order: docs/fmu.md quotes both tools' loops),
+which is stable only where the jack is stiffer than the film (``membrane_contact.coupling``
+iterates instead); their end values are the master's ``"jacobi"`` run's.
 
     python -m membrane_contact.ssp erection.ssp [--film F.fmu] [--jack J.fmu] [--stop 400]
         [--step 5] [--set jack.stiffness=1e5 --set film.archHeight=0.3 ...]
