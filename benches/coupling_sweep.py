@@ -91,9 +91,9 @@ def main(argv=None):
                 it = report.iterations
                 mean = f"{it.mean():.2f}" if len(it) else "—"
                 top = f"{it.max()}" if len(it) else "—"
-                jack = f"{sum(s.structure_steps for s in report.steps) / len(it):.1f}" if len(it) else "—"
+                extra = f"{sum(s.structure_steps for s in report.steps) / len(it):.1f}" if len(it) else "—"
                 print(f"| {ratio:g} | {h:g} | {scheme} | {len(it)} | {mean} | {top} | {report.rollbacks} | "
-                      f"{jack} | {fails} | {time.perf_counter() - t0:.1f} |", flush=True)
+                      f"{extra} | {fails} | {time.perf_counter() - t0:.1f} |", flush=True)
 
 
 if __name__ == "__main__":
