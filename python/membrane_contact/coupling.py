@@ -179,7 +179,7 @@ class CoupledSystem:
         self._jf = None  # the film's last finite-difference Jacobian (Newton's predictor)
         # the film's input of the last accepted step (self.x: the structure's output)
         self._film_x = np.asarray([film.get(b) for _, b in self.displacements], dtype=float)
-        self._last_sample = None  # (film input, reactions) of the step before
+        self._last_sample = None  # (film input, reactions, Jacobian or None) of the step before
 
     # -- one evaluation
 
@@ -400,7 +400,10 @@ class CoupledSystem:
         for _ in range(50):
             if norm <= target:
                 break
-            d = -np.linalg.solve(js @ model(x)[1] - eye, g)
+            try:
+                d = -np.linalg.solve(js @ model(x)[1] - eye, g)
+            except np.linalg.LinAlgError:  # J_s J_f = I: no Newton direction; the best x so far
+                return x
             t = 1.0
             while True:
                 gt = trial(x + t * d)
