@@ -192,7 +192,6 @@ def test_read_vtu_mirror(tmp_path):
     assert {tuple(q[2][:2]) for q in quarters} == {(0, 1), (0, -1)}
 
 
-@pytest.mark.skipif(INSTALLED, reason=f"the jack FMU is built from fmu/jack: {NEEDS_CHECKOUT}")
 def test_erection_sequence(tmp_path, fmu_path):
     relief, stiffness = 600.0, 1e5
     run_example("erection_sequence.py", tmp_path, "--relief", str(relief), "--stiffness", str(stiffness),
