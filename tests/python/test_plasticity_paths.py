@@ -1,5 +1,6 @@
-"""The elasto-plastic film through the FMU (issue 20) on the biaxial paths: equibiaxial stretch and
-pure shear, each to 30 % log strain and back to zero force, against closed forms written here.
+"""The elasto-plastic film through the FMU (issue 20) on the biaxial paths: equibiaxial stretch,
+pure shear and planar tension, each to 30 % log strain and back to zero force, against
+references written here.
 
 TEST GOAL: a square sheet whose edges are moved so that the film is in a homogeneous state
 reproduces, at every communication step, the closed form of plane-stress J2 plasticity with
@@ -22,6 +23,14 @@ and the y force of the top edge; ``film.minThickness`` to 1e-6 relative, ``sheet
 to 1e-9, ``film.yieldedElements``. Unloaded to the closed-form residual strain (``ε̄p/2``
 resp. ``(√3/2) ε̄p`` at the peak) both edge forces are zero to 1e-6 of the yield force.
 
+**Planar tension** (``λ, 1``: pure shear in the membrane-testing sense, a wide strip stretched
+across with its width held, here as the exact homogeneous state) has no closed form: the stress
+ratio moves from ``ν`` to ½ as the film flows. Its reference is the rate form of the same law
+integrated with RK4 (:class:`PlanarTension`): the stretching force to 1e-6 of the yield force,
+the width force to 3e-5 (the backward-Euler error of the FMU's increments); and, to 1e-6 for
+both, the suite's own backward-Euler return in principal stresses replayed on the FMU's
+increments (``axisymmetric_membrane.Film``).
+
 The FMU moves the groups linearly within a step; for pure shear that leaves the path between
 increments (see :data:`PURE_SHEAR`), so the pure-shear run takes one increment per step
 (``solver.incrementsPerStep = 1``) and checks that no increment was cut.
@@ -36,7 +45,9 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
+from axisymmetric_membrane import Film, Hardening
 from conftest import pack_model
 from fmu_helpers import OK, Slave
 
@@ -128,8 +139,107 @@ def residual_strain(path):
 def log_strains(path):
     """Log strains at the end of each step: one elastic step, six to the peak, four back to
     the closed-form residual strain."""
-    back = residual_strain(path)
+    back = path.residual_strain() if isinstance(path, PlanarTension) else residual_strain(path)
     return [0.005] + [PEAK * k / 6 for k in range(1, 7)] + [PEAK + (back - PEAK) * k / 4 for k in range(1, 5)]
+
+
+class PlanarTension:
+    """Pure shear in the membrane-testing sense: stretched along x, width held (``λ2 = 1``).
+
+    The stress ratio moves from ``ν`` towards ½ as the film flows, so the path is not
+    proportional and has no closed form: the reference is the rate form of plane-stress J2,
+    ``dτ = D dε − D n dγ``, ``dγ = nᵀD dε/(nᵀD n + H)``, ``n = ∂σeq/∂τ``, integrated with RK4 in
+    steps of 1e-5 of log strain from the exact yield point (elastic unloading). The FMU's
+    backward-Euler increments approach it as they shrink (measured: 200 increments to the
+    peak, 1.2e-6 of the yield stress at the first plastic step; 2000, 1.2e-7), hence
+    ``solver.incrementsPerStep = 2000``."""
+
+    name = "planar-tension"
+    increments = 2000
+
+    @staticmethod
+    def stretches(e):
+        return math.exp(e), 1.0
+
+    @staticmethod
+    def _rate(y, segment):
+        """d(τ1, τ2, εp1, εp2, ε̄p)/dε1 while flowing on the table's segment ``segment``."""
+        t1, t2 = y[0], y[1]
+        c = E / (1 - NU ** 2)
+        s = math.sqrt(t1 * t1 - t1 * t2 + t2 * t2)
+        n1, n2 = (2 * t1 - t2) / (2 * s), (2 * t2 - t1) / (2 * s)
+        dn1, dn2 = c * (n1 + NU * n2), c * (n2 + NU * n1)
+        (e0, s0), (e1, s1) = HARDENING[segment], HARDENING[segment + 1]
+        dg = dn1 / (n1 * dn1 + n2 * dn2 + (s1 - s0) / (e1 - e0))
+        return (c - dn1 * dg, NU * c - dn2 * dg, n1 * dg, n2 * dg, dg)
+
+    def _rk4(self, h, segment):
+        y = self.state
+        k1 = self._rate(y, segment)
+        k2 = self._rate([a + h / 2 * b for a, b in zip(y, k1)], segment)
+        k3 = self._rate([a + h / 2 * b for a, b in zip(y, k2)], segment)
+        k4 = self._rate([a + h * b for a, b in zip(y, k3)], segment)
+        return tuple(a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4) for a, b1, b2, b3, b4 in zip(y, k1, k2, k3, k4))
+
+    def __init__(self):
+        self.state = (0.0, 0.0, 0.0, 0.0, 0.0)  # τ1, τ2, εp1, εp2, ε̄p
+        self.e = 0.0
+
+    def go_to(self, target):
+        """Integrates the state to ``ln λ1 = target``."""
+        c = E / (1 - NU ** 2)
+        while abs(target - self.e) > 1e-15:
+            t1, t2, p1, p2, eb = self.state
+            de = target - self.e
+            seq = math.sqrt(t1 * t1 - t1 * t2 + t2 * t2)
+            sy = flow_stress(eb)
+            if de < 0 or seq < sy * (1 - 1e-12):  # elastic: up to the yield point at most
+                if de > 0:
+                    u1, u2 = c, NU * c
+                    qa = u1 * u1 - u1 * u2 + u2 * u2
+                    qb = 2 * t1 * u1 - t1 * u2 - t2 * u1 + 2 * t2 * u2
+                    qc = seq * seq - sy * sy
+                    de = min(de, (-qb + math.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa))
+                self.state = (t1 + c * de, t2 + NU * c * de, p1, p2, eb)
+                self.e = target if de == target - self.e else self.e + de
+                if de < 0:
+                    t1, t2 = self.state[:2]
+                    assert math.sqrt(t1 * t1 - t1 * t2 + t2 * t2) < sy  # unloading stays elastic
+                continue
+            # RK4 on one segment of the table; a step that would cross a row ends on it
+            segment = min(sum(r[0] <= eb for r in HARDENING), len(HARDENING) - 1) - 1
+            h = min(de, 1e-5)
+            row = HARDENING[segment + 1][0] if segment + 2 < len(HARDENING) else math.inf
+            y = self._rk4(h, segment)
+            if y[4] > row:  # secant on the step length for ε̄p = row
+                lo, hi, f_lo, f_hi = 0.0, h, eb - row, y[4] - row
+                for _ in range(50):
+                    h = lo - f_lo * (hi - lo) / (f_hi - f_lo)
+                    y = self._rk4(h, segment)
+                    if abs(y[4] - row) < 1e-15:
+                        break
+                    lo, f_lo, hi, f_hi = hi, f_hi, h, y[4] - row
+                y = (*y[:4], row)
+            self.state = y
+            self.e = target if h == de else self.e + h
+
+    def residual_strain(self):
+        """``ln λ1`` at zero x force after :data:`PEAK`: ``τ1 = 0`` ⇔ ``εe1 + ν εe2 = 0``."""
+        reference = PlanarTension()
+        reference.go_to(PEAK)
+        _, _, p1, p2, _ = reference.state
+        return p1 + NU * p2
+
+    def forces(self, e):
+        """Right-edge x force, top-edge y force, thickness and ε̄p at ``ln λ1 = e`` (after the
+        previous calls: the path is followed in order)."""
+        self.go_to(e)
+        t1, t2, p1, p2, eb = self.state
+        eps_e33 = -NU * (t1 + t2) / E
+        elastic_volume = math.exp((e - p1) + (0.0 - p2) + eps_e33)
+        thickness = T0 * math.exp(eps_e33 - p1 - p2)
+        l1, l2 = self.stretches(e)
+        return t1 / elastic_volume * thickness * S * l2, t2 / elastic_volume * thickness * S * l1, thickness, eb
 
 
 def sheet_model():
@@ -203,3 +313,53 @@ def test_biaxial_path_through_the_fmu_follows_the_closed_form_of_the_hardening_t
     last = outputs[-1]
     assert abs(last["right.Rx"] + last["corner.Rx"]) < 1e-6 * F_YIELD
     assert abs(last["top.Ry"] + last["corner.Ry"]) < 1e-6 * F_YIELD
+
+
+def planar_run(sheet_fmu, increments):
+    with Slave(sheet_fmu) as s:
+        s.initialize(parameters={"solver.incrementsPerStep": increments})
+        outputs = run(s, PlanarTension())
+        assert all(out["solver.cutbacks"] == 0 for out in outputs)  # increments of 1/increments
+    return outputs
+
+
+def test_planar_tension_through_the_fmu_follows_the_rate_form_of_the_hardening_table(sheet_fmu):
+    path = PlanarTension()
+    outputs = planar_run(sheet_fmu, path.increments)
+    ratios = []
+    for e, out in zip(log_strains(path), outputs):
+        fx, fy, thickness, ep = path.forces(e)
+        ratios.append(path.state[1] / path.state[0])
+        assert out["right.Rx"] + out["corner.Rx"] == pytest.approx(fx, abs=1e-6 * F_YIELD), e
+        # backward Euler's error on the stress ratio's transient after yield: 1.6e-5 (class doc)
+        assert out["top.Ry"] + out["corner.Ry"] == pytest.approx(fy, abs=3e-5 * F_YIELD), e
+        assert out["film.minThickness"] == pytest.approx(thickness, rel=1e-6), e
+        assert out["sheet.maxPlasticStrain"] == pytest.approx(ep, abs=1e-6), e
+        assert out["film.yieldedElements"] == (2 * N * N if ep > 0 else 0), e
+    # The stress ratio τ2/τ1 went from ν (elastic) to nearly ½ (flowing) at the peak; unloaded to
+    # the rate form's residual strain, the stretching force is zero and the held width still pulls.
+    assert ratios[0] == pytest.approx(NU) and 0.49 < ratios[log_strains(path).index(PEAK)] < 0.5
+    last = outputs[-1]
+    assert abs(last["right.Rx"] + last["corner.Rx"]) < 1e-6 * F_YIELD
+    assert last["top.Ry"] + last["corner.Ry"] > 0.1 * F_YIELD
+
+
+def test_planar_tension_through_the_fmu_is_backward_euler_of_plane_stress_j2(sheet_fmu):
+    """The same path with 20 increments a step against this suite's own backward-Euler return
+    in principal stresses (``axisymmetric_membrane.Film``) replayed on the FMU's increments
+    (the groups move linearly in displacement within a step)."""
+    increments = 20
+    outputs = planar_run(sheet_fmu, increments)
+    film = Film(E, NU, T0, Hardening(HARDENING))
+    history, previous = (np.zeros(1), np.zeros(1), np.zeros(1)), 1.0
+    for e, out in zip(log_strains(PlanarTension()), outputs):
+        stretch = math.exp(e)
+        for k in range(1, increments + 1):
+            strain = np.array([math.log(previous + (stretch - previous) * k / increments)])
+            history = film.stress(strain, np.zeros(1), history)[2]
+        previous = stretch
+        n1, n2, thickness, _ = film.membrane_forces(np.array([e]), np.zeros(1), history)
+        assert out["right.Rx"] + out["corner.Rx"] == pytest.approx(n1[0] * S, abs=1e-6 * F_YIELD), e
+        assert out["top.Ry"] + out["corner.Ry"] == pytest.approx(n2[0] * S * stretch, abs=1e-6 * F_YIELD), e
+        assert out["film.minThickness"] == pytest.approx(thickness[0], rel=1e-6), e
+        assert out["sheet.maxPlasticStrain"] == pytest.approx(history[2][0], abs=1e-9), e
