@@ -84,6 +84,13 @@ def pack(model_file, out_dir) -> Path:
     return path
 
 
+def pack_model(model: dict, out_dir) -> Path:
+    """Writes the model ``model`` to ``out_dir/<name>.json`` and packs its FMU (:func:`pack`)."""
+    path = Path(out_dir) / f"{model['name']}.json"
+    path.write_text(json.dumps(model))
+    return pack(path, out_dir)
+
+
 def _the_checkouts_build(word) -> bool:
     """``word`` names cargo or a file of ``target/`` that is not in the wheel's venv."""
     if not isinstance(word, (str, os.PathLike)):
