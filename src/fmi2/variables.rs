@@ -299,7 +299,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "E",
             m.youngs_modulus,
             "Pa",
-            "Young's modulus of the film",
+            "Young's modulus of the film at 23 °C (film.temperature scales it)",
             Binding::YoungsModulus,
         ),
         (
