@@ -48,6 +48,7 @@ fn film(prestress: f64) -> Material {
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
         plasticity: None,
+        temperature: 23.0,
     }
 }
 
@@ -958,6 +959,7 @@ fn example_cushion() -> Model {
         thickness: 250e-6,
         yield_stress: Some(15.0e6),
         plasticity: None,
+        temperature: 23.0,
         ..film(0.0)
     };
     let top = disc(1.0, 8, material);

@@ -36,6 +36,7 @@ fn etfe() -> Material {
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
         plasticity: None,
+        temperature: 23.0,
     }
 }
 
@@ -1300,6 +1301,7 @@ fn tension_field_film(eta: f64, prestress: f64) -> Material {
         wrinkling: Wrinkling::TensionField,
         yield_stress: None,
         plasticity: None,
+        temperature: 23.0,
         wrinkling_regularisation: eta,
     }
 }
@@ -1825,6 +1827,7 @@ fn rotated_hub_wrinkles_at_the_annulus_onset_torque() {
         density: 0.0,
         yield_stress: None,
         plasticity: None,
+        temperature: 23.0,
         wrinkling: Wrinkling::TensionField,
         wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
     };

@@ -82,6 +82,7 @@ fn strip(nx: usize) -> Model {
             plasticity: Some(Plasticity {
                 hardening: Hardening::new(vec![[0.0, SY], [1.0, SY + H]]).unwrap(),
             }),
+            temperature: 23.0,
         },
         supports,
         symmetry: vec![],
@@ -99,13 +100,18 @@ fn strip(nx: usize) -> Model {
 /// Uniaxial closed form at log strain `eps` after the largest plastic strain `ep_max`:
 /// `(Kirchhoff τ, ε̄p)`; loading `ln λ = σy(ε̄p)/E + ε̄p`, unloading elastic.
 fn closed_form(eps: f64, ep_max: f64) -> (f64, f64) {
-    let loading = (E * eps - SY) / (E + H);
-    if loading > ep_max && E * eps > SY {
-        (SY + H * loading, loading)
+    closed_form_of(E, SY, H, eps, ep_max)
+}
+
+/// [`closed_form`] for modulus `e` and table `σy = sy + h ε̄p`.
+fn closed_form_of(e: f64, sy: f64, h: f64, eps: f64, ep_max: f64) -> (f64, f64) {
+    let loading = (e * eps - sy) / (e + h);
+    if loading > ep_max && e * eps > sy {
+        (sy + h * loading, loading)
     } else if ep_max == 0.0 {
-        (E * eps, 0.0)
+        (e * eps, 0.0)
     } else {
-        (E * (eps - ep_max), ep_max)
+        (e * (eps - ep_max), ep_max)
     }
 }
 
@@ -256,4 +262,45 @@ fn cli_summary_of_the_plastic_film_matches_its_elements_csv() {
         "plastic film: {yielded} yielded elements, equivalent plastic strain ≤ {ep:.6}, smallest thickness {thickness:.4e} m"
     );
     assert_eq!(line, expected);
+}
+
+#[test]
+fn strip_at_0_and_50_celsius_follows_the_table_scaled_by_the_published_factors() {
+    use membrane_contact::mech::elements::temperature::{flow_stress_factor, modulus_factor};
+    for celsius in [0.0, 50.0] {
+        let mut model = strip(2);
+        model.material.temperature = celsius;
+        let (e, s) = (E * modulus_factor(celsius), flow_stress_factor(celsius));
+        let mut a = Analysis::new(model, Default::default()).unwrap();
+        let mut ep_max: f64 = 0.0;
+        // Elastic, then plastic loading, then elastic unloading.
+        for eps in [0.5 * SY * s / e, 0.1, 0.2, 0.15] {
+            a.step_to(&[[L * (f64::exp(eps) - 1.0), 0.0, 0.0]], 4)
+                .unwrap();
+            let (tau, ep) = closed_form_of(e, SY * s, H * s, eps, ep_max);
+            ep_max = ep_max.max(ep);
+            let force = tau / eps.exp() * W * T0;
+            let fx = a.results().reactions[0][0];
+            assert!(
+                (fx - force).abs() < 1e-6 * (SY * W * T0),
+                "{celsius} °C, ε {eps}: F {fx} vs {force}"
+            );
+        }
+        assert!(ep_max > 0.05, "the strip yielded");
+    }
+}
+
+#[test]
+fn temperature_outside_0_to_50_celsius_is_refused_naming_it() {
+    for celsius in [-0.5, 50.5] {
+        let mut model = strip(1);
+        model.material.temperature = celsius;
+        let err = Analysis::new(model, Default::default()).err().unwrap();
+        assert!(
+            err.to_string().contains(&format!(
+                "temperature = {celsius} °C lies outside [0, 50] °C"
+            )),
+            "{err}"
+        );
+    }
 }

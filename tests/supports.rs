@@ -254,6 +254,7 @@ fn film(prestress: [f64; 3]) -> membrane_contact::mech::Material {
             membrane_contact::mech::elements::material::DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,
         plasticity: None,
+        temperature: 23.0,
     }
 }
 

@@ -41,6 +41,7 @@ pub fn sheet(n: usize) -> Model {
             wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
             yield_stress: None,
             plasticity: None,
+            temperature: 23.0,
         },
         supports: edge
             .map(|node| Support {

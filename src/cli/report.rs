@@ -9,6 +9,9 @@ use std::io::Write as _;
 use std::path::Path;
 
 use membrane_contact::fmi2::variables::StepInputs;
+use membrane_contact::mech::elements::temperature::{
+    REFERENCE_TEMPERATURE, flow_stress_factor, modulus_factor,
+};
 use membrane_contact::mech::results::lines::{ReactionLine, reaction_lines};
 use membrane_contact::mech::results::warnings::{model_warnings, result_warnings};
 use membrane_contact::mech::{Analysis, Model, Results, StepReport, WrinklingState};
@@ -375,6 +378,15 @@ fn model_section(s: &mut String, model: &Model) {
         m.yield_stress
             .map_or("none".into(), |y| format!("{} Pa", num(y)))
     );
+    if m.temperature != REFERENCE_TEMPERATURE {
+        let _ = writeln!(
+            s,
+            "| temperature | {} °C: E × {:.4}, yield and flow stresses × {:.4} (given at 23 °C) |",
+            num(m.temperature),
+            modulus_factor(m.temperature),
+            flow_stress_factor(m.temperature)
+        );
+    }
 }
 
 fn reference_area(model: &Model, t: &[usize; 3]) -> f64 {
@@ -512,7 +524,31 @@ fn slip_section(s: &mut String, model: &Model, results: &Results) {
 
 #[cfg(test)]
 mod tests {
-    use super::num;
+    use super::{model_section, num};
+    use membrane_contact::mech::Model;
+
+    #[test]
+    fn model_section_states_a_temperature_other_than_23_celsius_with_its_factors() {
+        let mut model: Model = serde_json::from_str(
+            r#"{"name": "M", "nodes": [[0, 0, 0], [1, 0, 0], [0, 1, 0]], "triangles": [[0, 1, 2]],
+                "material": {"youngs_modulus": 1e9, "poisson_ratio": 0.4, "thickness": 1e-4}}"#,
+        )
+        .unwrap();
+        let section = |model: &Model| {
+            let mut s = String::new();
+            model_section(&mut s, model);
+            s
+        };
+        assert!(!section(&model).contains("temperature"));
+        model.material.temperature = 0.0;
+        assert!(
+            section(&model).contains(
+                "| temperature | 0 °C: E × 1.1300, yield and flow stresses × 1.2770 (given at 23 °C) |"
+            ),
+            "{}",
+            section(&model)
+        );
+    }
 
     #[test]
     fn numbers_keep_six_significant_digits() {

@@ -243,6 +243,7 @@ impl Instance {
                 (Binding::Thickness, Value::Real(x)) => model.material.thickness = x,
                 (Binding::Prestress(c), Value::Real(x)) => model.material.prestress[c] = x,
                 (Binding::Density, Value::Real(x)) => model.material.density = x,
+                (Binding::Temperature, Value::Real(x)) => model.material.temperature = x,
                 (Binding::Gravity(c), Value::Real(x)) => model.loads.gravity[c] = x,
                 (Binding::Wrinkling, Value::Boolean(b)) => {
                     model.material.wrinkling = if b {

@@ -137,6 +137,8 @@ pub enum Binding {
     },
     /// Film density (self-weight).
     Density,
+    /// Film temperature (°C).
+    Temperature,
     /// Gravity component along axis 0, 1, 2.
     Gravity(usize),
     ArchHeight,

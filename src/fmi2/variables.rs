@@ -25,6 +25,7 @@
 //! | `film.E`, `film.nu`, `film.thickness`, `film.prestressX/Y/XY` | Real | parameter | Pa, 1, m, Pa | film |
 //! | `film.wrinkling` | Boolean | parameter | | tension-field film (start: the model's `wrinkling`) |
 //! | `film.density` | Real | parameter | kg/m3 | film density for self-weight (start: the model's) |
+//! | `film.temperature` | Real | parameter | (°C) | film temperature in [0, 50]; E and the hardening table scale from 23 °C (start: the model's) |
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
@@ -298,7 +299,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "E",
             m.youngs_modulus,
             "Pa",
-            "Young's modulus of the film",
+            "Young's modulus of the film at 23 °C (film.temperature scales it)",
             Binding::YoungsModulus,
         ),
         (
@@ -359,6 +360,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         Some("kg/m3"),
         "film density for self-weight (ETFE about 1750); 0: weightless",
         Binding::Density,
+    );
+    table.parameter(
+        "film.temperature",
+        Value::Real(m.temperature),
+        None,
+        "film temperature in °C, 0 to 50: E and the plastic film's flow stresses are given at 23 °C \
+         and scaled by ETFE's published relation (docs/mechanics.md, Temperature)",
+        Binding::Temperature,
     );
     for (axis, a) in axes.iter().enumerate() {
         table.parameter(

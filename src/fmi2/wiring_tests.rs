@@ -133,6 +133,7 @@ fn edit(run: &mut CoreRun, name: &str, value: &Value) -> Result<(), String> {
         ("film", "prestressY") => "/material/prestress/1".into(),
         ("film", "prestressXY") => "/material/prestress/2".into(),
         ("film", "density") => "/material/density".into(),
+        ("film", "temperature") => "/material/temperature".into(),
         ("film", "wrinkling") => {
             let law = if x == true { "tension-field" } else { "none" };
             return put(&mut run.model, "/material/wrinkling", law.into());

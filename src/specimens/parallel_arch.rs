@@ -138,6 +138,7 @@ impl Default for ParallelArch {
                 wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
                 yield_stress: None,
                 plasticity: None,
+                temperature: 23.0,
             },
             normal_penalty_factor: 1000.0,
             tangential_penalty_ratio: 0.1,

@@ -243,9 +243,9 @@ def test_designs_factorial_latin_hypercube_and_seeded_monte_carlo():
 
 
 def test_names_the_fmu_does_not_have_are_refused_naming_them(fmu_path):
-    with pytest.raises(KeyError, match="design variable 'film.temperature' is not a parameter or an input of "
+    with pytest.raises(KeyError, match="design variable 'film.colour' is not a parameter or an input of "
                                        "ParallelArch .no such variable."):
-        Study(fmu_path, {"film.temperature": [20.0]}, PATH)
+        Study(fmu_path, {"film.colour": [20.0]}, PATH)
     with pytest.raises(KeyError, match="output 'frame.dz' is not an output of ParallelArch .a input."):
         Study(fmu_path, {"mu": [0.2]}, PATH, ["frame.dz"])
     with pytest.raises(KeyError, match="'scale:frame.dx': the load path has no column 'frame.dx'"):

@@ -228,8 +228,12 @@ fn bad_calls_return_error_with_a_message_and_change_nothing() {
             "{:?}",
             log.take()
         );
-        assert_eq!(fmu.set_integer("solver.incrementsPerStep", 0), 0);
         assert_eq!(fmu.set_real("film.E", 1e9), 0);
+        assert_eq!(fmu.set_real("film.temperature", 60.0), 0);
+        assert_eq!(fmi2_exit_initialization_mode(c), err);
+        assert!(log.contains(Status::Error, "temperature = 60 °C lies outside [0, 50] °C"));
+        assert_eq!(fmu.set_real("film.temperature", 23.0), 0);
+        assert_eq!(fmu.set_integer("solver.incrementsPerStep", 0), 0);
         assert_eq!(fmi2_exit_initialization_mode(c), err);
         assert!(log.contains(Status::Error, "solver.incrementsPerStep = 0 must be ≥ 1"));
         assert_eq!(fmu.set_integer("solver.incrementsPerStep", 2), 0);

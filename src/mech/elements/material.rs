@@ -26,6 +26,7 @@ use nalgebra::{Matrix3, Vector2, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::plasticity::{PlasticFilm, Plasticity};
+use super::temperature::{REFERENCE_TEMPERATURE, flow_stress_factor, modulus_factor};
 
 /// Default `η` of [`Material::wrinkling_regularisation`].
 pub const DEFAULT_WRINKLING_REGULARISATION: f64 = 1e-5;
@@ -95,6 +96,22 @@ pub struct Material {
     /// (`plasticity/`); none (the default): the elastic law (2.3), bit for bit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plasticity: Option<Plasticity>,
+    /// Film temperature (°C), in `[0, 50]`: `youngs_modulus`, `yield_stress` and the hardening
+    /// table are given at 23 °C (the default) and scaled by ETFE's published relation
+    /// ([`temperature`](super::temperature), [`Material::at_temperature`]).
+    #[serde(
+        default = "default_temperature",
+        skip_serializing_if = "is_default_temperature"
+    )]
+    pub temperature: f64,
+}
+
+fn default_temperature() -> f64 {
+    REFERENCE_TEMPERATURE
+}
+
+fn is_default_temperature(t: &f64) -> bool {
+    *t == REFERENCE_TEMPERATURE
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -124,6 +141,26 @@ pub struct MaterialResponse {
 }
 
 impl Material {
+    /// The material at 23 °C that behaves as this one at its `temperature`: `E` times
+    /// [`modulus_factor`], `yield_stress` and every flow stress of the hardening table times
+    /// [`flow_stress_factor`] (plastic strains kept). The solver uses this; at 23 °C it is the
+    /// material itself, bit for bit.
+    pub fn at_temperature(&self) -> Material {
+        if self.temperature == REFERENCE_TEMPERATURE {
+            return *self;
+        }
+        let stress = flow_stress_factor(self.temperature);
+        Material {
+            youngs_modulus: self.youngs_modulus * modulus_factor(self.temperature),
+            yield_stress: self.yield_stress.map(|y| y * stress),
+            plasticity: self.plasticity.map(|p| Plasticity {
+                hardening: p.hardening.scaled(stress),
+            }),
+            temperature: REFERENCE_TEMPERATURE,
+            ..*self
+        }
+    }
+
     /// The elasto-plastic film law of this material, if it has `plasticity`.
     pub fn plastic_film(&self) -> Option<PlasticFilm> {
         self.plasticity.map(|p| PlasticFilm {
@@ -270,6 +307,7 @@ mod tests {
             wrinkling_regularisation: 0.0,
             yield_stress: None,
             plasticity: None,
+            temperature: REFERENCE_TEMPERATURE,
         }
     }
 
@@ -429,6 +467,37 @@ mod tests {
             };
             assert!((added - expected).amax() < 1e-15 * mat.elasticity().amax());
         }
+    }
+
+    #[test]
+    fn at_temperature_scales_modulus_yield_stress_and_every_flow_stress() {
+        use crate::mech::elements::plasticity::Hardening;
+        use crate::mech::elements::temperature::{flow_stress_factor, modulus_factor};
+        let rows = vec![[0.0, 16e6], [0.02, 19e6], [1.0, 40e6]];
+        let at_23 = Material {
+            yield_stress: Some(15e6),
+            plasticity: Some(Plasticity {
+                hardening: Hardening::new(rows.clone()).unwrap(),
+            }),
+            ..film([1.0, 2.0, 0.5])
+        };
+        assert_eq!(at_23.at_temperature(), at_23, "23 °C: the material itself");
+        let cold = Material {
+            temperature: 0.0,
+            ..at_23
+        };
+        let m = cold.at_temperature();
+        let (e, s) = (modulus_factor(0.0), flow_stress_factor(0.0));
+        assert_eq!(m.youngs_modulus, 1000.0 * e);
+        assert_eq!(m.yield_stress, Some(15e6 * s));
+        let scaled: Vec<[f64; 2]> = rows.iter().map(|r| [r[0], r[1] * s]).collect();
+        assert_eq!(m.plasticity.unwrap().hardening.rows(), &scaled[..]);
+        // Everything else is kept; the result is a material at 23 °C (not scaled twice).
+        assert_eq!(
+            (m.poisson_ratio, m.prestress, m.temperature),
+            (0.3, [1.0, 2.0, 0.5], 23.0)
+        );
+        assert_eq!(m.at_temperature(), m);
     }
 
     #[test]

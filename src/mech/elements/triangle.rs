@@ -358,6 +358,7 @@ mod tests {
             wrinkling_regularisation: 1e-5,
             yield_stress: None,
             plasticity: None,
+            temperature: 23.0,
         }
     }
 

@@ -1,6 +1,6 @@
 //! Validation of a model: every item is checked before any analysis, and the first problem
 //! found is named (an unknown node index, a degenerate triangle, `E ≤ 0`, `ν` outside `[0, 0.5)`,
-//! `η` outside `[0, 1)`, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node both
+//! `η` outside `[0, 1)`, a temperature outside 0–50 °C, `μ < 0`, a non-orthonormal gap frame, a duplicate name, a node both
 //! constrained and prescribed, a control character in text bound for modelDescription.xml, a
 //! rigid-body mode no restraint holds ([`crate::mech::model::restraint`]). Nothing here panics on user input.
 
@@ -11,6 +11,7 @@ use nalgebra::Vector3;
 use super::format::*;
 use crate::mech::elements::curved_contact::Centreline;
 use crate::mech::elements::curved_contact::SurfaceContact;
+use crate::mech::elements::temperature::{TEMPERATURE_RANGE, in_range};
 use crate::mech::elements::triangle::MembraneTriangle;
 
 impl Model {
@@ -84,6 +85,16 @@ impl Model {
         {
             return Err(ModelError::Material {
                 message: format!("yield_stress = {y} must be > 0 (Pa)"),
+            });
+        }
+        if !in_range(m.temperature) {
+            let [low, high] = TEMPERATURE_RANGE;
+            return Err(ModelError::Material {
+                message: format!(
+                    "temperature = {} °C lies outside [{low}, {high}] °C, the range of ETFE's \
+                     published temperature relation (docs/mechanics.md § \"Temperature\")",
+                    m.temperature
+                ),
             });
         }
         for (t, tri) in self.triangles.iter().enumerate() {

@@ -79,7 +79,7 @@ pub fn result_warnings(model: &Model, results: &Results) -> Vec<String> {
                 |b, (i, v)| if v > b.1 { (i, v) } else { b },
             )
     };
-    if let Some(limit) = model.material.yield_stress {
+    if let Some(limit) = model.material.at_temperature().yield_stress {
         let (e, s) = worst(&|e| e.von_mises);
         if s > limit {
             let over = results

@@ -97,7 +97,7 @@ impl Analysis {
                 .collect(),
             last_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
-            plastic: model
+            plastic: system
                 .material
                 .plastic_film()
                 .map(|f| vec![f.initial_history(model.material.prestress); model.triangles.len()])
@@ -116,7 +116,7 @@ impl Analysis {
             last_work: 0.0,
         };
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
-        let force_floor = 1e-6 * model.material.membrane_stiffness() * length_scale;
+        let force_floor = 1e-6 * system.material.membrane_stiffness() * length_scale;
         Ok(Self {
             model,
             system,

@@ -66,7 +66,7 @@ pub struct System {
     pub triangles: Vec<([usize; 3], MembraneTriangle)>,
     /// Gap elements.
     pub gaps: Vec<GapGeometry>,
-    /// Film material.
+    /// Film material at the model's temperature ([`Material::at_temperature`]).
     pub material: Material,
     /// CSC pattern of the free–free tangent.
     symbolic: SymbolicSparseColMat<usize>,
@@ -205,7 +205,7 @@ impl System {
             free_count,
             triangles,
             gaps,
-            material: model.material,
+            material: model.material.at_temperature(),
             symbolic,
             slots,
             gap_offsets,
