@@ -173,9 +173,7 @@ def plot(fits, releases, table1, steps, path):
 
 
 def main(argv=None):
-    p = archfmu.example_parser(__doc__.splitlines()[0], steps=40)
-    p.add_argument("--heights", type=int, nargs="+", default=HEIGHTS_MM, choices=HEIGHTS_MM,
-                   help="arch heights (mm) of the specimens (default: all three)")
+    p = fig8_wrapped.parser(__doc__.splitlines()[0])
     p.add_argument("--no-lowered", action="store_true", help="skip the lowered-frame runs")
     a = p.parse_args(argv)
     out = Path(a.out)

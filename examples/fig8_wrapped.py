@@ -139,11 +139,16 @@ def plot(results, table1, steps, path):
     plt.close(fig)
 
 
-def main(argv=None):
-    p = archfmu.example_parser(__doc__.splitlines()[0], steps=40)
+def parser(description):
+    """The example options (40 steps by default) and --heights."""
+    p = archfmu.example_parser(description, steps=40)
     p.add_argument("--heights", type=int, nargs="+", default=HEIGHTS_MM, choices=HEIGHTS_MM,
                    help="arch heights (mm) of the specimens to fit (default: all three)")
-    a = p.parse_args(argv)
+    return p
+
+
+def main(argv=None):
+    a = parser(__doc__.splitlines()[0]).parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     table1 = archfmu.read_table1()

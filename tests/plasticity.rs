@@ -1,5 +1,6 @@
 //! The elasto-plastic film through the solver (issue 20): a strip pulled to 30 % log strain and
-//! back, against the closed form of its hardening table.
+//! back, against the closed form of its hardening table; the crown-to-foot specimen erected past
+//! yield, partly released and loaded in service.
 //!
 //! ```text
 //!   strip L × w (nx × 1 cells), z fixed everywhere
