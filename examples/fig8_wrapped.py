@@ -39,12 +39,15 @@ FIT_POINTS = [2, 3, 4, 5]
 PROBES = (0.01, 0.03)
 
 
-def export(height_mm, contact, eps, steps, work):
-    """Model dict and staged table (dict of columns) of a wrapped specimen (files in work)."""
-    table = Path(work) / f"wrap_{height_mm}_{contact}_{eps:.6f}.csv"
+def export(height_mm, contact, eps, steps, work, plastic=False):
+    """Model dict and staged table (dict of columns) of a wrapped specimen (files in work);
+    ``plastic``: ETFE's elasto-plastic film (``--plastic``) instead of the linear one."""
+    film = "_plastic" if plastic else ""
+    table = Path(work) / f"wrap_{height_mm}_{contact}{film}_{eps:.6f}.csv"
     text = subprocess.run([str(archfmu.CLI), "export-specimen", "--height", str(height_mm),
                            "--contact", contact, "--wrap", repr(eps), "--path-out", str(table),
-                           "--steps", str(steps)], check=True, capture_output=True, text=True).stdout
+                           "--steps", str(steps)] + (["--plastic"] if plastic else []),
+                          check=True, capture_output=True, text=True).stdout
     with open(table) as f:
         rows = list(csv.DictReader(f))
     columns = {k: [float(r[k]) for r in rows] for k in rows[0]}
@@ -54,12 +57,14 @@ def export(height_mm, contact, eps, steps, work):
 class Specimen:
     """One packed FMU per specimen and contact model; any eps is a table for it."""
 
-    def __init__(self, height_mm, contact, steps, work):
+    def __init__(self, height_mm, contact, steps, work, plastic=False):
         from membrane_contact import build_fmu
 
         self.height_mm, self.contact, self.steps, self.work = height_mm, contact, steps, work
-        model, _ = export(height_mm, contact, PROBES[-1], steps, work)
-        model["name"] = f"ParallelArchWrapped{height_mm}{'Curved' if contact != 'gaps' else 'Gaps'}"
+        self.plastic = plastic
+        model, _ = export(height_mm, contact, PROBES[-1], steps, work, plastic)
+        model["name"] = (f"ParallelArchWrapped{height_mm}{'Curved' if contact != 'gaps' else 'Gaps'}"
+                         + ("Plastic" if plastic else ""))
         self.model = model
         self.fmu = build_fmu(model, out_dir=Path(work) / "wrapped-fmu")
 
@@ -68,7 +73,7 @@ class Specimen:
         eps, or where the FMU stopped when a step stays refused (the state it keeps)."""
         from membrane_contact import Film, StepRefused
 
-        _, table = export(self.height_mm, self.contact, eps, self.steps, self.work)
+        _, table = export(self.height_mm, self.contact, eps, self.steps, self.work, self.plastic)
         with Film(self.fmu, logging=False) as film:
             film.initialize(inputs={"mu": MU})
             try:
@@ -134,11 +139,16 @@ def plot(results, table1, steps, path):
     plt.close(fig)
 
 
-def main(argv=None):
-    p = archfmu.example_parser(__doc__.splitlines()[0], steps=40)
+def parser(description):
+    """The example options (40 steps by default) and --heights."""
+    p = archfmu.example_parser(description, steps=40)
     p.add_argument("--heights", type=int, nargs="+", default=HEIGHTS_MM, choices=HEIGHTS_MM,
                    help="arch heights (mm) of the specimens to fit (default: all three)")
-    a = p.parse_args(argv)
+    return p
+
+
+def main(argv=None):
+    a = parser(__doc__.splitlines()[0]).parse_args(argv)
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     table1 = archfmu.read_table1()

@@ -6,7 +6,6 @@
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
-use membrane_contact::mech::elements::plasticity::{Plasticity, etfe_datasheet_hardening};
 use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::results::vtk;
@@ -14,7 +13,7 @@ use membrane_contact::mech::{
     Analysis, FrictionLaw, LoadLevels, Model, Results, SettingNames, SolverSettings,
 };
 use membrane_contact::specimens::ParallelArch;
-use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, table1};
+use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, etfe_plastic, table1};
 
 mod args;
 mod path;
@@ -75,9 +74,7 @@ fn specimen(args: &SpecimenArgs, law: Option<FrictionLaw>) -> Result<ParallelArc
         ..ParallelArch::with_height(args.height / 1000.0)
     };
     if args.plastic {
-        spec.material.plasticity = Some(Plasticity {
-            hardening: etfe_datasheet_hardening(),
-        });
+        spec.material = etfe_plastic(spec.material);
     }
     spec.check()?;
     Ok(spec)

@@ -36,6 +36,7 @@ use serde::{Deserialize, Serialize};
 use crate::mech::elements::curved_contact::{Centreline, CurvedSupport};
 use crate::mech::elements::gap::{FrictionLaw, GapFrame};
 use crate::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Material, Wrinkling};
+use crate::mech::elements::plasticity::{Plasticity, etfe_datasheet_hardening};
 use crate::mech::model::{Axis, BoundaryGroup, GapSpec, GapSupport, Model, Symmetry};
 
 /// Measured sliding along the arch at the final step (mm), the paper's Table 1 (points 1–5).
@@ -150,6 +151,17 @@ impl Default for ParallelArch {
             pipe_radius: 0.0243,
             frame_path: FramePath::Lowered,
         }
+    }
+}
+
+/// `material` with ETFE's elasto-plastic behaviour: finite-strain J2 with the documented data-sheet
+/// curve at 23 °C (`docs/mechanics.md` "Plastic film"); everything else unchanged.
+pub fn etfe_plastic(material: Material) -> Material {
+    Material {
+        plasticity: Some(Plasticity {
+            hardening: etfe_datasheet_hardening(),
+        }),
+        ..material
     }
 }
 

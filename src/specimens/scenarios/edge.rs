@@ -167,6 +167,7 @@ impl ArchEdge {
                     targets: vec![[0.0, 0.0, -depth * self.arch_height]],
                     steps,
                     friction: None,
+                    pressure: None,
                 }],
                 increments_per_step,
             },

@@ -6,6 +6,7 @@ use crate::mech::model::{
     OutputSpec, PressureSet,
 };
 use crate::specimens::scenarios::arc::validated;
+use crate::specimens::scenarios::{Family, LoadPath, Scenario, Stage};
 
 // ------------------------------------------------------------------------ circular membrane
 
@@ -112,6 +113,39 @@ impl CircularMembrane {
             },
             cables: vec![],
             curved_supports: vec![],
+        })
+    }
+
+    /// A cushion's pressure cycle: the set `top` raised from zero to `peak` (Pa) in `steps`
+    /// communication steps, then lowered to `deflated` in as many, the rim held (family
+    /// [`Family::Plastic`]: for a film that yields on the way up and unloads on the way down).
+    pub fn inflated(
+        &self,
+        peak: f64,
+        deflated: f64,
+        steps: usize,
+        increments_per_step: usize,
+    ) -> Result<Scenario, String> {
+        if steps == 0 || !(peak.is_finite() && deflated.is_finite()) {
+            return Err("cushion path: steps must be ≥ 1 and the pressures finite".into());
+        }
+        let stage = |p: f64| Stage {
+            targets: vec![[0.0; 3]],
+            steps,
+            friction: None,
+            pressure: Some(vec![p]),
+        };
+        Ok(Scenario {
+            family: Family::Plastic,
+            name: format!(
+                "cushion a={} peak={peak}Pa deflated={deflated}Pa steps={steps}",
+                self.radius
+            ),
+            model: self.model()?,
+            path: LoadPath {
+                stages: vec![stage(peak), stage(deflated)],
+                increments_per_step,
+            },
         })
     }
 }

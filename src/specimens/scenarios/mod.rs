@@ -58,6 +58,10 @@
 //! the non-linear frame path; gaps or curved supports; optionally released back to the wound
 //! film (the extension retraced).
 //!
+//! **Plastic** ([`plastic_paths`], issue 20): ETFE's elasto-plastic film (the data-sheet curve)
+//! on the specimens lowered at every height and wrapped then partly released, on circular
+//! cushions inflated past yield and deflated, and on panels jacked and released.
+//!
 //! **Circular membrane** ([`CircularMembrane`], issue 8): a flat disc meshed in rings (the
 //! centre, then `6k` nodes on ring `k`), its rim a boundary group `rim` held at zero (so the FMU
 //! reports the rim reaction), a pressure set `top` on every triangle (normals +Z). Hencky's
@@ -84,6 +88,7 @@
 
 use std::fmt;
 
+use crate::mech::elements::load::LoadLevels;
 use crate::mech::model::Model;
 use crate::mech::solve::{Analysis, SolverSettings, StepError};
 
@@ -97,7 +102,7 @@ mod strip;
 
 pub use arc::{CircularSupport, GapConstants, gaps_on_arc};
 pub use edge::ArchEdge;
-pub use grid::{grid_slice, robustness_grid};
+pub use grid::{grid_slice, plastic_paths, robustness_grid};
 pub use membrane::CircularMembrane;
 pub use panel::ArchPanel;
 pub use specimen::{PathShape, SpecimenPath, WrappedSpecimen};
@@ -105,7 +110,8 @@ pub use strip::CylinderStrip;
 
 // ------------------------------------------------------------------------------- load paths
 
-/// One stage of a load path: every group moves linearly to `targets` in `steps` steps.
+/// One stage of a load path: every group moves linearly to `targets` in `steps` steps (and the
+/// pressures to `pressure`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stage {
     /// Target displacement of every boundary group at the end of the stage (m).
@@ -114,6 +120,8 @@ pub struct Stage {
     pub steps: usize,
     /// Friction coefficient of every gap from this stage on (`None`: unchanged).
     pub friction: Option<f64>,
+    /// Pressure of every pressure set at the end of the stage (Pa, model order; `None`: kept).
+    pub pressure: Option<Vec<f64>>,
 }
 
 /// A load path: stages from the unloaded state, and the increments of every step.
@@ -147,16 +155,19 @@ pub enum Family {
     ArchEdge,
     /// [`WrappedSpecimen`].
     Wrapped,
+    /// ETFE's elasto-plastic film ([`plastic_paths`]): specimens, cushions, panels.
+    Plastic,
 }
 
 impl Family {
     /// Every family, in table order.
-    pub const ALL: [Family; 5] = [
+    pub const ALL: [Family; 6] = [
         Self::Specimen,
         Self::Panel,
         Self::Strip,
         Self::ArchEdge,
         Self::Wrapped,
+        Self::Plastic,
     ];
 
     /// Short name (the benchmark's `--family` filter).
@@ -167,6 +178,7 @@ impl Family {
             Self::Strip => "strip",
             Self::ArchEdge => "arch-edge",
             Self::Wrapped => "wrapped",
+            Self::Plastic => "plastic",
         }
     }
 }
@@ -287,7 +299,8 @@ impl Scenario {
     }
 
     /// [`Scenario::run`], calling `observe` after every converged step with the step's record
-    /// and the analysis at its converged state (to check what a path converges to).
+    /// and the analysis at its converged state (to check what a path converges to). Pressures
+    /// move linearly within a stage as the targets do, from zero at the start.
     pub fn run_observed(
         &self,
         settings: SolverSettings,
@@ -302,7 +315,12 @@ impl Scenario {
             }
         };
         let mut previous = vec![[0.0; 3]; self.model.groups.len()];
+        let mut levels = LoadLevels::zero(&self.model);
         for (s, stage) in self.path.stages.iter().enumerate() {
+            let mut end = levels.clone();
+            if let Some(p) = &stage.pressure {
+                end.pressure.clone_from(p);
+            }
             if let Some(mu) = stage.friction
                 && let Err(e) = analysis.set_friction(mu)
             {
@@ -327,7 +345,8 @@ impl Scenario {
                     residual: 0.0,
                     error: None,
                 };
-                match analysis.step_to(&target, self.path.increments_per_step) {
+                let loads = levels.interpolate(&end, f);
+                match analysis.step_to_with_loads(&target, &loads, self.path.increments_per_step) {
                     Ok(report) => {
                         record.iterations = report.total_iterations();
                         record.max_increment_iterations =
@@ -350,6 +369,7 @@ impl Scenario {
                 }
             }
             previous.clone_from(&stage.targets);
+            levels = end;
         }
         outcome
     }

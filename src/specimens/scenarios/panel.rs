@@ -196,6 +196,7 @@ impl ArchPanel {
                 targets: self.jack_targets(angle * k as f64 / stages as f64),
                 steps,
                 friction: if k == 1 { mu } else { None },
+                pressure: None,
             })
             .collect();
         Ok(Scenario {

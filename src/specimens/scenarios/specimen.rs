@@ -69,6 +69,7 @@ impl SpecimenPath {
             targets: vec![t],
             steps,
             friction: None,
+            pressure: None,
         };
         let stages = match self.shape {
             PathShape::Monotone => vec![stage(down, self.steps)],
@@ -139,6 +140,7 @@ impl WrappedSpecimen {
             targets: spec.boundary_targets(&model, t),
             steps: 1,
             friction: None,
+            pressure: None,
         };
         let mut stages: Vec<Stage> = (1..=self.steps)
             .map(|k| stage(k as f64 / self.steps as f64))

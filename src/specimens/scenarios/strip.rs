@@ -143,6 +143,7 @@ impl CylinderStrip {
                     targets: model.groups.iter().map(|g| g.target).collect(),
                     steps,
                     friction: None,
+                    pressure: None,
                 }],
                 increments_per_step,
             },
