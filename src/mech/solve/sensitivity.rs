@@ -5,13 +5,46 @@
 //! The last increment's Newton equation `g_f(u, p, λ, μ) = 0` (free DOFs `u`, prescribed values
 //! `p`, load levels `λ`, friction `μ`; gap laws and curved-support contacts from the
 //! increment's start, as Newton used them) is linearized at its solution:
-//! `K_ff du = −∂g_f/∂(p, λ, μ) · seed`, with `K_ff` the consistent tangent assembled at the
-//! converged point and factorized once for the seed, and the right-hand side the central
-//! difference of the assembled residual along the seed (step ε: a relative change of 1e-6 of
-//! the largest seeded quantity), free DOFs held. The results then move along
-//! `(du, dp, dλ, dμ)`: [`Response`] holds them at `±h, ±2h` along it (`h ≥ ε`, large enough
-//! that the rounding of the displacements does not swamp a small response), so that the
-//! derivative of any result is its fourth-order central difference.
+//! `K_ff du = −∂g_f/∂(p, λ, μ) · seed`, with `K_ff` the consistent tangent at the converged
+//! point.
+//!
+//! Cost: one solve per seed. The first seed at a converged state assembles `K_ff` there and
+//! factorizes it; the factor stays in the analysis's linear solver, and later seeds at the same
+//! state solve with it (`LinearSolver::solve_held`: the same path, a slipping gap's Woodbury
+//! block reused, every solution checked). It is held for the converged state, the increment's
+//! start and the factor's identity (`LinearSolver::factor_id`) together, so that a step (whose
+//! Newton iterations factorize), a restored state ([`Analysis::set_state`]) or a new μ
+//! ([`Analysis::set_friction`]) each make the next seed factorize again: the derivatives are
+//! then bit for bit those of an analysis that never held a factor. Newton's own last factor is
+//! not the one: it is the tangent at the iterate before the converged one (Newton stops once
+//! the correction it solved for is small), shifted by Levenberg–Marquardt or pseudo-time where
+//! those acted. The held tangent's values are kept beside the factor (one array of the
+//! pattern's size) for the solutions' checks.
+//!
+//! The right-hand side, by kind of input, free DOFs held:
+//! * loads (pressures, nodal forces): exact. The residual is linear in the load levels
+//!   (a follower pressure's force is `p/6 (x2 − x1) × (x3 − x1)` at the current positions), so
+//!   the loads' residual at the seed's levels is `∂g/∂λ · seed` itself;
+//! * μ (every gap's and curved-support contact's own coefficient, each moved by the seed): the
+//!   central difference of the residual of the gaps and curved-support contacts alone
+//!   (nothing else depends on μ), step ε below. A slipping gap's force `μ N t` is linear in μ
+//!   on its side of the cone, so the difference is exact but for rounding; at the cone it is
+//!   the law's average of the two sides (see below);
+//! * group translations and angles: the central difference of the assembled residual along
+//!   the prescribed displacements `dp` (step ε: a relative change of 1e-6 of the largest
+//!   seeded quantity). The exact form, `K_fp dp`, needs the tangent's prescribed columns, which
+//!   the pattern does not hold (prescribed DOFs are eliminated when it is built): a second
+//!   pattern and slot table for every contribution, against two residual assemblies per seed
+//!   (the same answers as FMU steps to 1e-6, unchanged). The difference's rounding is
+//!   that of the residual over ε: for a pressure seed on the cushion it was 5e-8 of the
+//!   derivatives, which the exact load form removed.
+//!
+//! The results then move along `(du, dp, dλ, dμ)`: [`Response`] holds them at `±h, ±2h` along
+//! it (`h ≥ ε`, large enough that the rounding of the displacements does not swamp a small
+//! response), so that the derivative of any result is its fourth-order central difference.
+//! Each of those results is that of the histories a step ending there would commit, as a
+//! step's results are (an open curved contact's anchor follows its node, so its slip does not
+//! move).
 //!
 //! What the derivatives mean:
 //! * exact (to the central difference's ~1e-9) where the step was one increment, or the
@@ -38,8 +71,9 @@ use crate::mech::solve::state::{AnalysisState, GroupMotion};
 /// steps by 2e-6 on the hinged panel's reaction, 3e-7 meets every check).
 const OUTPUT_STEP: f64 = 3e-7;
 
-/// The end values of a step's inputs moved along a seed: group motion, load levels, friction.
-type Moved = (GroupMotion, LoadLevels, Vec<f64>);
+/// The end values of a step's inputs moved along a seed: group motion, load levels, and the
+/// change of every friction coefficient.
+type Moved = (GroupMotion, LoadLevels, f64);
 
 /// The consistent tangent at a converged state and the identity of its factor in the
 /// analysis's linear solver: what every seed at that state solves with (module doc).
@@ -125,7 +159,11 @@ impl Analysis {
         let l = self.length_scale;
         let mut largest = relative(
             seed.friction,
-            end.friction.first().copied().unwrap_or(0.0),
+            end.friction
+                .first()
+                .or(end.contacts.first().map(|c| &c.friction))
+                .copied()
+                .unwrap_or(0.0),
             1e-2,
         );
         for (t, b) in seed.translation.iter().zip(&end.boundary) {
@@ -188,8 +226,7 @@ impl Analysis {
                     .collect(),
                 gravity: end.loads.gravity,
             };
-            let friction: Vec<f64> = end.friction.iter().map(|m| m + s * seed.friction).collect();
-            (motion, levels, friction)
+            (motion, levels, s * seed.friction)
         };
         // Prescribed values along the seed.
         let (plus, minus) = (moved(1.0), moved(-1.0));
@@ -208,7 +245,7 @@ impl Analysis {
         let mut dg = vec![0.0; end.displacement.len()];
         if du.iter().any(|&d| d != 0.0) {
             // Group motion: central difference of the whole residual (module doc: why).
-            let held = |m: Moved| (m.0, end.loads.clone(), end.friction.clone());
+            let held = |m: Moved| (m.0, end.loads.clone(), 0.0);
             let (_, g_plus) =
                 self.results_from(&start, along(&end.displacement, &du, eps), &held(plus));
             let (_, g_minus) =
@@ -287,8 +324,7 @@ impl Analysis {
     ) {
         let mut g = [vec![0.0; dg.len()], vec![0.0; dg.len()]];
         for (sign, g) in [1.0, -1.0].into_iter().zip(&mut g) {
-            let mu: Vec<f64> = end.friction.iter().map(|m| m + sign * delta).collect();
-            let from = with_friction(start, &mu);
+            let from = with_friction(start, end, sign * delta);
             let at = Evaluation {
                 system: &self.system,
                 u: &end.displacement,
@@ -329,7 +365,7 @@ impl Analysis {
             held.factor = self.linear.factor_id();
             return solved;
         }
-        let from = with_friction(start, &end.friction);
+        let from = with_friction(start, end, 0.0);
         for c in self.parts.all_mut() {
             c.restore(&from);
         }
@@ -347,7 +383,10 @@ impl Analysis {
 
     /// The results and the out-of-balance force of every DOF at displacements `u` and the
     /// group motion, load levels and friction `at`, the gap and contact histories of `start`;
-    /// the state is left as it was.
+    /// the state is left as it was. The force is that of `start`'s histories (what Newton's
+    /// last increment solves); the results are those of the histories a step ending at `u`
+    /// commits, as a step's results are (a curved contact's slip from its committed anchor,
+    /// which an open contact moves along with its node).
     fn results_from(
         &mut self,
         start: &AnalysisState,
@@ -355,34 +394,39 @@ impl Analysis {
         at: &Moved,
     ) -> (Results, Vec<f64>) {
         let (motion, levels, friction) = at;
-        let from = with_friction(start, friction);
+        let from = with_friction(start, &self.state, *friction);
         for c in self.parts.all_mut() {
             c.restore(&from);
         }
-        let trial = AnalysisState {
+        let mut trial = AnalysisState {
             displacement: u,
-            plastic_slip: from.plastic_slip,
-            contacts: from.contacts,
+            plastic_slip: from.plastic_slip.clone(),
+            contacts: from.contacts.clone(),
             boundary: motion.translation.clone(),
             angles: motion.angles.clone(),
             loads: levels.clone(),
-            friction: from.friction,
+            friction: from.friction.clone(),
             ..self.state.clone()
         };
+        self.assemble_at(&trial.displacement, &trial.loads, None);
+        let internal = self.work.internal.clone();
+        for c in self.parts.all() {
+            c.commit(&from, &mut trial);
+        }
         let saved = std::mem::replace(&mut self.state, trial);
         let results = self.results();
-        let internal = self.work.internal.clone();
         self.state = saved;
         (results, internal)
     }
 }
 
-/// `state` with the friction coefficients `friction` (gaps and curved-support contacts).
-fn with_friction(state: &AnalysisState, friction: &[f64]) -> AnalysisState {
-    let mut s = state.clone();
-    s.friction = friction.to_vec();
-    if let Some(&mu) = friction.first() {
-        s.contacts.iter_mut().for_each(|c| c.friction = mu);
+/// `start` with the friction coefficients of `end` (gaps and curved-support contacts, each its
+/// own) changed by `change`.
+fn with_friction(start: &AnalysisState, end: &AnalysisState, change: f64) -> AnalysisState {
+    let mut s = start.clone();
+    s.friction = end.friction.iter().map(|m| m + change).collect();
+    for (c, e) in s.contacts.iter_mut().zip(&end.contacts) {
+        c.friction = e.friction + change;
     }
     s
 }
@@ -535,7 +579,7 @@ mod tests {
                 translation: end.boundary.clone(),
                 angles: end.angles.clone(),
             };
-            (motion, l, end.friction.clone())
+            (motion, l, 0.0)
         };
         let (_, plus) = a.results_from(&start, end.displacement.clone(), &at(1.0));
         let (_, minus) = a.results_from(&start, end.displacement.clone(), &at(-1.0));
