@@ -408,14 +408,21 @@ impl Analysis {
             friction: from.friction.clone(),
             ..self.state.clone()
         };
-        self.assemble_at(&trial.displacement, &trial.loads, None);
-        let internal = self.work.internal.clone();
-        for c in self.parts.all() {
-            c.commit(&from, &mut trial);
+        // The committed histories differ in what the results report only for curved contacts
+        // (their anchors) and a plastic film: elsewhere one evaluation serves both.
+        let commit = !trial.contacts.is_empty() || !trial.plastic.is_empty();
+        let mut internal = None;
+        if commit {
+            self.assemble_at(&trial.displacement, &trial.loads, None);
+            internal = Some(self.work.internal.clone());
+            for c in self.parts.all() {
+                c.commit(&from, &mut trial);
+            }
         }
         let saved = std::mem::replace(&mut self.state, trial);
         let results = self.results();
         self.state = saved;
+        let internal = internal.unwrap_or_else(|| self.work.internal.clone());
         (results, internal)
     }
 }
