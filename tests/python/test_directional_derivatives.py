@@ -14,7 +14,9 @@ They are linear in the seed; an unknown reference, a known that is not an input,
 that is not a Real output, and a call before initialization are fmi2Error with a message; fmpy
 validate passes with the ModelStructure dependencies, which list every input for every output
 (ascending, no ``dependenciesKind``: "dependent" by the schema), the derivatives answer for every
-one of them, and the step statistics among the outputs are refused by name.
+one of them, and the step statistics among the outputs are refused by name. The tangent's factor
+held between calls is replaced after a step and a restored state (the answers of an instance
+that never held one, bit for bit).
 """
 
 from __future__ import annotations
@@ -177,6 +179,26 @@ def test_hinged_panel_derivatives_with_respect_to_the_angle_agree_with_steps(tmp
         film.step(1.0)
         d = check_against_steps(film, {}, {"rail.angle": 0.1}, "rail.angle", 1e-5)
         assert d["rail.moment"] != 0
+
+
+def test_a_restored_state_answers_like_an_instance_that_never_held_a_factor(fmu_path):
+    """The factorized tangent held between calls belongs to one state: after a step (the next
+    state's factor held) and fmi2SetFMUstate back, the derivatives are bit for bit those of
+    another instance restored to the same state, whose first call they are."""
+    with Film(fmu_path, quiet=True) as a, Film(fmu_path, quiet=True) as b:
+        end = lowered_specimen(a, 1.0)
+        assert lowered_specimen(b, 1.0) == end
+        names = real_outputs(a)
+        saved = a.save(), b.save()
+        a.set(end)
+        assert a.step(1.0) == 0
+        stepped = derivative(a, names, "frame.dz"), derivative(a, names, "mu")
+        a.restore(saved[0])
+        b.restore(saved[1])
+        for known, other in zip(("frame.dz", "mu"), stepped):
+            restored = derivative(a, names, known)
+            assert np.array_equal(restored, derivative(b, names, known)), known
+            assert not np.array_equal(restored, other), known
 
 
 def test_bad_derivative_requests_are_refused_with_a_message(fmu_path):
