@@ -1,8 +1,9 @@
 //! `fmi2GetDirectionalDerivative` (issue 21 item 1): derivatives of the Real outputs of the
 //! converged state with respect to the inputs (group displacements and angles, pressures,
 //! nodal forces, `mu`), from the core's linear response (`Analysis::linear_response`: the last
-//! increment's Newton equation linearized at its solution, the consistent tangent factorized
-//! once per call). One-sided where a gap sits on a switch; see the core's module doc.
+//! increment's Newton equation linearized at its solution; the consistent tangent factorized at
+//! the first call after a step or a restored state, each later call one solve with that
+//! factor). One-sided where a gap sits on a switch; see the core's module doc.
 
 use super::instance::Instance;
 use super::phase::{Failure, Outcome};

@@ -20,6 +20,7 @@ use crate::mech::solve::continuation::pseudo_mass;
 use crate::mech::solve::contributions::{Contributions, Evaluation};
 use crate::mech::solve::linear::{LinearSolver, SolveProfile, UnsymmetricMethod};
 use crate::mech::solve::report::{SetupError, StepError, StepReport};
+use crate::mech::solve::sensitivity::HeldTangent;
 use crate::mech::solve::settings::SolverSettings;
 use crate::mech::solve::state::AnalysisState;
 
@@ -38,6 +39,8 @@ pub struct Analysis {
     /// The state the last converged increment started from (None before the first step and
     /// after [`Analysis::set_state`]): what its linear response holds (`sensitivity`).
     pub(in crate::mech) increment_start: Option<AnalysisState>,
+    /// The factorized tangent of the derivatives, held between seeds (`sensitivity`).
+    pub(in crate::mech) held_tangent: Option<Box<HeldTangent>>,
 
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
     /// the input check.
@@ -126,6 +129,7 @@ impl Analysis {
             state,
             work,
             increment_start: None,
+            held_tangent: None,
             length_scale,
             force_floor,
         })

@@ -11,7 +11,7 @@ use crate::mech::solve::linear::timed;
 use crate::mech::solve::linear::woodbury::woodbury_correction;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::linalg::cholesky::{SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
@@ -44,6 +44,19 @@ pub(super) struct SymmetricPart {
     pub(super) block_scratch: MemBuffer,
     pub(super) block_columns: usize,
     pub(super) scratch: MemBuffer,
+    /// How the last factorization's system was solved (what a held solve repeats).
+    pub(super) path: Path,
+}
+
+/// How a system is solved on the symmetric part's LDLᵀ.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Path {
+    /// The LDLᵀ alone (no skew part).
+    Direct,
+    /// Woodbury: the block `W = S⁻¹ I_C` is kept, a new right-hand side costs one solve.
+    Woodbury,
+    /// GMRES preconditioned by the LDLᵀ.
+    Gmres,
 }
 
 /// Skew entries kept for the Woodbury correction at most (beyond: GMRES).
@@ -120,6 +133,7 @@ impl SymmetricPart {
             block_scratch: MemBuffer::new(StackReq::EMPTY),
             block_columns: 0,
             scratch: MemBuffer::new(StackReq::EMPTY),
+            path: Path::Direct,
         };
         part.scratch = MemBuffer::new(part.scratch_req());
         part
@@ -225,14 +239,11 @@ impl SymmetricPart {
         limit: usize,
         ctx: &mut Context<'_>,
     ) -> bool {
-        let n = rhs.len();
         let symmetric = timed(&mut ctx.profile.symmetric_part, || self.split(a));
         let woodbury = !symmetric && self.skew_dofs(limit).is_some();
         if self.factor.is_empty() {
             self.factor = vec![0.0; self.symbolic.len_val()];
         }
-        self.rhs.clear();
-        self.rhs.extend_from_slice(rhs);
         let s = SparseColMatRef::new(self.lower.as_ref().as_ref(), &self.symmetric_values);
         let stack = MemStack::new(&mut self.scratch);
         let start = Instant::now();
@@ -242,20 +253,50 @@ impl SymmetricPart {
             Side::Lower,
             LdltRegularization::default(),
             Par::Seq,
-            &mut *stack,
+            stack,
             Default::default(),
         );
         ctx.profile.ldlt += start.elapsed();
         ctx.profile.ldlt_count += 1;
-        let Ok(ldlt) = factored else {
+        if factored.is_err() {
+            self.rhs.clear();
+            self.rhs.extend_from_slice(rhs);
             return false;
+        }
+        self.path = if symmetric {
+            Path::Direct
+        } else if woodbury {
+            Path::Woodbury
+        } else {
+            Path::Gmres
         };
+        self.solve_factored(a, rhs, true, ctx)
+    }
+
+    /// Solves `a x = rhs` on the LDLᵀ held (of `a`'s symmetric part) along [`Self::path`]:
+    /// `fresh` when the factorization was just made (the Woodbury block `W` is then computed,
+    /// else reused: one solve per right-hand side on every path but GMRES's iterations). A
+    /// Woodbury solution that fails the check is tried again by GMRES, and the path follows.
+    /// False when no solution passes the accuracy check; `self.rhs` then holds the right-hand
+    /// side.
+    pub(super) fn solve_factored(
+        &mut self,
+        a: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+        fresh: bool,
+        ctx: &mut Context<'_>,
+    ) -> bool {
+        let n = rhs.len();
+        self.rhs.clear();
+        self.rhs.extend_from_slice(rhs);
+        let ldlt = LdltRef::new(&*self.symbolic, &self.factor);
+        let stack = MemStack::new(&mut self.scratch);
         let check = |x: &[f64], ctx: &mut Context<'_>| {
             timed(&mut ctx.profile.accuracy, || {
                 accurate(a, x, &self.rhs, &self.row_norms, ctx.krylov)
             })
         };
-        if symmetric {
+        if self.path == Path::Direct {
             let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
             timed(&mut ctx.profile.ldlt_solve, || {
                 ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack)
@@ -266,35 +307,42 @@ impl SymmetricPart {
             }
             return false;
         }
-        if woodbury {
+        if self.path == Path::Woodbury {
             let start = Instant::now();
             let c = self.dofs.len();
             let m = c + 1;
-            self.block.clear();
-            self.block.resize(n * m, 0.0);
-            for (k, &d) in self.dofs.iter().enumerate() {
-                self.block[k * n + d] = 1.0;
+            if fresh {
+                self.block.clear();
+                self.block.resize(n * m, 0.0);
+                for (k, &d) in self.dofs.iter().enumerate() {
+                    self.block[k * n + d] = 1.0;
+                }
             }
             self.block[c * n..].copy_from_slice(&self.rhs);
-            if self.block_columns < m {
-                self.block_scratch =
-                    MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(m, Par::Seq));
-                self.block_columns = m;
+            // A fresh block solves every column, a held one only the new right-hand side's.
+            let (first, columns) = if fresh { (0, m) } else { (c, 1) };
+            if self.block_columns < columns {
+                self.block_scratch = MemBuffer::new(
+                    self.symbolic
+                        .solve_in_place_scratch::<f64>(columns, Par::Seq),
+                );
+                self.block_columns = columns;
             }
             ldlt.solve_in_place_with_conj(
                 Conj::No,
-                MatMut::from_column_major_slice_mut(&mut self.block, n, m),
+                MatMut::from_column_major_slice_mut(&mut self.block[first * n..], n, columns),
                 Par::Seq,
                 MemStack::new(&mut self.block_scratch),
             );
             let solved = woodbury_correction(&self.dofs, &self.skew, &self.block, rhs);
             ctx.profile.woodbury += start.elapsed();
             ctx.profile.woodbury_count += 1;
-            ctx.profile.woodbury_columns += m;
+            ctx.profile.woodbury_columns += columns;
             if solved && check(rhs, ctx) {
                 ctx.counts[3] += 1;
                 return true;
             }
+            self.path = Path::Gmres;
         }
         let start = Instant::now();
         let mut precondition = |v: &mut [f64]| {

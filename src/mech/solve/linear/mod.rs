@@ -22,6 +22,12 @@
 //!   [`LinearSolver::counts`]). The LU's symbolic analysis is built at its first use: at 1 M DOF
 //!   it alone is larger than the LDLᵀ factor, and the fast paths usually never need it.
 //!
+//! The factor of the last factorization is held: [`LinearSolver::solve_held`] solves another
+//! right-hand side with it (the same path, the Woodbury block `W` reused, every solution
+//! checked), which is how each seed of a directional derivative costs one solve
+//! (`sensitivity.rs`). [`LinearSolver::factor_id`] names the factor held, so that a caller can
+//! tell that no factorization has replaced it since.
+//!
 //! Buffers (factor values, scratch) are allocated once and reused every iteration; where the
 //! time goes is summed in [`SolveProfile`].
 //!
@@ -35,12 +41,14 @@
 //! | `tests` | the solver's tests |
 
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::cholesky::{SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::lu::LuRef;
 use faer::{Conj, MatMut, Par, Side};
 
 use crate::mech::solve::assembly::{Dof, System};
@@ -105,6 +113,8 @@ pub struct SolveProfile {
     pub lu: Duration,
     /// Number of LU factorizations.
     pub lu_count: usize,
+    /// Solves with a held factor ([`LinearSolver::solve_held`]), no factorization.
+    pub held_solves: usize,
 }
 
 impl SolveProfile {
@@ -128,6 +138,21 @@ fn timed<T>(slot: &mut Duration, f: impl FnOnce() -> T) -> T {
     *slot += start.elapsed();
     out
 }
+
+/// Which factor the last factorization left for [`LinearSolver::solve_held`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Held {
+    None,
+    /// The LDLᵀ of a lower-triangle (Ju–Rowlands) matrix.
+    Ldlt,
+    /// The LDLᵀ of the symmetric part, solved along its path (`ldlt::Path`).
+    Symmetric,
+    /// The LU.
+    Lu,
+}
+
+/// Source of [`LinearSolver::factor_id`] (0: none).
+static FACTORS: AtomicU64 = AtomicU64::new(1);
 
 enum Kind {
     Ldlt {
@@ -157,6 +182,9 @@ pub struct LinearSolver {
     fast: bool,
     method: UnsymmetricMethod,
     profile: SolveProfile,
+    /// The factor the last factorization left, and its identity (0: none).
+    held: Held,
+    factor_id: u64,
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -192,6 +220,9 @@ impl Clone for LinearSolver {
             fast: true,
             method: self.method,
             profile: SolveProfile::default(),
+            // The copy's factor values are not copied: it holds none.
+            held: Held::None,
+            factor_id: 0,
         }
     }
 }
@@ -248,6 +279,8 @@ impl LinearSolver {
             fast: true,
             method: UnsymmetricMethod::Auto,
             profile: SolveProfile::default(),
+            held: Held::None,
+            factor_id: 0,
         };
         solver.scratch = MemBuffer::new(solver.scratch_req());
         solver.profile.symbolic = started.elapsed();
@@ -348,10 +381,24 @@ impl LinearSolver {
         matrix: SparseColMatRef<'_, usize, f64>,
         rhs: &mut [f64],
     ) -> Result<(), FactorizationError> {
+        self.held = Held::None;
+        self.factor_id = 0;
         let solved = self.factorize_and_solve_unchecked(matrix, rhs);
         if solved.is_ok() && rhs.iter().all(|v| v.is_finite()) {
+            self.factor_id = FACTORS.fetch_add(1, Ordering::Relaxed);
             return solved;
         }
+        self.held = Held::None;
+        self.finish_failure(matrix, rhs, solved)
+    }
+
+    /// The error of a failed solve, naming the DOFs behind it.
+    fn finish_failure(
+        &self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &[f64],
+        solved: Result<(), FactorizationError>,
+    ) -> Result<(), FactorizationError> {
         let why = solved
             .err()
             .map_or(String::new(), |e| format!(" ({})", e.0));
@@ -359,6 +406,76 @@ impl LinearSolver {
             "{}{why}",
             self.diagnose(matrix, rhs)
         )))
+    }
+
+    /// The identity of the factor held (unique in the process; 0 when none is held): it
+    /// changes with every factorization, so a caller that noted it knows whether
+    /// [`Self::solve_held`] still solves with the matrix it factorized.
+    pub fn factor_id(&self) -> u64 {
+        self.factor_id
+    }
+
+    /// Solves `matrix · x = rhs` in place with the factor held from the last
+    /// [`Self::factorize_and_solve`], which must have been given the same `matrix` (same
+    /// values): one solve along the same path, no factorization, the solution checked as
+    /// always. A solution that fails the check, or no factor held, falls back to
+    /// [`Self::factorize_and_solve`] (a new factor, a new [`Self::factor_id`]).
+    pub fn solve_held(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+    ) -> Result<(), FactorizationError> {
+        let original = rhs.to_vec();
+        let n = rhs.len();
+        let solved = match &mut self.kind {
+            _ if self.factor_id == 0 => false,
+            Kind::Ldlt { symbolic, factor } if self.held == Held::Ldlt => {
+                let ldlt = LdltRef::new(&**symbolic, factor);
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                timed(&mut self.profile.ldlt_solve, || {
+                    ldlt.solve_in_place_with_conj(
+                        Conj::No,
+                        x,
+                        Par::Seq,
+                        MemStack::new(&mut self.scratch),
+                    )
+                });
+                true
+            }
+            Kind::Full {
+                symmetric: Some(part),
+                ..
+            } if self.held == Held::Symmetric => {
+                let mut ctx = Context {
+                    krylov: &mut self.krylov,
+                    profile: &mut self.profile,
+                    counts: &mut self.counts,
+                };
+                part.solve_factored(matrix, rhs, false, &mut ctx)
+            }
+            Kind::Full { lu: Some(lu), .. } if self.held == Held::Lu => {
+                let start = Instant::now();
+                // The numeric part is the output of `factorize_numeric_lu` on this symbolic
+                // analysis (`held` is `Lu` only after it succeeded): what `new_unchecked` asks.
+                let factored = LuRef::new_unchecked(&lu.symbolic, &lu.numeric);
+                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                factored.solve_in_place_with_conj(
+                    Conj::No,
+                    x,
+                    Par::Seq,
+                    MemStack::new(&mut lu.scratch),
+                );
+                self.profile.lu += start.elapsed();
+                true
+            }
+            _ => false,
+        };
+        if solved && rhs.iter().all(|v| v.is_finite()) {
+            self.profile.held_solves += 1;
+            return Ok(());
+        }
+        rhs.copy_from_slice(&original);
+        self.factorize_and_solve(matrix, rhs)
     }
 
     /// Names the DOFs behind a failed solution: non-finite matrix entries, then DOFs without any
@@ -450,6 +567,7 @@ impl LinearSolver {
                     .map_err(|e| FactorizationError(format!("LDLᵀ: {e:?}")))?;
                 self.profile.ldlt += start.elapsed();
                 self.profile.ldlt_count += 1;
+                self.held = Held::Ldlt;
                 let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 timed(&mut self.profile.ldlt_solve, || {
                     ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack)
@@ -466,6 +584,7 @@ impl LinearSolver {
                         counts: &mut self.counts,
                     };
                     if part.solve(matrix, rhs, limit, &mut ctx) {
+                        self.held = Held::Symmetric;
                         return Ok(());
                     }
                     self.counts[2] += 1;
@@ -495,6 +614,7 @@ impl LinearSolver {
                 let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
                 factored.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
                 self.profile.lu += start.elapsed();
+                self.held = Held::Lu;
             }
         }
         Ok(())

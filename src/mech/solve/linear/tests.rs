@@ -246,3 +246,90 @@ fn non_finite_entry_is_named() {
     let err = solve(false, &entries).unwrap_err();
     assert!(err.contains("non-finite entries at node 1 (x)"), "{err}");
 }
+
+/// A name, whether the pattern is the lower triangle, the entries and the method (`None`: LU).
+type Case<'a> = (
+    &'a str,
+    bool,
+    &'a [(usize, usize, f64)],
+    Option<UnsymmetricMethod>,
+);
+
+/// `solve_held` solves a second right-hand side with the factor of the last factorization on
+/// every path (the Ju–Rowlands LDLᵀ, the symmetric part's LDLᵀ directly, by Woodbury and by
+/// GMRES, the LU): no new factorization, the same factor identity, and the answer of a new
+/// factorization to 1e-12. A new factorization gets a new identity.
+#[test]
+fn a_held_factor_solves_another_right_hand_side_on_every_path() {
+    let skew = unsymmetric(&[(2, 1, 1.5), (4, 1, -0.9), (4, 2, 0.4)]);
+    let symmetric = unsymmetric(&[]);
+    let lower: Vec<_> = symmetric.iter().copied().filter(|e| e.0 >= e.1).collect();
+    let cases: [Case<'_>; 5] = [
+        (
+            "Ju–Rowlands LDLt",
+            true,
+            &lower,
+            Some(UnsymmetricMethod::Auto),
+        ),
+        ("direct", false, &symmetric, Some(UnsymmetricMethod::Auto)),
+        ("Woodbury", false, &skew, Some(UnsymmetricMethod::Woodbury)),
+        ("GMRES", false, &skew, Some(UnsymmetricMethod::Gmres)),
+        ("LU", false, &skew, None),
+    ];
+    for (name, lower_only, entries, method) in cases {
+        let system = system(lower_only);
+        let new_solver = || {
+            let mut s = LinearSolver::new(&system, true).unwrap();
+            match method {
+                Some(m) => s.set_method(m),
+                None => s.set_fast(false),
+            }
+            s
+        };
+        let v = values(&system, entries);
+        let mut solver = new_solver();
+        assert_eq!(solver.factor_id(), 0);
+        let mut first = vec![1.0; system.free_count];
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut first)
+            .unwrap();
+        let (id, p) = (solver.factor_id(), solver.profile());
+        assert_ne!(id, 0, "{name}");
+        let second: Vec<f64> = (0..system.free_count)
+            .map(|i| 1.0 - 0.3 * i as f64)
+            .collect();
+        let mut held = second.clone();
+        solver.solve_held(system.matrix(&v), &mut held).unwrap();
+        let q = solver.profile();
+        assert_eq!(solver.factor_id(), id, "{name}");
+        assert_eq!(
+            (q.ldlt_count, q.lu_count, q.held_solves),
+            (p.ldlt_count, p.lu_count, 1),
+            "{name}"
+        );
+        // The same path again: one more column for Woodbury (its block kept), no GMRES for it.
+        let path = (
+            q.woodbury_columns - p.woodbury_columns,
+            q.gmres_count - p.gmres_count,
+        );
+        let expected = match name {
+            "Woodbury" => (1, 0),
+            "GMRES" => (0, 1),
+            _ => (0, 0),
+        };
+        assert_eq!(path, expected, "{name}");
+        let mut fresh = second;
+        new_solver()
+            .factorize_and_solve(system.matrix(&v), &mut fresh)
+            .unwrap();
+        let scale = fresh.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        assert!(
+            max_difference(&held, &fresh) <= 1e-12 * scale,
+            "{name}: {held:?} vs {fresh:?}"
+        );
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut first)
+            .unwrap();
+        assert!(solver.factor_id() > id, "{name}");
+    }
+}
