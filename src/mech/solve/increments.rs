@@ -81,14 +81,29 @@ impl Analysis {
             // excursion per halved increment was measured to turn a hard path into a failure).
             self.work.watchdog = report.cutbacks == 0;
             let attempt = match self.solve_increment(&current, &at(next), &levels) {
-                Err(_) if self.settings.continuation => {
-                    self.work.continuation = true;
-                    let again = self.solve_increment(&current, &at(next), &levels);
-                    self.work.continuation = false;
-                    if again.is_ok() {
-                        report.continued += 1;
-                        self.work.stabilization += self.work.last_work;
+                Err(e) if self.settings.continuation => {
+                    // Curved contacts: first Newton with their statuses held (`ActiveSet` in
+                    // `newton.rs`), then the continuation, with them held too.
+                    let contacts = !self.parts.curved.is_empty();
+                    let mut again = Err(e);
+                    if contacts {
+                        self.parts.curved.active_set = true;
+                        again = self.solve_increment(&current, &at(next), &levels);
+                        if again.is_ok() {
+                            report.active_set += 1;
+                        }
                     }
+                    if again.is_err() {
+                        self.work.continuation = true;
+                        again = self.solve_increment(&current, &at(next), &levels);
+                        self.work.continuation = false;
+                        if again.is_ok() {
+                            report.continued += 1;
+                            self.work.stabilization += self.work.last_work;
+                        }
+                    }
+                    self.parts.curved.active_set = false;
+                    self.parts.curved.frozen = None;
                     again
                 }
                 plain => plain,
