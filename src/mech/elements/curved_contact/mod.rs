@@ -545,6 +545,7 @@ impl SurfaceContacts {
     /// `frozen` imposed when given, [`SurfaceContact::respond_as`]) to `residual` and
     /// the Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
     /// once it has grown).
+    #[allow(clippy::too_many_arguments)] // the evaluation's inputs and outputs, each needed
     pub fn add_to(
         &self,
         system: &System,
