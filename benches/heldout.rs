@@ -24,8 +24,12 @@
 //!   `examples/hinged_panel.json`.
 //!
 //! Options (after `--`): `--family NAME` (repeatable), `--quick` (every 5th path),
+//! `--name TEXT` (only the paths whose name contains TEXT; repeatable: any of them),
 //! `--failures` (every failed path), `--threads N`, `--check` (exit 1 unless every path run
 //! converges), `--list` (the paths, not run), `--write DIR` (the model files, not run).
+//!
+//! After the family table, a table of the refusals by class ([`failure_class`]): what the
+//! refusal's message says stopped the last attempt of the refused increment.
 
 use std::fmt::Write as _;
 use std::sync::Mutex;
@@ -569,8 +573,12 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
 const FAMILIES: [&str; 4] = ["arches", "reversal", "slack", "steps"];
 
 fn main() {
-    let (mut list, mut write) = (false, None);
+    let (mut list, mut write, mut names) = (false, None, Vec::<String>::new());
     let o = PathOptions::parse(&FAMILIES, |flag, rest| match flag {
+        "--name" => {
+            names.push(rest.next().ok_or("--name needs a text")?);
+            Ok(true)
+        }
         "--list" => {
             list = true;
             Ok(true)
@@ -594,6 +602,7 @@ fn main() {
         .flat_map(|f| {
             set.iter()
                 .filter(|p| p.family == f.as_str())
+                .filter(|p| names.is_empty() || names.iter().any(|n| p.name.contains(n.as_str())))
                 .step_by(stride)
                 .cloned()
                 .collect::<Vec<_>>()
@@ -689,5 +698,53 @@ fn main() {
         .zip(&results)
         .filter_map(|(p, r)| r.error.clone().map(|e| (p.name.clone(), e)))
         .collect();
+    if !failed.is_empty() {
+        println!("\n| refusal class | paths | of them |\n|---|---|---|");
+        for class in CLASSES {
+            let of: Vec<&str> = failed
+                .iter()
+                .filter(|(_, e)| failure_class(e) == class)
+                .map(|(n, _)| n.split(' ').next().unwrap_or(n))
+                .collect();
+            if !of.is_empty() {
+                println!("| {class} | {} | {} |", of.len(), of.join(", "));
+            }
+        }
+    }
     o.finish(total, 1, wall, &failed);
+}
+
+/// The refusal classes of [`failure_class`], in table order.
+const CLASSES: [&str; 8] = [
+    "singular matrix",
+    "contact status chatter",
+    "wrinkling-state flips",
+    "linear film in compression",
+    "stall, forces balanced",
+    "stall",
+    "iteration limit",
+    "diverged or other",
+];
+
+/// The class of a refusal from its message: the first of these that it reports (a stall that
+/// names chattering gaps is chatter, one that names compressed elements is compression).
+fn failure_class(message: &str) -> &'static str {
+    if message.contains("singular Newton matrix") {
+        CLASSES[0]
+    } else if message.contains("contacts changing status") {
+        CLASSES[1]
+    } else if message.contains("changing wrinkling state") {
+        CLASSES[2]
+    } else if message.contains("in compression") {
+        CLASSES[3]
+    } else if message.contains("no progress") && message.contains("the residual met its tolerance")
+    {
+        CLASSES[4]
+    } else if message.contains("no progress") {
+        CLASSES[5]
+    } else if message.contains("iteration limit") {
+        CLASSES[6]
+    } else {
+        CLASSES[7]
+    }
 }

@@ -115,9 +115,25 @@ impl Analysis {
                         size /= 2.0;
                         continue;
                     }
-                    // Every smaller increment failed: try larger ones before giving up.
-                    let mut larger = 2.0 * largest;
+                    // Every smaller increment failed. With curved contacts, the smallest one
+                    // again with their statuses held (`ActiveSet` in `newton.rs`); only here, so
+                    // that no increment the earlier attempts converge changes its friction path
+                    // (tried before the continuation and after it: either changed the
+                    // curved-support specimen's stick/slip states, tests/surfaces.rs).
                     let mut reached = None;
+                    let mut held = false;
+                    if !self.parts.curved.is_empty() {
+                        self.parts.curved.active_set = true;
+                        if let Ok(converged) = self.solve_increment(&current, &at(next), &levels) {
+                            report.active_set += 1;
+                            reached = Some((next, converged));
+                            held = true;
+                        }
+                        self.parts.curved.active_set = false;
+                        self.parts.curved.frozen = None;
+                    }
+                    // Then larger ones before giving up.
+                    let mut larger = 2.0 * largest;
                     while reached.is_none() && larger < 2.0 * (1.0 - done) {
                         let next = (done + larger).min(1.0);
                         let levels = base_loads.interpolate(loads, next);
@@ -134,7 +150,9 @@ impl Analysis {
                             last,
                         });
                     };
-                    report.enlarged += 1;
+                    if !held {
+                        report.enlarged += 1;
+                    }
                     last_start = Some(std::mem::replace(&mut current, state));
                     done = next;
                     report.iterations.push(history.len() - 1);

@@ -1,6 +1,6 @@
 //! Newton–Raphson for one increment.
 
-use crate::mech::elements::gap::IterationMatrix;
+use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::elements::material::Wrinkling;
 use crate::mech::elements::triangle::ElementVector;
@@ -52,14 +52,23 @@ impl Analysis {
         // (`continuation.rs`), and the artificial force of its last correction.
         let mut ptc = self.work.continuation.then(Continuation::new);
         let mut artificial = 0.0_f64;
+        // Active-set iteration (`ActiveSet`): the contacts' statuses are held fixed while Newton
+        // converges, and changed only at a converged iterate, which is then solved again.
+        let mut active = self.parts.curved.active_set.then(ActiveSet::default);
+        self.parts.curved.frozen = None;
         self.work.last_work = 0.0;
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
-            let residual = if assembled {
+            let mut residual = if assembled {
                 self.free_norm_inf()
             } else {
                 self.assemble_at(&u, levels, Some(iteration))
             };
+            if active.is_some() && self.parts.curved.frozen.is_none() {
+                // The set of the first iterate (the predictor's).
+                self.parts.curved.frozen = Some(self.parts.curved.natural());
+                residual = self.assemble_at(&u, levels, Some(iteration));
+            }
             if !residual.is_finite() {
                 return Err(IncrementFailure::Diverged { iteration });
             }
@@ -78,10 +87,34 @@ impl Analysis {
                 correction: correction_norm,
                 correction_tolerance: s.displacement_tolerance * displacement_scale,
             };
-            let converged = (iteration > 0 || self.system.free_count == 0)
+            let mut converged = (iteration > 0 || self.system.free_count == 0)
                 && record.correction <= record.correction_tolerance
                 && residual <= tolerance
                 && artificial <= tolerance;
+            if converged && let Some(set) = active.as_mut() {
+                let natural = self.parts.curved.natural();
+                let frozen = self.parts.curved.frozen.take().unwrap_or_default();
+                if natural != frozen {
+                    // Equilibrium under the held statuses, not under the law's: solve again
+                    // with the law's statuses at this iterate (a set seen before is a cycle).
+                    if !set.next(frozen, &natural) {
+                        return Err(IncrementFailure::Stalled {
+                            iteration,
+                            closest: closest.unwrap_or(record),
+                            chattering: set.cycling(&self.parts.curved.names),
+                            flipping: Vec::new(),
+                            compressed: Vec::new(),
+                        });
+                    }
+                    self.parts.curved.frozen = Some(natural);
+                    residual = self.assemble_at(&u, levels, Some(iteration));
+                    (best, best_correction, best_at) = (f64::INFINITY, f64::INFINITY, iteration);
+                    (damping, watch) = (0.0, Watchdog::Used);
+                    converged = false;
+                } else {
+                    self.parts.curved.frozen = Some(frozen);
+                }
+            }
             if converged {
                 let mut state = AnalysisState {
                     boundary: motion.translation.clone(),
@@ -335,6 +368,42 @@ fn next_damping(damping: f64, step: f64, decreased: bool) -> f64 {
     }
 }
 
+/// The active-set strategy for the curved contacts (Wriggers, *Computational Contact
+/// Mechanics*, 2nd ed. 2006, §6.3.2 and §5.2; Alart & Curnier 1991 for the semi-smooth view it
+/// avoids): Newton iterates with each contact's status (open, stick, slip) held at the set of
+/// the increment's first iterate, so that the residual is smooth and no status switches between
+/// iterations; at a converged iterate the law's own statuses are compared with the held ones,
+/// and if any differs the set is replaced by the law's and the increment solved again from
+/// there. Sets already tried are remembered: a set that comes back is a cycle (the increment
+/// fails and names the contacts that switch). A converged increment's statuses are the law's,
+/// so its answer is the equilibrium of the contact law, not of the held set.
+#[derive(Debug, Default)]
+struct ActiveSet {
+    /// The sets tried so far in this increment.
+    tried: Vec<Vec<GapStatus>>,
+}
+
+impl ActiveSet {
+    /// Most sets tried in one increment.
+    const MAX_SETS: usize = 12;
+
+    /// Records the set `held` (just converged) before `next` replaces it; false when `next` was
+    /// tried before or too many sets were.
+    fn next(&mut self, held: Vec<GapStatus>, next: &[GapStatus]) -> bool {
+        self.tried.push(held);
+        !self.tried.iter().any(|t| t == next) && self.tried.len() < Self::MAX_SETS
+    }
+
+    /// The contacts whose status differs between the tried sets (named by `names`).
+    fn cycling(&self, names: &[String]) -> Vec<String> {
+        let first = self.tried.first().cloned().unwrap_or_default();
+        (0..first.len())
+            .filter(|&k| self.tried.iter().any(|t| t.get(k) != first.get(k)))
+            .filter_map(|k| names.get(k).cloned())
+            .collect()
+    }
+}
+
 /// `max |v|`, NaN when any value is NaN (`f64::max` alone would skip a NaN and report the
 /// rest: a NaN residual would then measure 0 and pass a convergence test).
 pub fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
@@ -371,6 +440,28 @@ mod tests {
         assert!(max_abs_difference(&[1.0, 2.0], &[1.0, f64::NAN]).is_nan());
         assert_eq!(max_abs_difference(&[1.0, -2.0], &[0.5, 1.0]), 3.0);
         assert_eq!(max_abs(&[]), 0.0);
+    }
+
+    /// The active set accepts new sets and refuses one tried before (a cycle between two sets
+    /// of statuses) and more than `MAX_SETS`; the contacts it names as cycling are those whose
+    /// status differs between the sets tried.
+    #[test]
+    fn active_set_refuses_a_set_tried_before_and_names_the_contacts_that_switch() {
+        use GapStatus::{Open, Slip, Stick};
+        let names: Vec<String> = ["a", "b", "c"].iter().map(|n| n.to_string()).collect();
+        let mut set = ActiveSet::default();
+        assert!(set.next(vec![Open, Stick, Stick], &[Stick, Stick, Stick]));
+        assert!(set.next(vec![Stick, Stick, Stick], &[Stick, Slip, Stick]));
+        // back to the first set: a cycle
+        assert!(!set.next(vec![Stick, Slip, Stick], &[Open, Stick, Stick]));
+        assert_eq!(set.cycling(&names), vec!["a".to_string(), "b".to_string()]);
+        let mut long = ActiveSet::default();
+        let mut fresh = true;
+        for k in 0..ActiveSet::MAX_SETS {
+            let held = vec![if k % 2 == 0 { Open } else { Stick }; k + 1];
+            fresh = long.next(held, &vec![Slip; k + 2]);
+        }
+        assert!(!fresh, "more than MAX_SETS sets accepted");
     }
 
     /// The shift starts at `DAMPING_START` when a step fails to decrease the merit, grows

@@ -26,6 +26,10 @@ pub struct StepReport {
     /// Increments solved by pseudo-transient continuation (`continuation.rs`).
     #[serde(default)]
     pub continued: usize,
+    /// Increments solved by the active-set iteration of the curved contacts (`newton.rs`):
+    /// statuses held while Newton converges, changed only between converged solves.
+    #[serde(default)]
+    pub active_set: usize,
     /// Artificial energy left at the end of the step (J): over the increments solved by
     /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
     /// each (the pseudo-time force still acting when the increment was accepted).
@@ -240,8 +244,8 @@ impl IncrementFailure {
                 "the residual did not fall below its start: move the inputs by less per step ({finer})"
             ),
             Self::Stalled { chattering, .. } if !chattering.is_empty() => format!(
-                "gaps {} kept changing status (open/closed or stick/slip) between iterations: move the inputs by \
-                 less per step ({finer})",
+                "gaps or curved-support contacts {} kept changing status (open/closed or stick/slip) between \
+                 iterations: move the inputs by less per step ({finer})",
                 name_list(chattering)
             ),
             Self::Stalled { flipping, .. } if !flipping.is_empty() => format!(
@@ -296,7 +300,11 @@ impl fmt::Display for IncrementFailure {
                 )?;
             }
             if !names.is_empty() {
-                write!(f, "; gaps changing status: {}", name_list(names))?;
+                write!(
+                    f,
+                    "; gaps or contacts changing status: {}",
+                    name_list(names)
+                )?;
             }
             if !elements.is_empty() {
                 let numbers: Vec<String> = elements.iter().map(|e| e.to_string()).collect();

@@ -101,8 +101,11 @@ pub struct ContactResponse {
     pub residual: Vector3<f64>,
     /// `∂(−F)/∂x`.
     pub tangent: Matrix3<f64>,
+    /// The status whose law gave this response (imposed in an active-set iteration).
     pub status: GapStatus,
-    /// `λN ≥ 0` (N).
+    /// The law's own status at this iterate (equal to `status` unless one was imposed).
+    pub natural: GapStatus,
+    /// `λN ≥ 0` (N; negative only where a closed status was imposed on an open gap).
     pub normal_force: f64,
     /// Friction force components `[f1, f2]` along `ξ1`, `ξ2` (N).
     pub friction: Vector2<f64>,
@@ -282,12 +285,39 @@ impl SurfaceContact {
 
     /// The contact's response at node position `x` from the converged `history`.
     pub fn respond(&self, x: &Vector3<f64>, history: &ContactHistory) -> ContactResponse {
+        self.respond_as(x, history, None)
+    }
+
+    /// The response with the status `frozen` imposed when given (an active-set iteration:
+    /// closed means the penalty force `−k_n g` even where the gap has opened, open means no
+    /// force even where it penetrates, stick or slip picks that branch of the friction law);
+    /// [`ContactResponse::natural`] is the law's own status at `x` either way.
+    pub fn respond_as(
+        &self,
+        x: &Vector3<f64>,
+        history: &ContactHistory,
+        frozen: Option<GapStatus>,
+    ) -> ContactResponse {
         let p = self.project(x, history.angle);
         let anchor = Vector2::from(history.anchor);
+        let lambda = -self.kn * p.gap;
+        let limit = history.friction * lambda;
+        let trial = -(p.xi - anchor) * self.ks;
+        let natural = if p.gap >= 0.0 {
+            GapStatus::Open
+        } else if match self.law {
+            FrictionLaw::Isotropic => trial.norm() <= limit,
+            FrictionLaw::SlidingDirection => trial.x.abs() <= limit,
+        } {
+            GapStatus::Stick
+        } else {
+            GapStatus::Slip
+        };
         let open = ContactResponse {
             residual: Vector3::zeros(),
             tangent: Matrix3::zeros(),
             status: GapStatus::Open,
+            natural,
             normal_force: 0.0,
             friction: Vector2::zeros(),
             xi: p.xi,
@@ -295,18 +325,16 @@ impl SurfaceContact {
             next_anchor: p.xi,
             angle: p.parameter,
         };
-        if p.gap >= 0.0 {
+        let used = frozen.unwrap_or(natural);
+        if used == GapStatus::Open {
             return open;
         }
-        let lambda = -self.kn * p.gap;
         let n = p.normal;
-        let limit = history.friction * lambda;
-        let trial = -(p.xi - anchor) * self.ks;
         // f, ∂f/∂ξ and ∂f/∂λN per law and status.
         let (status, f, df_dxi, df_dlambda) = match self.law {
             FrictionLaw::Isotropic => {
                 let m = trial.norm();
-                if m <= limit {
+                if used == GapStatus::Stick || m == 0.0 {
                     (
                         GapStatus::Stick,
                         trial,
@@ -323,7 +351,7 @@ impl SurfaceContact {
             }
             FrictionLaw::SlidingDirection => {
                 let mut dfd = -Matrix2::identity() * self.ks;
-                if trial.x.abs() <= limit {
+                if used == GapStatus::Stick {
                     (GapStatus::Stick, trial, dfd, Vector2::zeros())
                 } else {
                     let s = trial.x.signum();
@@ -351,6 +379,7 @@ impl SurfaceContact {
             residual: -force,
             tangent: k,
             status,
+            natural,
             normal_force: lambda,
             friction: f,
             xi: p.xi,
@@ -512,14 +541,17 @@ impl SurfaceContacts {
             .collect()
     }
 
-    /// Adds the contacts' residuals and tangents at `u` (from `histories`) to `residual` and
+    /// Adds the contacts' residuals and tangents at `u` (from `histories`; with the statuses
+    /// `frozen` imposed when given, [`SurfaceContact::respond_as`]) to `residual` and
     /// the Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
     /// once it has grown).
+    #[allow(clippy::too_many_arguments)] // the evaluation's inputs and outputs, each needed
     pub fn add_to(
         &self,
         system: &System,
         u: &[f64],
         histories: &[ContactHistory],
+        frozen: Option<&[GapStatus]>,
         residual: &mut [f64],
         mut values: Option<&mut [f64]>,
         responses: &mut Vec<ContactResponse>,
@@ -529,7 +561,8 @@ impl SurfaceContacts {
             self.contacts
                 .iter()
                 .zip(histories)
-                .map(|(c, h)| c.respond(&self.position(c, u), h)),
+                .enumerate()
+                .map(|(k, (c, h))| c.respond_as(&self.position(c, u), h, frozen.map(|f| f[k]))),
         );
         for ((c, r), &(triangle, local)) in
             self.contacts.iter().zip(responses.iter()).zip(&self.slots)

@@ -364,3 +364,36 @@ fn slip_counts_sliding_in_contact_not_the_approach() {
         "a node on the support starts in contact"
     );
 }
+
+/// An imposed status (active-set iteration) gives that status's law whatever the gap:
+/// closed on an open gap pulls the node back with `−k_n g` (an adhesive force), open on a
+/// penetrating gap carries nothing, and either way `natural` is the law's own status; with no
+/// status imposed the response is the plain one.
+#[test]
+fn an_imposed_status_gives_its_law_and_the_natural_status_stays_the_laws() {
+    let s = support(ring(None), FrictionLaw::Isotropic);
+    let c = SurfaceContact::new(&s, 0);
+    let centre = Vector3::new(0.0, 0.0, -1.0);
+    let outside = centre + Vector3::new(1.06, 0.0, 0.0); // 10 mm off the tube (r = 0.05)
+    let inside = centre + Vector3::new(1.04, 0.0, 0.0); // 10 mm into it
+    let history = c.initial_history(&inside, 0.3);
+    for x in [outside, inside] {
+        assert_eq!(c.respond_as(&x, &history, None), c.respond(&x, &history));
+    }
+    let held = c.respond_as(&outside, &history, Some(GapStatus::Stick));
+    assert_eq!(
+        (held.status, held.natural),
+        (GapStatus::Stick, GapStatus::Open)
+    );
+    assert!(
+        (held.normal_force - (-1.0e6 * 0.01)).abs() < 1e-6,
+        "{}",
+        held.normal_force
+    );
+    assert!(held.residual.norm() > 0.0);
+    let released = c.respond_as(&inside, &history, Some(GapStatus::Open));
+    assert_eq!(released.status, GapStatus::Open);
+    assert_eq!(released.natural, c.respond(&inside, &history).status);
+    assert_ne!(released.natural, GapStatus::Open);
+    assert_eq!(released.residual, Vector3::zeros());
+}

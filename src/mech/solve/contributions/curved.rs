@@ -2,7 +2,7 @@
 //! origin, status, μ) of each contact at the increment's start, the responses of the last
 //! evaluation, and the histories committed from them.
 
-use super::{Contribution, Evaluation};
+use super::{Contribution, Evaluation, StatusChanges};
 use crate::mech::elements::curved_contact::{ContactHistory, ContactResponse, SurfaceContacts};
 use crate::mech::elements::gap::GapStatus;
 use crate::mech::model::Model;
@@ -18,6 +18,14 @@ pub struct CurvedContacts {
     start: Vec<ContactHistory>,
     /// Responses at the last evaluation.
     responses: Vec<ContactResponse>,
+    /// The statuses imposed on the contacts during an active-set iteration (`newton.rs`).
+    pub frozen: Option<Vec<GapStatus>>,
+    /// Whether the next increments hold the statuses fixed (active-set iteration, `newton.rs`).
+    pub active_set: bool,
+    /// Each contact's name in messages: `<support>.<k>` (k-th node of the support).
+    pub names: Vec<String>,
+    /// The law's status changes over the Newton iterations.
+    changes: StatusChanges,
 }
 
 impl CurvedContacts {
@@ -28,6 +36,14 @@ impl CurvedContacts {
             start: contacts.initial_histories(model),
             contacts,
             responses: Vec::new(),
+            frozen: None,
+            active_set: false,
+            names: model
+                .curved_supports
+                .iter()
+                .flat_map(|s| (0..s.nodes.len()).map(move |k| format!("{}.{k}", s.name)))
+                .collect(),
+            changes: StatusChanges::default(),
         }
     }
 
@@ -37,9 +53,31 @@ impl CurvedContacts {
     }
 }
 
+impl CurvedContacts {
+    /// The law's own status of each contact at the last evaluation (whatever was imposed).
+    pub fn natural(&self) -> Vec<GapStatus> {
+        self.responses.iter().map(|r| r.natural).collect()
+    }
+
+    /// Whether the model has any curved-support contact.
+    pub fn is_empty(&self) -> bool {
+        self.contacts.contacts.is_empty()
+    }
+}
+
 impl Contribution for CurvedContacts {
     fn restore(&mut self, start: &AnalysisState) {
         self.start.clone_from(&start.contacts);
+        self.changes.reset(start.contacts.iter().map(|h| h.status));
+    }
+
+    fn note_iteration(&mut self, iteration: usize) {
+        self.changes
+            .note(iteration, self.responses.iter().map(|r| r.natural));
+    }
+
+    fn chattering(&self, since: usize, out: &mut Vec<String>) {
+        self.changes.changed_since(since, &self.names, out);
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
@@ -47,6 +85,7 @@ impl Contribution for CurvedContacts {
             at.system,
             at.u,
             &self.start,
+            self.frozen.as_deref(),
             residual,
             values,
             &mut self.responses,

@@ -4,7 +4,7 @@
 
 use nalgebra::Vector2;
 
-use super::{Contribution, Evaluation};
+use super::{Contribution, Evaluation, StatusChanges};
 use crate::mech::elements::gap::{GapLaw, GapResponse, GapStatus, IterationMatrix};
 use crate::mech::model::Model;
 use crate::mech::results::{GapResult, Results};
@@ -25,9 +25,8 @@ pub struct Gaps {
     latched: Vec<Option<Vector2<f64>>>,
     /// Gaps found closed at some iteration of the current Newton loop.
     closed: Vec<bool>,
-    /// Status at the previous Newton iteration, and the last iteration it changed.
-    previous: Vec<GapStatus>,
-    changed_at: Vec<Option<usize>>,
+    /// Status changes over the Newton iterations.
+    changes: StatusChanges,
     /// Names (for the advice of a stalled increment).
     names: Vec<String>,
 }
@@ -44,8 +43,7 @@ impl Gaps {
             responses: idle.map_or_else(Vec::new, |r| vec![r; n]),
             latched: vec![None; n],
             closed: vec![false; n],
-            previous: Vec::new(),
-            changed_at: Vec::new(),
+            changes: StatusChanges::default(),
             trial: Vec::new(),
             history: Vec::new(),
             names: model.gaps.iter().map(|g| g.name.clone()).collect(),
@@ -79,9 +77,7 @@ impl Contribution for Gaps {
         self.take_history(start);
         self.latched.iter_mut().for_each(|l| *l = None);
         self.closed.iter_mut().for_each(|c| *c = false);
-        self.previous.clone_from(&start.status);
-        self.changed_at.clear();
-        self.changed_at.resize(start.status.len(), None);
+        self.changes.reset(start.status.iter().copied());
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
@@ -150,22 +146,12 @@ impl Contribution for Gaps {
     }
 
     fn note_iteration(&mut self, iteration: usize) {
-        for (g, r) in self.responses.iter().enumerate() {
-            if r.status != self.previous[g] {
-                self.previous[g] = r.status;
-                self.changed_at[g] = Some(iteration);
-            }
-        }
+        self.changes
+            .note(iteration, self.responses.iter().map(|r| r.status));
     }
 
     fn chattering(&self, since: usize, out: &mut Vec<String>) {
-        out.extend(
-            self.changed_at
-                .iter()
-                .enumerate()
-                .filter(|(_, c)| c.is_some_and(|c| c > 0 && c >= since))
-                .map(|(g, _)| self.names[g].clone()),
-        );
+        self.changes.changed_since(since, &self.names, out);
     }
 
     /// The status is the one found when the increment converged.

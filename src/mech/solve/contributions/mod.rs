@@ -100,6 +100,45 @@ pub trait Contribution {
     }
 }
 
+/// The status of each item (gap, contact) at the previous Newton iteration and the last
+/// iteration it changed: to name the items that keep switching when an increment stalls.
+#[derive(Clone, Debug, Default)]
+pub struct StatusChanges {
+    previous: Vec<GapStatus>,
+    changed_at: Vec<Option<usize>>,
+}
+
+impl StatusChanges {
+    /// Starts an increment from the converged statuses `start`.
+    pub fn reset(&mut self, start: impl Iterator<Item = GapStatus>) {
+        self.previous.clear();
+        self.previous.extend(start);
+        self.changed_at.clear();
+        self.changed_at.resize(self.previous.len(), None);
+    }
+
+    /// Notes the statuses `now` at Newton iteration `iteration`.
+    pub fn note(&mut self, iteration: usize, now: impl Iterator<Item = GapStatus>) {
+        for ((p, c), s) in self.previous.iter_mut().zip(&mut self.changed_at).zip(now) {
+            if s != *p {
+                *p = s;
+                *c = Some(iteration);
+            }
+        }
+    }
+
+    /// Appends the `names` of the items that changed at an iteration `≥ since` (and > 0).
+    pub fn changed_since(&self, since: usize, names: &[String], out: &mut Vec<String>) {
+        out.extend(
+            self.changed_at
+                .iter()
+                .zip(names)
+                .filter(|(c, _)| c.is_some_and(|c| c > 0 && c >= since))
+                .map(|(_, n)| n.clone()),
+        );
+    }
+}
+
 /// Every contribution of an analysis.
 #[derive(Clone, Debug)]
 pub struct Contributions {
