@@ -377,12 +377,50 @@ impl System {
 
     /// Adds the triangles' internal forces (eq. 2.6) into `internal` and, when `values` is
     /// given, their tangents (eq. 2.7), in element order (on threads when set: same sums).
-    pub fn add_triangles(&self, u: &[f64], internal: &mut [f64], mut values: Option<&mut [f64]>) {
+    pub fn add_triangles(&self, u: &[f64], internal: &mut [f64], values: Option<&mut [f64]>) {
+        self.add_triangles_keeping(
+            u,
+            internal,
+            values,
+            |_, tri, ue, with_tangent| {
+                let (r, k) = tri.force_and_tangent(&self.material, ue, with_tangent);
+                (r, k, ())
+            },
+            &mut [],
+        );
+    }
+
+    /// [`System::add_triangles`] with the element computed by `element(e, triangle, u_e,
+    /// with_tangent)`, which also returns a value per triangle kept in `kept[e]` (a plastic
+    /// film's trial history; `kept` may be empty for `()`). On threads when set: a triangle
+    /// computed by two threads is kept from the first, and every result is the same bits.
+    pub fn add_triangles_keeping<X: Send>(
+        &self,
+        u: &[f64],
+        internal: &mut [f64],
+        values: Option<&mut [f64]>,
+        element: impl Fn(
+            usize,
+            &MembraneTriangle,
+            &ElementVector,
+            bool,
+        ) -> (ElementVector, ElementMatrix, X)
+        + Sync,
+        kept: &mut [X],
+    ) {
         if self.threads > 1 {
-            self.assemble_triangles_owned(u, internal, values.as_deref_mut());
+            for (e, x) in self.assemble_triangles_owned(u, internal, values, &element) {
+                if let Some(slot) = kept.get_mut(e) {
+                    *slot = x;
+                }
+            }
         } else {
-            self.add_triangles_with(u, internal, values, |e, _, _, with_tangent| {
-                self.element(e, u, with_tangent)
+            self.add_triangles_with(u, internal, values, |e, tri, ue, with_tangent| {
+                let (r, k, x) = element(e, tri, ue, with_tangent);
+                if let Some(slot) = kept.get_mut(e) {
+                    *slot = x;
+                }
+                (r, k)
             });
         }
     }
@@ -454,26 +492,24 @@ impl System {
 }
 
 impl System {
-    /// Force and tangent (zero unless `with_tangent`) of triangle `e` at `u`.
-    fn element(&self, e: usize, u: &[f64], with_tangent: bool) -> (ElementVector, ElementMatrix) {
-        let (nodes, tri) = &self.triangles[e];
-        let global = node_dofs(nodes);
-        let ue = ElementVector::from_fn(|i, _| u[global[i]]);
-        tri.force_and_tangent(&self.material, &ue, with_tangent)
-    }
-
     /// The triangles' part of [`System::assemble`] on scoped threads, owner computes (see the
-    /// module doc): thread `t` computes every triangle of its part and adds the entries that
-    /// fall in its own DOFs and slots.
-    fn assemble_triangles_owned(
+    /// module doc): thread `t` computes every triangle of its part with `element` and adds the
+    /// entries that fall in its own DOFs and slots. Returns each triangle's kept value, from the
+    /// first part that computes it.
+    fn assemble_triangles_owned<X: Send>(
         &self,
         u: &[f64],
         internal: &mut [f64],
         values: Option<&mut [f64]>,
-    ) {
+        element: &(
+             impl Fn(usize, &MembraneTriangle, &ElementVector, bool) -> (ElementVector, ElementMatrix, X)
+             + Sync
+         ),
+    ) -> Vec<(usize, X)> {
         let with_tangent = values.is_some();
         let mut forces = internal;
         let mut matrix = values;
+        let mut last = vec![];
         std::thread::scope(|scope| {
             let mut workers = Vec::with_capacity(self.parts.len());
             for (t, part) in self.parts.iter().enumerate() {
@@ -487,39 +523,54 @@ impl System {
                     }
                     None => None,
                 };
+                let earlier = &self.parts[..t];
                 let work = move || {
                     let mut mine_values = mine_values;
+                    let mut kept = vec![];
                     for &e in &part.triangles {
+                        let first = earlier
+                            .iter()
+                            .all(|p| p.triangles.binary_search(&e).is_err());
                         let e = e as usize;
-                        let (r, k) = self.element(e, u, with_tangent);
+                        let (nodes, tri) = &self.triangles[e];
+                        let global = node_dofs(nodes);
+                        let ue = ElementVector::from_fn(|i, _| u[global[i]]);
+                        let (r, k, x) = element(e, tri, &ue, with_tangent);
                         self.scatter_part(
                             e,
                             (&r, &k),
                             (part.dofs.start, &mut *mine),
                             mine_values.as_mut().map(|(v0, v)| (*v0, &mut **v)),
                         );
+                        if first {
+                            kept.push((e, x));
+                        }
                     }
+                    kept
                 };
                 if t + 1 < self.parts.len() {
                     let worker = std::thread::Builder::new()
                         .name(format!("assembly {t}"))
-                        .spawn_scoped(scope, move || {
-                            work();
-                            worker::own_task()
-                        })
+                        .spawn_scoped(scope, move || (work(), worker::own_task()))
                         .expect("the system gives a thread for the assembly");
                     workers.push(worker);
                 } else {
-                    work();
+                    last = work();
                 }
             }
+            let mut kept = vec![];
             for worker in workers {
                 match worker.join() {
-                    Ok(task) => worker::wait_until_gone(task),
+                    Ok((part, task)) => {
+                        worker::wait_until_gone(task);
+                        kept.extend(part);
+                    }
                     Err(panic) => std::panic::resume_unwind(panic),
                 }
             }
-        });
+            kept.append(&mut last);
+            kept
+        })
     }
 
     /// Adds triangle `e`'s force `r` and, when `matrix` is given, its tangent `k` to the parts of

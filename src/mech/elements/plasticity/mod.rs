@@ -20,11 +20,16 @@
 //! * **Stress.** `S = Q (τ̂ Y⁻¹) Qᵀ` (2nd Piola–Kirchhoff, per unit initial volume, element frame);
 //!   `Cp⁻¹ ← Q exp(−2Δεp) Qᵀ`.
 //! * **Tangent.** The algorithmic tangent `∂S/∂E` is the exact derivative of the stress update
-//!   above, computed by forward-mode differentiation (dual numbers) through the update and one
-//!   Newton step of the return from its converged root (which is the implicit-function
-//!   derivative). Matrix logarithm and exponential are written as `a I + b D` with `a`, `b`
-//!   smooth in `|D|²`, so equal principal stretches (the undeformed film, equibiaxial stretch)
-//!   need no special case.
+//!   above. Every tensor of the update is `x I + y dev Y` with `x`, `y` functions of the two
+//!   invariants `s = ½ tr Y`, `r² = −det dev Y` alone, so `S = p Cp⁻¹ + q M`
+//!   (`M = Q dev Y Qᵀ`, `(p, q)` from `τ̂ Y⁻¹`). `p`, `q` are computed on dual numbers in
+//!   `(s, r²)`, through the return and one Newton step of it from its converged root (the
+//!   implicit-function derivative); the chain rule to `E` is written out
+//!   (`ds = ½ Cp⁻¹ : dC`, `d(r²) = M : dC`, `dM = Cp⁻¹ dC Cp⁻¹ − ds Cp⁻¹`). Matrix logarithm and
+//!   exponential are written as `a I + b D` with `a`, `b` smooth in `|D|²`, so equal principal
+//!   stretches (the undeformed film, equibiaxial stretch) need no special case. The tests check
+//!   this against the same update run on dual numbers in the three strains, tensors included
+//!   (`reference.rs`).
 //! * **Tension field.** With wrinkling, the film carries no compression: the wrinkling strain is a
 //!   contraction across the tension direction that costs no energy. Slack if the larger trial
 //!   elastic log strain is `≤ 0` (no stress, no flow); otherwise the biaxial return is taut if its
@@ -40,9 +45,8 @@
 //! | `mod.rs` | the material point: history, the return mapping, stress and algorithmic tangent |
 //! | [`hardening`] | the hardening table, its validation, the default ETFE curve and its sources |
 //! | `numbers` | dual numbers and 2×2 symmetric tensors the update is differentiated through |
+//! | `reference` | (tests) the update on dual numbers in the three strains, the oracle of the tangent |
 //! | `tests` | closed forms (uniaxial, equibiaxial, pure shear) and finite-difference tangents |
-
-use std::ops::Add;
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -51,6 +55,8 @@ use super::material::WrinklingState;
 
 pub mod hardening;
 mod numbers;
+#[cfg(test)]
+mod reference;
 #[cfg(test)]
 mod tests;
 
@@ -145,6 +151,13 @@ pub struct PlasticResponse {
 /// Relative tolerance of the yield check and of the return's root.
 const YIELD_TOLERANCE: f64 = 1e-12;
 
+/// Relative rounding of the return's scalar equations, in the size of their terms.
+const ROUNDING: f64 = 1e-14;
+
+/// Units in the last place of the return's root below which a Newton step or the bracket
+/// counts as converged (the residual is then rounding noise).
+const ROOT_ULPS: f64 = 4.0;
+
 impl PlasticFilm {
     /// Shear modulus `G`.
     fn shear_modulus(&self) -> f64 {
@@ -178,241 +191,235 @@ impl PlasticFilm {
     /// Stress and updated history at the Green strain `strain` (Voigt `[Exx, Eyy, 2Exy]`),
     /// starting from `history`.
     pub fn response(&self, history: &PlasticHistory, strain: &Vector3<f64>) -> PlasticResponse {
-        let c = Sym2 {
-            xx: 1.0 + 2.0 * strain.x,
-            yy: 1.0 + 2.0 * strain.y,
-            xy: strain.z,
-        };
-        let update = self.update(history, c);
-        update.response(|s| s)
+        let trial = Trial::new(history, strain);
+        let ret = self.return_map(history.equivalent_plastic_strain, trial.s, trial.r2);
+        trial.response(history, &ret)
     }
 
     /// [`PlasticFilm::response`] and the consistent algorithmic tangent `∂S/∂E` (3×3, Voigt,
-    /// engineering shear in `E`).
+    /// engineering shear in `E`): the return runs on dual numbers in the invariants `(s, r²)`
+    /// of `Y`, and the chain rule through `S = p Cp⁻¹ + q M` is written out (module doc).
     pub fn response_and_tangent(
         &self,
         history: &PlasticHistory,
         strain: &Vector3<f64>,
     ) -> (PlasticResponse, Matrix3<f64>) {
-        // C = I + 2E: ∂Cxx/∂Exx = 2, ∂Cyy/∂Eyy = 2, ∂Cxy/∂γ = 1.
-        let c = Sym2 {
-            xx: Dual {
-                v: 1.0 + 2.0 * strain.x,
-                d: [2.0, 0.0, 0.0],
-            },
-            yy: Dual {
-                v: 1.0 + 2.0 * strain.y,
-                d: [0.0, 2.0, 0.0],
-            },
-            xy: Dual {
-                v: strain.z,
-                d: [0.0, 0.0, 1.0],
-            },
+        let trial = Trial::new(history, strain);
+        let s = Dual2 {
+            v: trial.s,
+            d: [1.0, 0.0],
         };
-        let update = self.update(history, c);
-        let s = update.stress;
-        let tangent = Matrix3::from_fn(|i, j| [s.xx, s.yy, s.xy][i].d[j]);
-        (update.response(|x: Dual| x.v), tangent)
+        let r2 = Dual2 {
+            v: trial.r2,
+            d: [0.0, 1.0],
+        };
+        let ret = self.return_map(history.equivalent_plastic_strain, s, r2);
+        let (p, q) = coefficients(s, r2, ret.a, ret.b);
+        let value = Return {
+            a: ret.a.v,
+            b: ret.b.v,
+            state: ret.state,
+            flow: ret.flow,
+            eps_e33: ret.eps_e33,
+        };
+        (trial.response(history, &value), trial.tangent(p, q))
     }
 
-    /// The stress update of the module doc, generic over plain and dual numbers.
-    fn update<T: Real>(&self, history: &PlasticHistory, c: Sym2<T>) -> Update<T> {
+    /// The return of the module doc in the invariants `s = ½ tr Y`, `r² = −det dev Y` of the
+    /// trial `Y`, from the equivalent plastic strain `ep_n`: generic over plain numbers and
+    /// dual numbers in `(s, r²)`. Every tensor of the update is `x I + y dev Y`.
+    fn return_map<T: Real>(&self, ep_n: f64, s: T, r2: T) -> Return<T> {
         let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
         let (g2, ebar) = (2.0 * self.shear_modulus(), self.areal_modulus());
+        // εtr = ½ ln Y = ¼ ln(s² − r²) I + β dev Y, β = g(r²/s²)/(2s).
+        let mean_tr = (s * s - r2).ln() * T::c(0.25);
+        let beta = atanh_over(r2 / (s * s)) / (s * T::c(2.0));
+        let r = r2.v().sqrt();
+        let hardening = &self.hardening;
+        // Largest trial principal log strain: slack test.
+        let (major, scale) = (mean_tr.v() + beta.v() * r, mean_tr.v().abs() + beta.v() * r);
+        if self.tension_field && major <= 1e-12 * scale {
+            return Return {
+                a: T::c(0.0),
+                b: T::c(0.0),
+                state: WrinklingState::Slack,
+                flow: None,
+                eps_e33: 0.0,
+            };
+        }
+        // Biaxial (taut) trial and return: τtr = m_tr I + b_tr dev Y, |dev τtr|² = 2 b_tr² r².
+        let m_trial = mean_tr * T::c(ebar);
+        let b_trial = beta * T::c(g2);
+        let d2_trial = b_trial * b_trial * r2 * T::c(2.0);
+        let (a, b, dgamma) = match taut_return(hardening, ebar, g2, ep_n, m_trial, d2_trial) {
+            Some(dg) => {
+                let a = m_trial / (T::c(1.0) + dg * T::c(ebar / 3.0));
+                let b = b_trial / (T::c(1.0) + dg * T::c(g2));
+                (a, b, Some(dg.v()))
+            }
+            None => (m_trial, b_trial, None),
+        };
+        let rho_tau = b.v().abs() * r;
+        let minor = a.v() - rho_tau;
+        if self.tension_field && minor < -1e-12 * (a.v().abs() + rho_tau) {
+            return self.wrinkled_return(ep_n, r2, mean_tr, beta);
+        }
+        // Taut: εe = Dps⁻¹ τ̂, Δεp = εtr − εe.
+        let flow = dgamma.map(|dg| {
+            let xi = a.v() * a.v() * (2.0 / 3.0) + 2.0 * b.v() * b.v() * r2.v();
+            Flow {
+                mean: mean_tr.v() - a.v() / ebar,
+                dev: beta.v() - b.v() / g2,
+                equivalent: dg * (xi * 2.0 / 3.0).sqrt(),
+            }
+        });
+        Return {
+            a,
+            b,
+            state: WrinklingState::Taut,
+            flow,
+            eps_e33: -2.0 * nu * a.v() / e,
+        }
+    }
+
+    /// Uniaxial return along the trial tension direction `n1n1 = ½ I + dev Y/(2r)` (wrinkled
+    /// point), from the trial strain `εtr = mean_tr I + β dev Y`.
+    fn wrinkled_return<T: Real>(&self, ep_n: f64, r2: T, mean_tr: T, beta: T) -> Return<T> {
+        let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
+        let hardening = &self.hardening;
+        let r = r2.sqrt();
+        let tau_trial = (mean_tr + beta * r) * T::c(e);
+        let (tau1, dl) = bar_return(hardening, e, ep_n, tau_trial);
+        // Δεp = Δ (n1n1 − ½ n2n2) = Δ (3/2 n1n1 − ½ I) = Δ/4 I + 3Δ/(4r) dev Y.
+        Return {
+            a: tau1 * T::c(0.5),
+            b: tau1 / (r * T::c(2.0)),
+            state: WrinklingState::Wrinkled,
+            flow: (dl > 0.0).then(|| Flow {
+                mean: 0.25 * dl,
+                dev: 0.75 * dl / r.v(),
+                equivalent: dl,
+            }),
+            eps_e33: -nu * tau1.v() / e,
+        }
+    }
+}
+
+/// The trial kinematics of one evaluation: `Cp⁻¹ = Q Qᵀ`, `Y = Qᵀ C Q` by its invariants
+/// `s = ½ tr Y`, `r² = −det dev Y` and its deviator, and `M = Q dev Y Qᵀ`.
+struct Trial {
+    q: [[f64; 2]; 2],
+    metric: Sym2<f64>,
+    s: f64,
+    r2: f64,
+    dev: Sym2<f64>,
+    m: Sym2<f64>,
+}
+
+/// What [`PlasticFilm::return_map`] gives: `τ̂ = a I + b dev Y` in `T` and the flow.
+struct Return<T> {
+    a: T,
+    b: T,
+    state: WrinklingState,
+    /// The plastic increment, when the point flows.
+    flow: Option<Flow>,
+    /// Elastic thickness strain `εe33`.
+    eps_e33: f64,
+}
+
+/// A plastic increment `Δεp = mean I + dev · dev Y` with its `Δε̄p`.
+#[derive(Clone, Copy)]
+struct Flow {
+    mean: f64,
+    dev: f64,
+    equivalent: f64,
+}
+
+/// `τ̂ Y⁻¹ = p I + q dev Y` from `τ̂ = a I + b dev Y` (with `(dev Y)² = r² I`).
+fn coefficients<T: Real>(s: T, r2: T, a: T, b: T) -> (T, T) {
+    let det = s * s - r2;
+    ((a * s - b * r2) / det, (b * s - a) / det)
+}
+
+impl Trial {
+    fn new(history: &PlasticHistory, strain: &Vector3<f64>) -> Self {
+        let c = Sym2 {
+            xx: 1.0 + 2.0 * strain.x,
+            yy: 1.0 + 2.0 * strain.y,
+            xy: strain.z,
+        };
         let [a, b, d] = history.inverse_plastic_metric;
         // Cp⁻¹ = Q Qᵀ, Q lower triangular.
         let q11 = a.sqrt();
         let q21 = d / q11;
         let q22 = (b - q21 * q21).sqrt();
         let q = [[q11, 0.0], [q21, q22]];
-        let qt = [[q11, q21], [0.0, q22]];
-        let y = c.congruence(&qt);
-        let (s_y, dev_y) = (y.mean(), y.dev());
-        let r2_y = dev_y.xx * dev_y.xx + dev_y.xy * dev_y.xy;
-        // εtr = ½ ln Y = ¼ ln(s² − r²) I + (g(r²/s²)/(2s)) dev Y.
-        let mean_tr = (s_y * s_y - r2_y).ln() * T::c(0.25);
-        let dev_tr = dev_y.scale_t(atanh_over(r2_y / (s_y * s_y)) / (s_y * T::c(2.0)));
-        let rho2_tr = dev_tr.xx * dev_tr.xx + dev_tr.xy * dev_tr.xy;
-        let ep_n = history.equivalent_plastic_strain;
-        let hardening = &self.hardening;
-        // Largest trial principal log strain: slack test.
-        let major = mean_tr.v() + rho2_tr.v().sqrt();
-        let scale = mean_tr.v().abs() + rho2_tr.v().sqrt();
-        if self.tension_field && major <= 1e-12 * scale {
-            return Update::slack(history);
-        }
-        // Biaxial (taut) trial and return.
-        let m_trial = mean_tr * T::c(ebar);
-        let dev_trial = dev_tr.scale(g2);
-        let d2_trial = dev_trial.frob2();
-        let phi = |dg, m, d2| taut_yield(hardening, ebar, g2, ep_n, m, d2, dg);
-        let sy_n = hardening.flow_stress(ep_n).0;
-        let trial_excess = phi(0.0, m_trial.v(), d2_trial.v());
-        let (m_tau, dev_tau, dgamma) = if trial_excess > YIELD_TOLERANCE * sy_n * sy_n {
-            let (m, d2) = (Dual1::c(m_trial.v()), Dual1::c(d2_trial.v()));
-            let dg: T = return_root(
-                |x| taut_yield(hardening, ebar, g2, ep_n, m, d2, x),
-                |x| taut_yield(hardening, ebar, g2, ep_n, m_trial, d2_trial, x),
-                1.0 / g2,
-            );
-            let m = m_trial / (T::c(1.0) + dg * T::c(ebar / 3.0));
-            let dev = dev_trial.scale_t(T::c(1.0) / (T::c(1.0) + dg * T::c(g2)));
-            (m, dev, Some(dg))
-        } else {
-            (m_trial, dev_trial, None)
-        };
-        let rho_tau = dev_tau.frob2().v().sqrt() / 2f64.sqrt();
-        let minor = m_tau.v() - rho_tau;
-        if self.tension_field && minor < -1e-12 * (m_tau.v().abs() + rho_tau) {
-            return self.wrinkled(history, q, &y, mean_tr, dev_tr);
-        }
-        // Taut: τ̂ = m I + dev τ, εe = Dps⁻¹ τ̂, Δεp = εtr − εe.
-        let tau = Sym2::identity(m_tau) + dev_tau;
-        let (yielding, dep_bar) = match dgamma {
-            Some(dg) => {
-                let xi = m_tau * m_tau * T::c(2.0 / 3.0) + dev_tau.frob2();
-                (true, dg.v() * (xi.v() * 2.0 / 3.0).sqrt())
-            }
-            None => (false, 0.0),
-        };
-        let eps_e33 = -2.0 * nu * m_tau.v() / e;
-        let dep_mean = mean_tr.v() - m_tau.v() / ebar;
-        let dep_dev = dev_tr.value().sub(dev_tau.value().scale(1.0 / g2));
-        let dep = Sym2::identity(dep_mean).add(dep_dev);
-        Update::finish(
-            q,
-            &y,
-            tau,
-            WrinklingState::Taut,
-            history,
-            if yielding { Some(dep) } else { None },
-            dep_bar,
-            eps_e33,
-        )
-    }
-
-    /// Uniaxial return along the trial tension direction `n1` (wrinkled point).
-    fn wrinkled<T: Real>(
-        &self,
-        history: &PlasticHistory,
-        q: [[f64; 2]; 2],
-        y: &Sym2<T>,
-        mean_tr: T,
-        dev_tr: Sym2<T>,
-    ) -> Update<T> {
-        let e = self.youngs_modulus;
-        let nu = self.poisson_ratio;
-        let ep_n = history.equivalent_plastic_strain;
-        let hardening = &self.hardening;
-        let rho = dev_tr.frob2().sqrt() * T::c(0.5f64.sqrt());
-        let n1n1 = Sym2::identity(T::c(0.5)) + dev_tr.scale_t(T::c(0.5) / rho);
-        let tau_trial = (mean_tr + rho) * T::c(e);
-        let sy_n = hardening.flow_stress(ep_n).0;
-        let (tau1, dl) =
-            if bar_yield(hardening, e, ep_n, tau_trial.v(), 0.0) > YIELD_TOLERANCE * sy_n {
-                let t = Dual1::c(tau_trial.v());
-                let dl: T = return_root(
-                    |x| bar_yield(hardening, e, ep_n, t, x),
-                    |x| bar_yield(hardening, e, ep_n, tau_trial, x),
-                    1.0 / e,
-                );
-                (tau_trial - dl * T::c(e), dl.v())
-            } else {
-                (tau_trial, 0.0)
-            };
-        let tau = n1n1.scale_t(tau1);
-        // Δεp = Δ (n1n1 − ½ n2n2) = Δ (3/2 n1n1 − ½ I).
-        let dep = n1n1.value().scale(1.5 * dl).add(Sym2::identity(-0.5 * dl));
-        let eps_e33 = -nu * tau1.v() / e;
-        Update::finish(
-            q,
-            y,
-            tau,
-            WrinklingState::Wrinkled,
-            history,
-            if dl > 0.0 { Some(dep) } else { None },
-            dl,
-            eps_e33,
-        )
-    }
-}
-
-/// Result of [`PlasticFilm::update`] in the number type `T`.
-struct Update<T> {
-    stress: Sym2<T>,
-    history: PlasticHistory,
-    state: WrinklingState,
-    yielding: bool,
-    thickness_ratio: f64,
-    principal: [f64; 2],
-}
-
-impl<T: Real> Update<T> {
-    fn slack(history: &PlasticHistory) -> Self {
-        Self {
-            stress: Sym2::identity(T::c(0.0)),
-            history: *history,
-            state: WrinklingState::Slack,
-            yielding: false,
-            thickness_ratio: history.unloaded_thickness_strain.exp(),
-            principal: [0.0; 2],
-        }
-    }
-
-    /// `S = Q (τ̂ Y⁻¹) Qᵀ` and the history update `Cp⁻¹ ← Q exp(−2Δεp) Qᵀ`.
-    #[allow(clippy::too_many_arguments)]
-    fn finish(
-        q: [[f64; 2]; 2],
-        y: &Sym2<T>,
-        tau: Sym2<T>,
-        state: WrinklingState,
-        history: &PlasticHistory,
-        plastic_increment: Option<Sym2<f64>>,
-        dep_bar: f64,
-        eps_e33: f64,
-    ) -> Self {
+        let y = c.congruence(&[[q11, q21], [0.0, q22]]);
         let (s, dev) = (y.mean(), y.dev());
-        let det = s * s - (dev.xx * dev.xx + dev.xy * dev.xy);
-        let y_inv = Sym2 {
-            xx: (s - dev.xx) / det,
-            yy: (s + dev.xx) / det,
-            xy: -dev.xy / det,
-        };
-        let stress = tau.commuting_product(&y_inv).congruence(&q);
+        Self {
+            q,
+            metric: Sym2 {
+                xx: a,
+                yy: b,
+                xy: d,
+            },
+            s,
+            r2: dev.xx * dev.xx + dev.xy * dev.xy,
+            dev,
+            m: dev.congruence(&q),
+        }
+    }
+
+    /// `S = Q (τ̂ Y⁻¹) Qᵀ = p Cp⁻¹ + q M` and the history update `Cp⁻¹ ← Q exp(−2Δεp) Qᵀ`.
+    fn response(&self, history: &PlasticHistory, ret: &Return<f64>) -> PlasticResponse {
+        let (p, q) = coefficients(self.s, self.r2, ret.a, ret.b);
+        let stress = self.metric.scale(p) + self.m.scale(q);
         let mut next = *history;
-        if let Some(dep) = plastic_increment {
-            let p = exp_sym(dep.scale(-2.0)).congruence(&q);
+        if let Some(flow) = ret.flow {
+            let dep = Sym2::identity(flow.mean) + self.dev.scale(flow.dev);
+            let p = exp_sym(dep.scale(-2.0)).congruence(&self.q);
             next.inverse_plastic_metric = [p.xx, p.yy, p.xy];
-            next.equivalent_plastic_strain += dep_bar;
+            next.equivalent_plastic_strain += flow.equivalent;
             next.unloaded_thickness_strain -= 2.0 * dep.mean();
         }
-        let tv = tau.value();
-        let (m, r) = (tv.mean(), (tv.dev().frob2() / 2.0).sqrt());
-        Self {
-            stress,
+        let radius = ret.b.abs() * self.r2.sqrt();
+        let [t1, t2] = [ret.a + radius, ret.a - radius];
+        PlasticResponse {
+            stress: Vector3::new(stress.xx, stress.yy, stress.xy),
             history: next,
-            state,
-            yielding: plastic_increment.is_some(),
-            thickness_ratio: (next.unloaded_thickness_strain + eps_e33).exp(),
-            principal: [m + r, m - r],
+            state: ret.state,
+            yielding: ret.flow.is_some(),
+            thickness_ratio: (next.unloaded_thickness_strain + ret.eps_e33).exp(),
+            equivalent_stress: (t1 * t1 - t1 * t2 + t2 * t2).sqrt(),
+            principal_kirchhoff: [t1, t2],
         }
     }
 
-    fn response(&self, value: impl Fn(T) -> f64) -> PlasticResponse {
-        let [t1, t2] = self.principal;
-        PlasticResponse {
-            stress: Vector3::new(
-                value(self.stress.xx),
-                value(self.stress.yy),
-                value(self.stress.xy),
-            ),
-            history: self.history,
-            state: self.state,
-            yielding: self.yielding,
-            thickness_ratio: self.thickness_ratio,
-            equivalent_stress: (t1 * t1 - t1 * t2 + t2 * t2).sqrt(),
-            principal_kirchhoff: self.principal,
-        }
+    /// `∂S/∂E` of `S = p(s, r²) Cp⁻¹ + q(s, r²) M`: with `P = Cp⁻¹` and `dC = 2 dE`,
+    /// `ds = ½ P : dC`, `d(r²) = M : dC` and `dM = P dC P − ds P`.
+    fn tangent(&self, p: Dual2, q: Dual2) -> Matrix3<f64> {
+        let pm = &self.metric;
+        let pv = [pm.xx, pm.yy, pm.xy];
+        let mv = [self.m.xx, self.m.yy, self.m.xy];
+        // (P dC_j P) in Voigt, column j = Exx, Eyy, γxy.
+        let (xx, yy, xy) = (pm.xx, pm.yy, pm.xy);
+        let pdcp = Matrix3::new(
+            2.0 * xx * xx,
+            2.0 * xy * xy,
+            2.0 * xx * xy,
+            2.0 * xy * xy,
+            2.0 * yy * yy,
+            2.0 * xy * yy,
+            2.0 * xx * xy,
+            2.0 * xy * yy,
+            xx * yy + xy * xy,
+        );
+        Matrix3::from_fn(|i, j| {
+            let (ds, dr2) = (pv[j], 2.0 * mv[j]);
+            let dp = p.d[0] * ds + p.d[1] * dr2;
+            let dq = q.d[0] * ds + q.d[1] * dr2;
+            dp * pv[i] + dq * mv[i] + q.v * (pdcp[(i, j)] - ds * pv[i])
+        })
     }
 }
 
@@ -435,41 +442,91 @@ fn taut_yield<U: Real>(
     xi * U::c(0.5) - sy * sy * U::c(1.0 / 3.0)
 }
 
+/// `Δγ` of the taut return from the trial mean Kirchhoff stress `m_trial` and squared deviator
+/// norm `d2_trial`, or `None` when the trial state is elastic.
+fn taut_return<T: Real>(
+    hardening: &Hardening,
+    ebar: f64,
+    g2: f64,
+    ep_n: f64,
+    m_trial: T,
+    d2_trial: T,
+) -> Option<T> {
+    let sy_n = hardening.flow_stress(ep_n).0;
+    let trial_excess = taut_yield(hardening, ebar, g2, ep_n, m_trial.v(), d2_trial.v(), 0.0);
+    (trial_excess > YIELD_TOLERANCE * sy_n * sy_n).then(|| {
+        let (m, d2) = (Dual1::c(m_trial.v()), Dual1::c(d2_trial.v()));
+        return_root(
+            |x| taut_yield(hardening, ebar, g2, ep_n, m, d2, x),
+            |x| taut_yield(hardening, ebar, g2, ep_n, m_trial, d2_trial, x),
+            1.0 / g2,
+            sy_n * sy_n / 3.0,
+        )
+    })
+}
+
+/// The uniaxial return from the trial stress `τ_tr`: the stress `τ1` and the plastic strain
+/// increment `Δ` (0 when elastic).
+fn bar_return<T: Real>(hardening: &Hardening, e: f64, ep_n: f64, tau_trial: T) -> (T, f64) {
+    let sy_n = hardening.flow_stress(ep_n).0;
+    if bar_yield(hardening, e, ep_n, tau_trial.v(), 0.0) > YIELD_TOLERANCE * sy_n {
+        let t = Dual1::c(tau_trial.v());
+        let dl: T = return_root(
+            |x| bar_yield(hardening, e, ep_n, t, x),
+            |x| bar_yield(hardening, e, ep_n, tau_trial, x),
+            1.0 / e,
+            sy_n,
+        );
+        (tau_trial - dl * T::c(e), dl.v())
+    } else {
+        (tau_trial, 0.0)
+    }
+}
+
 /// Uniaxial yield function after a plastic strain increment `Δ` from the trial stress `τ_tr`.
 fn bar_yield<U: Real>(hardening: &Hardening, e: f64, ep_n: f64, tau_trial: U, dl: U) -> U {
     tau_trial - dl * U::c(e) - hardening.flow_stress_of(U::c(ep_n) + dl)
 }
 
-/// Root in `T` of a decreasing scalar equation with `f(0) > 0`: solved on plain numbers (`f`
-/// with one derivative), then one Newton step in `T` (`ft`) from the root, which carries the
-/// implicit-function derivative of the root with respect to the strains.
-fn return_root<T: Real>(f: impl Fn(Dual1) -> Dual1, ft: impl Fn(T) -> T, scale: f64) -> T {
-    let eval = |x: f64| {
-        let r = f(Dual1 { v: x, d: 1.0 });
-        (r.v, r.d)
-    };
-    let root = solve_decreasing(eval, scale);
-    let slope = eval(root).1;
+/// Root in `T` of a decreasing scalar equation with `f(0) > 0` whose terms are of the size
+/// `terms`: solved on plain numbers (`f` with one derivative), then one Newton step in `T` (`ft`)
+/// from the root, which carries the implicit-function derivative of the root with respect to
+/// the strains.
+fn return_root<T: Real>(
+    f: impl Fn(Dual1) -> Dual1,
+    ft: impl Fn(T) -> T,
+    scale: f64,
+    terms: f64,
+) -> T {
+    let (root, slope) = solve_decreasing(
+        |x: f64| {
+            let r = f(Dual1 { v: x, d: 1.0 });
+            (r.v, r.d)
+        },
+        scale,
+        terms,
+    );
     T::c(root) - ft(T::c(root)) / T::c(slope)
 }
 
-/// Root of a decreasing function with `f(0) > 0`: Newton inside a bracket, bisection when
-/// Newton leaves it. `scale` is a first guess of the root's size.
-fn solve_decreasing(f: impl Fn(f64) -> (f64, f64), scale: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, scale);
-    for _ in 0..200 {
-        if f(hi).0 < 0.0 {
+/// Root of a decreasing function with `f(0) > 0`, and the slope there: Newton from 0 inside
+/// the bracket found so far, bisection when Newton leaves it; while no point with `f < 0` is
+/// known, a step Newton cannot take goes to `scale` (a first guess of the root's size) and then
+/// quadruples. Converged when `|f| ≤ 1e-15 f(0)`, or `|f|` is at the rounding of terms of size
+/// `terms` (a small `f(0)`: a point just past yield), or the step or the bracket is a few ulps.
+fn solve_decreasing(f: impl Fn(f64) -> (f64, f64), scale: f64, terms: f64) -> (f64, f64) {
+    #[cfg(test)]
+    let f = |x| {
+        tests::EVALUATIONS.with(|n| n.set(n.get() + 1));
+        f(x)
+    };
+    let (mut lo, mut hi) = (0.0, f64::INFINITY);
+    let mut x = 0.0;
+    let (mut fx, mut dfx) = f(x);
+    let tolerance = (1e-15 * fx.abs()).max(ROUNDING * terms);
+    for _ in 0..400 {
+        if fx.abs() <= tolerance {
             break;
-        }
-        lo = hi;
-        hi *= 4.0;
-    }
-    let mut x = lo;
-    let f0 = f(0.0).0.abs();
-    for _ in 0..200 {
-        let (fx, dfx) = f(x);
-        if fx.abs() <= 1e-15 * f0 {
-            return x;
         }
         if fx > 0.0 {
             lo = x;
@@ -477,14 +534,23 @@ fn solve_decreasing(f: impl Fn(f64) -> (f64, f64), scale: f64) -> f64 {
             hi = x;
         }
         let newton = x - fx / dfx;
+        if dfx < 0.0 && (newton - x).abs() <= ROOT_ULPS * f64::EPSILON * x {
+            // Converged to rounding: `fx` is noise in the terms of `f`, below 1e-15 f(0).
+            break;
+        }
         x = if dfx < 0.0 && newton > lo && newton < hi {
             newton
-        } else {
+        } else if hi.is_finite() {
             0.5 * (lo + hi)
+        } else if lo == 0.0 {
+            scale
+        } else {
+            4.0 * lo
         };
-        if hi - lo <= 1e-16 * hi {
-            return x;
+        (fx, dfx) = f(x);
+        if hi.is_finite() && hi - lo <= ROOT_ULPS * f64::EPSILON * hi {
+            break;
         }
     }
-    x
+    (x, dfx)
 }

@@ -38,11 +38,21 @@ impl Real for f64 {
     }
 }
 
-/// A number with its gradient with respect to the three Green strains.
+/// A number with its gradient with respect to the three Green strains (the reference update
+/// the tests compare against).
+#[cfg(test)]
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Dual {
     pub(super) v: f64,
     pub(super) d: [f64; 3],
+}
+
+/// A number with its gradient with respect to the two invariants `(s, r²)` of `Y` (module doc
+/// of `plasticity`: the tangent is assembled in closed form from these).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Dual2 {
+    pub(super) v: f64,
+    pub(super) d: [f64; 2],
 }
 
 /// A number with one derivative (the return's scalar equations).
@@ -131,6 +141,7 @@ macro_rules! dual_ops {
     };
 }
 
+#[cfg(test)]
 dual_ops!(
     Dual,
     |a: [f64; 3], b: [f64; 3], x: f64, y: f64| [
@@ -139,6 +150,11 @@ dual_ops!(
         a[2] * x + b[2] * y
     ],
     |a: [f64; 3], s: f64| [a[0] * s, a[1] * s, a[2] * s]
+);
+dual_ops!(
+    Dual2,
+    |a: [f64; 2], b: [f64; 2], x: f64, y: f64| [a[0] * x + b[0] * y, a[1] * x + b[1] * y],
+    |a: [f64; 2], s: f64| [a[0] * s, a[1] * s]
 );
 dual_ops!(
     Dual1,
@@ -212,6 +228,7 @@ impl<T: Real> Sym2<T> {
             xy: self.xy * s,
         }
     }
+    #[cfg(test)]
     pub(super) fn sub(&self, o: Self) -> Self {
         Self {
             xx: self.xx - o.xx,
@@ -219,9 +236,11 @@ impl<T: Real> Sym2<T> {
             xy: self.xy - o.xy,
         }
     }
+    #[cfg(test)]
     pub(super) fn frob2(&self) -> T {
         self.xx * self.xx + self.yy * self.yy + self.xy * self.xy * T::c(2.0)
     }
+    #[cfg(test)]
     pub(super) fn value(&self) -> Sym2<f64> {
         Sym2 {
             xx: self.xx.v(),
@@ -247,6 +266,7 @@ impl<T: Real> Sym2<T> {
             xy: entry(0, 1),
         }
     }
+    #[cfg(test)]
     /// `A B` of two commuting symmetric tensors (symmetric; off-diagonal averaged).
     pub(super) fn commuting_product(&self, b: &Self) -> Self {
         Self {

@@ -1,5 +1,6 @@
 //! The membrane triangles as a contribution: forces and tangents through the system's triangle
-//! loop (serial or owner-computes threads), the film's stresses and set summaries as results.
+//! loop (serial or owner-computes threads, the elastic and the plastic film alike), the film's
+//! stresses and set summaries as results.
 
 use super::{Contribution, Evaluation};
 use crate::mech::elements::material::Wrinkling;
@@ -31,9 +32,12 @@ impl Contribution for Triangles {
         match at.system.material.plastic_film() {
             None => at.system.add_triangles(at.u, residual, values),
             Some(film) => {
-                let (start, trial) = (&self.start, &mut self.trial);
-                at.system
-                    .add_triangles_with(at.u, residual, values, |e, tri, ue, tangent| {
+                let start = &self.start;
+                at.system.add_triangles_keeping(
+                    at.u,
+                    residual,
+                    values,
+                    |e, tri, ue, tangent| {
                         let (r, k, response) = tri.force_and_tangent_plastic(
                             &at.system.material,
                             &film,
@@ -41,9 +45,10 @@ impl Contribution for Triangles {
                             ue,
                             tangent,
                         );
-                        trial[e] = response.history;
-                        (r, k)
-                    });
+                        (r, k, response.history)
+                    },
+                    &mut self.trial,
+                );
             }
         }
     }
