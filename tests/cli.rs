@@ -166,6 +166,31 @@ fn model_command_ramps_the_loads_of_the_file_and_prints_their_level() {
     }
 }
 
+/// A film away from 23 °C says so on the console with the factors it applies (issue 20); a
+/// film at 23 °C prints no such line.
+#[test]
+fn model_command_states_a_film_temperature_other_than_23_celsius() {
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/circular_membrane.json"
+    );
+    let text = std::fs::read_to_string(example).unwrap();
+    let mut model: serde_json::Value = serde_json::from_str(&text).unwrap();
+    model["material"]["temperature"] = serde_json::json!(0.0);
+    let path = std::env::temp_dir().join(format!("mc-cli-cold-{}.json", std::process::id()));
+    std::fs::write(&path, model.to_string()).unwrap();
+    let line = "film: at 0 °C: E × 1.1300, yield and flow stresses × 1.2770 (given at 23 °C)";
+    for (file, expected) in [(path.to_str().unwrap(), true), (example, false)] {
+        let (ok, out, err) = cli(&["model", file, "--steps", "1", "--quiet"]);
+        assert!(ok, "{out}{err}");
+        assert_eq!(out.contains("film: at"), expected, "{out}");
+        if expected {
+            assert!(out.contains(line), "'{line}' missing in:\n{out}");
+        }
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
 #[test]
 fn no_line_search_option_reaches_the_same_inflated_state() {
     let run = |extra: &[&str]| {

@@ -6,6 +6,7 @@
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
+use membrane_contact::mech::elements::temperature;
 use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::results::vtk;
@@ -494,9 +495,18 @@ fn write_vtk(
     Ok(())
 }
 
-/// Prints the load levels of the converged state (the model file's at the last step).
+/// Prints the film's temperature when it is not the reference (with the factors it applies),
+/// then the load levels of the converged state (the model file's at the last step).
 fn report_loads(analysis: &Analysis) {
     let model = analysis.model();
+    let celsius = model.material.temperature;
+    if celsius != temperature::REFERENCE_TEMPERATURE {
+        out!(
+            "film: at {celsius} °C: E × {:.4}, yield and flow stresses × {:.4} (given at 23 °C)",
+            temperature::modulus_factor(celsius),
+            temperature::flow_stress_factor(celsius)
+        );
+    }
     let levels = &analysis.state().loads;
     for (set, p) in model.loads.pressures.iter().zip(&levels.pressure) {
         let count = match &set.elements {
