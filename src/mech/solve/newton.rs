@@ -2,8 +2,6 @@
 
 use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::LoadLevels;
-use crate::mech::elements::material::Wrinkling;
-use crate::mech::elements::triangle::ElementVector;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::continuation::{Continuation, Verdict};
@@ -257,23 +255,14 @@ impl Analysis {
         elements
     }
 
-    /// Elements of a linear film (`wrinkling: "none"`) in compression (`σ2 < 0`) at `u` (none
-    /// with the tension-field film). Called once when an increment fails.
+    /// Film elements in compression (`σ2 < 0`) at `u` where the film law carries compression
+    /// (`wrinkling: "none"`, elastic or plastic). Called once when an increment fails.
     fn compressed_elements(&self, u: &[f64]) -> Vec<usize> {
-        let material = &self.system.material;
-        if material.wrinkling != Wrinkling::None {
-            return vec![];
+        let mut elements = Vec::new();
+        for c in self.parts.all() {
+            c.compressed(&self.system, u, &mut elements);
         }
-        self.system
-            .triangles
-            .iter()
-            .enumerate()
-            .filter(|(_, (nodes, tri))| {
-                let ue = ElementVector::from_fn(|i, _| u[3 * nodes[i / 3] + i % 3]);
-                tri.stress_state(material, &ue).principal[1] < 0.0
-            })
-            .map(|(e, _)| e)
-            .collect()
+        elements
     }
 
     /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).

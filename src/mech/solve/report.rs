@@ -188,7 +188,7 @@ pub enum IncrementFailure {
         chattering: Vec<String>,
         /// Film elements whose tension-field state differs between the last two iterates.
         flipping: Vec<usize>,
-        /// Elements of a linear film in compression (`σ2 < 0`) at the last iterate.
+        /// Film elements in compression (`σ2 < 0`, no wrinkling) at the last iterate.
         compressed: Vec<usize>,
     },
     /// NaN/Inf or runaway corrections.
@@ -255,7 +255,7 @@ impl IncrementFailure {
                 flipping.len()
             ),
             Self::Stalled { compressed, .. } if !compressed.is_empty() => format!(
-                "{} elements of the linear film were in compression (the film as given carries it, a real ETFE \
+                "{} film elements were in compression (a film without wrinkling carries it, a real ETFE \
                  film wrinkles): move the inputs by less per step ({finer}), or give the material \
                  \"wrinkling\": \"tension-field\" if the film may wrinkle there",
                 compressed.len()
@@ -295,7 +295,7 @@ impl fmt::Display for IncrementFailure {
                 let numbers: Vec<String> = compressed.iter().map(|e| e.to_string()).collect();
                 write!(
                     f,
-                    "; linear-film elements in compression: {}",
+                    "; film elements in compression (no wrinkling): {}",
                     name_list(&numbers)
                 )?;
             }
@@ -448,12 +448,13 @@ mod advice_tests {
         };
         assert!(
             with.to_string()
-                .ends_with("; linear-film elements in compression: 4, 5, 6"),
+                .ends_with("; film elements in compression (no wrinkling): 4, 5, 6"),
             "{with}"
         );
         let advice = with.advice(&SettingNames::CORE);
         assert!(
-            advice.starts_with("3 elements of the linear film") && advice.contains("tension-field")
+            advice.starts_with("3 film elements were in compression")
+                && advice.contains("tension-field")
         );
         assert!(
             !stall(record(2.0e-4, 3.2e-6))

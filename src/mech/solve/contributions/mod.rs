@@ -89,6 +89,10 @@ pub trait Contribution {
     /// once when an increment fails).
     fn flipping(&self, _system: &System, _a: &[f64], _b: &[f64], _out: &mut Vec<usize>) {}
 
+    /// Appends the film elements in compression (`σ2 < 0`) at `u` where the film law carries
+    /// compression (`wrinkling: "none"`; called once when an increment fails).
+    fn compressed(&self, _system: &System, _u: &[f64], _out: &mut Vec<usize>) {}
+
     /// Fills its part of `out` at the converged `state` (after an evaluation at it).
     fn results(
         &self,

@@ -71,6 +71,19 @@ impl Contribution for Triangles {
         out.extend((0..system.triangles.len()).filter(|&e| state(a, e) != state(b, e)));
     }
 
+    /// Elements in compression at `u` for a film without wrinkling: the elastic film's stress,
+    /// or the plastic film's from the increment's start history (a film elongated by plastic
+    /// flow and then unloaded goes into compression while its Green strain is still positive).
+    fn compressed(&self, system: &System, u: &[f64], out: &mut Vec<usize>) {
+        if system.material.wrinkling != Wrinkling::None {
+            return;
+        }
+        out.extend(
+            (0..system.triangles.len())
+                .filter(|&e| stress_state(system, &self.start, e, u).principal[1] < 0.0),
+        );
+    }
+
     /// Element stresses and the summaries of the model's element sets.
     fn results(
         &self,
