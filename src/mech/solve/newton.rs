@@ -40,6 +40,9 @@ impl Analysis {
         let mut closest: Option<IterationRecord> = None;
         // Levenberg–Marquardt shift of the free diagonal, relative to its mean.
         let mut damping = 0.0_f64;
+        // Whether the last correction was solved with the shift (its size then says nothing
+        // of progress: the shift alone shrinks it).
+        let mut shifted = false;
         // The watchdog of the line search: non-monotone excursions until one fails.
         let mut watch = if self.work.watchdog {
             Watchdog::Ready
@@ -160,13 +163,10 @@ impl Analysis {
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            // Progress is a residual or a correction 10 % below the best so far: a cycle between
-            // two states repeats both to round-off and never makes it, while the slow approach
-            // along a soft direction of the film (small residual, shrinking corrections) does. The Ju–Rowlands matrix converges
-            // linearly and slowly by design (docs/mechanics.md): it is judged by the limit only.
-            if residual < Self::PROGRESS * best
-                || correction_norm < Self::PROGRESS * best_correction
-            {
+            // Progress (`made_progress`), else a stall after the patience. The Ju–Rowlands
+            // matrix converges linearly and slowly by design (docs/mechanics.md): it is judged
+            // by the limit only.
+            if made_progress(residual, best, correction_norm, best_correction, shifted) {
                 best = best.min(residual);
                 best_correction = best_correction.min(correction_norm);
                 best_at = iteration;
@@ -187,6 +187,7 @@ impl Analysis {
                     compressed: self.compressed_elements(&u),
                 });
             }
+            shifted = damping > 0.0;
             correction_norm = match (self.correction(damping, ptc.as_mut()), ptc.as_mut()) {
                 (Ok(norm), _) => norm,
                 (Err(_), Some(p)) => {
@@ -336,6 +337,23 @@ impl Analysis {
     }
 }
 
+/// Whether an iterate made progress: a residual or a correction [`Analysis::PROGRESS`] times
+/// the best so far. A cycle between two states repeats both to round-off and never makes it,
+/// while the slow approach along a soft direction of the film (small residual, shrinking
+/// corrections) does. A correction solved with the Levenberg–Marquardt shift (`shifted`) does
+/// not count by its size: the shift alone shrinks it (to 1e-65 m over a 100-iteration attempt,
+/// which then ran to the iteration limit instead of being cut back as stalled).
+fn made_progress(
+    residual: f64,
+    best: f64,
+    correction: f64,
+    best_correction: f64,
+    shifted: bool,
+) -> bool {
+    residual < Analysis::PROGRESS * best
+        || (!shifted && correction < Analysis::PROGRESS * best_correction)
+}
+
 /// The Levenberg–Marquardt shift after a line search that took `step` and `decreased` (or
 /// not) the merit: a direction that cannot lower the residual (a mechanism of an unstressed
 /// film, an indefinite compressed one) gets a diagonal shift, raised until steps succeed and
@@ -451,6 +469,18 @@ mod tests {
             fresh = long.next(held, &vec![Slip; k + 2]);
         }
         assert!(!fresh, "more than MAX_SETS sets accepted");
+    }
+
+    /// Progress is a residual or a correction 10 % below its best; a correction shrunk by the
+    /// Levenberg–Marquardt shift is not progress, a smaller residual still is.
+    #[test]
+    fn shifted_corrections_are_not_progress_by_their_size() {
+        let (best, best_correction) = (1.0, 1e-3);
+        assert!(made_progress(0.5, best, 1.0, best_correction, false));
+        assert!(made_progress(0.5, best, 1.0, best_correction, true));
+        assert!(made_progress(1.0, best, 1e-6, best_correction, false));
+        assert!(!made_progress(1.0, best, 1e-6, best_correction, true));
+        assert!(!made_progress(0.95, best, 0.95e-3, best_correction, false));
     }
 
     /// The shift starts at `DAMPING_START` when a step fails to decrease the merit, grows
