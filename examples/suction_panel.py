@@ -30,7 +30,7 @@ LOWERING, SUCTION = 0.30, 400.0
 def model(nx: int = 49, ny: int = 25, cables: bool = False, wrinkling: str | None = "tension-field",
           name: str | None = None) -> dict:
     """The model file (a dict). ``nx - 1`` must be a multiple of 4 (arches on mesh columns);
-    ``wrinkling=None`` leaves the entry out (the solver's default)."""
+    ``wrinkling=None`` leaves the entry out (the solver's default, the tension-field film)."""
     if (nx - 1) % 4 or nx < 5 or ny < 3:
         raise ValueError(f"nx = {nx} needs nx - 1 a multiple of 4 and ny = {ny} at least 3")
     dx, dy = LENGTH / (nx - 1), WIDTH / (ny - 1)

@@ -249,7 +249,8 @@ fn film(prestress: [f64; 3]) -> membrane_contact::mech::Material {
         thickness: THICKNESS,
         prestress,
         density: 0.0,
-        wrinkling: Default::default(),
+        // The paper's linear law: the closed forms below are for it (compression included).
+        wrinkling: membrane_contact::mech::Wrinkling::None,
         wrinkling_regularisation:
             membrane_contact::mech::elements::material::DEFAULT_WRINKLING_REGULARISATION,
         yield_stress: None,

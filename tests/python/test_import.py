@@ -297,10 +297,16 @@ def square(n=4, quads=False):
 
 
 MATERIAL = {"youngs_modulus": 1.0e9, "poisson_ratio": 0.43, "thickness": 250e-6, "prestress": [0.5e6, 0.5e6, 0.0]}
+# The paper's linear film, for the small squares that are run: their free edges go into compression
+# under the wind, where the tension-field film (the default of a file without the entry, issue 19)
+# has no unique equilibrium across the wrinkles, and both are refused with it (measured: the wind
+# square stalls at 5.2e-4 N against 9.4e-5 N, the closed cable loop with elements switching between
+# taut and wrinkled); they converge with the linear film, as before the default changed.
+LINEAR = {**MATERIAL, "wrinkling": "none"}
 
 
-def small_mapping(**groups) -> dict:
-    return {"name": "Small", "material": MATERIAL, "physical_groups": groups}
+def small_mapping(material=MATERIAL, **groups) -> dict:
+    return {"name": "Small", "material": material, "physical_groups": groups}
 
 
 @pytest.fixture()
@@ -311,6 +317,7 @@ def small_mesh(tmp_path):
 def test_meshio_written_gmsh41_binary_with_a_cable_and_supports_runs(tmp_path):
     path = write_msh(tmp_path / "square41.msh", *square(), file_format="gmsh", binary=True)
     m = small_mapping(
+        LINEAR,
         film={"role": "pressure", "name": "wind", "pressure": 50.0},
         left={"role": "support", "set": "held"},
         bottom={"role": "support", "fixed": ["y", "z"], "set": "held"},
@@ -357,6 +364,7 @@ def test_a_closed_line_loop_becomes_a_closed_cable(tmp_path):
     names["rim"] = (6, 1)
     path = write_msh(tmp_path / "loop.msh", pts, blocks, names)
     model = import_mesh(path, small_mapping(
+        LINEAR,
         film={"role": "pressure", "name": "inflation", "pressure": 10.0},
         rim={"role": "cable", "area": 1e-5, "youngs_modulus": 1.6e11, "prestress_force": 50.0},
         left={"role": "support"}, bottom={"role": "support", "fixed": ["z"]}, top={"role": "support", "fixed": ["z"]},

@@ -57,6 +57,10 @@ def strip_model():
             "thickness": T0,
             "prestress": [0.0, 0.0, 0.0],
             "plasticity": {"hardening": [[0.0, SY], [1.0, SY + H]]},
+            # The closed form is for a film that carries the lateral compression of the uniaxial
+            # strip (its Poisson contraction is held): the linear film's law, written since the
+            # tension-field film became the default (issue 19).
+            "wrinkling": "none",
         },
         "supports": supports,
         "groups": [{"name": "pull", "nodes": [node(NX, 0), node(NX, 1)], "target": [0.0, 0.0, 0.0],

@@ -251,7 +251,9 @@ impl IncrementFailure {
             Self::Stalled { flipping, .. } if !flipping.is_empty() => format!(
                 "{} film elements switched between taut, wrinkled and slack between the last iterations \
                  (a region on the verge of wrinkling): move the inputs by less per step ({finer}); more \
-                 prestress keeps a film taut",
+                 prestress keeps a film taut; a free film edge in compression has no unique tension-field \
+                 equilibrium: if the film may carry compression there, give the material \
+                 \"wrinkling\": \"none\" (the paper's linear film, which a file without the entry got before)",
                 flipping.len()
             ),
             Self::Stalled { compressed, .. } if !compressed.is_empty() => format!(
