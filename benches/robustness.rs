@@ -135,6 +135,19 @@ fn main() {
             total.5 + r.5,
         );
     }
+    println!(
+        "\n| family | converged | of them every step within the stabilization bound | increments viscously stabilized |\n|---|---|---|---|"
+    );
+    for family in &families {
+        let sel: Vec<_> = pairs.iter().filter(|(s, _)| s.family == *family).collect();
+        println!(
+            "| {} | {} | {} | {} |",
+            family.name(),
+            sel.iter().filter(|(_, (r, _))| r.converged()).count(),
+            sel.iter().filter(|(_, (r, _))| r.within_bound()).count(),
+            sel.iter().map(|(_, (r, _))| r.stabilized()).sum::<usize>()
+        );
+    }
     let failed: Vec<(String, String)> = pairs
         .iter()
         .filter_map(|(s, (r, _))| r.failure_message().map(|m| (s.name.clone(), m.to_string())))

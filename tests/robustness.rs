@@ -875,9 +875,11 @@ fn generated_models_round_trip_through_the_model_file_format() {
 fn refused_step_names_film_elements_that_flip_wrinkling_state() {
     let edge = ArchEdge::default();
     let scenario = edge.lowered(0.5, 80, fmu_increments()).unwrap();
+    // Refused only without the viscous stabilization (with it, the step converges).
     let settings = SolverSettings {
         max_iterations: 6,
         max_cutbacks: 0,
+        stabilization: false,
         ..SolverSettings::default()
     };
     let mut analysis = Analysis::new(scenario.model, settings).unwrap();
@@ -887,4 +889,36 @@ fn refused_step_names_film_elements_that_flip_wrinkling_state() {
         message.contains("film elements changing wrinkling state"),
         "{message}"
     );
+}
+
+/// Issues 19 and 20: ETFE's plastic specimen H = 0.45 m lowered to −H in 40 steps, raised to
+/// −H/2 and lowered again: raised, the plastically lengthened linear film is compressed and its
+/// increments have no unique equilibrium. Without the viscous stabilization the path is refused;
+/// with it (the default) it converges, the stabilization acting in some steps and leaving every
+/// step within its energy bound.
+#[test]
+fn plastic_specimen_raised_after_flowing_converges_with_the_stabilization_within_its_bound() {
+    let name = "plastic specimen H=0.45 mu=0.2 depth=1H steps=40 down-up-down";
+    let s = membrane_contact::specimens::scenarios::plastic_paths(fmu_increments())
+        .unwrap()
+        .into_iter()
+        .find(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no path named {name}"));
+    let without = s.run(SolverSettings {
+        stabilization: false,
+        ..SolverSettings::default()
+    });
+    assert!(
+        !without.converged(),
+        "{name} converges without the stabilization"
+    );
+    assert_eq!(without.stabilized(), 0);
+    let with = s.run(SolverSettings::default());
+    assert!(
+        with.converged(),
+        "{name}: {}",
+        with.failure_message().unwrap_or_default()
+    );
+    assert!(with.stabilized() > 0, "{name}: no increment stabilized");
+    assert!(with.within_bound(), "{name}: a step above the bound");
 }

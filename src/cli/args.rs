@@ -181,6 +181,11 @@ pub struct RunArgs {
     /// at once (the stabilization-free reference of a slack start; docs/mechanics.md)
     #[arg(long)]
     pub no_continuation: bool,
+    /// No viscous stabilization: a step whose increment neither plain Newton nor the
+    /// continuation converge is halved without it (the answer then carries no damping force;
+    /// docs/mechanics.md "Viscous stabilization")
+    #[arg(long)]
+    pub no_stabilization: bool,
     /// Threads of the element assembly (0 = automatic: one below 100 000 triangles, else up to
     /// two; results are identical for every count).
     #[arg(long, value_name = "N", default_value_t = 0)]

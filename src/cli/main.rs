@@ -160,6 +160,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
         line_search: !o.no_line_search,
         continuation: !o.no_continuation,
+        stabilization: !o.no_stabilization,
         threads: o.threads,
         ..defaults
     };
@@ -207,6 +208,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     let (mut iterations, mut cutbacks, mut enlarged, mut increments) = (Vec::new(), 0, 0, 0);
     // Increments solved by continuation, and the step of the largest stabilization ratio.
     let (mut continued, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
+    // Increments solved with the viscous stabilization on.
+    let mut stabilized = 0;
     let count = path.steps.len();
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
@@ -238,7 +241,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         cutbacks += report.cutbacks;
         enlarged += report.enlarged;
         continued += report.continued;
-        if report.continued > 0 {
+        stabilized += report.stabilized;
+        if report.continued > 0 || report.stabilized > 0 {
             let ratio = report.stabilization_ratio();
             if let Some(w) = report.stabilization_warning() {
                 eprintln!("warning: step {step}: {w}");
@@ -294,9 +298,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     );
     if let Some((step, ratio, energy, dissipated)) = stabilization {
         out!(
-            "stabilization: {continued} increments by pseudo-transient continuation; largest artificial energy \
-             left {energy:.3e} J at step {step} ({ratio:.2e} of the strain energy; bound {:.0e}; {dissipated:.3e} J \
-             taken out on the way)",
+            "stabilization: {continued} increments by pseudo-transient continuation, {stabilized} viscously \
+             stabilized; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
+             energy; bound {:.0e}; {dissipated:.3e} J taken out on the way)",
             membrane_contact::mech::solve::report::STABILIZATION_BOUND
         );
     }

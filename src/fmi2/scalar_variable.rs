@@ -163,6 +163,8 @@ pub enum Binding {
     LineSearch,
     /// Pseudo-transient continuation before halving (true) or halving only.
     Continuation,
+    /// Viscous stabilization as the last resort of a step (true) or none.
+    Stabilization,
     /// Threads of the element assembly (0: automatic).
     Threads,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:

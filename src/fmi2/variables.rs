@@ -29,7 +29,7 @@
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
-//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation` | | parameter | | Newton settings |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation`, `solver.stabilization` | | parameter | | Newton settings |
 //! | `solver.threads` | Integer | parameter | | threads of the element assembly (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
@@ -408,7 +408,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          (the paper's: slides along the gap's local x, or along the support, only); empty: each keeps the model file's",
         Binding::FrictionLaw,
     );
-    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 9] = [
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 10] = [
         (
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
@@ -468,6 +468,15 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
              before it is halved (slack films, contacts opening; its remaining artificial energy is \
              solver.stabilizationEnergy); false: halving only",
             Binding::Continuation,
+        ),
+        (
+            "stabilization",
+            Value::Boolean(solver.stabilization),
+            None,
+            "true: a step whose smallest increment nothing else converges is solved on with viscous \
+             stabilization (a film without a unique equilibrium; the work of its force is in \
+             solver.stabilizationEnergy); false: the step is discarded there",
+            Binding::Stabilization,
         ),
         (
             "threads",
@@ -710,8 +719,8 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     table.output(
         "solver.stabilizationEnergy",
         "N.m",
-        "artificial energy the pseudo-transient continuation left at the end of the last step (0 when no \
-         increment needed it)",
+        "artificial energy the pseudo-transient continuation and the viscous stabilization left at the end \
+         of the last step (0 when no increment needed them)",
         Binding::StabilizationEnergy,
     );
     table.output(

@@ -85,7 +85,7 @@ impl Analysis {
         system.set_threads(settings.threads);
         let linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
-        let parts = Contributions::new(&model, &system);
+        let parts = Contributions::new(&model, &system, diagonal_slots(&system));
         let laws = parts.gaps.laws();
         let state = AnalysisState {
             displacement: vec![0.0; model.dof_count()],
@@ -336,7 +336,7 @@ impl Analysis {
 }
 
 /// Slot of each equation's diagonal entry in the value array (the pattern keeps them all).
-fn diagonal_slots(system: &System) -> Vec<usize> {
+pub(crate) fn diagonal_slots(system: &System) -> Vec<usize> {
     let pattern = system.pattern();
     let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
     (0..system.free_count)

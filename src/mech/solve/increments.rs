@@ -35,6 +35,8 @@ impl Analysis {
         // The start of the last converged increment (the linear response's, `sensitivity`).
         let mut last_start = None;
         let mut report = StepReport::default();
+        // The work of the viscous stabilization over the last increment it acted in (J).
+        let mut last_stabilized = 0.0;
         let largest = 1.0 / increments as f64;
         let smallest = largest / 2f64.powi(self.settings.max_cutbacks as i32);
         let (mut done, mut size) = (0.0_f64, largest);
@@ -93,6 +95,9 @@ impl Analysis {
                 }
                 plain => plain,
             };
+            if let Ok((state, _)) = &attempt {
+                self.account_stabilized(&mut report, &state.displacement, &mut last_stabilized);
+            }
             match attempt {
                 Ok((state, history)) => {
                     last_start = Some(std::mem::replace(&mut current, state));
@@ -132,7 +137,7 @@ impl Analysis {
                         self.parts.curved.active_set = false;
                         self.parts.curved.frozen = None;
                     }
-                    // Then larger ones before giving up.
+                    // Then larger ones.
                     let mut larger = 2.0 * largest;
                     while reached.is_none() && larger < 2.0 * (1.0 - done) {
                         let next = (done + larger).min(1.0);
@@ -143,7 +148,30 @@ impl Analysis {
                         }
                         larger *= 2.0;
                     }
+                    // Last, the viscous stabilization at the smallest increment, for the rest of
+                    // the step, from the smallest damping (`contributions/stabilization.rs`):
+                    // only here, so that no increment the attempts above converge carries its
+                    // force.
+                    if reached.is_none()
+                        && self.settings.stabilization
+                        && !self.parts.stabilization.is_on()
+                    {
+                        for c in Self::STABILIZATION_DAMPING {
+                            self.parts.stabilization.switch_on(c);
+                            if let Ok(converged) =
+                                self.solve_increment(&current, &at(next), &levels)
+                            {
+                                reached = Some((next, converged));
+                                held = true;
+                                break;
+                            }
+                        }
+                        if reached.is_none() {
+                            self.parts.stabilization.switch_off();
+                        }
+                    }
                     let Some((next, (state, history))) = reached else {
+                        self.parts.stabilization.switch_off();
                         return Err(StepError::NotConverged {
                             fraction_done: done,
                             cutbacks: report.cutbacks,
@@ -153,6 +181,7 @@ impl Analysis {
                     if !held {
                         report.enlarged += 1;
                     }
+                    self.account_stabilized(&mut report, &state.displacement, &mut last_stabilized);
                     last_start = Some(std::mem::replace(&mut current, state));
                     done = next;
                     report.iterations.push(history.len() - 1);
@@ -165,11 +194,28 @@ impl Analysis {
         self.state = current;
         self.increment_start = last_start;
         self.linear.set_fast(true);
+        self.parts.stabilization.switch_off();
+        self.work.stabilization += last_stabilized;
         report.stabilization_energy = std::mem::take(&mut self.work.stabilization);
         report.stabilization_dissipated = std::mem::take(&mut self.work.dissipated);
         report.strain_energy = self.strain_energy();
         Ok(report)
     }
+
+    /// Counts an increment converged at `u` with the viscous stabilization on, and adds its work
+    /// to the work taken out (`last`: the work of the last such increment, J).
+    fn account_stabilized(&mut self, report: &mut StepReport, u: &[f64], last: &mut f64) {
+        if self.parts.stabilization.is_on() {
+            report.stabilized += 1;
+            let (work, _) = self.parts.stabilization.work_and_force(&self.system, u);
+            self.work.dissipated += work;
+            *last = work;
+        }
+    }
+
+    /// The damping coefficients `c` the viscous stabilization tries, in turn, on the increment
+    /// that turns it on (relative to the mean stiffness: `contributions/stabilization.rs`).
+    pub(crate) const STABILIZATION_DAMPING: [f64; 2] = [1e-5, 1e-3];
 
     /// Converged increments with at most this many iterations let the increment grow.
     pub(crate) const EASY_ITERATIONS: usize = 5;

@@ -30,13 +30,19 @@ pub struct StepReport {
     /// statuses held while Newton converges, changed only between converged solves.
     #[serde(default)]
     pub active_set: usize,
+    /// Increments solved with the viscous stabilization on (`contributions/stabilization.rs`).
+    #[serde(default)]
+    pub stabilized: usize,
     /// Artificial energy left at the end of the step (J): over the increments solved by
     /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
-    /// each (the pseudo-time force still acting when the increment was accepted).
+    /// each (the pseudo-time force still acting when the increment was accepted); and, when the
+    /// viscous stabilization acted, the work of its force over the step's last increment (the
+    /// force the converged answer still carries).
     #[serde(default)]
     pub stabilization_energy: f64,
-    /// Work of the pseudo-time term over all the step's continuation iterations (J): what the
-    /// artificial damping took out on the way to the converged states (Abaqus' ALLSD).
+    /// Work of the pseudo-time term over all the step's continuation iterations, and of the
+    /// viscous stabilization over all its increments (J): what the artificial damping took out on
+    /// the way to the converged states (Abaqus' ALLSD).
     #[serde(default)]
     pub stabilization_dissipated: f64,
     /// Elastic strain energy of the film at the end of the step (J), `Σ A t ½ (S − S0)·E`:
@@ -66,7 +72,7 @@ impl StepReport {
         let ratio = self.stabilization_ratio();
         (ratio > STABILIZATION_BOUND).then(|| {
             format!(
-                "the pseudo-transient continuation left an artificial energy of {:.3e} J, {ratio:.2e} of the \
+                "the stabilization left an artificial energy of {:.3e} J, {ratio:.2e} of the \
                  strain energy {:.3e} J, above the bound {STABILIZATION_BOUND:.0e}: the step's equilibrium is \
                  not reached to the model's accuracy",
                 self.stabilization_energy, self.strain_energy

@@ -39,6 +39,10 @@ pub struct SolverSettings {
     /// not converge, before they are halved; false: halving only (the stabilization-free
     /// reference).
     pub continuation: bool,
+    /// Viscous stabilization (`contributions/stabilization.rs`) for the rest of a step whose
+    /// increment neither plain Newton nor the continuation converge, before it is halved; its
+    /// work is reported against the strain energy. false: never (the stabilization-free answer).
+    pub stabilization: bool,
     /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
     /// below [`crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results
     /// are bit-identical for every count.
@@ -63,6 +67,7 @@ impl Default for SolverSettings {
             line_search: true,
             symmetric_factorization: true,
             continuation: true,
+            stabilization: true,
             threads: 0,
         }
     }

@@ -219,6 +219,10 @@ pub struct StepOutcome {
     pub cutbacks: usize,
     /// Increments made larger than asked because every smaller one failed.
     pub enlarged: usize,
+    /// Increments solved with the viscous stabilization on.
+    pub stabilized: usize,
+    /// Whether the artificial energy left exceeds `STABILIZATION_BOUND` of the strain energy.
+    pub over_bound: bool,
     /// `‖R_free‖∞` at the converged end of the step (N; 0 for a refused step).
     pub residual: f64,
     /// The error text when the step was refused.
@@ -273,6 +277,16 @@ impl RunOutcome {
     /// Cut-backs (including those of a refused step).
     pub fn cutbacks(&self) -> usize {
         self.steps.iter().map(|s| s.cutbacks).sum()
+    }
+
+    /// Increments solved with the viscous stabilization on, over all steps.
+    pub fn stabilized(&self) -> usize {
+        self.steps.iter().map(|s| s.stabilized).sum()
+    }
+
+    /// Whether every step converged within the stabilization bound.
+    pub fn within_bound(&self) -> bool {
+        self.converged() && self.steps.iter().all(|s| !s.over_bound)
     }
 
     /// Enlarged increments over all steps.
@@ -342,6 +356,8 @@ impl Scenario {
                     increments: 0,
                     cutbacks: 0,
                     enlarged: 0,
+                    stabilized: 0,
+                    over_bound: false,
                     residual: 0.0,
                     error: None,
                 };
@@ -354,6 +370,8 @@ impl Scenario {
                         record.increments = report.iterations.len();
                         record.cutbacks = report.cutbacks;
                         record.enlarged = report.enlarged;
+                        record.stabilized = report.stabilized;
+                        record.over_bound = report.stabilization_warning().is_some();
                         record.residual = report.residual;
                         observe(&record, &mut analysis);
                         outcome.steps.push(record);

@@ -19,7 +19,8 @@
 //! a trial copy in `add` and writes it in `commit`; the loop stays as it is.
 //!
 //! The order of [`Contributions::all_mut`] is the order of the floating-point sums into the
-//! residual and the matrix: triangles, gaps, loads, cables, curved contacts.
+//! residual and the matrix: triangles, gaps, loads, cables, curved contacts, and last the
+//! viscous stabilization (off unless a step needs it; it sizes itself from the others' matrix).
 //!
 //! | file | what |
 //! |---|---|
@@ -27,14 +28,17 @@
 //! | `gaps` | the friction gaps: trial laws and slip history, Ju–Rowlands latching |
 //! | `loads` | external loads and edge cables |
 //! | `curved` | node-to-surface contacts on curved supports |
+//! | `stabilization` | the viscous stabilization of a step whose equilibrium is not unique |
 
 mod curved;
 mod gaps;
 mod loads;
+mod stabilization;
 mod triangles;
 
 pub use curved::CurvedContacts;
 pub use gaps::Gaps;
+pub use stabilization::ViscousStabilization;
 pub use triangles::Triangles;
 
 use crate::mech::elements::cable::Cables;
@@ -156,39 +160,44 @@ pub struct Contributions {
     pub cables: Cables,
     /// Node-to-surface contacts on curved supports.
     pub curved: CurvedContacts,
+    /// The viscous stabilization of the current step (off unless a step turns it on).
+    pub stabilization: ViscousStabilization,
 }
 
 impl Contributions {
-    /// The contributions of `model` on `system`.
-    pub fn new(model: &Model, system: &System) -> Self {
+    /// The contributions of `model` on `system` (`diagonal`: each free equation's diagonal slot).
+    pub fn new(model: &Model, system: &System, diagonal: Vec<usize>) -> Self {
         Self {
             triangles: Triangles::default(),
             gaps: Gaps::new(model),
             loads: Loads::new(model, system),
             cables: Cables::new(model),
             curved: CurvedContacts::new(model),
+            stabilization: ViscousStabilization::new(system, diagonal),
         }
     }
 
     /// All of them, in assembly order (the order of the floating-point sums).
-    pub fn all_mut(&mut self) -> [&mut dyn Contribution; 5] {
+    pub fn all_mut(&mut self) -> [&mut dyn Contribution; 6] {
         [
             &mut self.triangles,
             &mut self.gaps,
             &mut self.loads,
             &mut self.cables,
             &mut self.curved,
+            &mut self.stabilization,
         ]
     }
 
     /// All of them, in assembly order.
-    pub fn all(&self) -> [&dyn Contribution; 5] {
+    pub fn all(&self) -> [&dyn Contribution; 6] {
         [
             &self.triangles,
             &self.gaps,
             &self.loads,
             &self.cables,
             &self.curved,
+            &self.stabilization,
         ]
     }
 
