@@ -157,7 +157,11 @@ impl Analysis {
     /// the triangles (the prestress's share left out, so that it is never negative for the
     /// linear film; cables and contacts not included).
     pub fn strain_energy(&self) -> f64 {
-        let u = &self.state.displacement;
+        self.strain_energy_at(&self.state.displacement)
+    }
+
+    /// [`Self::strain_energy`] at the displacements `u` (J).
+    pub(crate) fn strain_energy_at(&self, u: &[f64]) -> f64 {
         let m = &self.system.material;
         self.system
             .triangles

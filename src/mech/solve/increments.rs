@@ -4,7 +4,7 @@ use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
-use crate::mech::solve::report::{StepError, StepReport};
+use crate::mech::solve::report::{STABILIZATION_BOUND, StepError, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
 impl Analysis {
@@ -152,11 +152,13 @@ impl Analysis {
                     // the step, from the smallest damping (`contributions/stabilization.rs`):
                     // only here, so that no increment the attempts above converge carries its
                     // force.
-                    if reached.is_none()
-                        && self.settings.stabilization
-                        && !self.parts.stabilization.is_on()
-                    {
-                        for c in Self::STABILIZATION_DAMPING {
+                    if reached.is_none() && self.settings.stabilization {
+                        // Already on (softened by `account_stabilized`): only larger dampings.
+                        let from = self.parts.stabilization.coefficient;
+                        for c in Self::STABILIZATION_DAMPING
+                            .into_iter()
+                            .filter(|&c| c > from)
+                        {
                             self.parts.stabilization.switch_on(c);
                             if let Ok(converged) =
                                 self.solve_increment(&current, &at(next), &levels)
@@ -210,6 +212,11 @@ impl Analysis {
             let (work, _) = self.parts.stabilization.work_and_force(&self.system, u);
             self.work.dissipated += work;
             *last = work;
+            // Adaptive, as Abaqus' adaptive stabilization: an increment that left more than the
+            // bound makes the damping of the next ones ten times smaller.
+            if work > STABILIZATION_BOUND * self.strain_energy_at(u).abs() {
+                self.parts.stabilization.soften();
+            }
         }
     }
 

@@ -66,6 +66,14 @@ impl ViscousStabilization {
         (self.coefficient, self.scale) = (coefficient, 0.0);
     }
 
+    /// A tenth of the damping for the next increments (not below [`Self::SMALLEST`]), `k̄` kept.
+    pub fn soften(&mut self) {
+        self.coefficient = (0.1 * self.coefficient).max(Self::SMALLEST);
+    }
+
+    /// The smallest damping [`Self::soften`] goes to.
+    pub const SMALLEST: f64 = 1e-7;
+
     /// Turns it off (the end of a step).
     pub fn switch_off(&mut self) {
         (self.coefficient, self.scale) = (0.0, 0.0);
