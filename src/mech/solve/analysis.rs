@@ -85,7 +85,10 @@ impl Analysis {
         system.set_threads(settings.threads);
         let linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
-        let parts = Contributions::new(&model, &system, diagonal_slots(&system));
+        // Computed once: the workspace (Levenberg–Marquardt shift, continuation) and the viscous
+        // stabilization both use them.
+        let (diagonal, mass) = (diagonal_slots(&system), pseudo_mass(&system));
+        let parts = Contributions::new(&model, &system, diagonal.clone(), mass.clone());
         let laws = parts.gaps.laws();
         let state = AnalysisState {
             displacement: vec![0.0; model.dof_count()],
@@ -110,10 +113,10 @@ impl Analysis {
             internal: vec![0.0; model.dof_count()],
             values: vec![0.0; system.nonzeros()],
             rhs: vec![0.0; system.free_count],
-            diagonal: diagonal_slots(&system),
+            diagonal,
             watchdog: true,
             continuation: false,
-            pseudo_mass: pseudo_mass(&system),
+            pseudo_mass: mass,
             stabilization: 0.0,
             dissipated: 0.0,
             last_work: 0.0,

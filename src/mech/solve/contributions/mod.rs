@@ -165,15 +165,16 @@ pub struct Contributions {
 }
 
 impl Contributions {
-    /// The contributions of `model` on `system` (`diagonal`: each free equation's diagonal slot).
-    pub fn new(model: &Model, system: &System, diagonal: Vec<usize>) -> Self {
+    /// The contributions of `model` on `system` (`diagonal`: each free equation's diagonal slot;
+    /// `mass`: its pseudo-mass, `continuation::pseudo_mass`).
+    pub fn new(model: &Model, system: &System, diagonal: Vec<usize>, mass: Vec<f64>) -> Self {
         Self {
             triangles: Triangles::default(),
             gaps: Gaps::new(model),
             loads: Loads::new(model, system),
             cables: Cables::new(model),
             curved: CurvedContacts::new(model),
-            stabilization: ViscousStabilization::new(system, diagonal),
+            stabilization: ViscousStabilization::new(diagonal, mass),
         }
     }
 

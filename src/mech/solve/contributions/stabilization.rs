@@ -9,7 +9,7 @@
 //!
 //! `F_v,i = c k̄ m_i (U_i − U_i,start)`,   `∂F_v,i/∂U_i = c k̄ m_i`,
 //!
-//! `m_i` the pseudo-mass of [`pseudo_mass`] (the node's tributary area over the mean), `k̄` the
+//! `m_i` the pseudo-mass of [`pseudo_mass`](crate::mech::solve::continuation::pseudo_mass) (the node's tributary area over the mean), `k̄` the
 //! mean magnitude of the free diagonal of the Newton matrix where the stabilization starts (so
 //! that `c` is dimensionless: the force is `c` times what the mean stiffness gives for the same
 //! motion), `U_start` the converged state the increment starts from. A film with no stiffness in
@@ -26,7 +26,6 @@
 
 use super::{Contribution, Evaluation};
 use crate::mech::solve::assembly::{Dof, System};
-use crate::mech::solve::continuation::pseudo_mass;
 use crate::mech::solve::state::AnalysisState;
 
 /// The viscous stabilization of the current step ([module doc](self)).
@@ -45,12 +44,13 @@ pub struct ViscousStabilization {
 }
 
 impl ViscousStabilization {
-    /// Off, for `system` (`diagonal`: each free equation's diagonal slot).
-    pub fn new(system: &System, diagonal: Vec<usize>) -> Self {
+    /// Off (`diagonal`: each free equation's diagonal slot; `mass`: its pseudo-mass,
+    /// [`pseudo_mass`](crate::mech::solve::continuation::pseudo_mass)).
+    pub fn new(diagonal: Vec<usize>, mass: Vec<f64>) -> Self {
         Self {
             coefficient: 0.0,
             scale: 0.0,
-            mass: pseudo_mass(system),
+            mass,
             diagonal,
             start: Vec::new(),
         }
@@ -128,6 +128,7 @@ mod tests {
     use super::*;
     use crate::mech::elements::load::LoadLevels;
     use crate::mech::solve::analysis::{Analysis, diagonal_slots};
+    use crate::mech::solve::continuation::pseudo_mass;
     use crate::mech::solve::settings::SolverSettings;
     use crate::specimens::ParallelArch;
 
@@ -143,7 +144,7 @@ mod tests {
         .unwrap();
         let system = &a.system;
         let diagonal = diagonal_slots(system);
-        let mut s = ViscousStabilization::new(system, diagonal.clone());
+        let mut s = ViscousStabilization::new(diagonal.clone(), pseudo_mass(system));
         let dofs = system.dofs.len();
         let wave = |k: usize, a: f64| (0..dofs).map(|i| a * ((i * k) as f64).sin()).collect();
         let start = AnalysisState {
