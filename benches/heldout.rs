@@ -736,8 +736,9 @@ fn main() {
 }
 
 /// The refusal classes of [`failure_class`], in table order.
-const CLASSES: [&str; 8] = [
+const CLASSES: [&str; 9] = [
     "singular matrix",
+    "sliding-direction lift-off",
     "contact status chatter",
     "wrinkling-state flips",
     "linear film in compression",
@@ -752,20 +753,22 @@ const CLASSES: [&str; 8] = [
 fn failure_class(message: &str) -> &'static str {
     if message.contains("singular Newton matrix") {
         CLASSES[0]
-    } else if message.contains("contacts changing status") {
+    } else if message.contains("lifting off with more than μN across") {
         CLASSES[1]
-    } else if message.contains("changing wrinkling state") {
+    } else if message.contains("contacts changing status") {
         CLASSES[2]
-    } else if message.contains("in compression") {
+    } else if message.contains("changing wrinkling state") {
         CLASSES[3]
+    } else if message.contains("in compression") {
+        CLASSES[4]
     } else if message.contains("no progress") && message.contains("the residual met its tolerance")
     {
-        CLASSES[4]
-    } else if message.contains("no progress") {
         CLASSES[5]
-    } else if message.contains("iteration limit") {
+    } else if message.contains("no progress") {
         CLASSES[6]
-    } else {
+    } else if message.contains("iteration limit") {
         CLASSES[7]
+    } else {
+        CLASSES[8]
     }
 }

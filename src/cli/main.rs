@@ -134,6 +134,7 @@ fn setting_names(o: &RunArgs) -> SettingNames {
         residual_tolerance: "--residual-tolerance",
         displacement_tolerance: "--displacement-tolerance",
         consistent_tangent: "--matrix consistent",
+        isotropic_friction: "--friction-law isotropic (or \"friction_law\": \"isotropic\" on those supports or gaps in the model file)",
     }
 }
 

@@ -27,6 +27,7 @@ const SETTING_NAMES: SettingNames = SettingNames {
     residual_tolerance: "solver.residualTolerance",
     displacement_tolerance: "solver.displacementTolerance",
     consistent_tangent: "solver.useJuRowlands = false",
+    isotropic_friction: "the parameter frictionLaw = \"isotropic\" (or \"friction_law\": \"isotropic\" on those supports or gaps in the model file)",
 };
 
 impl Instance {

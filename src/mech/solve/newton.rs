@@ -105,6 +105,7 @@ impl Analysis {
                             chattering: set.cycling(&self.parts.curved.names),
                             flipping: Vec::new(),
                             compressed: Vec::new(),
+                            lifting: self.lifting_contacts(),
                         });
                     }
                     self.parts.curved.frozen = Some(natural);
@@ -158,6 +159,7 @@ impl Analysis {
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
                     compressed: self.compressed_elements(&u),
+                    lifting: self.lifting_contacts(),
                 });
             }
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
@@ -185,6 +187,7 @@ impl Analysis {
                     chattering: chattering(),
                     flipping: self.flipping_elements(&previous_u, &u),
                     compressed: self.compressed_elements(&u),
+                    lifting: self.lifting_contacts(),
                 });
             }
             shifted = damping > 0.0;
@@ -264,6 +267,16 @@ impl Analysis {
             c.compressed(&self.system, u, &mut elements);
         }
         elements
+    }
+
+    /// Contacts of the sliding-direction law that opened and closed in this attempt while
+    /// holding more than `μN` across (`contributions::LiftOff`). Called once when an increment fails.
+    fn lifting_contacts(&self) -> Vec<String> {
+        let mut names = Vec::new();
+        for c in self.parts.all() {
+            c.lifting_off(&mut names);
+        }
+        names
     }
 
     /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).

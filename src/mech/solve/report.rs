@@ -149,6 +149,8 @@ pub struct SettingNames {
     pub displacement_tolerance: &'static str,
     /// How to choose the consistent tangent over the Ju–Rowlands matrix.
     pub consistent_tangent: &'static str,
+    /// How to give the supports and gaps the isotropic friction law.
+    pub isotropic_friction: &'static str,
 }
 
 impl SettingNames {
@@ -159,6 +161,7 @@ impl SettingNames {
         residual_tolerance: "residual_tolerance",
         displacement_tolerance: "displacement_tolerance",
         consistent_tangent: "iteration_matrix = Consistent",
+        isotropic_friction: "\"friction_law\": \"isotropic\" on those supports or gaps in the model file",
     };
 }
 
@@ -182,6 +185,9 @@ pub enum IncrementFailure {
         /// Elements of a linear film (`wrinkling: "none"`) in compression (`σ2 < 0`) at the last
         /// iterate.
         compressed: Vec<usize>,
+        /// Sliding-direction contacts that lifted off holding more than `μN` across
+        /// ([`crate::mech::solve::contributions::LiftOff`]).
+        lifting: Vec<String>,
     },
     /// Neither the residual nor the correction improved for a while (a cycle between states or
     /// a plateau).
@@ -196,6 +202,8 @@ pub enum IncrementFailure {
         flipping: Vec<usize>,
         /// Film elements in compression (`σ2 < 0`, no wrinkling) at the last iterate.
         compressed: Vec<usize>,
+        /// Sliding-direction contacts that lifted off holding more than `μN` across.
+        lifting: Vec<String>,
     },
     /// NaN/Inf or runaway corrections.
     Diverged { iteration: usize },
@@ -228,8 +236,21 @@ impl IncrementFailure {
             residual_tolerance,
             displacement_tolerance,
             consistent_tangent,
+            isotropic_friction,
         } = names;
         match self {
+            Self::MaxIterations { lifting, .. } | Self::Stalled { lifting, .. }
+                if !lifting.is_empty() =>
+            {
+                format!(
+                    "contacts {} opened and closed while the sliding-direction friction law (the paper's) \
+                     held the film across the support with more than μN: that law keeps the cross direction \
+                     elastic however little a contact presses, so the cross force vanishes at once where it \
+                     lifts off, a jump Newton cannot settle; give them the isotropic law, whose friction \
+                     vanishes with the contact force ({isotropic_friction})",
+                    name_list(lifting)
+                )
+            }
             Self::MaxIterations {
                 matrix: IterationMatrix::JuRowlands,
                 ..
@@ -298,7 +319,15 @@ impl fmt::Display for IncrementFailure {
         let chatter = |f: &mut fmt::Formatter<'_>,
                        names: &[String],
                        elements: &[usize],
-                       compressed: &[usize]| {
+                       compressed: &[usize],
+                       lifting: &[String]| {
+            if !lifting.is_empty() {
+                write!(
+                    f,
+                    "; sliding-direction contacts lifting off with more than μN across: {}",
+                    name_list(lifting)
+                )?;
+            }
             if !compressed.is_empty() {
                 let numbers: Vec<String> = compressed.iter().map(|e| e.to_string()).collect();
                 write!(
@@ -331,6 +360,7 @@ impl fmt::Display for IncrementFailure {
                 chattering,
                 flipping,
                 compressed,
+                lifting,
                 ..
             } => {
                 write!(
@@ -340,7 +370,7 @@ impl fmt::Display for IncrementFailure {
                     last.iteration,
                     last.verdict()
                 )?;
-                chatter(f, chattering, flipping, compressed)
+                chatter(f, chattering, flipping, compressed, lifting)
             }
             Self::Stalled {
                 iteration,
@@ -348,6 +378,7 @@ impl fmt::Display for IncrementFailure {
                 chattering,
                 flipping,
                 compressed,
+                lifting,
             } => {
                 write!(
                     f,
@@ -356,7 +387,7 @@ impl fmt::Display for IncrementFailure {
                     closest.iteration,
                     closest.verdict()
                 )?;
-                chatter(f, chattering, flipping, compressed)
+                chatter(f, chattering, flipping, compressed, lifting)
             }
             Self::Diverged { iteration } => {
                 write!(
@@ -453,6 +484,7 @@ mod advice_tests {
             chattering: vec![],
             flipping: vec![],
             compressed: vec![4, 5, 6],
+            lifting: vec![],
         };
         assert!(
             with.to_string()
@@ -488,6 +520,7 @@ mod advice_tests {
             chattering: vec![],
             flipping: vec![],
             compressed: vec![],
+            lifting: vec![],
         }
     }
 
@@ -528,6 +561,7 @@ mod advice_tests {
             chattering: vec![],
             flipping: vec![],
             compressed: vec![],
+            lifting: vec![],
         }
         .advice(&SettingNames::CORE)
     }
@@ -543,6 +577,36 @@ mod advice_tests {
         );
         let jr = out_of_iterations(4.9, 3.4, IterationMatrix::JuRowlands);
         assert!(jr.contains("consistent tangent"), "{jr}");
+    }
+
+    /// A contact that lifted off holding more than `μN` across is named in the message, and
+    /// the advice (before any other) is the isotropic law, as the front end sets it.
+    #[test]
+    fn a_stall_with_a_sliding_direction_contact_lifting_off_advises_the_isotropic_law() {
+        let mut failure = stall(record(2.0e-4, 1.0e-9));
+        if let IncrementFailure::Stalled {
+            chattering,
+            lifting,
+            ..
+        } = &mut failure
+        {
+            (*chattering, *lifting) = (vec!["tube1.3".into()], vec!["tube1.3".into()]);
+        }
+        assert!(
+            failure
+                .to_string()
+                .contains("lifting off with more than μN across: tube1.3")
+        );
+        let fmu = SettingNames {
+            isotropic_friction: "frictionLaw = \"isotropic\"",
+            ..SettingNames::CORE
+        };
+        let advice = failure.advice(&fmu);
+        assert!(
+            advice.starts_with("contacts tube1.3 opened and closed"),
+            "{advice}"
+        );
+        assert!(advice.contains("(frictionLaw = \"isotropic\")"), "{advice}");
     }
 
     #[test]

@@ -288,6 +288,11 @@ impl SurfaceContact {
         self.respond_as(x, history, None)
     }
 
+    /// The friction law.
+    pub fn law(&self) -> FrictionLaw {
+        self.law
+    }
+
     /// The response with the status `frozen` imposed when given (an active-set iteration:
     /// closed means the penalty force `−k_n g` even where the gap has opened, open means no
     /// force even where it penetrates, stick or slip picks that branch of the friction law);

@@ -2,9 +2,9 @@
 //! origin, status, μ) of each contact at the increment's start, the responses of the last
 //! evaluation, and the histories committed from them.
 
-use super::{Contribution, Evaluation, StatusChanges};
+use super::{Contribution, Evaluation, LiftOff, StatusChanges};
 use crate::mech::elements::curved_contact::{ContactHistory, ContactResponse, SurfaceContacts};
-use crate::mech::elements::gap::GapStatus;
+use crate::mech::elements::gap::{FrictionLaw, GapStatus};
 use crate::mech::model::Model;
 use crate::mech::results::Results;
 use crate::mech::solve::state::AnalysisState;
@@ -26,6 +26,8 @@ pub struct CurvedContacts {
     pub names: Vec<String>,
     /// The law's status changes over the Newton iterations.
     changes: StatusChanges,
+    /// Sliding-direction contacts lifting off with more than `μN` across ([`LiftOff`]).
+    lift: LiftOff,
 }
 
 impl CurvedContacts {
@@ -44,6 +46,7 @@ impl CurvedContacts {
                 .flat_map(|s| (0..s.nodes.len()).map(move |k| format!("{}.{k}", s.name)))
                 .collect(),
             changes: StatusChanges::default(),
+            lift: LiftOff::default(),
         }
     }
 
@@ -69,6 +72,7 @@ impl Contribution for CurvedContacts {
     fn restore(&mut self, start: &AnalysisState) {
         self.start.clone_from(&start.contacts);
         self.changes.reset(start.contacts.iter().map(|h| h.status));
+        self.lift.reset(self.start.len());
     }
 
     fn note_iteration(&mut self, iteration: usize) {
@@ -78,6 +82,10 @@ impl Contribution for CurvedContacts {
 
     fn chattering(&self, since: usize, out: &mut Vec<String>) {
         self.changes.changed_since(since, &self.names, out);
+    }
+
+    fn lifting_off(&self, out: &mut Vec<String>) {
+        self.lift.lifted(&self.names, out);
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
@@ -90,6 +98,20 @@ impl Contribution for CurvedContacts {
             values,
             &mut self.responses,
         );
+        for (k, ((c, h), r)) in self
+            .contacts
+            .contacts
+            .iter()
+            .zip(&self.start)
+            .zip(&self.responses)
+            .enumerate()
+        {
+            if c.law() == FrictionLaw::SlidingDirection {
+                let open = r.status == GapStatus::Open;
+                self.lift
+                    .note(k, open, r.friction.y, h.friction * r.normal_force);
+            }
+        }
     }
 
     fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {

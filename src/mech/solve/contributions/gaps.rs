@@ -4,8 +4,8 @@
 
 use nalgebra::Vector2;
 
-use super::{Contribution, Evaluation, StatusChanges};
-use crate::mech::elements::gap::{GapLaw, GapResponse, GapStatus, IterationMatrix};
+use super::{Contribution, Evaluation, LiftOff, StatusChanges};
+use crate::mech::elements::gap::{FrictionLaw, GapLaw, GapResponse, GapStatus, IterationMatrix};
 use crate::mech::model::Model;
 use crate::mech::results::{GapResult, Results};
 use crate::mech::solve::state::AnalysisState;
@@ -29,6 +29,8 @@ pub struct Gaps {
     changes: StatusChanges,
     /// Names (for the advice of a stalled increment).
     names: Vec<String>,
+    /// Sliding-direction gaps lifting off with more than `μN` across ([`LiftOff`]).
+    lift: LiftOff,
 }
 
 impl Gaps {
@@ -47,6 +49,7 @@ impl Gaps {
             trial: Vec::new(),
             history: Vec::new(),
             names: model.gaps.iter().map(|g| g.name.clone()).collect(),
+            lift: LiftOff::default(),
             laws,
         }
     }
@@ -78,6 +81,7 @@ impl Contribution for Gaps {
         self.latched.iter_mut().for_each(|l| *l = None);
         self.closed.iter_mut().for_each(|c| *c = false);
         self.changes.reset(start.status.iter().copied());
+        self.lift.reset(self.laws.len());
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
@@ -125,6 +129,13 @@ impl Contribution for Gaps {
             };
             (response.force, matrix)
         });
+        for (g, (law, r)) in self.trial.iter().zip(&self.responses).enumerate() {
+            if law.friction_law == FrictionLaw::SlidingDirection {
+                let open = r.status == GapStatus::Open;
+                self.lift
+                    .note(g, open, r.force.y, law.friction * r.normal_force);
+            }
+        }
     }
 
     fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
@@ -152,6 +163,10 @@ impl Contribution for Gaps {
 
     fn chattering(&self, since: usize, out: &mut Vec<String>) {
         self.changes.changed_since(since, &self.names, out);
+    }
+
+    fn lifting_off(&self, out: &mut Vec<String>) {
+        self.lift.lifted(&self.names, out);
     }
 
     /// The status is the one found when the increment converged.
