@@ -26,7 +26,9 @@
 //! Options (after `--`): `--family NAME` (repeatable), `--quick` (every 5th path),
 //! `--name TEXT` (only the paths whose name contains TEXT; repeatable: any of them),
 //! `--failures` (every failed path), `--threads N`, `--check` (exit 1 unless every path run
-//! converges), `--list` (the paths, not run), `--write DIR` (the model files, not run).
+//! converges), `--list` (the paths, not run), `--write DIR` (the model files and, beside each,
+//! its stages as `*.stages.json`, not run), `--seed N` (another set from the same generator:
+//! paths this set never showed, to check that a gain is not particular to it).
 //!
 //! After the family table, a table of the refusals by class ([`failure_class`]): what the
 //! refusal's message says stopped the last attempt of the refused increment.
@@ -485,8 +487,11 @@ fn steps_family() -> Vec<HeldOut> {
 }
 
 /// Every path of the set, in a fixed order.
-fn held_out_set() -> Vec<HeldOut> {
-    let mut r = Random(0x1915_2026);
+/// The seed of the held-out set (`--seed` draws another set from the same generator).
+const SEED: u64 = 0x1915_2026;
+
+fn held_out_set(seed: u64) -> Vec<HeldOut> {
+    let mut r = Random(seed);
     let mut set = arches_family(&mut r, 40);
     set.extend(reversal_family(&mut r, 24));
     set.extend(slack_family(&mut r, 30));
@@ -580,6 +585,7 @@ const FAMILIES: [&str; 4] = ["arches", "reversal", "slack", "steps"];
 
 fn main() {
     let (mut list, mut write, mut names) = (false, None, Vec::<String>::new());
+    let mut seed = SEED;
     let o = PathOptions::parse(&FAMILIES, |flag, rest| match flag {
         "--name" => {
             names.push(rest.next().ok_or("--name needs a text")?);
@@ -593,6 +599,11 @@ fn main() {
             write = Some(rest.next().ok_or("--write needs a directory")?);
             Ok(true)
         }
+        "--seed" => {
+            let text = rest.next().ok_or("--seed needs a number")?;
+            seed = text.parse().map_err(|e| format!("--seed {text}: {e}"))?;
+            Ok(true)
+        }
         _ => Ok(false),
     });
     let o = o.unwrap_or_else(|e| {
@@ -601,7 +612,7 @@ fn main() {
     });
     let increments = usize::try_from(DEFAULT_INCREMENTS_PER_STEP).unwrap();
     let stride = if o.quick { 5 } else { 1 };
-    let set = held_out_set();
+    let set = held_out_set(seed);
     let paths: Vec<HeldOut> = o
         .families
         .iter()
@@ -625,6 +636,16 @@ fn main() {
         for (k, p) in paths.iter().enumerate() {
             let file = format!("{dir}/{}_{k}.json", p.family);
             std::fs::write(&file, p.model.to_string()).expect("--write: a file");
+            let stages: Vec<Value> = p
+                .stages
+                .iter()
+                .map(|s| {
+                    json!({"targets": s.targets, "angles": s.angles, "pressure": s.pressure,
+                        "force": s.force, "gravity": s.gravity, "steps": s.steps})
+                })
+                .collect();
+            let staged = format!("{dir}/{}_{k}.stages.json", p.family);
+            std::fs::write(&staged, Value::from(stages).to_string()).expect("--write: a file");
             println!("{file}: {}", p.name);
         }
         return;

@@ -160,9 +160,20 @@ impl Analysis {
                             .filter(|&c| c > from)
                         {
                             self.parts.stabilization.switch_on(c);
-                            if let Ok(converged) =
-                                self.solve_increment(&current, &at(next), &levels)
-                            {
+                            let mut attempt = self.solve_increment(&current, &at(next), &levels);
+                            // With the damping, as without it: the continuation after plain
+                            // Newton (a contact changing status raises its pseudo-time shift
+                            // instead of cutting the step along a direction of the other status).
+                            if attempt.is_err() && self.settings.continuation {
+                                self.work.continuation = true;
+                                attempt = self.solve_increment(&current, &at(next), &levels);
+                                self.work.continuation = false;
+                                if attempt.is_ok() {
+                                    report.continued += 1;
+                                    self.work.stabilization += self.work.last_work;
+                                }
+                            }
+                            if let Ok(converged) = attempt {
                                 reached = Some((next, converged));
                                 held = true;
                                 break;
