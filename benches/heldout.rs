@@ -28,7 +28,10 @@
 //! `--failures` (every failed path), `--threads N`, `--check` (exit 1 unless every path run
 //! converges), `--list` (the paths, not run), `--write DIR` (the model files and, beside each,
 //! its stages as `*.stages.json`, not run), `--seed N` (another set from the same generator:
-//! paths this set never showed, to check that a gain is not particular to it).
+//! paths this set never showed, to check that a gain is not particular to it), `--advice` (after
+//! the tables, every refused path again with the change its refusal advises: the isotropic law
+//! on the supports it names, or four times the increments per step; a table of how many then
+//! converge, per class).
 //!
 //! After the family table, a table of the refusals by class ([`failure_class`]): what the
 //! refusal's message says stopped the last attempt of the refused increment.
@@ -585,6 +588,7 @@ const FAMILIES: [&str; 4] = ["arches", "reversal", "slack", "steps"];
 
 fn main() {
     let (mut list, mut write, mut names) = (false, None, Vec::<String>::new());
+    let mut advice = false;
     let mut seed = SEED;
     let o = PathOptions::parse(&FAMILIES, |flag, rest| match flag {
         "--name" => {
@@ -593,6 +597,10 @@ fn main() {
         }
         "--list" => {
             list = true;
+            Ok(true)
+        }
+        "--advice" => {
+            advice = true;
             Ok(true)
         }
         "--write" => {
@@ -754,6 +762,119 @@ fn main() {
         }
     }
     o.finish(total, 1, wall, &failed);
+    if advice && !failed.is_empty() {
+        follow_advice(&paths, &results, increments, o.threads);
+    }
+}
+
+/// A path changed as a refusal advises, its increments per step and what was changed.
+type Advised = (HeldOut, usize, String);
+
+/// The change a refusal's advice names, applied to its path (`--advice`): the isotropic law
+/// on the supports of the named sliding-direction contacts, otherwise four times the
+/// increments per step ("move the inputs by less per step"). `None` where the advice names
+/// nothing to apply.
+fn advised(path: &HeldOut, message: &str, increments: usize) -> Option<Advised> {
+    if failure_class(message) == CLASSES[1] {
+        let named = message
+            .split("lifting off with more than μN across: ")
+            .nth(1)?
+            .split([')', ';'])
+            .next()?;
+        let supports: Vec<&str> = named
+            .split(", ")
+            .filter_map(|c| c.rsplit_once('.').map(|(s, _)| s))
+            .collect();
+        let mut changed = path.clone();
+        let list = changed.model.get_mut("curved_supports")?.as_array_mut()?;
+        let mut count = 0;
+        for s in list.iter_mut() {
+            if supports.iter().any(|n| s["name"] == *n) {
+                s["friction_law"] = json!("isotropic");
+                count += 1;
+            }
+        }
+        (count > 0).then(|| {
+            (
+                changed,
+                increments,
+                format!("isotropic law on {count} supports"),
+            )
+        })
+    } else if message.contains("raise the increments per step") {
+        Some((
+            path.clone(),
+            4 * increments,
+            format!("{} increments per step", 4 * increments),
+        ))
+    } else {
+        None
+    }
+}
+
+/// Runs every refused path again with the change its refusal advises ([`advised`]) and prints,
+/// per refusal class, how many then converge: the advice measured on the cases that produced it
+/// (issue 19 item 3).
+fn follow_advice(paths: &[HeldOut], results: &[Outcome], increments: usize, threads: usize) {
+    let tries: Vec<(&str, &str, Option<Advised>)> = paths
+        .iter()
+        .zip(results)
+        .filter_map(|(p, r)| {
+            let e = r.error.as_deref()?;
+            Some((failure_class(e), p.name.as_str(), advised(p, e, increments)))
+        })
+        .collect();
+    let next = AtomicUsize::new(0);
+    let outcomes = Mutex::new(vec![None; tries.len()]);
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some((_, _, t)) = tries.get(i) else { break };
+                    if let Some((path, n, _)) = t {
+                        let outcome = run(path, *n);
+                        outcomes.lock().unwrap()[i] = Some(outcome);
+                    }
+                }
+            });
+        }
+    });
+    let outcomes = outcomes.into_inner().unwrap();
+    println!(
+        "\n### The refusals' advice followed\n\n| refusal class | refused | advice applied | converged after it | of them |\n|---|---|---|---|---|"
+    );
+    for class in CLASSES {
+        let rows: Vec<usize> = (0..tries.len()).filter(|&i| tries[i].0 == class).collect();
+        if rows.is_empty() {
+            continue;
+        }
+        let applied = rows.iter().filter(|&&i| tries[i].2.is_some()).count();
+        let gained: Vec<&str> = rows
+            .iter()
+            .filter(|&&i| outcomes[i].as_ref().is_some_and(|o| o.error.is_none()))
+            .map(|&i| tries[i].1.split(' ').next().unwrap_or(tries[i].1))
+            .collect();
+        println!(
+            "| {class} | {} | {applied} | {} | {} |",
+            rows.len(),
+            gained.len(),
+            gained.join(", ")
+        );
+    }
+    for (i, (_, name, t)) in tries.iter().enumerate() {
+        let what = t
+            .as_ref()
+            .map_or("nothing to apply", |(_, _, w)| w.as_str());
+        let result = match &outcomes[i] {
+            Some(o) => o.error.as_deref().unwrap_or("converged").to_string(),
+            None => "–".into(),
+        };
+        println!(
+            "- {name} ({what}): {}",
+            result.chars().take(300).collect::<String>()
+        );
+    }
 }
 
 /// The refusal classes of [`failure_class`], in table order.

@@ -1040,3 +1040,19 @@ fn panel_lowered_and_turned_over_one_arch_converges_with_the_stabilization_withi
         "converges without the stabilization"
     );
 }
+
+/// Held-out `reversal#9` (four arches, 0.9 MPa, tension-field film; rails lowered, then 388 Pa of
+/// suction, pressure and suction again, released): a contact that landed in the last increment
+/// is predicted further into its tube by the extrapolation, 8.9e4 N of penalty force at the first
+/// iterate in the traces. With the predictor keeping closed contacts at their converged gap
+/// (`SurfaceContacts::keep_gaps`) every step converges; it was refused at step 5 without.
+#[test]
+fn reversed_wind_over_four_arches_converges_with_closed_contacts_kept_at_their_gap() {
+    let run = run_staged(
+        "heldout_reversal9.json",
+        "heldout_reversal9.stages.json",
+        SolverSettings::default(),
+    );
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert_eq!(run.steps, 22);
+}

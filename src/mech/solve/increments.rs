@@ -244,7 +244,9 @@ impl Analysis {
     /// The first iterate of an increment from the converged `start` to `motion`: the
     /// prescribed DOFs at their values and, when the boundary keeps moving the same way, the
     /// free DOFs extrapolated along the last converged increment (fewer iterations, same
-    /// converged answer).
+    /// converged answer), then corrected by each contribution where the extrapolation leaves
+    /// its constraint (`Contribution::correct_prediction`: closed curved-support contacts
+    /// kept at their converged gap).
     pub(super) fn predict(&self, start: &AnalysisState, motion: &GroupMotion) -> Vec<f64> {
         let mut u = start.displacement.clone();
         let (mut dot, mut old, mut new) = (0.0, 0.0, 0.0);
@@ -266,6 +268,9 @@ impl Analysis {
                 if let Dof::Free(_) = d {
                     u[i] += ratio * start.last_increment[i];
                 }
+            }
+            for c in self.parts.all() {
+                c.correct_prediction(&self.system, start, &mut u);
             }
         }
         u

@@ -397,3 +397,55 @@ fn an_imposed_status_gives_its_law_and_the_natural_status_stays_the_laws() {
     assert_ne!(released.natural, GapStatus::Open);
     assert_eq!(released.residual, Vector3::zeros());
 }
+
+/// The predictor's correction (`keep_gaps`): a closed contact predicted further into its
+/// support goes back to the gap it had, along the normal only; an open contact, a node that
+/// is not free and a prediction away from the support are left as predicted.
+#[test]
+fn a_prediction_into_the_support_is_moved_back_to_the_converged_gap() {
+    let s = CurvedSupport {
+        centreline: Centreline::Line {
+            point: [0.0; 3],
+            axis: [0.0, 1.0, 0.0],
+        },
+        ..support(kinds().remove(0).1, FrictionLaw::Isotropic)
+    };
+    let r = s.tube_radius;
+    let c = SurfaceContact::new(&s, 0);
+    let x0 = Vector3::new(0.0, 0.0, 0.99 * r);
+    let contacts = SurfaceContacts {
+        contacts: vec![c.clone()],
+        slots: vec![],
+        reference: vec![x0],
+    };
+    let closed = c.initial_history(&x0, 0.3);
+    assert_ne!(closed.status, GapStatus::Open);
+    let start = [0.0; 3];
+    let gap = |u: &[f64]| c.project(&(x0 + Vector3::new(u[0], u[1], u[2])), 0.0).gap;
+    let into = [0.004, 0.002, -0.01];
+    let mut u = into;
+    contacts.keep_gaps(&start, &[closed], |_| true, &mut u);
+    assert!(
+        (gap(&u) - gap(&start)).abs() < 1e-15,
+        "{} vs {}",
+        gap(&u),
+        gap(&start)
+    );
+    // Along the normal at the predicted point only: the angle round the tube and the
+    // position along it are the prediction's.
+    assert_eq!(u[1], into[1]);
+    assert!((u[0] / (u[2] + x0.z) - into[0] / (into[2] + x0.z)).abs() < 1e-12);
+    let open = ContactHistory {
+        status: GapStatus::Open,
+        ..closed
+    };
+    for (history, free, predicted) in [
+        (open, true, into),
+        (closed, false, into),
+        (closed, true, [0.004, 0.0, 0.01]),
+    ] {
+        let mut u = predicted;
+        contacts.keep_gaps(&start, &[history], |_| free, &mut u);
+        assert_eq!(u, predicted);
+    }
+}

@@ -7,6 +7,7 @@ use crate::mech::elements::curved_contact::{ContactHistory, ContactResponse, Sur
 use crate::mech::elements::gap::{FrictionLaw, GapStatus};
 use crate::mech::model::Model;
 use crate::mech::results::Results;
+use crate::mech::solve::assembly::{Dof, System};
 use crate::mech::solve::state::AnalysisState;
 
 /// The curved-support contacts with their trial history.
@@ -116,6 +117,12 @@ impl Contribution for CurvedContacts {
 
     fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {
         state.contacts = SurfaceContacts::commit(&self.responses, &start.contacts);
+    }
+
+    fn correct_prediction(&self, system: &System, start: &AnalysisState, u: &mut [f64]) {
+        let free = |node: usize| (0..3).all(|k| matches!(system.dofs[3 * node + k], Dof::Free(_)));
+        self.contacts
+            .keep_gaps(&start.displacement, &start.contacts, free, u);
     }
 
     // `at_converged` keeps the histories of the last increment's start: the converged

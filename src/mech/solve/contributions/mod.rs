@@ -101,6 +101,11 @@ pub trait Contribution {
     /// ([`LiftOff`]; called once when an increment fails).
     fn lifting_off(&self, _out: &mut Vec<String>) {}
 
+    /// Corrects the first iterate `u` of an increment predicted from the converged `start`
+    /// (`increments.rs`) where the prediction leaves the item's constraint (a closed contact
+    /// pushed into its support).
+    fn correct_prediction(&self, _system: &System, _start: &AnalysisState, _u: &mut [f64]) {}
+
     /// Fills its part of `out` at the converged `state` (after an evaluation at it).
     fn results(
         &self,
