@@ -37,8 +37,6 @@
 //! refusal's message says stopped the last attempt of the refused increment.
 
 use std::fmt::Write as _;
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
@@ -47,7 +45,7 @@ use serde_json::{Value, json};
 
 #[path = "common/options.rs"]
 mod options;
-use options::PathOptions;
+use options::{PathOptions, on_threads};
 
 /// splitmix64: a small deterministic generator, so that the set is the same on every run.
 struct Random(u64);
@@ -663,22 +661,8 @@ fn main() {
         paths.len(),
         o.threads
     );
-    let next = AtomicUsize::new(0);
-    let results = Mutex::new(vec![Outcome::default(); paths.len()]);
     let wall = Instant::now();
-    std::thread::scope(|s| {
-        for _ in 0..o.threads {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(p) = paths.get(i) else { break };
-                    let outcome = run(p, increments);
-                    results.lock().unwrap()[i] = outcome;
-                }
-            });
-        }
-    });
-    let results = results.into_inner().unwrap();
+    let results = on_threads(&paths, o.threads, |p| run(p, increments));
     let wall = wall.elapsed().as_secs_f64();
     println!(
         "| family | paths | converged | % | iterations / increment (mean) | max per increment | cut-backs | steps converged | path s | first failure |"
@@ -824,23 +808,9 @@ fn follow_advice(paths: &[HeldOut], results: &[Outcome], increments: usize, thre
             Some((failure_class(e), p.name.as_str(), advised(p, e, increments)))
         })
         .collect();
-    let next = AtomicUsize::new(0);
-    let outcomes = Mutex::new(vec![None; tries.len()]);
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some((_, _, t)) = tries.get(i) else { break };
-                    if let Some((path, n, _)) = t {
-                        let outcome = run(path, *n);
-                        outcomes.lock().unwrap()[i] = Some(outcome);
-                    }
-                }
-            });
-        }
+    let outcomes = on_threads(&tries, threads, |(_, _, t)| {
+        t.as_ref().map(|(path, n, _)| run(path, *n))
     });
-    let outcomes = outcomes.into_inner().unwrap();
     println!(
         "\n### The refusals' advice followed\n\n| refusal class | refused | advice applied | converged after it | of them |\n|---|---|---|---|---|"
     );

@@ -16,8 +16,6 @@
 //! This measures convergence, not speed; the wall time is printed only so that the run can be
 //! planned.
 
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
@@ -28,32 +26,15 @@ use membrane_contact::specimens::scenarios::{
 
 #[path = "common/options.rs"]
 mod options;
-use options::PathOptions;
+use options::{PathOptions, on_threads};
 
 /// Runs `paths` on `threads` worker threads; results in the order of `paths`.
 fn run_all(paths: &[Scenario], threads: usize) -> Vec<(RunOutcome, f64)> {
-    let next = AtomicUsize::new(0);
-    let results = Mutex::new(vec![None; paths.len()]);
-    std::thread::scope(|s| {
-        for _ in 0..threads {
-            s.spawn(|| {
-                loop {
-                    let i = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(p) = paths.get(i) else { break };
-                    let start = Instant::now();
-                    let outcome = p.run(SolverSettings::default());
-                    let seconds = start.elapsed().as_secs_f64();
-                    results.lock().unwrap()[i] = Some((outcome, seconds));
-                }
-            });
-        }
-    });
-    results
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|r| r.unwrap())
-        .collect()
+    on_threads(paths, threads, |p| {
+        let start = Instant::now();
+        let outcome = p.run(SolverSettings::default());
+        (outcome, start.elapsed().as_secs_f64())
+    })
 }
 
 fn main() {
