@@ -727,6 +727,18 @@ fn main() {
     for row in &bound_rows {
         println!("{row}");
     }
+    let over: Vec<String> = paths
+        .iter()
+        .zip(&results)
+        .filter(|(_, r)| r.error.is_none() && r.over_bound > 0)
+        .map(|(p, r)| format!("{} ({} steps)", p.name, r.over_bound))
+        .collect();
+    if !over.is_empty() {
+        println!(
+            "\nconverged with steps above the stabilization bound: {}",
+            over.join(", ")
+        );
+    }
     let failed: Vec<(String, String)> = paths
         .iter()
         .zip(&results)

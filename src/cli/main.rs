@@ -210,7 +210,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     // Increments solved by continuation, and the step of the largest stabilization ratio.
     let (mut continued, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
     // Increments solved with the viscous stabilization on.
-    let mut stabilized = 0;
+    let (mut stabilized, mut released) = (0, 0);
     let count = path.steps.len();
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
@@ -243,6 +243,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         enlarged += report.enlarged;
         continued += report.continued;
         stabilized += report.stabilized;
+        released += report.released;
         if report.continued > 0 || report.stabilized > 0 {
             let ratio = report.stabilization_ratio();
             if let Some(w) = report.stabilization_warning() {
@@ -300,7 +301,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     if let Some((step, ratio, energy, dissipated)) = stabilization {
         out!(
             "stabilization: {continued} increments by pseudo-transient continuation, {stabilized} viscously \
-             stabilized; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
+             stabilized, {released} at steps' ends to release it; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
              energy; bound {:.0e}; {dissipated:.3e} J taken out on the way)",
             membrane_contact::mech::solve::report::STABILIZATION_BOUND
         );

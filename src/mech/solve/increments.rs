@@ -204,6 +204,21 @@ impl Analysis {
                 }
             }
         }
+        if self.parts.stabilization.is_on()
+            && last_stabilized
+                > STABILIZATION_BOUND * self.strain_energy_at(&current.displacement).abs()
+        {
+            let motion = at(1.0);
+            let levels = base_loads.interpolate(loads, 1.0);
+            self.release_stabilization(
+                &mut current,
+                &mut last_start,
+                &motion,
+                &levels,
+                &mut report,
+                &mut last_stabilized,
+            );
+        }
         self.state = current;
         self.increment_start = last_start;
         self.linear.set_fast(true);
@@ -214,6 +229,84 @@ impl Analysis {
         report.strain_energy = self.strain_energy();
         Ok(report)
     }
+
+    /// Lets the viscous stabilization's force decay at the step's end (`current`: the last
+    /// converged state, at the step's target `motion` and `levels`), where its last increment left
+    /// more work than [`STABILIZATION_BOUND`] of the strain energy: the damping force is `c k̄ m ΔU`
+    /// with `ΔU` the motion since the increment's start, so an increment at the same target from
+    /// the damped equilibrium is the same load held for more pseudo-time, and its force is that of
+    /// the (smaller) remaining motion. Each round tries the equilibrium without damping (plain
+    /// Newton, then the continuation); failing that, one more damped increment (whose damping
+    /// [`Self::account_stabilized`] softens; if the softened one fails, ten times larger ones up to
+    /// the largest of [`Self::STABILIZATION_DAMPING`]). Ends within the bound, after
+    /// [`Self::RELEASE_ROUNDS`], or at a failure, which keeps the last converged state. An
+    /// increment converged here is counted in `report.released`.
+    fn release_stabilization(
+        &mut self,
+        current: &mut AnalysisState,
+        last_start: &mut Option<AnalysisState>,
+        motion: &GroupMotion,
+        levels: &LoadLevels,
+        report: &mut StepReport,
+        last_stabilized: &mut f64,
+    ) {
+        for _ in 0..Self::RELEASE_ROUNDS {
+            let damping = self.parts.stabilization.coefficient;
+            let scale = self.parts.stabilization.scale;
+            self.parts.stabilization.switch_off();
+            let mut plain = self.solve_increment(current, motion, levels);
+            if plain.is_err() && self.settings.continuation {
+                self.work.continuation = true;
+                plain = self.solve_increment(current, motion, levels);
+                self.work.continuation = false;
+                if plain.is_ok() {
+                    report.continued += 1;
+                    self.work.stabilization += self.work.last_work;
+                }
+            }
+            let mut released = None;
+            if let Ok(converged) = plain {
+                *last_stabilized = 0.0;
+                released = Some(converged);
+            } else {
+                // The softened damping, and where that fails larger ones up to the largest the
+                // step tries (shorter pseudo-time steps).
+                let largest = Self::STABILIZATION_DAMPING[Self::STABILIZATION_DAMPING.len() - 1];
+                let mut c = damping;
+                while c <= largest * (1.0 + 1e-9) {
+                    self.parts.stabilization.resume(c, scale);
+                    if let Ok(converged) = self.solve_increment(current, motion, levels) {
+                        self.account_stabilized(report, &converged.0.displacement, last_stabilized);
+                        released = Some(converged);
+                        break;
+                    }
+                    c *= 10.0;
+                }
+            }
+            let Some((mut state, history)) = released else {
+                return;
+            };
+            // The step's last increment, for the predictor of the next step, is the motion from
+            // the start of the last loaded increment to here.
+            for (l, a) in state.last_increment.iter_mut().zip(&current.last_increment) {
+                *l += a;
+            }
+            report.released += 1;
+            report.iterations.push(history.len() - 1);
+            report.residual = *history.last().unwrap_or(&0.0);
+            report.residual_history = history;
+            *last_start = Some(std::mem::replace(current, state));
+            if !self.parts.stabilization.is_on()
+                || *last_stabilized
+                    <= STABILIZATION_BOUND * self.strain_energy_at(&current.displacement).abs()
+            {
+                return;
+            }
+        }
+    }
+
+    /// Most increments [`Self::release_stabilization`] adds to a step.
+    const RELEASE_ROUNDS: usize = 8;
 
     /// Counts an increment converged at `u` with the viscous stabilization on, and adds its work
     /// to the work taken out (`last`: the work of the last such increment, J).
@@ -333,6 +426,40 @@ mod tests {
             }
         }
         assert!(extrapolated > 0, "the first step moved no free DOF");
+    }
+
+    /// A step whose viscously stabilized last increment leaves more work than the bound is not
+    /// left there: the damping is released at the step's target, and the answer is the
+    /// undamped equilibrium (the 300 mm specimen without friction, so that the equilibrium
+    /// does not depend on the path to it; the damping forced on at `c` = 0.1, ten thousand times
+    /// what the controller starts with, for every increment).
+    #[test]
+    fn a_step_ending_above_the_stabilization_bound_is_released_to_the_undamped_equilibrium() {
+        let spec = ParallelArch {
+            friction: 0.0,
+            ..ParallelArch::default()
+        };
+        let model = spec.model().unwrap();
+        let target = spec.boundary_targets(&model, 0.1);
+        let mut plain = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+        let undamped = plain.step_to(&target, 1).unwrap();
+        assert_eq!((undamped.stabilized, undamped.released), (0, 0));
+        let mut damped = Analysis::new(model, SolverSettings::default()).unwrap();
+        damped.parts.stabilization.switch_on(0.1);
+        let report = damped.step_to(&target, 1).unwrap();
+        assert!(report.stabilized >= 1 && report.released >= 1, "{report:?}");
+        assert!(
+            report.stabilization_ratio() <= STABILIZATION_BOUND,
+            "{}",
+            report.stabilization_ratio()
+        );
+        let (a, b) = (&plain.state().displacement, &damped.state().displacement);
+        let scale = a.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let differ = a
+            .iter()
+            .zip(b)
+            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(differ <= 1e-4 * scale, "{differ:e} m against {scale:e} m");
     }
 
     /// The first step of the 80-step arch edge (a film slack across its edge) does not converge

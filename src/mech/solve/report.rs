@@ -33,6 +33,11 @@ pub struct StepReport {
     /// Increments solved with the viscous stabilization on (`contributions/stabilization.rs`).
     #[serde(default)]
     pub stabilized: usize,
+    /// Increments added at the step's end, at its target, to let the viscous stabilization's
+    /// force decay where its last increment left more than [`STABILIZATION_BOUND`]
+    /// (`Analysis::release_stabilization`).
+    #[serde(default)]
+    pub released: usize,
     /// Artificial energy left at the end of the step (J): over the increments solved by
     /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
     /// each (the pseudo-time force still acting when the increment was accepted); and, when the

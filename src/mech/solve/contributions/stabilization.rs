@@ -66,6 +66,12 @@ impl ViscousStabilization {
         (self.coefficient, self.scale) = (coefficient, 0.0);
     }
 
+    /// Turns it on again with the damping `coefficient` and the `scale` `k̄` it had (the release
+    /// at a step's end, `increments.rs`).
+    pub fn resume(&mut self, coefficient: f64, scale: f64) {
+        (self.coefficient, self.scale) = (coefficient, scale);
+    }
+
     /// A tenth of the damping for the next increments (not below [`Self::SMALLEST`]), `k̄` kept.
     pub fn soften(&mut self) {
         self.coefficient = (0.1 * self.coefficient).max(Self::SMALLEST);
