@@ -4,7 +4,7 @@ use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
-use crate::mech::solve::report::{STABILIZATION_BOUND, StepError, StepReport};
+use crate::mech::solve::report::{IncrementFailure, STABILIZATION_BOUND, StepError, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
 impl Analysis {
@@ -82,19 +82,7 @@ impl Analysis {
             // Likewise the watchdog: after a cut-back, monotone backtracking only (a failed
             // excursion per halved increment was measured to turn a hard path into a failure).
             self.work.watchdog = report.cutbacks == 0;
-            let attempt = match self.solve_increment(&current, &at(next), &levels) {
-                Err(_) if self.settings.continuation => {
-                    self.work.continuation = true;
-                    let again = self.solve_increment(&current, &at(next), &levels);
-                    self.work.continuation = false;
-                    if again.is_ok() {
-                        report.continued += 1;
-                        self.work.stabilization += self.work.last_work;
-                    }
-                    again
-                }
-                plain => plain,
-            };
+            let attempt = self.solve_or_continue(&current, &at(next), &levels, &mut report);
             if let Ok((state, _)) = &attempt {
                 self.account_stabilized(&mut report, &state.displacement, &mut last_stabilized);
             }
@@ -160,19 +148,11 @@ impl Analysis {
                             .filter(|&c| c > from)
                         {
                             self.parts.stabilization.switch_on(c);
-                            let mut attempt = self.solve_increment(&current, &at(next), &levels);
                             // With the damping, as without it: the continuation after plain
                             // Newton (a contact changing status raises its pseudo-time shift
                             // instead of cutting the step along a direction of the other status).
-                            if attempt.is_err() && self.settings.continuation {
-                                self.work.continuation = true;
-                                attempt = self.solve_increment(&current, &at(next), &levels);
-                                self.work.continuation = false;
-                                if attempt.is_ok() {
-                                    report.continued += 1;
-                                    self.work.stabilization += self.work.last_work;
-                                }
-                            }
+                            let attempt =
+                                self.solve_or_continue(&current, &at(next), &levels, &mut report);
                             if let Ok(converged) = attempt {
                                 reached = Some((next, converged));
                                 held = true;
@@ -230,6 +210,30 @@ impl Analysis {
         Ok(report)
     }
 
+    /// The increment from `start` to `motion` and `levels` by plain Newton, then, where that fails
+    /// and the continuation is on, by the continuation (counted in `report.continued`, the
+    /// artificial energy of its last correction added to the step's). Err: the last attempt's.
+    fn solve_or_continue(
+        &mut self,
+        start: &AnalysisState,
+        motion: &GroupMotion,
+        levels: &LoadLevels,
+        report: &mut StepReport,
+    ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
+        let plain = self.solve_increment(start, motion, levels);
+        if plain.is_ok() || !self.settings.continuation {
+            return plain;
+        }
+        self.work.continuation = true;
+        let again = self.solve_increment(start, motion, levels);
+        self.work.continuation = false;
+        if again.is_ok() {
+            report.continued += 1;
+            self.work.stabilization += self.work.last_work;
+        }
+        again
+    }
+
     /// Lets the viscous stabilization's force decay at the step's end (`current`: the last
     /// converged state, at the step's target `motion` and `levels`), where its last increment left
     /// more work than [`STABILIZATION_BOUND`] of the strain energy: the damping force is `c k̄ m ΔU`
@@ -254,16 +258,7 @@ impl Analysis {
             let damping = self.parts.stabilization.coefficient;
             let scale = self.parts.stabilization.scale;
             self.parts.stabilization.switch_off();
-            let mut plain = self.solve_increment(current, motion, levels);
-            if plain.is_err() && self.settings.continuation {
-                self.work.continuation = true;
-                plain = self.solve_increment(current, motion, levels);
-                self.work.continuation = false;
-                if plain.is_ok() {
-                    report.continued += 1;
-                    self.work.stabilization += self.work.last_work;
-                }
-            }
+            let plain = self.solve_or_continue(current, motion, levels, report);
             let mut released = None;
             if let Ok(converged) = plain {
                 *last_stabilized = 0.0;
