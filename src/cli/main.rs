@@ -211,6 +211,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     let (mut continued, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
     // Increments solved with the viscous stabilization on.
     let (mut stabilized, mut released) = (0, 0);
+    // Cross holds released at sliding-direction contacts lifting off: how many, the largest (N).
+    let (mut lifted, mut largest_lift) = (0, 0.0_f64);
     let count = path.steps.len();
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
@@ -244,6 +246,11 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         continued += report.continued;
         stabilized += report.stabilized;
         released += report.released;
+        lifted += report.lifted_off.len();
+        largest_lift = report
+            .lifted_off
+            .iter()
+            .fold(largest_lift, |m, &f| m.max(f));
         if report.continued > 0 || report.stabilized > 0 {
             let ratio = report.stabilization_ratio();
             if let Some(w) = report.stabilization_warning() {
@@ -304,6 +311,12 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
              stabilized, {released} at steps' ends to release it; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
              energy; bound {:.0e}; {dissipated:.3e} J taken out on the way)",
             membrane_contact::mech::solve::report::STABILIZATION_BOUND
+        );
+    }
+    if lifted > 0 {
+        out!(
+            "lift-off: {lifted} cross holds of the sliding-direction law released at contacts that lifted off \
+             where no equilibrium held on either side of the law's jump (largest {largest_lift:.3e} N; docs/mechanics.md)"
         );
     }
     let [lu, ldlt, redone, gmres] = analysis.factorization_counts();

@@ -102,6 +102,7 @@ impl Analysis {
                 .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
                 .collect(),
             last_increment: Vec::new(),
+            landing: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
             plastic: system
                 .material

@@ -163,6 +163,30 @@ impl Analysis {
                             self.parts.stabilization.switch_off();
                         }
                     }
+                    // Then, where the last attempt saw sliding-direction contacts lift off while
+                    // holding the film across (the law's jump, with no equilibrium on either
+                    // side), they lift off and land again within the increment, and it is tried
+                    // again from the same start (docs/mechanics.md, "Lift-off with the paper's
+                    // law"): only here, so that every path the attempts above converge is
+                    // computed as before.
+                    if reached.is_none()
+                        && report.lifted_off.len() < Self::LIFT_OFF_RELEASES
+                        && !last.lifting().is_empty()
+                    {
+                        let before = report.lifted_off.len();
+                        for c in self.parts.all_mut() {
+                            c.release_lift_off(
+                                last.lifting(),
+                                &mut current,
+                                &mut report.lifted_off,
+                            );
+                        }
+                        if report.lifted_off.len() > before {
+                            // The retry starts as the increment did: without the damping.
+                            self.parts.stabilization.switch_off();
+                            continue;
+                        }
+                    }
                     let Some((next, (state, history))) = reached else {
                         self.parts.stabilization.switch_off();
                         return Err(StepError::NotConverged {
@@ -299,6 +323,10 @@ impl Analysis {
             }
         }
     }
+
+    /// Most cross holds [`Self::step_to_motion`] releases in a step at sliding-direction
+    /// contacts lifting off (each contact at most once per increment).
+    const LIFT_OFF_RELEASES: usize = 64;
 
     /// Most increments [`Self::release_stabilization`] adds to a step.
     const RELEASE_ROUNDS: usize = 8;

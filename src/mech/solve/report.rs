@@ -38,6 +38,13 @@ pub struct StepReport {
     /// (`Analysis::release_stabilization`).
     #[serde(default)]
     pub released: usize,
+    /// Sliding-direction contacts released where an increment found no equilibrium on either
+    /// side of the law's jump at lift-off: marked as lifting off and landing again within it
+    /// ([`crate::mech::elements::curved_contact::ContactHistory::lands`]); one entry per
+    /// contact so released, the largest cross force it was seen holding in the refused
+    /// attempt (N).
+    #[serde(default)]
+    pub lifted_off: Vec<f64>,
     /// Artificial energy left at the end of the step (J): over the increments solved by
     /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
     /// each (the pseudo-time force still acting when the increment was accepted); and, when the
@@ -232,6 +239,14 @@ fn name_list(names: &[String]) -> String {
 }
 
 impl IncrementFailure {
+    /// The sliding-direction contacts named as lifting off in the failed attempt.
+    pub fn lifting(&self) -> &[String] {
+        match self {
+            Self::MaxIterations { lifting, .. } | Self::Stalled { lifting, .. } => lifting,
+            _ => &[],
+        }
+    }
+
     /// What a user can change to get past this failure, naming the settings as `names` does.
     /// It states what was observed; a cause is named only where the solver established it.
     pub fn advice(&self, names: &SettingNames) -> String {

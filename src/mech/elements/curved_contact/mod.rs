@@ -92,6 +92,12 @@ pub struct ContactHistory {
     pub status: GapStatus,
     /// Friction coefficient.
     pub friction: f64,
+    /// Lifted off at the start of the increment and landing again within it (the
+    /// sliding-direction law's lift-off release, `Analysis::step_to_motion`): it holds nothing
+    /// across until the increment converges, and then holds from where it ended. Never set in a
+    /// converged state.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub lands: bool,
 }
 
 /// Force on the film, tangent and status of a contact at one iterate.
@@ -307,7 +313,10 @@ impl SurfaceContact {
         let anchor = Vector2::from(history.anchor);
         let lambda = -self.kn * p.gap;
         let limit = history.friction * lambda;
-        let trial = -(p.xi - anchor) * self.ks;
+        let mut trial = -(p.xi - anchor) * self.ks;
+        if history.lands {
+            trial.y = 0.0;
+        }
         let natural = if p.gap >= 0.0 {
             GapStatus::Open
         } else if match self.law {
@@ -356,6 +365,9 @@ impl SurfaceContact {
             }
             FrictionLaw::SlidingDirection => {
                 let mut dfd = -Matrix2::identity() * self.ks;
+                if history.lands {
+                    dfd[(1, 1)] = 0.0;
+                }
                 if used == GapStatus::Stick {
                     (GapStatus::Stick, trial, dfd, Vector2::zeros())
                 } else {
@@ -452,6 +464,7 @@ impl SurfaceContact {
                 GapStatus::Open
             },
             friction: mu,
+            lands: false,
         }
     }
 }
@@ -633,6 +646,7 @@ impl SurfaceContacts {
                 } else {
                     h.origin
                 },
+                lands: false,
                 ..*h
             })
             .collect()

@@ -104,7 +104,8 @@ fn sampled_range(shape: &Shape) -> [f64; 2] {
 
 /// Central differences of the residual against the tangent, for random positions near the
 /// support (in every region of its surface: tube, polyline corners, end caps) and anchors
-/// chosen to give each status.
+/// chosen to give each status; the sliding-direction law also landing after a lift-off
+/// release (`ContactHistory::lands`: no hold across).
 #[test]
 fn tangent_matches_finite_differences_in_every_status() {
     let mut seen = std::collections::HashSet::new();
@@ -132,44 +133,52 @@ fn tangent_matches_finite_differences_in_every_status() {
                 let p0 = c.project(&x, py.parameter);
                 // Anchors near ξ (stick) or far (slip), either side.
                 let offset = if case % 3 == 0 { 1e-6 } else { 5e-3 } * rand().signum();
-                let history = ContactHistory {
-                    anchor: [p0.xi.x + offset, p0.xi.y - 0.5 * offset],
-                    angle: p0.parameter,
-                    origin: 0.0,
-                    status: GapStatus::Stick,
-                    friction: 0.3,
+                let landing: &[bool] = match law {
+                    FrictionLaw::SlidingDirection => &[false, true],
+                    FrictionLaw::Isotropic => &[false],
                 };
-                let r = c.respond(&x, &history);
-                // Skip points within reach of a change of status or region.
-                let h = 1e-7;
-                let unchanged = (0..3).all(|k| {
-                    [-1.0, 1.0].iter().all(|sgn| {
-                        let y = x + Vector3::ith(k, 20.0 * h * sgn);
-                        c.respond(&y, &history).status == r.status
-                            && c.project(&y, history.angle).region == p0.region
-                    })
-                });
-                if !unchanged {
-                    continue;
+                for &lands in landing {
+                    let history = ContactHistory {
+                        anchor: [p0.xi.x + offset, p0.xi.y - 0.5 * offset],
+                        angle: p0.parameter,
+                        origin: 0.0,
+                        status: GapStatus::Stick,
+                        friction: 0.3,
+                        // The sliding-direction law also landing (no hold across).
+                        lands,
+                    };
+                    let r = c.respond(&x, &history);
+                    // Skip points within reach of a change of status or region.
+                    let h = 1e-7;
+                    let unchanged = (0..3).all(|k| {
+                        [-1.0, 1.0].iter().all(|sgn| {
+                            let y = x + Vector3::ith(k, 20.0 * h * sgn);
+                            c.respond(&y, &history).status == r.status
+                                && c.project(&y, history.angle).region == p0.region
+                        })
+                    });
+                    if !unchanged {
+                        continue;
+                    }
+                    seen.insert((law, kind, p0.region, r.status as u8, history.lands));
+                    let mut fd = Matrix3::zeros();
+                    for k in 0..3 {
+                        let e = Vector3::ith(k, h);
+                        let plus = c.respond(&(x + e), &history).residual;
+                        let minus = c.respond(&(x - e), &history).residual;
+                        fd.set_column(k, &((plus - minus) / (2.0 * h)));
+                    }
+                    let scale = r.tangent.norm().max(s.normal_stiffness * 1e-3);
+                    let error = (fd - r.tangent).norm() / scale;
+                    assert!(
+                        error < 1e-5,
+                        "{law:?} {kind} {:?} {:?} (landing: {lands}): relative error {error:e}\nanalytic {}\nfd {}",
+                        p0.region,
+                        r.status,
+                        r.tangent,
+                        fd
+                    );
                 }
-                seen.insert((law, kind, p0.region, r.status as u8));
-                let mut fd = Matrix3::zeros();
-                for k in 0..3 {
-                    let e = Vector3::ith(k, h);
-                    let plus = c.respond(&(x + e), &history).residual;
-                    let minus = c.respond(&(x - e), &history).residual;
-                    fd.set_column(k, &((plus - minus) / (2.0 * h)));
-                }
-                let scale = r.tangent.norm().max(s.normal_stiffness * 1e-3);
-                let error = (fd - r.tangent).norm() / scale;
-                assert!(
-                    error < 1e-5,
-                    "{law:?} {kind} {:?} {:?}: relative error {error:e}\nanalytic {}\nfd {}",
-                    p0.region,
-                    r.status,
-                    r.tangent,
-                    fd
-                );
             }
         }
     }
@@ -183,15 +192,21 @@ fn tangent_matches_finite_differences_in_every_status() {
                 regions.push(Region::Corner);
             }
             assert!(
-                seen.contains(&(law, kind, Region::Tube, GapStatus::Open as u8)),
+                seen.contains(&(law, kind, Region::Tube, GapStatus::Open as u8, false)),
                 "{law:?} {kind} open never tested"
             );
+            let landing = [false, law == FrictionLaw::SlidingDirection];
             for region in regions {
                 for status in [GapStatus::Stick, GapStatus::Slip] {
-                    assert!(
-                        seen.contains(&(law, kind, region, status as u8)),
-                        "{law:?} {kind} {region:?} {status:?} never tested"
-                    );
+                    for lands in landing
+                        .into_iter()
+                        .filter(|&l| !l || region == Region::Tube)
+                    {
+                        assert!(
+                            seen.contains(&(law, kind, region, status as u8, lands)),
+                            "{law:?} {kind} {region:?} {status:?} (landing: {lands}) never tested"
+                        );
+                    }
                 }
             }
         }

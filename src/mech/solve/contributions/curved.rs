@@ -115,6 +115,21 @@ impl Contribution for CurvedContacts {
         }
     }
 
+    fn release_lift_off(
+        &mut self,
+        names: &[String],
+        start: &mut AnalysisState,
+        out: &mut Vec<f64>,
+    ) {
+        for (k, name) in self.names.iter().enumerate() {
+            let h = &mut start.contacts[k];
+            if names.contains(name) && !h.lands {
+                h.lands = true;
+                out.push(self.lift.hold(k));
+            }
+        }
+    }
+
     fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {
         state.contacts = SurfaceContacts::commit(&self.responses, &start.contacts);
     }

@@ -28,9 +28,12 @@ pub struct Gaps {
     /// Status changes over the Newton iterations.
     changes: StatusChanges,
     /// Names (for the advice of a stalled increment).
-    names: Vec<String>,
+    pub names: Vec<String>,
     /// Sliding-direction gaps lifting off with more than `μN` across ([`LiftOff`]).
     lift: LiftOff,
+    /// Gaps landing again within this increment after a lift-off release
+    /// ([`AnalysisState::landing`]).
+    landing: Vec<bool>,
 }
 
 impl Gaps {
@@ -50,6 +53,7 @@ impl Gaps {
             history: Vec::new(),
             names: model.gaps.iter().map(|g| g.name.clone()).collect(),
             lift: LiftOff::default(),
+            landing: vec![false; n],
             laws,
         }
     }
@@ -72,6 +76,10 @@ impl Gaps {
             .iter()
             .map(|s| Vector2::from(*s))
             .collect();
+        self.landing.iter_mut().for_each(|l| *l = false);
+        for &g in &state.landing {
+            self.landing[g] = true;
+        }
     }
 }
 
@@ -91,12 +99,17 @@ impl Contribution for Gaps {
             responses,
             latched,
             closed,
+            landing,
             ..
         } = self;
         let (mode, iteration) = (at.matrix, at.iteration);
         at.system.add_gaps(at.u, residual, values, |g, d| {
             let law = &laws[g];
-            let response = law.evaluate(d, history[g]);
+            let response = if landing[g] {
+                law.evaluate_landing(d, history[g])
+            } else {
+                law.evaluate(d, history[g])
+            };
             responses[g] = response;
             let matrix = match mode {
                 IterationMatrix::Consistent => law.consistent_tangent(&response),
@@ -127,6 +140,11 @@ impl Contribution for Gaps {
                     }
                 }
             };
+            let matrix = if landing[g] {
+                GapLaw::landing_matrix(matrix)
+            } else {
+                matrix
+            };
             (response.force, matrix)
         });
         for (g, (law, r)) in self.trial.iter().zip(&self.responses).enumerate() {
@@ -145,6 +163,21 @@ impl Contribution for Gaps {
             .map(|r| r.plastic_slip.into())
             .collect();
         state.status = self.responses.iter().map(|r| r.status).collect();
+        state.landing.clear();
+    }
+
+    fn release_lift_off(
+        &mut self,
+        names: &[String],
+        start: &mut AnalysisState,
+        out: &mut Vec<f64>,
+    ) {
+        for (g, name) in self.names.iter().enumerate() {
+            if names.contains(name) && !start.landing.contains(&g) {
+                start.landing.push(g);
+                out.push(self.lift.hold(g));
+            }
+        }
     }
 
     /// The law at the converged point with the updated history gives the same forces.

@@ -101,6 +101,18 @@ pub trait Contribution {
     /// ([`LiftOff`]; called once when an increment fails).
     fn lifting_off(&self, _out: &mut Vec<String>) {}
 
+    /// Marks, in an increment's converged start `start`, the contacts in `names` that lift off
+    /// ([`LiftOff`]) as lifting off there and landing again within the increment, holding
+    /// nothing across until it converges; appends the largest cross force each was seen holding
+    /// in the increment's last attempt (N). Contacts already marked are left.
+    fn release_lift_off(
+        &mut self,
+        _names: &[String],
+        _start: &mut AnalysisState,
+        _out: &mut Vec<f64>,
+    ) {
+    }
+
     /// Corrects the first iterate `u` of an increment predicted from the converged `start`
     /// (`increments.rs`) where the prediction leaves the item's constraint (a closed contact
     /// pushed into its support).
@@ -170,6 +182,8 @@ impl StatusChanges {
 pub struct LiftOff {
     /// Per contact: seen open, seen closed holding more than `μN` across.
     seen: Vec<(bool, bool)>,
+    /// Per contact: the largest cross force seen while closed beyond `μN` (N).
+    hold: Vec<f64>,
 }
 
 impl LiftOff {
@@ -177,6 +191,8 @@ impl LiftOff {
     pub fn reset(&mut self, count: usize) {
         self.seen.clear();
         self.seen.resize(count, (false, false));
+        self.hold.clear();
+        self.hold.resize(count, 0.0);
     }
 
     /// Notes contact `k` at an evaluation: open, or closed with the cross force `cross` (N)
@@ -187,8 +203,14 @@ impl LiftOff {
                 s.0 = true;
             } else if cross.abs() > limit {
                 s.1 = true;
+                self.hold[k] = self.hold[k].max(cross.abs());
             }
         }
+    }
+
+    /// The largest cross force contact `k` was seen holding beyond `μN` in this attempt (N).
+    pub fn hold(&self, k: usize) -> f64 {
+        self.hold.get(k).copied().unwrap_or(0.0)
     }
 
     /// Appends the `names` of the contacts seen both open and closed beyond the limit.
@@ -287,17 +309,14 @@ impl Contributions {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mech::elements::gap::FrictionLaw;
+    use crate::mech::elements::gap::{FrictionLaw, GapLaw};
     use crate::mech::solve::Analysis;
     use crate::mech::solve::settings::SolverSettings;
     use crate::specimens::ParallelArch;
     use crate::specimens::parallel_arch::SpecimenContact;
 
-    /// The contacts named as lifting off with more than `μN` across (`LiftOff`) after
-    /// evaluating, from the 300 mm specimen lowered a quarter of the way, the film dragged
-    /// 10 µm across the arch (closed, the cross force `k_s` × 10 µm above `μN`) and then
-    /// `lift` m up.
-    fn lifted_after_a_drag(contact: SpecimenContact, law: FrictionLaw, lift: f64) -> Vec<String> {
+    /// The 300 mm specimen with `contact` and friction `law`, lowered a quarter of the way.
+    fn lowered_specimen(contact: SpecimenContact, law: FrictionLaw) -> Analysis {
         let spec = ParallelArch {
             contact,
             friction_law: law,
@@ -307,6 +326,15 @@ mod tests {
         let targets = spec.boundary_targets(&model, 0.6);
         let mut analysis = Analysis::new(model, SolverSettings::default()).unwrap();
         analysis.step_to(&targets, 5).unwrap();
+        analysis
+    }
+
+    /// The contacts named as lifting off with more than `μN` across (`LiftOff`) after
+    /// evaluating, from the 300 mm specimen lowered a quarter of the way, the film dragged
+    /// 10 µm across the arch (closed, the cross force `k_s` × 10 µm above `μN`) and then
+    /// `lift` m up.
+    fn lifted_after_a_drag(contact: SpecimenContact, law: FrictionLaw, lift: f64) -> Vec<String> {
+        let mut analysis = lowered_specimen(contact, law);
         let converged = analysis.state().clone();
         let Analysis { system, parts, .. } = &mut analysis;
         let mut residual = vec![0.0; converged.displacement.len()];
@@ -338,6 +366,100 @@ mod tests {
             c.lifting_off(&mut names);
         }
         names
+    }
+
+    /// Contacts released at lift-off (`Contribution::release_lift_off`, gaps and curved
+    /// contacts alike) hold nothing across while the increment is solved, and the converged
+    /// state they commit carries no mark and holds from where it ended: re-evaluated there,
+    /// still nothing across. Unreleased, the same drag holds more than `μN` across.
+    #[test]
+    fn released_contacts_hold_nothing_across_and_commit_where_they_landed() {
+        for contact in [SpecimenContact::Gaps, SpecimenContact::CurvedSupport] {
+            let mut analysis = lowered_specimen(contact, FrictionLaw::SlidingDirection);
+            let converged = analysis.state().clone();
+            let Analysis { system, parts, .. } = &mut analysis;
+            let mut residual = vec![0.0; converged.displacement.len()];
+            let dragged: Vec<f64> = (converged.displacement.iter().enumerate())
+                .map(|(i, u)| if i % 3 == 0 { u + 1e-5 } else { *u })
+                .collect();
+            let at = Evaluation {
+                system,
+                u: &dragged,
+                levels: &converged.loads,
+                iteration: Some(1),
+                matrix: IterationMatrix::Consistent,
+            };
+            // The cross force of every closed sliding-direction contact at `dragged`.
+            let across = |parts: &Contributions, state: &AnalysisState| -> Vec<f64> {
+                match contact {
+                    SpecimenContact::Gaps => (0..state.plastic_slip.len())
+                        .map(|g| {
+                            let d = system.gap_relative(g, &dragged);
+                            let law = GapLaw {
+                                friction: state.friction[g],
+                                ..parts.gaps.laws()[g]
+                            };
+                            let r = if state.landing.contains(&g) {
+                                law.evaluate_landing(d, state.plastic_slip[g].into())
+                            } else {
+                                law.evaluate(d, state.plastic_slip[g].into())
+                            };
+                            r.force.y
+                        })
+                        .collect(),
+                    SpecimenContact::CurvedSupport => parts
+                        .curved
+                        .contacts
+                        .respond(&dragged, &state.contacts)
+                        .iter()
+                        .map(|r| r.friction.y)
+                        .collect(),
+                }
+            };
+            let held = across(parts, &converged);
+            assert!(
+                held.iter().any(|f| f.abs() > 1.0),
+                "{contact:?}: nothing held across"
+            );
+            let names: Vec<String> = match contact {
+                SpecimenContact::Gaps => model_names(parts, false),
+                SpecimenContact::CurvedSupport => model_names(parts, true),
+            };
+            let mut start = converged.clone();
+            let mut released = Vec::new();
+            for c in parts.all_mut() {
+                c.release_lift_off(&names, &mut start, &mut released);
+            }
+            assert_eq!(released.len(), names.len(), "{contact:?}");
+            assert!(
+                across(parts, &start).iter().all(|f| *f == 0.0),
+                "{contact:?}"
+            );
+            for c in parts.all_mut() {
+                c.restore(&start);
+            }
+            parts.assemble(&at, &mut residual, None);
+            let mut committed = start.clone();
+            for c in parts.all() {
+                c.commit(&start, &mut committed);
+            }
+            assert!(committed.landing.is_empty(), "{contact:?}");
+            assert!(committed.contacts.iter().all(|h| !h.lands), "{contact:?}");
+            let after = across(parts, &committed);
+            assert!(
+                after.iter().all(|f| f.abs() < 1e-9),
+                "{contact:?}: {after:?}"
+            );
+        }
+    }
+
+    /// The names of every gap (`curved` false) or curved-support contact.
+    fn model_names(parts: &Contributions, curved: bool) -> Vec<String> {
+        if curved {
+            parts.curved.names.clone()
+        } else {
+            parts.gaps.names.clone()
+        }
     }
 
     /// The paper's sliding-direction law holds the film across the arch with more than `μN`;
