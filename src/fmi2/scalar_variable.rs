@@ -195,6 +195,8 @@ pub enum Binding {
     Residual,
     StabilizationEnergy,
     StabilizationRatio,
+    /// Contacts released at lift-off in the last step (`StepReport::lifted_off`).
+    LiftOffReleases,
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,

@@ -772,6 +772,14 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
+    // Last, so that the value references of the variables above stay where they were.
+    integer_output(
+        &mut table,
+        "solver.liftOffReleases",
+        "sliding-direction contacts released at lift-off in the last step (their hold across the \
+         support: no equilibrium held on either side of the law's jump)",
+        Binding::LiftOffReleases,
+    );
     table.0
 }
 
@@ -969,8 +977,15 @@ mod tests {
             .count();
         assert_eq!(
             outputs,
-            9 * 7 + 3 + 3 + 6 + 2,
-            "gaps, group and total reactions, statistics (with the stabilization energy and ratio), film"
+            9 * 7 + 3 + 3 + 7 + 2,
+            "gaps, group and total reactions, statistics (with the stabilization energy and ratio \
+             and the lift-off releases), film"
+        );
+        // Appended last: the value references before it are those of the earlier tables.
+        let last = table.last().unwrap();
+        assert_eq!(
+            (last.name.as_str(), last.var_type),
+            ("solver.liftOffReleases", VarType::Integer)
         );
         assert_eq!(find("film.wrinkling").start, Some(Value::Boolean(false)));
         assert_eq!(find("film.slackElements").var_type, VarType::Integer);

@@ -332,6 +332,7 @@ fn expected(name: &str, model: &Model, r: &Results, report: &StepReport) -> Valu
             ("solver", "residual") => Some(Value::Real(report.residual)),
             ("solver", "stabilizationEnergy") => Some(Value::Real(report.stabilization_energy)),
             ("solver", "stabilizationRatio") => Some(Value::Real(report.stabilization_ratio())),
+            ("solver", "liftOffReleases") => Some(integer(report.lifted_off.len())),
             ("film", "maxEquivalentStress") => Some(Value::Real(r.von_mises_range().1)),
             ("film", "wrinkledElements") => Some(integer(counts[1])),
             ("film", "slackElements") => Some(integer(counts[2])),
