@@ -315,8 +315,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     }
     if lifted > 0 {
         out!(
-            "lift-off: {lifted} cross holds of the sliding-direction law released at contacts that lifted off \
-             where no equilibrium held on either side of the law's jump (largest {largest_lift:.3e} N; docs/mechanics.md)"
+            "lift-off: {lifted} cross hold{} of the sliding-direction law released at contacts that lifted off \
+             where no equilibrium held on either side of the law's jump (largest {largest_lift:.3e} N; docs/mechanics.md)",
+            if lifted == 1 { "" } else { "s" }
         );
     }
     let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
