@@ -186,6 +186,10 @@ pub struct RunArgs {
     /// docs/mechanics.md "Viscous stabilization")
     #[arg(long)]
     pub no_stabilization: bool,
+    /// No smoothing homotopy: an increment every other attempt refused is not solved again with
+    /// the contact and wrinkling laws' switches rounded (docs/mechanics.md "Smoothing homotopy")
+    #[arg(long)]
+    pub no_smoothing: bool,
     /// Threads of the element assembly (0 = automatic: one below 100 000 triangles, else up to
     /// two; results are identical for every count).
     #[arg(long, value_name = "N", default_value_t = 0)]

@@ -162,6 +162,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         line_search: !o.no_line_search,
         continuation: !o.no_continuation,
         stabilization: !o.no_stabilization,
+        smoothing: !o.no_smoothing,
         threads: o.threads,
         ..defaults
     };
@@ -213,6 +214,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     let (mut stabilized, mut released) = (0, 0);
     // Cross holds released at sliding-direction contacts lifting off: how many, the largest (N).
     let (mut lifted, mut largest_lift) = (0, 0.0_f64);
+    // Increments solved by the smoothing homotopy, and of them accepted on the law's residual.
+    let (mut smoothed, mut on_residual) = (0, 0);
     let count = path.steps.len();
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
@@ -247,6 +250,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         stabilized += report.stabilized;
         released += report.released;
         lifted += report.lifted_off.len();
+        smoothed += report.smoothed;
+        on_residual += report.smoothed_on_residual;
         largest_lift = report
             .lifted_off
             .iter()
@@ -318,6 +323,14 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             "lift-off: {lifted} cross hold{} of the sliding-direction law released at contacts that lifted off \
              where no equilibrium held on either side of the law's jump (largest {largest_lift:.3e} N; docs/mechanics.md)",
             if lifted == 1 { "" } else { "s" }
+        );
+    }
+    if smoothed > 0 {
+        out!(
+            "smoothing: {smoothed} increment{} solved from the contact and wrinkling laws with their \
+             switches rounded, the rounding reduced ({on_residual} of them accepted on the law's residual \
+             at the rounded solution; docs/mechanics.md \"Smoothing homotopy\")",
+            if smoothed == 1 { "" } else { "s" }
         );
     }
     let [lu, ldlt, redone, gmres] = analysis.factorization_counts();

@@ -272,6 +272,7 @@ impl Instance {
                 (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
                 (Binding::Continuation, Value::Boolean(b)) => settings.continuation = b,
                 (Binding::Stabilization, Value::Boolean(b)) => settings.stabilization = b,
+                (Binding::Smoothing, Value::Boolean(b)) => settings.smoothing = b,
                 (Binding::Threads, Value::Integer(x)) => {
                     settings.threads = count(x, 0)?;
                     if settings.threads > MAX_THREADS {

@@ -75,6 +75,7 @@ impl Instance {
                     Value::Real(report.map_or(0.0, |r| r.stabilization_ratio()))
                 }
                 Binding::LiftOffReleases => count(report.map_or(0, |r| r.lifted_off.len())),
+                Binding::SmoothedIncrements => count(report.map_or(0, |r| r.smoothed)),
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
                 Binding::YieldedElements => count(plastic.map_or(0, |p| p.yielded_elements)),

@@ -165,6 +165,8 @@ pub enum Binding {
     Continuation,
     /// Viscous stabilization as the last resort of a step (true) or none.
     Stabilization,
+    /// The smoothing homotopy for an increment every other attempt refused (true) or none.
+    Smoothing,
     /// Threads of the element assembly (0: automatic).
     Threads,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
@@ -197,6 +199,8 @@ pub enum Binding {
     StabilizationRatio,
     /// Contacts released at lift-off in the last step (`StepReport::lifted_off`).
     LiftOffReleases,
+    /// Increments solved by the smoothing homotopy in the last step (`StepReport::smoothed`).
+    SmoothedIncrements,
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,

@@ -29,7 +29,7 @@
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
-//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation`, `solver.stabilization` | | parameter | | Newton settings |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation`, `solver.stabilization`, `solver.smoothing` | | parameter | | Newton settings (`solver.smoothing` is appended after `solver.liftOffReleases`) |
 //! | `solver.threads` | Integer | parameter | | threads of the element assembly (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
@@ -780,6 +780,22 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          support: no equilibrium held on either side of the law's jump)",
         Binding::LiftOffReleases,
     );
+    // Appended after it for the same reason.
+    table.parameter(
+        "solver.smoothing",
+        Value::Boolean(solver.smoothing),
+        None,
+        "true: an increment every other attempt refused (curved contacts or a tension-field film) is \
+         solved again with the contact and wrinkling laws' switches rounded, the rounding reduced, and \
+         the law's own equilibrium solved from there; false: the step is discarded there",
+        Binding::Smoothing,
+    );
+    integer_output(
+        &mut table,
+        "solver.smoothedIncrements",
+        "increments of the last step solved by the smoothing homotopy (solver.smoothing)",
+        Binding::SmoothedIncrements,
+    );
     table.0
 }
 
@@ -977,15 +993,22 @@ mod tests {
             .count();
         assert_eq!(
             outputs,
-            9 * 7 + 3 + 3 + 7 + 2,
-            "gaps, group and total reactions, statistics (with the stabilization energy and ratio \
-             and the lift-off releases), film"
+            9 * 7 + 3 + 3 + 8 + 2,
+            "gaps, group and total reactions, statistics (with the stabilization energy and ratio, \
+             the lift-off releases and the smoothed increments), film"
         );
-        // Appended last: the value references before it are those of the earlier tables.
-        let last = table.last().unwrap();
+        // Appended last: the value references before them are those of the earlier tables.
+        let names: Vec<_> = table[table.len() - 3..]
+            .iter()
+            .map(|v| (v.name.as_str(), v.var_type))
+            .collect();
         assert_eq!(
-            (last.name.as_str(), last.var_type),
-            ("solver.liftOffReleases", VarType::Integer)
+            names,
+            [
+                ("solver.liftOffReleases", VarType::Integer),
+                ("solver.smoothing", VarType::Boolean),
+                ("solver.smoothedIncrements", VarType::Integer)
+            ]
         );
         assert_eq!(find("film.wrinkling").start, Some(Value::Boolean(false)));
         assert_eq!(find("film.slackElements").var_type, VarType::Integer);

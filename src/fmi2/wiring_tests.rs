@@ -41,7 +41,7 @@ use crate::specimens::parallel_arch::SpecimenContact;
 
 /// Variables whose change no output can show, and why (each is still set and the outputs
 /// still compared with the core's).
-const UNSEEN: [(&str, &str); 4] = [
+const UNSEEN: [(&str, &str); 5] = [
     (
         "solver.threads",
         "the assembly is bit-identical for every thread count, by design",
@@ -58,6 +58,11 @@ const UNSEEN: [(&str, &str); 4] = [
         "solver.stabilization",
         "the last resort of a step: no run here refuses its smallest increment, so it never acts \
          (fmi2/tests/stepping.rs: a jump it converges is discarded with it off)",
+    ),
+    (
+        "solver.smoothing",
+        "the last resort of an increment: no run here refuses its smallest increment, so it never \
+         acts (tests/robustness.rs: a held-out path it converges is refused with it off)",
     ),
 ];
 
@@ -159,6 +164,7 @@ fn edit(run: &mut CoreRun, name: &str, value: &Value) -> Result<(), String> {
                 "lineSearch" => ("line_search", x),
                 "continuation" => ("continuation", x),
                 "stabilization" => ("stabilization", x),
+                "smoothing" => ("smoothing", x),
                 "threads" => ("threads", x),
                 "useJuRowlands" if x == true => ("iteration_matrix", "JuRowlands".into()),
                 "useJuRowlands" => ("iteration_matrix", "Consistent".into()),
@@ -333,6 +339,7 @@ fn expected(name: &str, model: &Model, r: &Results, report: &StepReport) -> Valu
             ("solver", "stabilizationEnergy") => Some(Value::Real(report.stabilization_energy)),
             ("solver", "stabilizationRatio") => Some(Value::Real(report.stabilization_ratio())),
             ("solver", "liftOffReleases") => Some(integer(report.lifted_off.len())),
+            ("solver", "smoothedIncrements") => Some(integer(report.smoothed)),
             ("film", "maxEquivalentStress") => Some(Value::Real(r.von_mises_range().1)),
             ("film", "wrinkledElements") => Some(integer(counts[1])),
             ("film", "slackElements") => Some(integer(counts[2])),

@@ -250,23 +250,26 @@ impl Material {
         }
     }
 
+    /// `ε̂ = ε + D⁻¹ S0`, `D⁻¹ = (1/Y) [[1, −ν, 0], [−ν, 1, 0], [0, 0, 2(1 + ν)]]` (module doc).
+    #[inline]
+    pub fn effective_strain(&self, strain: &Vector3<f64>) -> Vector3<f64> {
+        let (y, nu) = (self.youngs_modulus, self.poisson_ratio);
+        let s0 = self.prestress;
+        strain
+            + Vector3::new(
+                s0[0] - nu * s0[1],
+                s0[1] - nu * s0[0],
+                2.0 * (1.0 + nu) * s0[2],
+            ) / y
+    }
+
     /// Tension-field response (mixed criterion, closed form for isotropic SVK). Kept out of line
     /// so that the `none` path of [`Material::response`] inlines into the element loop.
     #[inline(never)]
     fn tension_field(&self, d: Matrix3<f64>, strain: &Vector3<f64>) -> MaterialResponse {
         let (y, nu) = (self.youngs_modulus, self.poisson_ratio);
-        let s0 = self.prestress;
-        // ε̂ = ε + D⁻¹ S0, D⁻¹ = (1/Y) [[1, −ν, 0], [−ν, 1, 0], [0, 0, 2(1 + ν)]].
-        let e = strain
-            + Vector3::new(
-                s0[0] - nu * s0[1],
-                s0[1] - nu * s0[0],
-                2.0 * (1.0 + nu) * s0[2],
-            ) / y;
-        let half_diff = 0.5 * (e.x - e.y);
-        let rho = (half_diff * half_diff + 0.25 * e.z * e.z).sqrt();
-        let mean = 0.5 * (e.x + e.y);
-        let (e1, e2) = (mean + rho, mean - rho);
+        let e = self.effective_strain(strain);
+        let (e1, e2, rho) = principal_strains(&e);
         // Relative tolerance: exactly zero strain is slack; never divide by ρ outside `wrinkled`.
         let tol = 1e-12 * (e1.abs() + e2.abs());
         if e1 <= tol {
@@ -296,6 +299,15 @@ impl Material {
             kappa: y * e1 / rho,
         }
     }
+}
+
+/// The principal strains `ê1 ≥ ê2` of the Voigt strain `e` and `ρ = (ê1 − ê2)/2`.
+#[inline]
+pub fn principal_strains(e: &Vector3<f64>) -> (f64, f64, f64) {
+    let half_diff = 0.5 * (e.x - e.y);
+    let rho = (half_diff * half_diff + 0.25 * e.z * e.z).sqrt();
+    let mean = 0.5 * (e.x + e.y);
+    (mean + rho, mean - rho, rho)
 }
 
 #[cfg(test)]

@@ -73,6 +73,25 @@ pub(in crate::mech) struct Workspace {
     pub(super) dissipated: f64,
     /// The work of the current increment's last correction (J).
     pub(super) last_work: f64,
+    /// The first iterate of the next increment instead of the predictor's (taken by it): the
+    /// smoothing homotopy's last solution (`smoothing.rs`).
+    pub(super) guess: Option<Vec<f64>>,
+    /// What ends an increment besides the residual tolerance (`newton.rs`).
+    pub(super) acceptance: Acceptance,
+}
+
+/// What ends an increment's Newton iteration besides the residual within its tolerance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Acceptance {
+    /// The solver's own test: an iterate after the first, its last correction within the
+    /// displacement tolerance.
+    Law,
+    /// Any iterate after the first: the smoothing homotopy's rounded problems, whose solutions
+    /// are only starting points (`smoothing.rs`).
+    Residual,
+    /// The first iterate only: the smoothing homotopy's last resort, the law's residual at a
+    /// rounded problem's solution (`smoothing.rs`).
+    Start,
 }
 
 impl Analysis {
@@ -121,6 +140,8 @@ impl Analysis {
             stabilization: 0.0,
             dissipated: 0.0,
             last_work: 0.0,
+            guess: None,
+            acceptance: Acceptance::Law,
         };
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * system.material.membrane_stiffness() * length_scale;

@@ -187,6 +187,17 @@ impl Analysis {
                             continue;
                         }
                     }
+                    // Last, with curved contacts, the smoothing homotopy (`smoothing.rs`): only
+                    // here, so that every path the attempts above converge is computed as before.
+                    if reached.is_none() && self.settings.smoothing && self.smoothing_applies() {
+                        self.parts.stabilization.switch_off();
+                        if let Some(converged) =
+                            self.solve_smoothed(&current, &at(next), &levels, &mut report)
+                        {
+                            reached = Some((next, converged));
+                            held = true;
+                        }
+                    }
                     let Some((next, (state, history))) = reached else {
                         self.parts.stabilization.switch_off();
                         return Err(StepError::NotConverged {

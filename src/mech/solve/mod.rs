@@ -10,6 +10,7 @@
 //! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
 //! | `increments` | the increment controller: cut-back, enlargement, predictor |
 //! | `newton` | Newton–Raphson for one increment |
+//! | `smoothing` | the smoothing homotopy of a refused increment with curved contacts |
 //! | `line_search` | backtracking line search with a watchdog |
 //! | [`settings`] | [`SolverSettings`] |
 //! | [`state`] | [`AnalysisState`], the converged state an FMU state serializes |
@@ -28,6 +29,7 @@ mod newton;
 pub mod report;
 mod sensitivity;
 pub mod settings;
+mod smoothing;
 pub mod state;
 
 pub use analysis::Analysis;

@@ -2,7 +2,7 @@
 
 use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::LoadLevels;
-use crate::mech::solve::analysis::Analysis;
+use crate::mech::solve::analysis::{Acceptance, Analysis};
 use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::continuation::{Continuation, Verdict};
 use crate::mech::solve::line_search::Watchdog;
@@ -18,7 +18,10 @@ impl Analysis {
         motion: &GroupMotion,
         levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
-        let mut u = self.predict(start, motion);
+        let mut u = match self.work.guess.take() {
+            Some(guess) => guess,
+            None => self.predict(start, motion),
+        };
         // Trial history from the converged start (also after a cut-back or for an enlarged retry).
         for c in self.parts.all_mut() {
             c.restore(start);
@@ -88,9 +91,14 @@ impl Analysis {
                 correction: correction_norm,
                 correction_tolerance: s.displacement_tolerance * displacement_scale,
             };
-            let mut converged = (iteration > 0 || self.system.free_count == 0)
-                && record.correction <= record.correction_tolerance
-                && residual <= tolerance
+            let mut converged = match self.work.acceptance {
+                Acceptance::Law => {
+                    (iteration > 0 || self.system.free_count == 0)
+                        && record.correction <= record.correction_tolerance
+                }
+                Acceptance::Residual => iteration > 0,
+                Acceptance::Start => iteration == 0,
+            } && residual <= tolerance
                 && artificial <= tolerance;
             if converged && let Some(set) = active.as_mut() {
                 let natural = self.parts.curved.natural();
@@ -116,6 +124,17 @@ impl Analysis {
                 } else {
                     self.parts.curved.frozen = Some(frozen);
                 }
+            }
+            if !converged && self.work.acceptance == Acceptance::Start {
+                // Only the first iterate is judged.
+                return Err(IncrementFailure::Stalled {
+                    iteration,
+                    closest: record,
+                    chattering: Vec::new(),
+                    flipping: Vec::new(),
+                    compressed: Vec::new(),
+                    lifting: Vec::new(),
+                });
             }
             if converged {
                 let mut state = AnalysisState {

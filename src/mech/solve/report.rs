@@ -45,6 +45,13 @@ pub struct StepReport {
     /// attempt (N).
     #[serde(default)]
     pub lifted_off: Vec<f64>,
+    /// Increments solved by the smoothing homotopy (`smoothing.rs`): the curved contacts' law
+    /// with its corners rounded, the rounding reduced, then the law itself from there.
+    pub smoothed: usize,
+    /// Of [`Self::smoothed`], those whose answer is a rounded problem's solution at which the
+    /// law's residual is within its tolerance, Newton on the law having been refused from it
+    /// (its correction, along a soft mode of the film, not within the displacement tolerance).
+    pub smoothed_on_residual: usize,
     /// Artificial energy left at the end of the step (J): over the increments solved by
     /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
     /// each (the pseudo-time force still acting when the increment was accepted); and, when the

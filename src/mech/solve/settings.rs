@@ -43,6 +43,10 @@ pub struct SolverSettings {
     /// increment neither plain Newton nor the continuation converge, before it is halved; its
     /// work is reported against the strain energy. false: never (the stabilization-free answer).
     pub stabilization: bool,
+    /// The smoothing homotopy (`smoothing.rs`) for an increment every other attempt refused,
+    /// with curved contacts or an elastic tension-field film: the laws' switches rounded, the
+    /// rounding reduced, the law's own equilibrium solved from there. false: never.
+    pub smoothing: bool,
     /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
     /// below [`crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results
     /// are bit-identical for every count.
@@ -68,6 +72,7 @@ impl Default for SolverSettings {
             symmetric_factorization: true,
             continuation: true,
             stabilization: true,
+            smoothing: true,
             threads: 0,
         }
     }

@@ -52,6 +52,7 @@
 //! |---|---|
 //! | `mod.rs` | the contact law: [`SurfaceContact`], [`SurfaceContacts`], histories, responses |
 //! | [`surface`] | the supports' geometry: centrelines, frames, closest-point projection |
+//! | [`smoothing`] | the law with its corners rounded: the smoothing homotopy's problems |
 //! | `tests` | tangent against central differences, caps, corners, slip |
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
@@ -61,6 +62,7 @@ use crate::mech::elements::gap::{FrictionLaw, GapStatus};
 use crate::mech::elements::triangle::ElementMatrix;
 use crate::mech::model::Model;
 use crate::mech::solve::assembly::{System, node_vector};
+pub mod smoothing;
 pub mod surface;
 
 use surface::*;
@@ -292,6 +294,11 @@ impl SurfaceContact {
     /// The contact's response at node position `x` from the converged `history`.
     pub fn respond(&self, x: &Vector3<f64>, history: &ContactHistory) -> ContactResponse {
         self.respond_as(x, history, None)
+    }
+
+    /// The tube's radius (m).
+    pub fn tube_radius(&self) -> f64 {
+        self.tube_radius
     }
 
     /// The friction law.
@@ -588,7 +595,8 @@ impl SurfaceContacts {
     }
 
     /// Adds the contacts' residuals and tangents at `u` (from `histories`; with the statuses
-    /// `frozen` imposed when given, [`SurfaceContact::respond_as`]) to `residual` and
+    /// `frozen` imposed when given, [`SurfaceContact::respond_as`]; under the law smoothed over
+    /// the width `smoothing` where it is positive, [`SurfaceContact::respond_smoothed`]) to `residual` and
     /// the Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
     /// once it has grown).
     #[allow(clippy::too_many_arguments)] // the evaluation's inputs and outputs, each needed
@@ -598,6 +606,7 @@ impl SurfaceContacts {
         u: &[f64],
         histories: &[ContactHistory],
         frozen: Option<&[GapStatus]>,
+        smoothing: f64,
         residual: &mut [f64],
         mut values: Option<&mut [f64]>,
         responses: &mut Vec<ContactResponse>,
@@ -608,7 +617,14 @@ impl SurfaceContacts {
                 .iter()
                 .zip(histories)
                 .enumerate()
-                .map(|(k, (c, h))| c.respond_as(&self.position(c, u), h, frozen.map(|f| f[k]))),
+                .map(|(k, (c, h))| {
+                    let x = self.position(c, u);
+                    if smoothing > 0.0 {
+                        c.respond_smoothed(&x, h, smoothing)
+                    } else {
+                        c.respond_as(&x, h, frozen.map(|f| f[k]))
+                    }
+                }),
         );
         for ((c, r), &(triangle, local)) in
             self.contacts.iter().zip(responses.iter()).zip(&self.slots)
@@ -668,6 +684,16 @@ impl SurfaceContacts {
                 .map_err(|e| (k, e))?;
         }
         Ok(())
+    }
+
+    /// The largest penetration `−g` (m) at `u` of the contacts closed in `histories`, 0 if none.
+    pub fn largest_penetration(&self, u: &[f64], histories: &[ContactHistory]) -> f64 {
+        self.contacts
+            .iter()
+            .zip(histories)
+            .filter(|(_, h)| h.status != GapStatus::Open)
+            .map(|(c, h)| -c.project(&self.position(c, u), h.angle).gap)
+            .fold(0.0, f64::max)
     }
 
     /// Results at `u` with the converged `histories`.

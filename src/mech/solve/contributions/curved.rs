@@ -23,6 +23,9 @@ pub struct CurvedContacts {
     pub frozen: Option<Vec<GapStatus>>,
     /// Whether the next increments hold the statuses fixed (active-set iteration, `newton.rs`).
     pub active_set: bool,
+    /// The width (m) over which the contact law's corners are rounded in the smoothing
+    /// homotopy (`curved_contact::smoothing`); 0: the law itself.
+    pub smoothing: f64,
     /// Each contact's name in messages: `<support>.<k>` (k-th node of the support).
     pub names: Vec<String>,
     /// The law's status changes over the Newton iterations.
@@ -41,6 +44,7 @@ impl CurvedContacts {
             responses: Vec::new(),
             frozen: None,
             active_set: false,
+            smoothing: 0.0,
             names: model
                 .curved_supports
                 .iter()
@@ -62,6 +66,26 @@ impl CurvedContacts {
     pub fn natural(&self) -> Vec<GapStatus> {
         self.responses.iter().map(|r| r.natural).collect()
     }
+
+    /// The first width (m) of the smoothing homotopy from the converged `u`, `histories`: the
+    /// larger of [`Self::SMOOTHING_START`] times the largest penetration of a closed contact
+    /// (the scale of the penalty's forces, `λN/k_n`) and [`Self::SMOOTHING_FLOOR`] times the
+    /// largest tube radius.
+    pub fn smoothing_width(&self, u: &[f64], histories: &[ContactHistory]) -> f64 {
+        let depth = self.contacts.largest_penetration(u, histories);
+        let radius = self
+            .contacts
+            .contacts
+            .iter()
+            .map(|c| c.tube_radius())
+            .fold(0.0, f64::max);
+        (Self::SMOOTHING_START * depth).max(Self::SMOOTHING_FLOOR * radius)
+    }
+
+    /// The first smoothing width in penetrations.
+    const SMOOTHING_START: f64 = 4.0;
+    /// The least first smoothing width in tube radii.
+    const SMOOTHING_FLOOR: f64 = 1e-3;
 
     /// Whether the model has any curved-support contact.
     pub fn is_empty(&self) -> bool {
@@ -95,6 +119,7 @@ impl Contribution for CurvedContacts {
             at.u,
             &self.start,
             self.frozen.as_deref(),
+            self.smoothing,
             residual,
             values,
             &mut self.responses,

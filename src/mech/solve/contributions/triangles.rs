@@ -20,6 +20,9 @@ pub struct Triangles {
     start: Vec<PlasticHistory>,
     /// Plastic history of the last evaluation (the trial).
     trial: Vec<PlasticHistory>,
+    /// The strain width over which an elastic tension-field film's switches are rounded in the
+    /// smoothing homotopy (`elements/smoothing.rs`); 0: the law itself.
+    pub smoothing: f64,
 }
 
 impl Contribution for Triangles {
@@ -29,7 +32,21 @@ impl Contribution for Triangles {
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
-        match at.system.material.plastic_film() {
+        let material = &at.system.material;
+        match material.plastic_film() {
+            None if self.smoothing > 0.0 && material.wrinkling == Wrinkling::TensionField => {
+                at.system.add_triangles_keeping(
+                    at.u,
+                    residual,
+                    values,
+                    |_, tri, ue, tangent| {
+                        let (r, k) =
+                            tri.force_and_tangent_rounded(material, ue, tangent, self.smoothing);
+                        (r, k, ())
+                    },
+                    &mut [],
+                );
+            }
             None => at.system.add_triangles(at.u, residual, values),
             Some(film) => {
                 let start = &self.start;
