@@ -1033,8 +1033,8 @@ fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: u
 /// A held-out path (`benches/heldout.rs`, `arches#24`: a 98-node panel, tension-field film,
 /// prestress 2.1/1.1 MPa, lowered 0.27 m onto one tube arch in 2 × 10 steps while its rails
 /// move in and one turns about its hinge; files in `tests/data/`, written by the bench's
-/// `--write`). Without the viscous stabilization and the smoothing homotopy it is refused; with the defaults it converges,
-/// some increments stabilized, every step within the energy bound. The stabilization's first
+/// `--write`). Without the viscous stabilization and the smoothing homotopy it is refused; with
+/// the defaults it converges, some increments stabilized, every step within the energy bound. The stabilization's first
 /// increment needs the continuation after plain Newton, as the increments after it have it
 /// (refused when the first one was plain Newton only).
 #[test]

@@ -187,8 +187,9 @@ impl Analysis {
                             continue;
                         }
                     }
-                    // Last, with curved contacts, the smoothing homotopy (`smoothing.rs`): only
-                    // here, so that every path the attempts above converge is computed as before.
+                    // Last, with curved contacts or a tension-field film, the smoothing homotopy
+                    // (`smoothing.rs`): only here, so that every path the attempts above converge
+                    // is computed as before.
                     if reached.is_none() && self.settings.smoothing && self.smoothing_applies() {
                         self.parts.stabilization.switch_off();
                         if let Some(converged) =
