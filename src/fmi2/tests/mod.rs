@@ -351,7 +351,7 @@ fn deserialize_status(fmu: &Fmu, bytes: &[u8]) -> (c_int, Fmi2FmuState) {
 }
 
 /// The state's serialized bytes (`fmi2SerializedFMUstateSize` + `fmi2SerializeFMUstate`).
-fn serialized(fmu: &Fmu, state: Fmi2FmuState) -> Vec<Fmi2Byte> {
+pub(super) fn serialized(fmu: &Fmu, state: Fmi2FmuState) -> Vec<Fmi2Byte> {
     let mut size = 0;
     assert_eq!(
         unsafe { fmi2_serialized_fmu_state_size(fmu.c, state, &mut size) },

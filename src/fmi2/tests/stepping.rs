@@ -229,7 +229,7 @@ fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
 /// its hinge. Every attempt at step 4's smallest increment but the smoothing homotopy is
 /// refused: with the default `solver.smoothing` the step converges and
 /// `solver.smoothedIncrements` counts the homotopy's increments; with it off the step is
-/// discarded.
+/// discarded. The state after the smoothed step round-trips.
 #[test]
 fn a_step_only_the_smoothing_homotopy_converges_is_discarded_without_it() {
     let data = |f: &str| {
@@ -277,6 +277,38 @@ fn a_step_only_the_smoothing_homotopy_converges_is_discarded_without_it() {
         if smoothing {
             assert!(status <= Status::Warning.raw(), "{:?}", log.take());
             assert!(fmu.integer("solver.smoothedIncrements") > 0);
+            // The state after the smoothed step round-trips (get/set and serialized): it is the
+            // laws' own, no rounding in it, and step 5 continues from it identically.
+            let mut state: Fmi2FmuState = std::ptr::null_mut();
+            assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+            let bytes = serialized(&fmu, state);
+            let at_save = fmu.all_values();
+            let fifth = |fmu: &Fmu| {
+                assert_eq!(fmu.set_real("railW.dz", target(0, 2) * 5.0 / steps), 0);
+                assert!(fmu.step(4.0, 1.0) <= Status::Warning.raw());
+                fmu.all_values()
+            };
+            let reference = fifth(&fmu);
+            assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, state) }, 0);
+            assert_eq!(fmu.all_values(), at_save);
+            assert_eq!(fifth(&fmu), reference);
+            let mut read: Fmi2FmuState = std::ptr::null_mut();
+            assert_eq!(
+                unsafe {
+                    fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr(), bytes.len(), &mut read)
+                },
+                0
+            );
+            assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, read) }, 0);
+            assert_eq!(fmu.all_values(), at_save);
+            assert_eq!(
+                fifth(&fmu),
+                reference,
+                "the deserialized state continues exactly"
+            );
+            for mut s in [state, read] {
+                assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut s) }, 0);
+            }
         } else {
             assert_eq!(status, Status::Discard.raw(), "{:?}", log.take());
         }
