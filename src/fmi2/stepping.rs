@@ -113,13 +113,14 @@ impl Instance {
                 self.event(|| {
                     format!(
                         "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, {} enlarged \
-                         (larger than 1/solver.incrementsPerStep because every smaller one failed), residual {:.3e} N",
+                         (larger than 1/solver.incrementsPerStep because every smaller one failed), residual {:.3e} N{}",
                         self.time,
                         report.iterations.len(),
                         report.total_iterations(),
                         report.cutbacks,
                         report.enlarged,
-                        report.residual
+                        report.residual,
+                        report.attempts()
                     )
                 });
                 self.steps += 1;

@@ -35,6 +35,13 @@ def rows_under(md: str, heading: str) -> list[list[str]]:
     return [[c.strip() for c in ln.strip("|").split("|")] for ln in lines]
 
 
+def head_of(md: str, heading: str) -> list[str]:
+    """The header cells of the table right under ``heading``."""
+    block = md.split(heading, 1)[1].split("\n#", 1)[0]
+    line = next(ln for ln in block.splitlines() if ln.startswith("|"))
+    return [c.strip() for c in line.strip("|").split("|")]
+
+
 def close(text: str, value: float, rel: float = 5e-6) -> bool:
     return abs(float(text) - value) <= rel * max(abs(value), 1e-12) + 1e-12
 
@@ -76,6 +83,11 @@ def test_film_report_has_every_section_with_the_recorded_numbers(fmu_path, tmp_p
     assert solver["steps taken"] == str(results.steps) == "2"
     assert int(solver["solver.iterations (sum)"]) == int(results["solver.iterations"][1:].sum()) > 0
     assert re.search(r"\| rollbacks \| 0 \|", md)
+    # Every Integer statistic of the solver, as a column of the steps and summed.
+    for s in ("solver.cutbacks", "solver.liftOffReleases", "solver.smoothedIncrements"):
+        column = head_of(md, "## Load steps").index(s)
+        assert [int(r[column]) for r in steps[1:]] == [int(v) for v in results[s][1:]], s
+        assert int(solver[f"{s} (sum)"]) == int(results[s][1:].sum()), s
 
 
 def strip_model() -> dict:

@@ -277,6 +277,12 @@ fn a_step_only_the_smoothing_homotopy_converges_is_discarded_without_it() {
         if smoothing {
             assert!(status <= Status::Warning.raw(), "{:?}", log.take());
             assert!(fmu.integer("solver.smoothedIncrements") > 0);
+            // The step's log line says so.
+            assert!(
+                log.contains(Status::Ok, "by the smoothing homotopy"),
+                "{:?}",
+                log.take()
+            );
             // The state after the smoothed step round-trips (get/set and serialized): it is the
             // laws' own, no rounding in it, and step 5 continues from it identically.
             let mut state: Fmi2FmuState = std::ptr::null_mut();

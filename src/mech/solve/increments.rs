@@ -376,15 +376,13 @@ impl Analysis {
     /// its constraint (`Contribution::correct_prediction`: closed curved-support contacts
     /// kept at their converged gap).
     pub(super) fn predict(&self, start: &AnalysisState, motion: &GroupMotion) -> Vec<f64> {
-        let mut u = start.displacement.clone();
+        let mut u = self.unextrapolated(start, motion);
         let (mut dot, mut old, mut new) = (0.0, 0.0, 0.0);
         for (i, d) in self.system.dofs.iter().enumerate() {
-            if let Dof::Prescribed { group, component } = d {
-                let value = self.prescribed_value(i, *group, *component, motion);
-                let step = value - start.displacement[i];
+            if let Dof::Prescribed { .. } = d {
+                let step = u[i] - start.displacement[i];
                 let last = start.last_increment.get(i).copied().unwrap_or(0.0);
                 (dot, old, new) = (dot + step * last, old + last * last, new + step * step);
-                u[i] = value;
             }
         }
         if old > 0.0 && dot > 0.99 * (old * new).sqrt() {
@@ -399,6 +397,18 @@ impl Analysis {
             }
             for c in self.parts.all() {
                 c.correct_prediction(&self.system, start, &mut u);
+            }
+        }
+        u
+    }
+
+    /// The converged `start` with the prescribed DOFs moved to `motion` and every other DOF
+    /// where it was: the predictor without its extrapolation.
+    pub(super) fn unextrapolated(&self, start: &AnalysisState, motion: &GroupMotion) -> Vec<f64> {
+        let mut u = start.displacement.clone();
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Prescribed { group, component } = d {
+                u[i] = self.prescribed_value(i, *group, *component, motion);
             }
         }
         u

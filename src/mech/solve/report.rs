@@ -47,6 +47,7 @@ pub struct StepReport {
     pub lifted_off: Vec<f64>,
     /// Increments solved by the smoothing homotopy (`smoothing.rs`): the curved contacts' law
     /// with its corners rounded, the rounding reduced, then the law itself from there.
+    #[serde(default)]
     pub smoothed: usize,
     /// Of [`Self::smoothed`], those whose answer is a rounded problem's solution at which the
     /// law's residual is within its tolerance, Newton on the law having been refused from it
@@ -102,6 +103,36 @@ impl StepReport {
     /// Total Newton iterations (converged increments only).
     pub fn total_iterations(&self) -> usize {
         self.iterations.iter().sum()
+    }
+
+    /// The attempts beyond plain Newton the step needed, for a log line: "" where none, else
+    /// "; " and a comma-separated count of each (continuation, active set, viscous
+    /// stabilization and its release, lift-off releases, smoothing homotopy).
+    pub fn attempts(&self) -> String {
+        let mut said = Vec::new();
+        let counts = [
+            (self.continued, "continued"),
+            (self.active_set, "with the contact statuses held"),
+            (self.stabilized, "viscously stabilized"),
+            (self.released, "added to release the stabilization"),
+            (self.lifted_off.len(), "lift-off release(s)"),
+        ];
+        for (n, what) in counts {
+            if n > 0 {
+                said.push(format!("{n} {what}"));
+            }
+        }
+        if self.smoothed > 0 {
+            said.push(format!(
+                "{} by the smoothing homotopy ({} on the laws' residual)",
+                self.smoothed, self.smoothed_on_residual
+            ));
+        }
+        if said.is_empty() {
+            String::new()
+        } else {
+            format!("; increments {}", said.join(", "))
+        }
     }
 }
 
