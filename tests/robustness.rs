@@ -1138,3 +1138,19 @@ fn smoothing_homotopy_restarts_without_the_predictors_extrapolation() {
     assert_eq!(run.steps, 10);
     assert!(run.smoothed > 0, "no increment smoothed");
 }
+
+/// Held-out `arches#23` (four tube arches, isotropic friction, tension-field film at 2.9 and
+/// 1.0 MPa; rails lowered 0.35 m, turned and moved over 3 × 26 steps): in step 77 the smoothing
+/// homotopy's rounded problems converge down to small widths, but Newton on the laws from each
+/// rounded solution switches one contact back and forth across its corner (a stiff penalty,
+/// 2e8 N/m: residuals of hundreds of newtons after corrections of 1e-7 m). From the rounded
+/// solution with the contacts' statuses there held (the active set), the laws' equilibrium
+/// converges (`Analysis::smoothing_path`).
+#[test]
+fn smoothing_homotopy_holds_the_contact_statuses_of_its_rounded_solution() {
+    let (model, stages) = ("heldout_arches23.json", "heldout_arches23.stages.json");
+    let run = run_staged_until(model, stages, SolverSettings::default(), 78);
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert_eq!(run.steps, 78);
+    assert!(run.smoothed > 0, "no increment smoothed");
+}

@@ -5,8 +5,10 @@
 //! Newton's iterates do not switch. The rounding starts at a width of its own scale (four times
 //! the deepest contact penetration, at least 1e-3 of the tube radius; a strain of 1e-4 for the
 //! film), tenfold wider (twice at most) where that problem is refused. From each rounded
-//! solution the laws' own equilibrium is solved by Newton with the solver's own test; where that
-//! is refused, the rounded solution itself is the answer if the laws' residual there is within
+//! solution the laws' own equilibrium is solved by Newton with the solver's own test, then, with
+//! curved contacts, by Newton with the contacts' statuses at the rounded solution held (the
+//! active set, changed only between converged solves); where both are refused, the rounded
+//! solution itself is the answer if the laws' residual there is within
 //! its tolerance (Newton's correction from it then runs along a soft mode of the film and is not
 //! within the displacement tolerance: `StepReport::smoothed_on_residual`). Else the rounding is
 //! reduced tenfold, the next problem started from the last solution (a refused one: a shorter
@@ -122,6 +124,20 @@ impl Analysis {
             if let Ok(converged) = self.solve_increment(start, motion, levels) {
                 report.smoothed += 1;
                 return Some(converged);
+            }
+            // Newton on the law refused where it switches a contact back and forth across its
+            // corner: the law with the contacts' statuses at the smoothed solution held
+            // (`ActiveSet`), changed only between converged solves.
+            if !self.parts.curved.is_empty() {
+                self.work.guess = Some(u.clone());
+                self.parts.curved.active_set = true;
+                let held = self.solve_increment(start, motion, levels);
+                self.parts.curved.active_set = false;
+                self.parts.curved.frozen = None;
+                if let Ok(converged) = held {
+                    report.smoothed += 1;
+                    return Some(converged);
+                }
             }
             // Newton on the law refused (a correction along a soft mode of the film undoing
             // the solution): the smoothed solution itself where the law's residual there is
