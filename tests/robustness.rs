@@ -1154,3 +1154,18 @@ fn smoothing_homotopy_holds_the_contact_statuses_of_its_rounded_solution() {
     assert_eq!(run.steps, 78);
     assert!(run.smoothed > 0, "no increment smoothed");
 }
+
+/// Held-out `slack#8` (an unstressed tension-field film over four tube arches, rails lowered
+/// 0.27 m over 20 steps): in step 18 the smoothing homotopy's rounded problems stall below a
+/// width of 0.56 of its first (film elements switching between slack and wrinkled, where only
+/// the film's soft modes resist). With the viscous stabilization's damping on the rounded
+/// problems alone, they converge, and the laws' own equilibrium from them, undamped
+/// (`Analysis::solve_smoothed_problem`).
+#[test]
+fn smoothing_homotopy_damps_its_rounded_problems_on_a_slack_film() {
+    let (model, stages) = ("heldout_slack8.json", "heldout_slack8.stages.json");
+    let run = run_staged_until(model, stages, SolverSettings::default(), 18);
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert_eq!(run.steps, 18);
+    assert!(run.smoothed > 0, "no increment smoothed");
+}

@@ -158,8 +158,9 @@ impl Analysis {
     }
 
     /// The rounded problem of widths `(contact, strain)` from `guess` (the predictor's iterate if
-    /// none): plain Newton, then the continuation, each accepted on the residual alone; its
-    /// displacements, None where both are refused.
+    /// none): plain Newton, then the continuation, then Newton with the viscous stabilization at
+    /// each of its dampings, each accepted on the residual alone; its displacements, None where
+    /// all are refused.
     fn solve_smoothed_problem(
         &mut self,
         start: &AnalysisState,
@@ -178,6 +179,20 @@ impl Analysis {
             self.work.continuation = true;
             smoothed = self.solve_increment(start, motion, levels);
             self.work.continuation = false;
+        }
+        // Then with the viscous stabilization's damping (a slack or wrinkled film's soft modes,
+        // where Newton on the rounded problem stalls): its solution is only the start of the
+        // next problem and of Newton on the laws, which carry no damping.
+        if smoothed.is_err() && self.settings.stabilization {
+            for c in Self::STABILIZATION_DAMPING {
+                self.work.guess.clone_from(guess);
+                self.parts.stabilization.switch_on(c);
+                smoothed = self.solve_increment(start, motion, levels);
+                self.parts.stabilization.switch_off();
+                if smoothed.is_ok() {
+                    break;
+                }
+            }
         }
         self.work.acceptance = Acceptance::Law;
         self.parts.curved.smoothing = 0.0;
