@@ -1169,3 +1169,18 @@ fn smoothing_homotopy_damps_its_rounded_problems_on_a_slack_film() {
     assert_eq!(run.steps, 18);
     assert!(run.smoothed > 0, "no increment smoothed");
 }
+
+/// Held-out `arches#26` (three tube arches, the paper's sliding-direction friction at μ = 0.45,
+/// tension-field film at 2.3 MPa; rails lowered 0.12 m, moved and turned over 80 steps): in step
+/// 20, after the contacts the controller's attempts named were released, only the smoothing
+/// homotopy's rounded problems find further contacts lifting off while they hold more than μN
+/// across (the law's jump, with no equilibrium on either side). Released in turn, the
+/// increment converges (`Analysis::step_to_motion`).
+#[test]
+fn contacts_the_smoothing_homotopy_finds_lifting_off_are_released_and_the_increment_retried() {
+    let (model, stages) = ("heldout_arches26.json", "heldout_arches26.stages.json");
+    let run = run_staged_until(model, stages, SolverSettings::default(), 20);
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert_eq!(run.steps, 20);
+    assert!(run.lifted_off > 0, "no cross hold released");
+}

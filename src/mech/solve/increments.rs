@@ -170,33 +170,28 @@ impl Analysis {
                     // law"): only here, so that every path the attempts above converge is
                     // computed as before.
                     if reached.is_none()
-                        && report.lifted_off.len() < Self::LIFT_OFF_RELEASES
-                        && !last.lifting().is_empty()
+                        && self.release_lift_off(last.lifting(), &mut current, &mut report)
                     {
-                        let before = report.lifted_off.len();
-                        for c in self.parts.all_mut() {
-                            c.release_lift_off(
-                                last.lifting(),
-                                &mut current,
-                                &mut report.lifted_off,
-                            );
-                        }
-                        if report.lifted_off.len() > before {
-                            // The retry starts as the increment did: without the damping.
-                            self.parts.stabilization.switch_off();
-                            continue;
-                        }
+                        continue;
                     }
                     // Last, with curved contacts or a tension-field film, the smoothing homotopy
                     // (`smoothing.rs`): only here, so that every path the attempts above converge
-                    // is computed as before.
+                    // is computed as before. Where it is refused naming contacts that lift off
+                    // with more than μN across (its rounded problems see lift-offs the attempts
+                    // above did not reach), they are released as above and the increment tried
+                    // again.
                     if reached.is_none() && self.settings.smoothing && self.smoothing_applies() {
                         self.parts.stabilization.switch_off();
-                        if let Some(converged) =
-                            self.solve_smoothed(&current, &at(next), &levels, &mut report)
-                        {
-                            reached = Some((next, converged));
-                            held = true;
+                        match self.solve_smoothed(&current, &at(next), &levels, &mut report) {
+                            Ok(converged) => {
+                                reached = Some((next, converged));
+                                held = true;
+                            }
+                            Err(lifting) => {
+                                if self.release_lift_off(&lifting, &mut current, &mut report) {
+                                    continue;
+                                }
+                            }
                         }
                     }
                     let Some((next, (state, history))) = reached else {
@@ -334,6 +329,31 @@ impl Analysis {
                 return;
             }
         }
+    }
+
+    /// Marks the sliding-direction contacts `lifting` (named by a refused attempt as lifting off
+    /// with more than μN across) as lifting off and landing again within the increment from
+    /// `current` (`Contribution::release_lift_off`), up to [`Self::LIFT_OFF_RELEASES`] in a
+    /// step; whether any was, the increment then to be tried again from the same start, without
+    /// the damping.
+    fn release_lift_off(
+        &mut self,
+        lifting: &[String],
+        current: &mut AnalysisState,
+        report: &mut StepReport,
+    ) -> bool {
+        if report.lifted_off.len() >= Self::LIFT_OFF_RELEASES || lifting.is_empty() {
+            return false;
+        }
+        let before = report.lifted_off.len();
+        for c in self.parts.all_mut() {
+            c.release_lift_off(lifting, current, &mut report.lifted_off);
+        }
+        if report.lifted_off.len() == before {
+            return false;
+        }
+        self.parts.stabilization.switch_off();
+        true
     }
 
     /// Most cross holds [`Self::step_to_motion`] releases in a step at sliding-direction

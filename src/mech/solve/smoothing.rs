@@ -27,7 +27,7 @@
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::elements::material::Wrinkling;
 use crate::mech::solve::analysis::{Acceptance, Analysis};
-use crate::mech::solve::report::StepReport;
+use crate::mech::solve::report::{IncrementFailure, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
 impl Analysis {
@@ -49,30 +49,54 @@ impl Analysis {
     }
 
     /// The increment from `start` to `motion` and `levels` by the smoothing homotopy (module
-    /// doc), counted in `report.smoothed`; None where it is refused (the increment's failure is
-    /// that of the attempts before it).
+    /// doc), counted in `report.smoothed`. Where it is refused (the increment's failure is that
+    /// of the attempts before it): the sliding-direction contacts its refused attempts named as
+    /// lifting off with more than the friction limit across (`IncrementFailure::lifting`), for
+    /// the controller's lift-off release.
     pub(super) fn solve_smoothed(
         &mut self,
         start: &AnalysisState,
         motion: &GroupMotion,
         levels: &LoadLevels,
         report: &mut StepReport,
-    ) -> Option<(AnalysisState, Vec<f64>)> {
-        if let Some(converged) = self.smoothing_path(start, motion, levels, None, report) {
-            return Some(converged);
+    ) -> Result<(AnalysisState, Vec<f64>), Vec<String>> {
+        let mut lifting = Vec::new();
+        if let Some(converged) =
+            self.smoothing_path(start, motion, levels, None, report, &mut lifting)
+        {
+            return Ok(converged);
         }
         // Where the predictor extrapolated, the path again from the start as it was: an
         // extrapolated film can be so far from equilibrium that no rounded problem converges
         // from it (first residuals of 1.3e5 N and 4.5e5 N on held-out `arches#15` and `#21`).
         let unextrapolated = self.unextrapolated(start, motion);
-        if unextrapolated == self.predict(start, motion) {
-            return None;
+        if unextrapolated != self.predict(start, motion)
+            && let Some(converged) = self.smoothing_path(
+                start,
+                motion,
+                levels,
+                Some(unextrapolated),
+                report,
+                &mut lifting,
+            )
+        {
+            return Ok(converged);
         }
-        self.smoothing_path(start, motion, levels, Some(unextrapolated), report)
+        Err(lifting)
+    }
+
+    /// Appends to `out` the contacts `failure` names as lifting off that it does not hold yet.
+    fn note_lifting(failure: &IncrementFailure, out: &mut Vec<String>) {
+        for name in failure.lifting() {
+            if !out.contains(name) {
+                out.push(name.clone());
+            }
+        }
     }
 
     /// The homotopy's path from the first rounded problem, started at `first` (the predictor's
-    /// iterate if None), to the laws' equilibrium; None where it is refused.
+    /// iterate if None), to the laws' equilibrium; None where it is refused (the contacts its
+    /// refused attempts named as lifting off appended to `lifting`).
     fn smoothing_path(
         &mut self,
         start: &AnalysisState,
@@ -80,6 +104,7 @@ impl Analysis {
         levels: &LoadLevels,
         first: Option<Vec<f64>>,
         report: &mut StepReport,
+        lifting: &mut Vec<String>,
     ) -> Option<(AnalysisState, Vec<f64>)> {
         // The widths at level 1 (contacts, m; film, strain); `w` is the level.
         let contact_width = if self.parts.curved.is_empty() {
@@ -100,7 +125,15 @@ impl Analysis {
                 .map(|(u, _)| u.clone())
                 .or_else(|| first.clone());
             let widths = (w * widths.0, w * widths.1);
-            let Some(u) = self.solve_smoothed_problem(start, motion, levels, widths, &guess) else {
+            let trial = self.solve_smoothed_problem(start, motion, levels, widths, &guess);
+            let u = match trial {
+                Ok(u) => Some(u),
+                Err(failure) => {
+                    Self::note_lifting(&failure, lifting);
+                    None
+                }
+            };
+            let Some(u) = u else {
                 match &solved {
                     // Refused from the start: a wider rounding.
                     None if wider < Self::SMOOTHING_WIDER => {
@@ -121,9 +154,12 @@ impl Analysis {
             };
             // The law itself from the smoothed solution.
             self.work.guess = Some(u.clone());
-            if let Ok(converged) = self.solve_increment(start, motion, levels) {
-                report.smoothed += 1;
-                return Some(converged);
+            match self.solve_increment(start, motion, levels) {
+                Ok(converged) => {
+                    report.smoothed += 1;
+                    return Some(converged);
+                }
+                Err(failure) => Self::note_lifting(&failure, lifting),
             }
             // Newton on the law refused where it switches a contact back and forth across its
             // corner: the law with the contacts' statuses at the smoothed solution held
@@ -159,8 +195,8 @@ impl Analysis {
 
     /// The rounded problem of widths `(contact, strain)` from `guess` (the predictor's iterate if
     /// none): plain Newton, then the continuation, then Newton with the viscous stabilization at
-    /// each of its dampings, each accepted on the residual alone; its displacements, None where
-    /// all are refused.
+    /// each of its dampings, each accepted on the residual alone; its displacements, or the last
+    /// attempt's failure.
     fn solve_smoothed_problem(
         &mut self,
         start: &AnalysisState,
@@ -168,7 +204,7 @@ impl Analysis {
         levels: &LoadLevels,
         (contact, strain): (f64, f64),
         guess: &Option<Vec<f64>>,
-    ) -> Option<Vec<f64>> {
+    ) -> Result<Vec<f64>, IncrementFailure> {
         self.parts.curved.smoothing = contact;
         self.parts.triangles.smoothing = strain;
         self.work.acceptance = Acceptance::Residual;
@@ -197,6 +233,6 @@ impl Analysis {
         self.work.acceptance = Acceptance::Law;
         self.parts.curved.smoothing = 0.0;
         self.parts.triangles.smoothing = 0.0;
-        smoothed.ok().map(|(state, _)| state.displacement)
+        smoothed.map(|(state, _)| state.displacement)
     }
 }
