@@ -14,7 +14,8 @@
 //! reduced tenfold, the next problem started from the last solution (a refused one: a shorter
 //! step in the width, its ratio square-rooted), up to 16 problems. The first problem starts from
 //! the predictor's iterate; where that path is refused and the predictor extrapolated, the path
-//! is tried once more from the converged start with only the prescribed DOFs moved. The
+//! is tried once more from the converged start with only the prescribed DOFs moved; last, from
+//! the predictor's iterate with the rounded problems Newton refuses solved damped. The
 //! increment's answer is always the laws' own equilibrium; a rounded problem's solution is never
 //! accepted unless it is one.
 //!
@@ -61,26 +62,26 @@ impl Analysis {
         report: &mut StepReport,
     ) -> Result<(AnalysisState, Vec<f64>), Vec<String>> {
         let mut lifting = Vec::new();
-        if let Some(converged) =
-            self.smoothing_path(start, motion, levels, None, report, &mut lifting)
-        {
-            return Ok(converged);
-        }
-        // Where the predictor extrapolated, the path again from the start as it was: an
-        // extrapolated film can be so far from equilibrium that no rounded problem converges
-        // from it (first residuals of 1.3e5 N and 4.5e5 N on held-out `arches#15` and `#21`).
+        // From the predictor's iterate; then, where the predictor extrapolated, from the start as
+        // it was (an extrapolated film can be so far from equilibrium that no rounded problem
+        // converges from it: first residuals of 1.3e5 N and 4.5e5 N on held-out `arches#15` and
+        // `#21`); last, from the predictor's iterate with the rounded problems that Newton and
+        // the continuation refuse tried damped (`solve_smoothed_problem`).
         let unextrapolated = self.unextrapolated(start, motion);
-        if unextrapolated != self.predict(start, motion)
-            && let Some(converged) = self.smoothing_path(
-                start,
-                motion,
-                levels,
-                Some(unextrapolated),
-                report,
-                &mut lifting,
-            )
-        {
-            return Ok(converged);
+        let extrapolated = unextrapolated != self.predict(start, motion);
+        let paths = [(None, false), (Some(unextrapolated), false), (None, true)];
+        for (first, damped) in paths {
+            if first.is_some() && !extrapolated {
+                continue;
+            }
+            if damped && !self.settings.stabilization {
+                break;
+            }
+            let path =
+                self.smoothing_path(start, motion, levels, first, damped, report, &mut lifting);
+            if let Some(converged) = path {
+                return Ok(converged);
+            }
         }
         Err(lifting)
     }
@@ -103,6 +104,7 @@ impl Analysis {
         motion: &GroupMotion,
         levels: &LoadLevels,
         first: Option<Vec<f64>>,
+        damped: bool,
         report: &mut StepReport,
         lifting: &mut Vec<String>,
     ) -> Option<(AnalysisState, Vec<f64>)> {
@@ -125,7 +127,7 @@ impl Analysis {
                 .map(|(u, _)| u.clone())
                 .or_else(|| first.clone());
             let widths = (w * widths.0, w * widths.1);
-            let trial = self.solve_smoothed_problem(start, motion, levels, widths, &guess);
+            let trial = self.solve_smoothed_problem(start, motion, levels, widths, &guess, damped);
             let u = match trial {
                 Ok(u) => Some(u),
                 Err(failure) => {
@@ -194,9 +196,9 @@ impl Analysis {
     }
 
     /// The rounded problem of widths `(contact, strain)` from `guess` (the predictor's iterate if
-    /// none): plain Newton, then the continuation, then Newton with the viscous stabilization at
-    /// each of its dampings, each accepted on the residual alone; its displacements, or the last
-    /// attempt's failure.
+    /// none): plain Newton, then the continuation, then where `damped` Newton with the viscous
+    /// stabilization at each of its dampings, each accepted on the residual alone; its
+    /// displacements, or the last attempt's failure.
     fn solve_smoothed_problem(
         &mut self,
         start: &AnalysisState,
@@ -204,6 +206,7 @@ impl Analysis {
         levels: &LoadLevels,
         (contact, strain): (f64, f64),
         guess: &Option<Vec<f64>>,
+        damped: bool,
     ) -> Result<Vec<f64>, IncrementFailure> {
         self.parts.curved.smoothing = contact;
         self.parts.triangles.smoothing = strain;
@@ -219,7 +222,7 @@ impl Analysis {
         // Then with the viscous stabilization's damping (a slack or wrinkled film's soft modes,
         // where Newton on the rounded problem stalls): its solution is only the start of the
         // next problem and of Newton on the laws, which carry no damping.
-        if smoothed.is_err() && self.settings.stabilization {
+        if smoothed.is_err() && damped {
             for c in Self::STABILIZATION_DAMPING {
                 self.work.guess.clone_from(guess);
                 self.parts.stabilization.switch_on(c);
