@@ -106,8 +106,9 @@ impl StepReport {
     }
 
     /// The attempts beyond plain Newton the step needed, for a log line: "" where none, else
-    /// "; " and a comma-separated count of each (continuation, active set, viscous
-    /// stabilization and its release, lift-off releases, smoothing homotopy).
+    /// "; increments " and a comma-separated count of each kind (continuation, active set,
+    /// viscous stabilization and its release, smoothing homotopy), then the contacts released
+    /// at lift-off.
     pub fn attempts(&self) -> String {
         let mut said = Vec::new();
         let counts = [
@@ -115,7 +116,6 @@ impl StepReport {
             (self.active_set, "with the contact statuses held"),
             (self.stabilized, "viscously stabilized"),
             (self.released, "added to release the stabilization"),
-            (self.lifted_off.len(), "lift-off release(s)"),
         ];
         for (n, what) in counts {
             if n > 0 {
@@ -128,11 +128,18 @@ impl StepReport {
                 self.smoothed, self.smoothed_on_residual
             ));
         }
-        if said.is_empty() {
+        let mut text = if said.is_empty() {
             String::new()
         } else {
             format!("; increments {}", said.join(", "))
+        };
+        if !self.lifted_off.is_empty() {
+            text += &format!(
+                "; {} contact(s) released at lift-off",
+                self.lifted_off.len()
+            );
         }
+        text
     }
 }
 
