@@ -31,6 +31,14 @@ use crate::mech::solve::analysis::{Acceptance, Analysis};
 use crate::mech::solve::report::{IncrementFailure, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
+/// Where one of the homotopy's paths starts and how its rounded problems are solved.
+struct SmoothingPath {
+    /// The first rounded problem's first iterate (the predictor's if None).
+    first: Option<Vec<f64>>,
+    /// Whether rounded problems that Newton and the continuation refuse are solved damped.
+    damped: bool,
+}
+
 impl Analysis {
     /// Most smoothed problems the homotopy solves in one increment.
     const SMOOTHING_SOLVES: usize = 16;
@@ -69,17 +77,29 @@ impl Analysis {
         // the continuation refuse tried damped (`solve_smoothed_problem`).
         let unextrapolated = self.unextrapolated(start, motion);
         let extrapolated = unextrapolated != self.predict(start, motion);
-        let paths = [(None, false), (Some(unextrapolated), false), (None, true)];
-        for (first, damped) in paths {
-            if first.is_some() && !extrapolated {
+        let paths = [
+            SmoothingPath {
+                first: None,
+                damped: false,
+            },
+            SmoothingPath {
+                first: Some(unextrapolated),
+                damped: false,
+            },
+            SmoothingPath {
+                first: None,
+                damped: true,
+            },
+        ];
+        for path in paths {
+            if path.first.is_some() && !extrapolated {
                 continue;
             }
-            if damped && !self.settings.stabilization {
+            if path.damped && !self.settings.stabilization {
                 break;
             }
-            let path =
-                self.smoothing_path(start, motion, levels, first, damped, report, &mut lifting);
-            if let Some(converged) = path {
+            let converged = self.smoothing_path(start, motion, levels, path, report, &mut lifting);
+            if let Some(converged) = converged {
                 return Ok(converged);
             }
         }
@@ -95,16 +115,15 @@ impl Analysis {
         }
     }
 
-    /// The homotopy's path from the first rounded problem, started at `first` (the predictor's
-    /// iterate if None), to the laws' equilibrium; None where it is refused (the contacts its
-    /// refused attempts named as lifting off appended to `lifting`).
+    /// The homotopy's `path` from the first rounded problem to the laws' equilibrium; None where
+    /// it is refused (the contacts its refused attempts named as lifting off appended to
+    /// `lifting`).
     fn smoothing_path(
         &mut self,
         start: &AnalysisState,
         motion: &GroupMotion,
         levels: &LoadLevels,
-        first: Option<Vec<f64>>,
-        damped: bool,
+        SmoothingPath { first, damped }: SmoothingPath,
         report: &mut StepReport,
         lifting: &mut Vec<String>,
     ) -> Option<(AnalysisState, Vec<f64>)> {
