@@ -946,6 +946,15 @@ fn run_staged(model: &str, stages: &str, settings: SolverSettings) -> StagedRun 
     run_staged_until(model, stages, settings, usize::MAX)
 }
 
+/// [`run_staged_until`] with the default settings, asserted to converge through its first `last`
+/// steps.
+fn converges_until(model: &str, stages: &str, last: usize) -> StagedRun {
+    let run = run_staged_until(model, stages, SolverSettings::default(), last);
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert_eq!(run.steps, last);
+    run
+}
+
 /// [`run_staged`] for the first `last` steps at most.
 fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: usize) -> StagedRun {
     use membrane_contact::mech::{LoadLevels, Model};
@@ -1108,9 +1117,7 @@ fn suction_lifting_the_film_off_a_sliding_direction_arch_converges_by_releasing_
 #[test]
 fn contacts_and_wrinkles_switching_between_iterates_converge_by_the_smoothing_homotopy() {
     let (model, stages) = ("heldout_arches35.json", "heldout_arches35.stages.json");
-    let run = run_staged_until(model, stages, SolverSettings::default(), 4);
-    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
-    assert_eq!(run.steps, 4);
+    let run = converges_until(model, stages, 4);
     assert!(run.smoothed > 0, "no increment smoothed");
     let without = run_staged_until(
         model,
@@ -1133,9 +1140,7 @@ fn contacts_and_wrinkles_switching_between_iterates_converge_by_the_smoothing_ho
 #[test]
 fn smoothing_homotopy_restarts_without_the_predictors_extrapolation() {
     let (model, stages) = ("heldout_arches15.json", "heldout_arches15.stages.json");
-    let run = run_staged_until(model, stages, SolverSettings::default(), 10);
-    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
-    assert_eq!(run.steps, 10);
+    let run = converges_until(model, stages, 10);
     assert!(run.smoothed > 0, "no increment smoothed");
 }
 
@@ -1149,9 +1154,7 @@ fn smoothing_homotopy_restarts_without_the_predictors_extrapolation() {
 #[test]
 fn smoothing_homotopy_holds_the_contact_statuses_of_its_rounded_solution() {
     let (model, stages) = ("heldout_arches23.json", "heldout_arches23.stages.json");
-    let run = run_staged_until(model, stages, SolverSettings::default(), 78);
-    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
-    assert_eq!(run.steps, 78);
+    let run = converges_until(model, stages, 78);
     assert!(run.smoothed > 0, "no increment smoothed");
 }
 
@@ -1164,9 +1167,7 @@ fn smoothing_homotopy_holds_the_contact_statuses_of_its_rounded_solution() {
 #[test]
 fn smoothing_homotopy_damps_its_rounded_problems_on_a_slack_film() {
     let (model, stages) = ("heldout_slack8.json", "heldout_slack8.stages.json");
-    let run = run_staged_until(model, stages, SolverSettings::default(), 18);
-    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
-    assert_eq!(run.steps, 18);
+    let run = converges_until(model, stages, 18);
     assert!(run.smoothed > 0, "no increment smoothed");
 }
 
@@ -1179,8 +1180,6 @@ fn smoothing_homotopy_damps_its_rounded_problems_on_a_slack_film() {
 #[test]
 fn contacts_the_smoothing_homotopy_finds_lifting_off_are_released_and_the_increment_retried() {
     let (model, stages) = ("heldout_arches26.json", "heldout_arches26.stages.json");
-    let run = run_staged_until(model, stages, SolverSettings::default(), 20);
-    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
-    assert_eq!(run.steps, 20);
+    let run = converges_until(model, stages, 20);
     assert!(run.lifted_off > 0, "no cross hold released");
 }

@@ -147,14 +147,8 @@ impl Analysis {
                 .or_else(|| first.clone());
             let widths = (w * widths.0, w * widths.1);
             let trial = self.solve_smoothed_problem(start, motion, levels, widths, &guess, damped);
-            let u = match trial {
-                Ok(u) => Some(u),
-                Err(failure) => {
-                    Self::note_lifting(&failure, lifting);
-                    None
-                }
-            };
-            let Some(u) = u else {
+            let trial = trial.map_err(|failure| Self::note_lifting(&failure, lifting));
+            let Ok(u) = trial else {
                 match &solved {
                     // Refused from the start: a wider rounding.
                     None if wider < Self::SMOOTHING_WIDER => {
