@@ -266,6 +266,13 @@ pub enum IncrementFailure {
     Diverged { iteration: usize },
     /// The Newton matrix could not be factorized.
     Singular { message: String },
+    /// The step's damped increments after its larger dampings went beyond their budget
+    /// (`Analysis::LAST_RESORT_INCREMENTS`) before the step's target was reached: the film kept
+    /// flowing under the damping instead of settling to an equilibrium.
+    Unsettled {
+        /// Damped increments taken since the larger dampings first carried one.
+        increments: usize,
+    },
 }
 
 /// `names` as a short list: the first few, then how many more.
@@ -380,6 +387,12 @@ impl IncrementFailure {
                  reach): add prestress, supports or wrinkling-aware material, or move the inputs by less per \
                  step ({finer})"
             ),
+            // Nothing measured gets such a step through (the slack plastic film released in
+            // examples/fig8_plastic.py flowed on for 22 458 damped increments).
+            Self::Unsettled { .. } => "the damped increments kept moving the film: a film with nothing to \
+                 hold it (slack, or off its supports) has no equilibrium to settle to; no setting is \
+                 advised"
+                .to_string(),
         }
     }
 }
@@ -466,6 +479,11 @@ impl fmt::Display for IncrementFailure {
                 )
             }
             Self::Singular { message } => write!(f, "singular Newton matrix ({message})"),
+            Self::Unsettled { increments } => write!(
+                f,
+                "the film did not settle: {increments} increments damped by the viscous \
+                 stabilization's larger dampings without reaching the step's target"
+            ),
         }
     }
 }
