@@ -860,7 +860,7 @@ fn follow_advice(paths: &[HeldOut], results: &[Outcome], increments: usize, thre
 }
 
 /// The refusal classes of [`failure_class`], in table order.
-const CLASSES: [&str; 9] = [
+const CLASSES: [&str; 10] = [
     "singular matrix",
     "sliding-direction lift-off",
     "contact status chatter",
@@ -869,6 +869,7 @@ const CLASSES: [&str; 9] = [
     "stall, forces balanced",
     "stall",
     "iteration limit",
+    "film did not settle under the damping",
     "diverged or other",
 ];
 
@@ -892,7 +893,9 @@ fn failure_class(message: &str) -> &'static str {
         CLASSES[6]
     } else if message.contains("iteration limit") {
         CLASSES[7]
-    } else {
+    } else if message.contains("the film did not settle") {
         CLASSES[8]
+    } else {
+        CLASSES[9]
     }
 }
