@@ -936,6 +936,8 @@ struct StagedRun {
     lifted_off: usize,
     /// Increments solved by the smoothing homotopy.
     smoothed: usize,
+    /// Increments carried by the viscous stabilization's larger dampings.
+    damped_jumps: usize,
     refusal: Option<String>,
     /// The last converged state.
     state: AnalysisState,
@@ -950,6 +952,7 @@ impl From<AnalysisState> for StagedRun {
             over_bound: 0,
             lifted_off: 0,
             smoothed: 0,
+            damped_jumps: 0,
             refusal: None,
             state,
         }
@@ -1024,6 +1027,7 @@ fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: u
                     run.over_bound += usize::from(report.stabilization_warning().is_some());
                     run.lifted_off += report.lifted_off.len();
                     run.smoothed += report.smoothed;
+                    run.damped_jumps += report.damped_jumps;
                     if run.steps == last {
                         run.state = analysis.state().clone();
                         return run;
@@ -1097,6 +1101,7 @@ fn run_saved(
                 run.steps += 1;
                 run.stabilized += report.stabilized;
                 run.over_bound += usize::from(report.stabilization_warning().is_some());
+                run.damped_jumps += report.damped_jumps;
             }
             Err(e) => {
                 run.refusal = Some(format!("step {}: {e}", run.steps + 1));
@@ -1122,6 +1127,7 @@ fn a_step_every_other_attempt_refuses_is_carried_by_the_larger_dampings_within_t
     assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
     assert_eq!(run.steps, 2);
     assert!(run.stabilized > 0, "no increment stabilized");
+    assert_eq!(run.damped_jumps, 1, "one increment carried by the larger dampings");
     assert_eq!(run.over_bound, 0, "steps above the bound");
 }
 

@@ -211,7 +211,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     // Increments solved by continuation, and the step of the largest stabilization ratio.
     let (mut continued, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
     // Increments solved with the viscous stabilization on.
-    let (mut stabilized, mut released) = (0, 0);
+    let (mut stabilized, mut released, mut jumps) = (0, 0, 0);
     // Cross holds released at sliding-direction contacts lifting off: how many, the largest (N).
     let (mut lifted, mut largest_lift) = (0, 0.0_f64);
     // Increments solved by the smoothing homotopy, and of them accepted on the law's residual.
@@ -249,6 +249,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         continued += report.continued;
         stabilized += report.stabilized;
         released += report.released;
+        jumps += report.damped_jumps;
         lifted += report.lifted_off.len();
         smoothed += report.smoothed;
         on_residual += report.smoothed_on_residual;
@@ -259,6 +260,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         if report.continued > 0 || report.stabilized > 0 {
             let ratio = report.stabilization_ratio();
             if let Some(w) = report.stabilization_warning() {
+                eprintln!("warning: step {step}: {w}");
+            }
+            if let Some(w) = report.jump_warning() {
                 eprintln!("warning: step {step}: {w}");
             }
             if stabilization.is_none_or(|(_, r, _, _)| ratio > r) {
@@ -313,8 +317,13 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     if let Some((step, ratio, energy, dissipated)) = stabilization {
         out!(
             "stabilization: {continued} increments by pseudo-transient continuation, {stabilized} viscously \
-             stabilized, {released} at steps' ends to release it; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
+             stabilized{}, {released} at steps' ends to release it; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
              energy; bound {:.0e}; {dissipated:.3e} J taken out on the way)",
+            if jumps > 0 {
+                format!(" ({jumps} of them carried by the larger dampings)")
+            } else {
+                String::new()
+            },
             membrane_contact::mech::solve::report::STABILIZATION_BOUND
         );
     }

@@ -217,6 +217,7 @@ impl Analysis {
                         {
                             reached = Some((next, converged));
                             held = true;
+                            report.damped_jumps += 1;
                             last_resort_from.get_or_insert(report.stabilized);
                         }
                     }

@@ -38,6 +38,12 @@ pub struct StepReport {
     /// (`Analysis::release_stabilization`).
     #[serde(default)]
     pub released: usize,
+    /// Increments carried by the viscous stabilization's larger dampings
+    /// (`Analysis::STABILIZATION_LAST_RESORT`) after every other attempt was refused: the film
+    /// crossed to an equilibrium that is not near the last one (a jump), and the path inside the
+    /// step is the damped flow's ([`Self::jump_warning`]).
+    #[serde(default)]
+    pub damped_jumps: usize,
     /// Sliding-direction contacts released where an increment found no equilibrium on either
     /// side of the law's jump at lift-off: marked as lifting off and landing again within it
     /// ([`crate::mech::elements::curved_contact::ContactHistory::lands`]); one entry per
@@ -100,6 +106,19 @@ impl StepReport {
         })
     }
 
+    /// Where the larger dampings carried an increment of the step ([`Self::damped_jumps`]): a
+    /// warning that the path inside the step is the damped flow's, not a quasi-static one.
+    pub fn jump_warning(&self) -> Option<String> {
+        (self.damped_jumps > 0).then(|| {
+            format!(
+                "{} increment(s) carried by the viscous stabilization's larger dampings where no \
+                 equilibrium was found near the last one: the film jumped, and its path inside the \
+                 step (slips, plastic flow) is that of the damped flow",
+                self.damped_jumps
+            )
+        })
+    }
+
     /// Total Newton iterations (converged increments only).
     pub fn total_iterations(&self) -> usize {
         self.iterations.iter().sum()
@@ -116,6 +135,7 @@ impl StepReport {
             (self.active_set, "with the contact statuses held"),
             (self.stabilized, "viscously stabilized"),
             (self.released, "added to release the stabilization"),
+            (self.damped_jumps, "carried by the larger dampings"),
         ];
         for (n, what) in counts {
             if n > 0 {
