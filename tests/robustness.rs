@@ -22,6 +22,7 @@ use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::elements::gap::FrictionLaw;
 use membrane_contact::mech::elements::load::{pressure_force, pressure_signs};
 use membrane_contact::mech::model::{GapSupport, LoadSpec};
+use membrane_contact::mech::solve::report::StepReport;
 use membrane_contact::mech::solve::state::AnalysisState;
 use membrane_contact::mech::{Analysis, GapStatus, Results, SolverSettings};
 use membrane_contact::specimens::ParallelArch;
@@ -928,6 +929,7 @@ fn plastic_specimen_raised_after_flowing_converges_with_the_stabilization_within
 
 /// What a stored load path did: steps converged, increments viscously stabilized, steps whose
 /// artificial energy left is above the bound, and the refusal if any.
+#[derive(Default)]
 struct StagedRun {
     steps: usize,
     stabilized: usize,
@@ -939,23 +941,17 @@ struct StagedRun {
     /// Increments carried by the viscous stabilization's larger dampings.
     damped_jumps: usize,
     refusal: Option<String>,
-    /// The last converged state.
-    state: AnalysisState,
 }
 
-impl From<AnalysisState> for StagedRun {
-    /// A run that has not stepped yet from `state`.
-    fn from(state: AnalysisState) -> Self {
-        Self {
-            steps: 0,
-            stabilized: 0,
-            over_bound: 0,
-            lifted_off: 0,
-            smoothed: 0,
-            damped_jumps: 0,
-            refusal: None,
-            state,
-        }
+impl StagedRun {
+    /// Counts a converged step.
+    fn add(&mut self, report: &StepReport) {
+        self.steps += 1;
+        self.stabilized += report.stabilized;
+        self.over_bound += usize::from(report.stabilization_warning().is_some());
+        self.lifted_off += report.lifted_off.len();
+        self.smoothed += report.smoothed;
+        self.damped_jumps += report.damped_jumps;
     }
 }
 
@@ -1001,7 +997,7 @@ fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: u
             .unwrap_or_default()
     };
     let mut analysis = Analysis::new(model, settings).unwrap();
-    let mut run = StagedRun::from(analysis.state().clone());
+    let mut run = StagedRun::default();
     for stage in stages.as_array().unwrap() {
         let s = analysis.state().clone();
         let (targets, angles) = (triples(&stage["targets"]), numbers(&stage["angles"]));
@@ -1022,26 +1018,18 @@ fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: u
             let loads = s.loads.interpolate(&target_loads, f);
             match analysis.step_to_motion(&at, &turned, &loads, fmu_increments()) {
                 Ok(report) => {
-                    run.steps += 1;
-                    run.stabilized += report.stabilized;
-                    run.over_bound += usize::from(report.stabilization_warning().is_some());
-                    run.lifted_off += report.lifted_off.len();
-                    run.smoothed += report.smoothed;
-                    run.damped_jumps += report.damped_jumps;
+                    run.add(&report);
                     if run.steps == last {
-                        run.state = analysis.state().clone();
                         return run;
                     }
                 }
                 Err(e) => {
                     run.refusal = Some(format!("step {}: {e}", run.steps + 1));
-                    run.state = analysis.state().clone();
                     return run;
                 }
             }
         }
     }
-    run.state = analysis.state().clone();
     run
 }
 
@@ -1093,23 +1081,17 @@ fn run_saved(
         .set_state(serde_json::from_str(&read(state)).unwrap())
         .unwrap();
     let s = analysis.state().clone();
-    let mut run = StagedRun::from(s.clone());
+    let mut run = StagedRun::default();
     for k in 1..=steps {
         let (at, turned) = motion_at(&s, &targets, &angles, k as f64 / steps as f64);
         match analysis.step_to_motion(&at, &turned, &s.loads, fmu_increments()) {
-            Ok(report) => {
-                run.steps += 1;
-                run.stabilized += report.stabilized;
-                run.over_bound += usize::from(report.stabilization_warning().is_some());
-                run.damped_jumps += report.damped_jumps;
-            }
+            Ok(report) => run.add(&report),
             Err(e) => {
                 run.refusal = Some(format!("step {}: {e}", run.steps + 1));
                 break;
             }
         }
     }
-    run.state = analysis.state().clone();
     run
 }
 
@@ -1127,7 +1109,10 @@ fn a_step_every_other_attempt_refuses_is_carried_by_the_larger_dampings_within_t
     assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
     assert_eq!(run.steps, 2);
     assert!(run.stabilized > 0, "no increment stabilized");
-    assert_eq!(run.damped_jumps, 1, "one increment carried by the larger dampings");
+    assert_eq!(
+        run.damped_jumps, 1,
+        "one increment carried by the larger dampings"
+    );
     assert_eq!(run.over_bound, 0, "steps above the bound");
 }
 
@@ -1144,7 +1129,9 @@ fn a_slack_film_that_does_not_settle_under_the_larger_dampings_is_refused_within
         "fig8_plastic_release.stages.json",
     );
     let run = run_staged_until(model, stages, SolverSettings::default(), 8);
-    let refusal = run.refusal.expect("a slack film has no equilibrium to settle to");
+    let refusal = run
+        .refusal
+        .expect("a slack film has no equilibrium to settle to");
     assert!(refusal.starts_with("step 7:"), "{refusal}");
     assert!(
         refusal.contains("the film did not settle: 101 increments damped"),

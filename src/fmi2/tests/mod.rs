@@ -210,6 +210,17 @@ impl<'a> Fmu<'a> {
         reals: &[(&str, f64)],
         integers: &[(&str, i32)],
     ) -> Self {
+        Self::initialized_with(u, log, reals, integers, &[])
+    }
+
+    /// [`Self::initialized`] with Boolean parameters too.
+    fn initialized_with(
+        u: &'a Unpacked,
+        log: &'a Log,
+        reals: &[(&str, f64)],
+        integers: &[(&str, i32)],
+        booleans: &[(&str, bool)],
+    ) -> Self {
         let fmu = Self::new(u, log);
         unsafe {
             assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
@@ -220,6 +231,9 @@ impl<'a> Fmu<'a> {
         }
         for (n, v) in integers {
             assert_eq!(fmu.set_integer(n, *v), 0, "{n}");
+        }
+        for (n, v) in booleans {
+            assert_eq!(fmu.set_boolean(n, *v), 0, "{n}");
         }
         assert_eq!(
             unsafe { fmi2_exit_initialization_mode(fmu.c) },

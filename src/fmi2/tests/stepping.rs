@@ -87,17 +87,9 @@ fn repeating_a_refused_step_identically_reports_terminated() {
         ("solver.maxIterations", 6),
         ("solver.incrementsPerStep", 1),
     ];
-    let fmu = Fmu::new(&u, &log);
-    unsafe {
-        assert_eq!(fmi2_setup_experiment(fmu.c, 0, 0.0, 0.0, 0, 0.0), 0);
-        assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
-    }
-    for (n, v) in settings {
-        assert_eq!(fmu.set_integer(n, v), 0, "{n}");
-    }
     // Without the viscous stabilization, whose larger dampings carry this step (with a warning).
-    assert_eq!(fmu.set_boolean("solver.stabilization", false), 0);
-    assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+    let without = [("solver.stabilization", false)];
+    let fmu = Fmu::initialized_with(&u, &log, &[], &settings, &without);
     let terminated = || {
         let mut value = -1;
         assert_eq!(
@@ -240,8 +232,8 @@ fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
 /// refused: with the default `solver.smoothing` the step converges and
 /// `solver.smoothedIncrements` counts the homotopy's increments. With it off, the viscous
 /// stabilization's larger dampings, tried after the homotopy, carry the step instead (nothing
-/// smoothed; before them the step was discarded), with the warning that the film jumped. The state after the smoothed
-/// step round-trips.
+/// smoothed; before them the step was discarded), with the warning that the film jumped. The
+/// state after the smoothed step round-trips.
 #[test]
 fn a_step_the_smoothing_homotopy_converges_is_carried_by_the_larger_dampings_without_it() {
     let data = |f: &str| {
