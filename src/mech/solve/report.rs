@@ -61,9 +61,10 @@ pub struct StepReport {
     pub smoothed_on_residual: usize,
     /// Artificial energy left at the end of the step (J): over the increments solved by
     /// continuation, the work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term in the last correction of
-    /// each (the pseudo-time force still acting when the increment was accepted); and, when the
-    /// viscous stabilization acted, the work of its force over the step's last increment (the
-    /// force the converged answer still carries).
+    /// each (the pseudo-time force still acting when the increment was accepted); and, where the
+    /// step's last increment was solved with the viscous stabilization on, the work of its force
+    /// over that increment (the force the converged answer still carries; none where the last
+    /// increments were solved without it).
     #[serde(default)]
     pub stabilization_energy: f64,
     /// Work of the pseudo-time term over all the step's continuation iterations, and of the
