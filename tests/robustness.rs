@@ -974,6 +974,20 @@ fn converges_until(model: &str, stages: &str, last: usize) -> StagedRun {
 
 /// [`run_staged`] for the first `last` steps at most.
 fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: usize) -> StagedRun {
+    run_staged_from(model, stages, settings, None, last)
+}
+
+/// [`run_staged_until`], resumed where `resume` is `(state, done)`: from the converged state after
+/// step `done` of the path's first stage, saved in `state` (`AnalysisState` as JSON), the
+/// motions and loads of the steps after it computed from the stage's start as the whole run
+/// computes them, so that they repeat its steps bit for bit.
+fn run_staged_from(
+    model: &str,
+    stages: &str,
+    settings: SolverSettings,
+    resume: Option<(&str, usize)>,
+    last: usize,
+) -> StagedRun {
     use membrane_contact::mech::{LoadLevels, Model};
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/");
     let read = |f: &str| std::fs::read_to_string(format!("{dir}{f}")).unwrap();
@@ -998,6 +1012,7 @@ fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: u
     };
     let mut analysis = Analysis::new(model, settings).unwrap();
     let mut run = StagedRun::default();
+    let (saved, mut skip) = resume.map_or((None, 0), |(state, done)| (Some(read(state)), done));
     for stage in stages.as_array().unwrap() {
         let s = analysis.state().clone();
         let (targets, angles) = (triples(&stage["targets"]), numbers(&stage["angles"]));
@@ -1013,13 +1028,23 @@ fn run_staged_until(model: &str, stages: &str, settings: SolverSettings, last: u
         };
         let steps = stage["steps"].as_u64().unwrap() as usize;
         for k in 1..=steps {
+            if skip > 0 {
+                skip -= 1;
+                if skip == 0 {
+                    let saved = saved.as_deref().unwrap();
+                    analysis
+                        .set_state(serde_json::from_str(saved).unwrap())
+                        .unwrap();
+                }
+                continue;
+            }
             let f = k as f64 / steps as f64;
             let (at, turned) = motion_at(&s, &targets, &angles, f);
             let loads = s.loads.interpolate(&target_loads, f);
             match analysis.step_to_motion(&at, &turned, &loads, fmu_increments()) {
                 Ok(report) => {
                     run.add(&report);
-                    if run.steps == last {
+                    if run.steps + resume.map_or(0, |(_, done)| done) == last {
                         return run;
                     }
                 }
@@ -1299,16 +1324,28 @@ fn smoothing_homotopy_holds_the_contact_statuses_of_its_rounded_solution() {
 }
 
 /// Held-out `slack#8` (an unstressed tension-field film over four tube arches, rails lowered
-/// 0.27 m over 20 steps): in step 18 the smoothing homotopy's rounded problems stall below a
-/// width of 0.56 of its first (film elements switching between slack and wrinkled, where only
-/// the film's soft modes resist). With the viscous stabilization's damping on the rounded
-/// problems alone, they converge, and the laws' own equilibrium from them, undamped
-/// (`Analysis::solve_smoothed_problem`).
+/// 0.27 m over 20 steps), step 18: film elements switch between slack and wrinkled, where only
+/// the film's soft modes resist, and every attempt before the smoothing homotopy is refused; the
+/// homotopy carries the step, so the larger dampings tried after it are not needed. Without the
+/// homotopy (`smoothing: false`) the step is carried otherwise, and the test fails. From the
+/// converged state after step 17 as the fifteenth round's code left it
+/// (`tests/data/heldout_slack8.step17.state.json`): since the sixteenth round the earlier steps'
+/// releases go on longer and the whole path reaches step 18 elsewhere. (This test was written for
+/// the damping of the homotopy's rounded problems, `Analysis::solve_smoothed_problem`; by
+/// `51b551a` step 18 converged without that damping too, checked, so no test needs it now.)
 #[test]
-fn smoothing_homotopy_damps_its_rounded_problems_on_a_slack_film() {
+fn smoothing_homotopy_carries_a_slack_films_step_before_the_larger_dampings() {
     let (model, stages) = ("heldout_slack8.json", "heldout_slack8.stages.json");
-    let run = converges_until(model, stages, 18);
+    let state = "heldout_slack8.step17.state.json";
+    let settings = SolverSettings::default();
+    let run = run_staged_from(model, stages, settings, Some((state, 17)), 18);
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert_eq!(run.steps, 1);
     assert!(run.smoothed > 0, "no increment smoothed");
+    assert_eq!(
+        run.damped_jumps, 0,
+        "increments carried by the larger dampings"
+    );
 }
 
 /// Held-out `arches#26` (three tube arches, the paper's sliding-direction friction at μ = 0.45,
