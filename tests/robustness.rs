@@ -1012,7 +1012,8 @@ fn run_staged_from(
     };
     let mut analysis = Analysis::new(model, settings).unwrap();
     let mut run = StagedRun::default();
-    let (saved, mut skip) = resume.map_or((None, 0), |(state, done)| (Some(read(state)), done));
+    let (saved, done) = resume.map_or((None, 0), |(state, done)| (Some(read(state)), done));
+    let mut skip = done;
     for stage in stages.as_array().unwrap() {
         let s = analysis.state().clone();
         let (targets, angles) = (triples(&stage["targets"]), numbers(&stage["angles"]));
@@ -1044,7 +1045,7 @@ fn run_staged_from(
             match analysis.step_to_motion(&at, &turned, &loads, fmu_increments()) {
                 Ok(report) => {
                     run.add(&report);
-                    if run.steps + resume.map_or(0, |(_, done)| done) == last {
+                    if run.steps + done == last {
                         return run;
                     }
                 }
@@ -1054,6 +1055,11 @@ fn run_staged_from(
                 }
             }
         }
+        // The motions are interpolated from the stage's start, known only for the first stage.
+        assert_eq!(
+            skip, 0,
+            "the saved state must be within the path's first stage"
+        );
     }
     run
 }

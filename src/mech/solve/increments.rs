@@ -422,9 +422,7 @@ impl Analysis {
     /// the damping (after the smoothing homotopy or a lift-off release switched it off), whose
     /// answer carries none of an earlier increment's.
     fn account_stabilized(&mut self, report: &mut StepReport, u: &[f64], last: &mut f64) {
-        if !self.parts.stabilization.is_on() {
-            *last = 0.0;
-        } else {
+        if self.parts.stabilization.is_on() {
             report.stabilized += 1;
             let (work, _) = self.parts.stabilization.work_and_force(&self.system, u);
             self.work.dissipated += work;
@@ -434,6 +432,8 @@ impl Analysis {
             if work > STABILIZATION_BOUND * self.strain_energy_at(u).abs() {
                 self.parts.stabilization.soften();
             }
+        } else {
+            *last = 0.0;
         }
     }
 
