@@ -12,21 +12,31 @@ TEST GOAL, one test per finding of the issue:
 5. ``membrane-contact export-specimen ... | head -c 10`` ends quietly;
 and ``fmi2FreeFMUstate(c, NULL)`` returns fmi2Error.
 
-MODEL: ParallelArch.fmu, and the renamed 200 mm specimen of ``custom_model`` (conftest.py).
+Issue 47, defect 2: the jack FMU (fmu/jack) holds the same rule. A step whose output overflows
+(``stiffness = 1e-10``, ``force = 1e308``: ``dz = -inf``) is discarded with a message and the
+last good state kept; inputs whose outputs overflow in initialization mode, and non-finite or
+out-of-range values, are refused by ``fmi2SetReal`` with a message.
+
+MODEL: ParallelArch.fmu, the renamed 200 mm specimen of ``custom_model`` (conftest.py), and
+HydraulicJack.fmu packed as test_coupling.py packs it (``pack_jack_fmu``).
 """
 
 from __future__ import annotations
 
 import json
 import math
+import re
 import struct
 import subprocess
 import zlib
 from ctypes import byref, c_size_t, c_void_p, create_string_buffer
 
+import pytest
 from conftest import CLI, fmu_pack
 from fmpy import read_model_description
 from fmu_helpers import DISCARD, ERROR, OK, Slave
+from membrane_contact.film import FmuError
+from membrane_contact.ssp import pack_jack_fmu
 
 RAMP = {"frame.dz": -0.15}
 
@@ -155,3 +165,47 @@ def test_cli_ends_quietly_on_a_closed_pipe():
         shell=True, executable="/bin/bash", capture_output=True, text=True)
     assert r.stdout.startswith("{") and r.stdout.rstrip().endswith("status 0"), r.stdout
     assert r.stderr == "", r.stderr
+
+
+@pytest.fixture(scope="module")
+def jack_fmu(tmp_path_factory):
+    return pack_jack_fmu(tmp_path_factory.mktemp("jack") / "HydraulicJack.fmu")
+
+
+def test_jack_discards_a_step_to_an_infinite_output_and_keeps_its_last_state(jack_fmu):
+    with Slave(jack_fmu) as s:
+        s.initialize(parameters={"stiffness": 1e-10})
+        s.set({"force": -1e-9})
+        assert s.step(0.0, 1.0) == OK
+        before = s.outputs()
+        s.set({"force": 1e308})  # dz = piston - force / stiffness = -inf
+        status = s.step(1.0, 1.0)
+        assert status == DISCARD, (status, s.messages[-2:])
+        assert s.logged(DISCARD, "fmi2DoStep: dz would be -inf"), s.messages[-1:]
+        assert s.logged(DISCARD, "force = 1e308, stiffness = 1e-10"), s.messages[-1:]
+        after = s.outputs()
+        assert all(math.isfinite(v) for v in after.values()), after
+        assert after == before
+        assert s.fmu.getRealStatus(2) == 1.0  # fmi2LastSuccessfulTime: the discarded step is not
+        # The master goes on from the same state with a sensible force.
+        s.set({"force": -1e-9})
+        assert s.step(1.0, 1.0) == OK
+        assert all(math.isfinite(v) for v in s.outputs().values())
+
+
+def test_jack_refuses_values_whose_outputs_overflow_and_non_finite_values_with_a_message(jack_fmu):
+    with Slave(jack_fmu) as s:
+        s.fmu.setupExperiment(startTime=0.0)
+        s.fmu.enterInitializationMode()
+        s.set({"stiffness": 1e-10})
+        with pytest.raises(FmuError, match=r"dz would be -inf"):
+            s.set({"force": 1e308})
+        assert s.get("force") == 0.0 and s.get("dz") == 0.0
+        for name, value, message in [("force", math.nan, "force = NaN: values must be finite"),
+                                     ("relief", -math.inf, "relief = -inf: values must be finite"),
+                                     ("stiffness", -1e308, "stiffness = -1e308 must be > 0"),
+                                     ("crack", 1.0, "crack = 1 must lie in [0, 1)")]:
+            with pytest.raises(FmuError, match=re.escape(message)):
+                s.set({name: value})
+        s.fmu.exitInitializationMode()
+        assert all(math.isfinite(v) for v in s.outputs().values())

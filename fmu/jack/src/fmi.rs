@@ -51,6 +51,11 @@ struct Instance {
 
 impl Instance {
     fn log(&self, status: Status, message: &str) {
+        let category = if status == DISCARD {
+            c"logStatusDiscard"
+        } else {
+            c"logStatusError"
+        };
         if let Some(logger) = self.logger {
             let text = CString::new(message.replace('\0', " ")).unwrap_or_default();
             // SAFETY: the importer's logger, called with a "%s" format and one NUL-terminated
@@ -60,7 +65,7 @@ impl Instance {
                     self.environment,
                     self.name.as_ptr(),
                     status,
-                    c"logStatusError".as_ptr(),
+                    category.as_ptr(),
                     c"%s".as_ptr(),
                     text.as_ptr(),
                 )
@@ -71,6 +76,13 @@ impl Instance {
     fn fail(&self, function: &str, message: &str) -> Status {
         self.log(ERROR, &format!("{function}: {message}"));
         ERROR
+    }
+
+    /// fmi2Discard with the message logged: the call did nothing, the instance can go on (FMI
+    /// 2.0 §4.2.2: a step the FMU cannot take, the master may retry it otherwise).
+    fn discard(&self, function: &str, message: &str) -> Status {
+        self.log(DISCARD, &format!("{function}: {message}"));
+        DISCARD
     }
 }
 
@@ -230,8 +242,10 @@ pub unsafe extern "C" fn enter_initialization_mode(c: *mut c_void) -> Status {
                     "only allowed after fmi2Instantiate",
                 );
             }
+            if let Err(m) = i.jack.initialize() {
+                return i.fail("fmi2EnterInitializationMode", &m);
+            }
             i.phase = Phase::Initialization;
-            i.jack.initialize();
             OK
         })
     }
@@ -245,7 +259,9 @@ pub unsafe extern "C" fn exit_initialization_mode(c: *mut c_void) -> Status {
             if i.phase != Phase::Initialization {
                 return i.fail("fmi2ExitInitializationMode", "not in initialization mode");
             }
-            i.jack.initialize();
+            if let Err(m) = i.jack.initialize() {
+                return i.fail("fmi2ExitInitializationMode", &m);
+            }
             i.phase = Phase::Stepping;
             OK
         })
@@ -333,12 +349,18 @@ pub unsafe extern "C" fn set_real(
                     return i.fail("fmi2SetReal", &m);
                 }
             }
+            let mut next = i.jack;
             for (&r, &v) in refs.iter().zip(values) {
-                i.jack.values[r as usize] = v;
+                next.values[r as usize] = v;
             }
-            if i.phase == Phase::Initialization {
-                i.jack.initialize();
+            // In initialization mode the outputs follow the inputs at once: values whose outputs
+            // overflow (force / stiffness) are refused as a whole, the jack unchanged.
+            if i.phase == Phase::Initialization
+                && let Err(m) = next.initialize()
+            {
+                return i.fail("fmi2SetReal", &m);
             }
+            i.jack = next;
             OK
         })
     }
@@ -370,8 +392,12 @@ pub unsafe extern "C" fn do_step(c: *mut c_void, t: f64, h: f64, _no_prior: c_in
                     ),
                 );
             }
-            i.jack.step(h);
-            OK
+            // A step whose outputs would overflow is discarded: the jack keeps its last good
+            // state (never fmi2OK with a value that is not finite).
+            match i.jack.step(h) {
+                Ok(()) => OK,
+                Err(m) => i.discard("fmi2DoStep", &m),
+            }
         })
     }
 }
@@ -428,6 +454,16 @@ pub unsafe extern "C" fn get_directional_derivative(
                         None => return i.fail(F, &format!("known {} is not an input", name(kn))),
                     }
                 }
+            }
+            if let Some((k, d)) = result.iter().enumerate().find(|(_, d)| !d.is_finite()) {
+                return i.fail(
+                    F,
+                    &format!(
+                        "the derivative of {} overflows ({}): scale the seed down",
+                        name(unknowns[k]),
+                        crate::short(*d)
+                    ),
+                );
             }
             out.copy_from_slice(&result);
             OK
@@ -580,4 +616,129 @@ refused! {
     "fmi2GetEventIndicators" fn get_event_indicators(x: *mut f64, n: usize);
     "fmi2GetContinuousStates" fn get_continuous_states(x: *mut f64, n: usize);
     "fmi2GetNominalsOfContinuousStates" fn get_nominals(x: *mut f64, n: usize);
+}
+
+#[cfg(test)]
+mod tests {
+    //! The FMI layer as an importer calls it, without a logger (the messages are the model's,
+    //! tested in `lib.rs`; tests/python/test_never_ok_with_nan.py reads them through a logger).
+    use super::*;
+    use crate::START;
+
+    /// An instance past fmi2ExitInitializationMode with `inputs` set in initialization mode.
+    fn stepping(inputs: &[(u32, f64)]) -> *mut c_void {
+        let guid = CString::new(GUID).unwrap();
+        // SAFETY: NUL-terminated strings and no callbacks (NULL), as the FMI 2.0 contract allows.
+        let c = unsafe {
+            instantiate(
+                c"jack".as_ptr(),
+                1,
+                guid.as_ptr(),
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                0,
+            )
+        };
+        assert!(!c.is_null());
+        // SAFETY: `c` is a live instance; the arrays hold the announced number of elements.
+        unsafe {
+            assert_eq!(setup_experiment(c, 0, 0.0, 0.0, 0, 0.0), OK);
+            assert_eq!(enter_initialization_mode(c), OK);
+            for &(r, v) in inputs {
+                assert_eq!(set_real(c, &r, 1, &v), OK);
+            }
+            assert_eq!(exit_initialization_mode(c), OK);
+        }
+        c
+    }
+
+    /// The value of `r` (fmi2GetReal).
+    fn get(c: *mut c_void, r: u32) -> f64 {
+        let mut v = f64::NAN;
+        // SAFETY: `c` is a live instance; one reference, one value.
+        assert_eq!(unsafe { get_real(c, &r, 1, &mut v) }, OK);
+        v
+    }
+
+    #[test]
+    fn a_step_to_an_infinite_output_is_discarded_and_the_jack_steps_on_from_its_last_state() {
+        let c = stepping(&[(vr::STIFFNESS, 1e-10)]);
+        // SAFETY: `c` is a live instance; one reference, one value per call.
+        unsafe {
+            assert_eq!(set_real(c, &vr::FORCE, 1, &-1e-9), OK);
+            assert_eq!(do_step(c, 0.0, 1.0, 1), OK);
+            let before: Vec<f64> = (vr::DZ..=vr::SPEED).map(|r| get(c, r)).collect();
+            assert!(before.iter().all(|v| v.is_finite()));
+            // The case: force / stiffness = 1e318 overflows to dz = -inf.
+            assert_eq!(set_real(c, &vr::FORCE, 1, &1e308), OK);
+            assert_eq!(do_step(c, 1.0, 1.0, 1), DISCARD);
+            let after: Vec<f64> = (vr::DZ..=vr::SPEED).map(|r| get(c, r)).collect();
+            assert_eq!(after, before, "the last good outputs stay");
+            let mut last = f64::NAN;
+            assert_eq!(get_real_status(c, 2, &mut last), OK);
+            assert_eq!(
+                last, 1.0,
+                "fmi2LastSuccessfulTime: the discarded step did not count"
+            );
+            // A sensible force: the same step is taken from the same state.
+            assert_eq!(set_real(c, &vr::FORCE, 1, &-1e-9), OK);
+            assert_eq!(do_step(c, 1.0, 1.0, 1), OK);
+            assert!(get(c, vr::DZ).is_finite());
+            free_instance(c);
+        }
+    }
+
+    #[test]
+    fn inputs_whose_outputs_overflow_in_initialization_are_refused_whole() {
+        let guid = CString::new(GUID).unwrap();
+        // SAFETY: as in `stepping`; then `c` is a live instance, arrays of the announced sizes.
+        unsafe {
+            let c = instantiate(
+                c"jack".as_ptr(),
+                1,
+                guid.as_ptr(),
+                std::ptr::null(),
+                std::ptr::null(),
+                0,
+                0,
+            );
+            assert_eq!(enter_initialization_mode(c), OK);
+            let (refs, values) = ([vr::STIFFNESS, vr::FORCE], [1e-10, 1e308]);
+            assert_eq!(set_real(c, refs.as_ptr(), 2, values.as_ptr()), ERROR);
+            assert_eq!(get(c, vr::STIFFNESS), START[vr::STIFFNESS as usize]);
+            assert_eq!(get(c, vr::DZ), 0.0);
+            // Non-finite and out-of-range values are refused before anything is set.
+            for (r, v) in [
+                (vr::FORCE, f64::NAN),
+                (vr::STIFFNESS, f64::INFINITY),
+                (vr::STIFFNESS, 0.0),
+                (vr::RELIEF, -1.0),
+                (vr::CRACK, 1.0),
+                (vr::STROKE, -1e-300),
+            ] {
+                assert_eq!(set_real(c, &r, 1, &v), ERROR, "{} = {v}", NAMES[r as usize]);
+                assert_eq!(get(c, r), START[r as usize]);
+            }
+            assert_eq!(exit_initialization_mode(c), OK);
+            free_instance(c);
+        }
+    }
+
+    #[test]
+    fn a_derivative_that_overflows_is_an_error_not_an_infinite_answer() {
+        let c = stepping(&[(vr::STIFFNESS, 1e-300)]);
+        // SAFETY: `c` is a live instance; arrays of one element.
+        unsafe {
+            assert_eq!(do_step(c, 0.0, 1.0, 1), OK);
+            let mut d = 0.0;
+            // d dz / d force = -1 / stiffness = -1e300, seeded by 1e10
+            let status = get_directional_derivative(c, &vr::DZ, 1, &vr::FORCE, 1, &1e10, &mut d);
+            assert_eq!(status, ERROR);
+            assert_eq!(d, 0.0, "nothing written");
+            let status = get_directional_derivative(c, &vr::DZ, 1, &vr::FORCE, 1, &1.0, &mut d);
+            assert_eq!((status, d), (OK, -1.0 / 1e-300));
+            free_instance(c);
+        }
+    }
 }

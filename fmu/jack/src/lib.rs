@@ -87,13 +87,24 @@ impl Default for Jack {
     }
 }
 
+/// A real for a message: plain decimals between 1e-4 and 1e15, else the shortest exponent form
+/// (`1e308`, not 309 digits; `1e-300`, not `0.000…`).
+pub fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e15).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
 /// Why a value was refused: the variable's name and the rule, ready for the log.
 pub fn check_value(vr: u32, value: f64) -> Result<(), String> {
     let name = NAMES
         .get(vr as usize)
         .ok_or_else(|| format!("unknown value reference {vr}"))?;
+    let shown = short(value);
     if !value.is_finite() {
-        return Err(format!("{name} = {value}: values must be finite"));
+        return Err(format!("{name} = {shown}: values must be finite"));
     }
     let ok = match vr {
         vr::STIFFNESS | vr::RELIEF => value > 0.0,
@@ -109,7 +120,7 @@ pub fn check_value(vr: u32, value: f64) -> Result<(), String> {
             vr::CRACK => "must lie in [0, 1)",
             _ => "must be >= 0",
         };
-        Err(format!("{name} = {value} {rule}"))
+        Err(format!("{name} = {shown} {rule}"))
     }
 }
 
@@ -170,18 +181,52 @@ impl Jack {
     }
 
     /// Recomputes the outputs of the current time from the inputs (initialization: no step yet).
-    pub fn initialize(&mut self) {
-        self.piston_start = self.v(vr::PISTON);
-        self.last_step = 0.0;
-        self.update_outputs();
+    /// Refused, the jack unchanged, when an output would not be finite ([`Self::finite`]).
+    pub fn initialize(&mut self) -> Result<(), String> {
+        let mut next = *self;
+        next.piston_start = next.v(vr::PISTON);
+        next.last_step = 0.0;
+        next.update_outputs();
+        *self = next.finite()?;
+        Ok(())
     }
 
-    /// One communication step of size `h > 0` to the inputs as they are now.
-    pub fn step(&mut self, h: f64) {
-        self.piston_start = self.v(vr::PISTON);
-        self.last_step = h;
-        self.update_outputs();
-        self.time += h;
+    /// One communication step of size `h > 0` to the inputs as they are now. Refused, the jack
+    /// unchanged (the last good state: outputs, piston and time), when an output or the time
+    /// would not be finite ([`Self::finite`]): never a step that ends in an overflow.
+    pub fn step(&mut self, h: f64) -> Result<(), String> {
+        let mut next = *self;
+        next.piston_start = next.v(vr::PISTON);
+        next.last_step = h;
+        next.update_outputs();
+        next.time += h;
+        *self = next
+            .finite()
+            .map_err(|e| format!("{e}; the jack stays at t = {}", short(self.time)))?;
+        Ok(())
+    }
+
+    /// `self` when every value and the time are finite; else why not: the first one that is
+    /// not, with the inputs and parameters it came from.
+    pub fn finite(self) -> Result<Self, String> {
+        let bad = (self.values.iter().zip(NAMES))
+            .map(|(&v, name)| (name, v))
+            .chain([("time", self.time)])
+            .find(|(_, v)| !v.is_finite());
+        match bad {
+            None => Ok(self),
+            Some((name, v)) => {
+                let inputs: Vec<String> = (0..vr::DZ as usize)
+                    .map(|k| format!("{} = {}", NAMES[k], short(self.values[k])))
+                    .collect();
+                Err(format!(
+                    "{name} would be {} ({}, step size {}): the result overflows",
+                    short(v),
+                    inputs.join(", "),
+                    short(self.last_step)
+                ))
+            }
+        }
     }
 
     /// Derivative of output `unknown` with respect to input `known` at the end of the last
@@ -229,7 +274,7 @@ mod tests {
         j.values[vr::PISTON as usize] = -0.05;
         j.values[vr::FORCE as usize] = force;
         j.values[vr::RELIEF as usize] = relief;
-        j.step(h);
+        j.step(h).unwrap();
         j
     }
 
@@ -256,7 +301,7 @@ mod tests {
                 minus.values[known as usize] = x - d;
                 for s in [&mut plus, &mut minus] {
                     s.values[vr::PISTON as usize] = -0.05;
-                    s.step(5.0);
+                    s.step(5.0).unwrap();
                 }
                 for unknown in [vr::DZ, vr::PISTON, vr::SPEED] {
                     let fd = (plus.values[unknown as usize] - minus.values[unknown as usize])
@@ -285,7 +330,7 @@ mod tests {
             }
             j.values[vr::PISTON as usize] = -0.05;
             j.values[vr::FORCE as usize] = force;
-            j.step(h);
+            j.step(h).unwrap();
             (
                 j.values[vr::PISTON as usize],
                 j.derivative(vr::PISTON, vr::FORCE).unwrap(),
@@ -307,6 +352,51 @@ mod tests {
                 "pull {pull}: {exact} = {below}"
             );
         }
+    }
+
+    #[test]
+    fn a_step_whose_output_overflows_is_refused_naming_it_and_keeps_the_last_state() {
+        let mut j = Jack::default();
+        j.values[vr::STIFFNESS as usize] = 1e-10;
+        j.initialize().unwrap();
+        j.step(1.0).unwrap();
+        let good = j;
+        j.values[vr::FORCE as usize] = 1e308;
+        let e = j.step(1.0).unwrap_err();
+        for part in [
+            "dz would be -inf",
+            "force = 1e308",
+            "stiffness = 1e-10",
+            "the jack stays at t = 1",
+        ] {
+            assert!(e.contains(part), "'{e}' lacks '{part}'");
+        }
+        assert_eq!(j.values[vr::DZ as usize], good.values[vr::DZ as usize]);
+        assert_eq!((j.time, j.piston_start), (good.time, good.piston_start));
+        // initialization recomputes the outputs too: refused alike, the jack unchanged
+        let before = j;
+        assert!(j.initialize().unwrap_err().contains("dz would be -inf"));
+        assert_eq!(j, before);
+    }
+
+    #[test]
+    fn refused_values_are_shown_short_whatever_their_magnitude() {
+        assert_eq!(
+            check_value(vr::STIFFNESS, -1e308).unwrap_err(),
+            "stiffness = -1e308 must be > 0"
+        );
+        assert_eq!(
+            check_value(vr::RELIEF, -1e-300).unwrap_err(),
+            "relief = -1e-300 must be > 0"
+        );
+        assert_eq!(
+            check_value(vr::FORCE, f64::INFINITY).unwrap_err(),
+            "force = inf: values must be finite"
+        );
+        assert_eq!(
+            check_value(vr::STIFFNESS, -1.0).unwrap_err(),
+            "stiffness = -1 must be > 0"
+        );
     }
 
     #[test]
