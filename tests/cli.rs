@@ -901,3 +901,139 @@ fn advice_of_a_failed_run_names_the_option_that_applies() {
     assert!(!err.contains("--increments"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A scratch directory of this test process for the tests of issue 47.
+fn scratch(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("membrane-contact-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// TEST GOAL (issue 47, defect 6): a `--path` table saved with a UTF-8 byte-order mark (as
+/// spreadsheets write it) runs as the same table without it; the old code refused it as
+/// "unknown column 'time'" (the mark is invisible).
+#[test]
+fn a_path_table_with_a_byte_order_mark_reads_its_time_column() {
+    let dir = scratch("bom");
+    let rows = "time, frame.dz\n0.5, -0.01\n1.0, -0.02\n";
+    let plain = write_file(&dir, "plain.csv", rows);
+    let marked = write_file(&dir, "marked.csv", &format!("\u{feff}{rows}"));
+    let run = |table: &str| cli(&["specimen", "--height", "200", "--quiet", "--path", table]);
+    let (ok, without, err) = run(&plain);
+    assert!(ok, "{err}");
+    let (ok, with, err) = run(&marked);
+    assert!(ok, "{err}");
+    assert_eq!(results_text(&with), results_text(&without));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 47, defect 6): a `time` column that is not first is refused saying that it
+/// must be the first column; the old code said it "is not an input of the FMU, not an input:
+/// set it in the model file".
+#[test]
+fn a_time_column_that_is_not_first_is_refused_saying_it_must_be_first() {
+    let dir = scratch("time-column");
+    let table = write_file(&dir, "late.csv", "frame.dz, time\n-0.01, 0.5\n");
+    let (ok, _, err) = cli(&["specimen", "--height", "200", "--path", &table]);
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("late.csv line 1: column 'time' is column 2; it must be the first column"),
+        "{err}"
+    );
+    assert!(!err.contains("set it in the model file"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 47, defects 5 and 6): the command line accepts exactly the friction
+/// coefficients the FMU accepts, by the FMU's own check (`Variable::check_value`): `--mu 11`
+/// and a `mu` cell of 1e300 were run by the old code, a negative cell was refused without its
+/// line and column. Each refusal names the option, or the table's line and column.
+#[test]
+fn the_cli_refuses_the_friction_coefficients_the_fmu_refuses_naming_where() {
+    let dir = scratch("mu");
+    let bound = "the friction coefficient must be ≥ 0 and ≤ 10";
+    let specimen = ["specimen", "--height", "200", "--steps", "1", "--quiet"];
+    let (ok, _, err) = cli(&[&specimen[..], &["--mu", "11"]].concat());
+    assert!(
+        !ok && err.contains(&format!("--mu: mu = 11: {bound}")),
+        "{err}"
+    );
+    let (ok, _, err) = cli(&[&specimen[..], &["--mu", "10"]].concat());
+    assert!(ok, "the FMU's bound itself is accepted: {err}");
+    for (rows, line, shown) in [
+        ("0.5, -0.01, 1e300\n", 2, "1e300"),
+        ("0.5, -0.01, 0.2\n1.0, -0.02, -0.1\n", 3, "-0.1"),
+    ] {
+        let table = write_file(&dir, "mu.csv", &format!("time, frame.dz, mu\n{rows}"));
+        let (ok, _, err) = cli(&["specimen", "--height", "200", "--path", &table]);
+        let expected = format!("mu.csv line {line}, column 'mu': mu = {shown}: {bound}");
+        assert!(!ok && err.contains(&expected), "'{err}' lacks '{expected}'");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The 200 mm specimen as a model file, with `edit` applied to its JSON, written to `dir`.
+fn edited_specimen(dir: &std::path::Path, plastic: bool, edit: impl Fn(&mut String)) -> String {
+    let mut args = vec!["export-specimen", "--height", "200"];
+    if plastic {
+        args.push("--plastic");
+    }
+    let (ok, mut json, err) = cli(&args);
+    assert!(ok, "{err}");
+    edit(&mut json);
+    write_file(dir, "edited.json", &json)
+}
+
+/// TEST GOAL (issue 47, defect 6): a hardening row of three numbers is refused naming the row
+/// (`material.plasticity.hardening[1]`) and what a row holds; the old code said only "trailing
+/// characters at line 1 column 528".
+#[test]
+fn a_hardening_row_of_three_numbers_is_refused_naming_the_row() {
+    let dir = scratch("hardening");
+    let file = edited_specimen(&dir, true, |json| {
+        let mut model: serde_json::Value = serde_json::from_str(json).unwrap();
+        let rows = &mut model["material"]["plasticity"]["hardening"];
+        rows[1].as_array_mut().unwrap().push(5.0.into());
+        *json = model.to_string();
+    });
+    let (ok, _, err) = cli(&["check", &file]);
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains(
+            "material.plasticity.hardening[1]: 3 numbers; a row is [equivalent plastic strain, \
+             flow stress in Pa]"
+        ),
+        "{err}"
+    );
+    assert!(!err.contains("trailing characters"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 47, defect 6): values far from everyday magnitudes print with their
+/// magnitude: a yield stress of 1e-300 Pa is "1.000e-306 MPa" in the warning (the old code
+/// printed "0.000 MPa"), a temperature of 1e308 °C is refused as "1e308" (the old code printed
+/// 309 digits).
+#[test]
+fn tiny_and_huge_values_print_with_their_magnitude() {
+    let dir = scratch("magnitudes");
+    let set = |key: &'static str, value: f64| {
+        move |json: &mut String| {
+            let mut model: serde_json::Value = serde_json::from_str(json).unwrap();
+            model["material"][key] = value.into();
+            *json = model.to_string();
+        }
+    };
+    let file = edited_specimen(&dir, false, set("yield_stress", 1e-300));
+    let (ok, _, err) = cli(&["model", &file, "--steps", "1", "--quiet"]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("above the material's yield_stress 1.000e-306 MPa"),
+        "{err}"
+    );
+    let file = edited_specimen(&dir, false, set("temperature", 1e308));
+    let (ok, _, err) = cli(&["check", &file]);
+    assert!(!ok, "{err}");
+    assert!(err.contains("temperature = 1e308 °C lies outside"), "{err}");
+    assert!(err.len() < 300, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

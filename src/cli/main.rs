@@ -9,6 +9,7 @@ use std::process::ExitCode;
 use membrane_contact::mech::elements::temperature;
 use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
+use membrane_contact::mech::results::summary::mpa;
 use membrane_contact::mech::results::vtk;
 use membrane_contact::mech::{
     Analysis, FrictionLaw, LoadLevels, Model, Results, SettingNames, SolverSettings,
@@ -166,6 +167,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         threads: o.threads,
         ..defaults
     };
+    if let Some(mu) = o.mu {
+        // The FMU's own check of its `mu` input: the CLI accepts exactly what the FMU accepts.
+        path::check_input(&model, "mu", mu).map_err(|e| format!("--mu: {e}"))?;
+    }
     for w in membrane_contact::mech::results::warnings::model_warnings(&model) {
         eprintln!("warning: {w}");
     }
@@ -692,9 +697,9 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     );
     let (lo, hi) = results.von_mises_range();
     out!(
-        "equivalent (von Mises) stress: {:.3} … {:.3} MPa",
-        lo / 1e6,
-        hi / 1e6
+        "equivalent (von Mises) stress: {} … {} MPa",
+        mpa(lo),
+        mpa(hi)
     );
     for (p, u) in model.outputs.points.iter().zip(&results.points) {
         out!(
@@ -708,12 +713,12 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     }
     for (set, s) in model.outputs.element_sets.iter().zip(&results.sets) {
         out!(
-            "element set {}: principal stress {:.3} … {:.3} MPa, von Mises ≤ {:.3} MPa, \
+            "element set {}: principal stress {} … {} MPa, von Mises ≤ {} MPa, \
              principal strain ≤ {:.6}, compressed area {:.6} m²",
             set.name,
-            s.min_principal_stress / 1e6,
-            s.max_principal_stress / 1e6,
-            s.max_equivalent_stress / 1e6,
+            mpa(s.min_principal_stress),
+            mpa(s.max_principal_stress),
+            mpa(s.max_equivalent_stress),
             s.max_strain,
             s.compressed_area
         );

@@ -8,14 +8,16 @@
 //! 1.0,  -0.10,    0.05,      -100
 //! ```
 //!
-//! Blank lines and lines starting with `#` are skipped; cells are trimmed. An input without a
+//! A UTF-8 byte-order mark (spreadsheets write one) is skipped. Blank lines and lines starting
+//! with `#` are skipped; cells are trimmed. Every cell is checked as `fmi2SetReal` checks the
+//! input ([`Variable::check_value`]: `mu` in `[0, 10]`, …). An input without a
 //! column keeps its FMU start value (a group's displacement and angle 0, a load the model
 //! file's, reached in the first step as by the FMU); `mu` applies from the first row when it has
 //! a column. The optional first column `time` (increasing) is the pseudo-time of the VTK
 //! collection; without it, row k of N is at k/N.
 
 use membrane_contact::fmi2::variables::{
-    Causality, Kind, StepInputs, Value, Variable, step_inputs, variables,
+    Causality, Kind, StepInputs, Value, Variable, message_real, step_inputs, variables,
 };
 use membrane_contact::mech::Model;
 
@@ -31,6 +33,8 @@ pub struct StagedPath {
 /// Reads a staged path for `model` from the CSV `text` (`source` names it in errors).
 pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, String> {
     let table = variables(model, Kind::Model);
+    // The mark is invisible: left on, it would be read as part of the first column's name.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
@@ -41,6 +45,17 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
         .ok_or_else(|| format!("{source}: no header line (the FMU's input names)"))?;
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let has_time = names.first() == Some(&"time");
+    if let Some(k) = names.iter().skip(1).position(|&n| n == "time") {
+        return Err(if has_time {
+            format!("{source} line {header_line}: column 'time' appears twice")
+        } else {
+            format!(
+                "{source} line {header_line}: column 'time' is column {}; it must be the first \
+                 column (the pseudo-time of each row), or left out",
+                k + 2
+            )
+        });
+    }
     let columns: Vec<usize> = names[usize::from(has_time)..]
         .iter()
         .map(|name| column(&table, name, names.as_slice()))
@@ -62,19 +77,20 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
             ));
         }
         let number = |k: usize| -> Result<f64, String> {
-            let v: f64 = cells[k].parse().map_err(|_| {
-                format!(
-                    "{source} line {line}, column '{}': '{}' is not a number",
-                    names[k], cells[k]
-                )
-            })?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(format!(
-                    "{source} line {line}, column '{}': {v} is not finite",
-                    names[k]
-                ))
+            let at = || format!("{source} line {line}, column '{}'", names[k]);
+            let v: f64 = cells[k]
+                .parse()
+                .map_err(|_| format!("{}: '{}' is not a number", at(), cells[k]))?;
+            if !v.is_finite() {
+                return Err(format!("{}: {v} is not finite", at()));
+            }
+            // An input's cell passes the FMU's own check of the value (fmi2SetReal's).
+            let input = k
+                .checked_sub(usize::from(has_time))
+                .map(|c| &table[columns[c]]);
+            match input.map(|var| var.check_value(&Value::Real(v))) {
+                Some(Err(e)) => Err(format!("{}: {e}", at())),
+                _ => Ok(v),
             }
         };
         if has_time {
@@ -83,7 +99,9 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
                 && t <= last
             {
                 return Err(format!(
-                    "{source} line {line}: time {t} does not increase (the row before is at {last})"
+                    "{source} line {line}: time {} does not increase (the row before is at {})",
+                    message_real(t),
+                    message_real(last)
                 ));
             }
             times.push(t);
@@ -101,6 +119,27 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
         times = (1..=rows.len()).map(|k| k as f64 / n).collect();
     }
     Ok(StagedPath { times, steps: rows })
+}
+
+/// Checks `value` for the FMU input `name` of `model` as `fmi2SetReal` does
+/// ([`Variable::check_value`]): the command line's options that stand for an input (`--mu`)
+/// accept exactly what the FMU accepts.
+pub fn check_input(model: &Model, name: &str, value: f64) -> Result<(), String> {
+    let table = variables(model, Kind::Model);
+    match table
+        .iter()
+        .find(|v| v.name == name && v.causality == Causality::Input)
+    {
+        Some(v) => v.check_value(&Value::Real(value)),
+        None => Err(format!(
+            "the model has no input '{name}' (its FMU would have none){}",
+            if name == "mu" {
+                ": no gaps or curved supports, no friction coefficient to set"
+            } else {
+                ""
+            }
+        )),
+    }
 }
 
 /// Writes the staged table of `steps` steps whose groups reach `targets_at(k / steps)` at step
@@ -221,10 +260,49 @@ mod tests {
                 "line 2: 1 cells, the header has 2 columns",
             ),
             ("time, frame.dz\n1, 0\n1, 0\n", "time 1 does not increase"),
+            (
+                "frame.dz, time\n-0.1, 1\n",
+                "t.csv line 1: column 'time' is column 2; it must be the first column",
+            ),
+            (
+                "time, frame.dz, time\n1, 0, 1\n",
+                "column 'time' appears twice",
+            ),
+            (
+                "mu\n0.2\n11\n",
+                "t.csv line 3, column 'mu': mu = 11: the friction coefficient must be ≥ 0 and ≤ 10",
+            ),
+            (
+                "time, mu\n1, -1e300\n",
+                "line 2, column 'mu': mu = -1e300: the friction",
+            ),
         ];
         for (text, expected) in cases {
             let e = read(text, &specimen(), "t.csv").unwrap_err();
             assert!(e.contains(expected), "'{e}' lacks '{expected}'");
         }
+    }
+
+    #[test]
+    fn a_byte_order_mark_before_the_header_is_skipped() {
+        let text = "time, frame.dz, mu\n0.5, -0.05, 0.3\n";
+        let marked = read(&format!("\u{feff}{text}"), &specimen(), "t.csv").unwrap();
+        assert_eq!(marked, read(text, &specimen(), "t.csv").unwrap());
+        assert_eq!(marked.times, vec![0.5]);
+    }
+
+    #[test]
+    fn options_that_stand_for_an_input_pass_the_fmus_check_of_it() {
+        let model = specimen();
+        assert_eq!(check_input(&model, "mu", 10.0), Ok(()));
+        let e = check_input(&model, "mu", 10.5).unwrap_err();
+        assert_eq!(
+            e,
+            "mu = 10.5: the friction coefficient must be ≥ 0 and ≤ 10"
+        );
+        let mut free = model.clone();
+        free.gaps.clear();
+        let e = check_input(&free, "mu", 0.3).unwrap_err();
+        assert!(e.contains("no gaps or curved supports"), "{e}");
     }
 }

@@ -104,11 +104,7 @@ pub fn format_real(v: f64) -> String {
 /// A real for a message: plain between 1e-4 and 1e15 in magnitude (`0.25`, `11`), else in
 /// `{:e}` form (`1e300`, `5e-324`), so that no huge or tiny value prints as hundreds of digits.
 pub fn message_real(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
+    crate::mech::model::message_number(v)
 }
 
 /// "n" before a word starting with a vowel sound ("an Integer"), else "".

@@ -575,6 +575,17 @@ impl std::error::Error for ModelError {}
 /// §4); at 10 a gap practically never slips, and larger values only risk overflowing `μN`.
 pub const MAX_FRICTION: f64 = 10.0;
 
+/// A real for a message: plain between 1e-4 and 1e15 in magnitude (`0.25`, `11`), else in
+/// `{:e}` form (`1e308`, `5e-324`), so that no huge or tiny value prints as hundreds of digits
+/// (`{}` of 1e308 is 309 of them) or as a zero.
+pub fn message_number(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 /// Whether `name` can be used as an FMU variable prefix and a C identifier.
 pub fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
@@ -582,11 +593,41 @@ pub fn is_identifier(name: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// The rows of fixed length of a model file: where they are, their length, what a row holds.
+const FIXED_ROWS: [(&[&str], usize, &str); 3] = [
+    (&["nodes"], 3, "[x, y, z] in m"),
+    (&["triangles"], 3, "three node indices"),
+    (
+        &["material", "plasticity", "hardening"],
+        2,
+        "[equivalent plastic strain, flow stress in Pa]",
+    ),
+];
+
+/// The first row of [`FIXED_ROWS`] of another length in the JSON `text`, named
+/// (`material.plasticity.hardening[1]: 3 numbers, …`): serde_json reports a long row only as
+/// "trailing characters at line 1 column 528", which names no item. None when the text is not
+/// JSON or every such row has its length.
+fn row_length_error(text: &str) -> Option<String> {
+    let root: serde_json::Value = serde_json::from_str(text).ok()?;
+    FIXED_ROWS.iter().find_map(|(path, length, holds)| {
+        let rows = path
+            .iter()
+            .try_fold(&root, |v, key| v.get(key))?
+            .as_array()?;
+        rows.iter().enumerate().find_map(|(k, row)| {
+            let given = row.as_array()?.len();
+            (given != *length)
+                .then(|| format!("{}[{k}]: {given} numbers; a row is {holds}", path.join(".")))
+        })
+    })
+}
+
 impl Model {
     /// Parses and validates a JSON model file.
     pub fn from_json(text: &str) -> Result<Self, ModelError> {
         let model: Model = serde_json::from_str(text).map_err(|e| ModelError::Syntax {
-            message: e.to_string(),
+            message: row_length_error(text).unwrap_or_else(|| e.to_string()),
         })?;
         model.validate()?;
         Ok(model)

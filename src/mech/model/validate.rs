@@ -51,17 +51,20 @@ impl Model {
         let m = &self.material;
         if !(m.youngs_modulus > 0.0 && m.youngs_modulus.is_finite()) {
             return Err(ModelError::Material {
-                message: format!("E = {} must be > 0", m.youngs_modulus),
+                message: format!("E = {} must be > 0", message_number(m.youngs_modulus)),
             });
         }
         if !(m.poisson_ratio >= 0.0 && m.poisson_ratio < 0.5) {
             return Err(ModelError::Material {
-                message: format!("ν = {} must lie in [0, 0.5)", m.poisson_ratio),
+                message: format!(
+                    "ν = {} must lie in [0, 0.5)",
+                    message_number(m.poisson_ratio)
+                ),
             });
         }
         if !(m.thickness > 0.0 && m.thickness.is_finite()) {
             return Err(ModelError::Material {
-                message: format!("thickness = {} must be > 0", m.thickness),
+                message: format!("thickness = {} must be > 0", message_number(m.thickness)),
             });
         }
         if m.prestress.iter().any(|v| !v.is_finite()) {
@@ -72,19 +75,25 @@ impl Model {
         let eta = m.wrinkling_regularisation;
         if !(0.0..1.0).contains(&eta) {
             return Err(ModelError::Material {
-                message: format!("wrinkling_regularisation = {eta} must lie in [0, 1)"),
+                message: format!(
+                    "wrinkling_regularisation = {} must lie in [0, 1)",
+                    message_number(eta)
+                ),
             });
         }
         if !(m.density >= 0.0 && m.density.is_finite()) {
             return Err(ModelError::Material {
-                message: format!("density = {} must be ≥ 0 (kg/m³)", m.density),
+                message: format!(
+                    "density = {} must be ≥ 0 (kg/m³)",
+                    message_number(m.density)
+                ),
             });
         }
         if let Some(y) = m.yield_stress
             && !(y > 0.0 && y.is_finite())
         {
             return Err(ModelError::Material {
-                message: format!("yield_stress = {y} must be > 0 (Pa)"),
+                message: format!("yield_stress = {} must be > 0 (Pa)", message_number(y)),
             });
         }
         if !in_range(m.temperature) {
@@ -93,7 +102,7 @@ impl Model {
                 message: format!(
                     "temperature = {} °C lies outside [{low}, {high}] °C, the range of ETFE's \
                      published temperature relation (docs/mechanics.md § \"Temperature\")",
-                    m.temperature
+                    message_number(m.temperature)
                 ),
             });
         }

@@ -27,6 +27,18 @@ pub struct FieldSummary {
     pub max_plastic_strain: f64,
 }
 
+/// A stress given in Pa, in MPa for a summary or a message: three decimals (`14.708`) where they
+/// show its magnitude, else three significant digits in exponent form (`1.000e-306` for
+/// 1e-300 Pa, which three decimals print as `0.000`; `1.000e302` instead of 303 digits).
+pub fn mpa(pa: f64) -> String {
+    let x = pa / 1e6;
+    if x == 0.0 || !x.is_finite() || (1e-3..1e9).contains(&x.abs()) {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.3e}")
+    }
+}
+
 /// Major principal value of a Voigt tensor `[xx, yy, 2·xy]` (engineering shear, as strains)
 /// or `[xx, yy, xy]` (`shear_factor` 1, as stresses).
 pub(super) fn major_principal(v: [f64; 3], shear_factor: f64) -> f64 {
@@ -145,5 +157,19 @@ mod tests {
         ];
         let s = summarize(&elements, &[1.0, 1.0], &[0, 1]);
         assert!(s.max_principal_stress.is_nan());
+    }
+
+    #[test]
+    fn stresses_in_mpa_keep_their_magnitude_at_every_scale() {
+        for (pa, text) in [
+            (14.708e6, "14.708"),
+            (0.0, "0.000"),
+            (-2.5e5, "-0.250"),
+            (1e-300, "1.000e-306"),
+            (400.0, "4.000e-4"),
+            (1e308, "1.000e302"),
+        ] {
+            assert_eq!(mpa(pa), text, "{pa} Pa");
+        }
     }
 }

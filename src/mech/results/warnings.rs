@@ -3,9 +3,10 @@
 
 use crate::mech::elements::plasticity::ETFE_RUPTURE_PLASTIC_STRAIN;
 use crate::mech::elements::triangle::ElementStress;
+use crate::mech::model::message_number;
 use crate::mech::model::{GapSupport, Model};
 use crate::mech::results::Results;
-use crate::mech::results::summary::major_principal;
+use crate::mech::results::summary::{major_principal, mpa};
 
 /// Major principal Green–Lagrange strain beyond which a result is outside the model's
 /// assumptions: the law (2.3) is linear elastic, and ETFE leaves its elastic range near 2–3 %
@@ -28,8 +29,9 @@ pub fn model_warnings(model: &Model) -> Vec<String> {
     let e = model.material.youngs_modulus;
     if e < SUSPICIOUS_MODULUS {
         warnings.push(format!(
-            "material youngs_modulus = {e} Pa looks like a value in MPa (ETFE: about 1e9 Pa); \
-             the model file takes Pa"
+            "material youngs_modulus = {} Pa looks like a value in MPa (ETFE: about 1e9 Pa); \
+             the model file takes Pa",
+            message_number(e)
         ));
     }
     warnings.extend(crate::mech::elements::load::orientation_warnings(model));
@@ -88,10 +90,10 @@ pub fn result_warnings(model: &Model, results: &Results) -> Vec<String> {
                 .filter(|e| e.von_mises > limit)
                 .count();
             warnings.push(format!(
-                "equivalent stress {:.3} MPa in triangle {e} is above the material's yield_stress \
-                 {:.3} MPa ({over} triangles above it): the linear film law no longer holds there",
-                s / 1e6,
-                limit / 1e6
+                "equivalent stress {} MPa in triangle {e} is above the material's yield_stress \
+                 {} MPa ({over} triangles above it): the linear film law no longer holds there",
+                mpa(s),
+                mpa(limit)
             ));
         }
     }
