@@ -63,6 +63,7 @@ use membrane_contact::mech::{Analysis, LoadLevels, Model, SolverSettings};
 use serde_json::{Value, json};
 
 #[path = "common/options.rs"]
+#[allow(dead_code)] // `finish` prints the total row last; this bench prints its own
 mod options;
 use options::{PathOptions, on_threads};
 
@@ -980,6 +981,9 @@ fn main() {
             .filter(|(p, _)| p.family == f.as_str())
             .collect();
         let n = sel.len();
+        if n == 0 {
+            continue; // a family left out by --name
+        }
         let ok = sel.iter().filter(|(_, r)| r.error.is_none()).count();
         let within = sel
             .iter()
@@ -1019,6 +1023,16 @@ fn main() {
             total.5 + cpu,
         );
     }
+    // the total row under the family table (options.rs's `finish` prints it last)
+    println!(
+        "| **total** | {} | {} | {:.1} | {:.2} | | {} | | {:.1} | |",
+        total.0,
+        total.1,
+        100.0 * total.1 as f64 / total.0.max(1) as f64,
+        total.2 as f64 / total.3.max(1) as f64,
+        total.4,
+        total.5
+    );
     println!(
         "\n| family | converged | of them every step within the stabilization bound ({STABILIZATION_BOUND:.0e}) | steps above the bound | largest stabilization ratio |\n|---|---|---|---|---|"
     );
@@ -1042,5 +1056,21 @@ fn main() {
         .zip(&results)
         .filter_map(|(p, r)| r.error.clone().map(|e| (p.name.clone(), e)))
         .collect();
-    o.finish(total, 1, wall, &failed);
+    println!("\nwall time {wall:.1} s");
+    if o.failures || (o.check && !failed.is_empty()) {
+        println!("\n### failed paths\n");
+        for (name, message) in &failed {
+            println!("- {name}: {message}");
+        }
+    }
+    if o.check {
+        if total.0 == 0 || !failed.is_empty() {
+            eprintln!(
+                "check failed: {} of {} load paths converge",
+                total.1, total.0
+            );
+            std::process::exit(1);
+        }
+        println!("\ncheck passed: all {} load paths converge", total.0);
+    }
 }
