@@ -129,6 +129,20 @@ MUTATIONS = [
         )],
         first=["--lib curved_contact::", "--test surfaces"],
     ),
+    Mutation(
+        "dx-seed",
+        "directional derivatives: the prescribed motion of a group's x seed with its sign flipped "
+        "(the right-hand side and the outputs' motion of a frame.dx seed; issue 47 item 11: "
+        "every derivative test seeded dz, mu, a pressure or an angle)",
+        "src/mech/solve/sensitivity.rs",
+        [(
+            "                du[i] = (self.prescribed_value(i, group, component, &plus.0)",
+            "                du[i] = if component == 0 { -1.0 } else { 1.0 }\n"
+            "                    * (self.prescribed_value(i, group, component, &plus.0)",
+        )],
+        first=["--lib fmi2::tests::derivatives"],
+        fmu=True,
+    ),
 ]
 
 

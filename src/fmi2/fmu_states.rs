@@ -99,6 +99,8 @@ impl Instance {
                     }
                     return Err(e);
                 }
+                // The restored state's derivatives are those of one increment from it.
+                built.step_increments = 0;
                 Some(built)
             }
         };

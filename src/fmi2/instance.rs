@@ -33,6 +33,11 @@ pub(super) struct Built {
     /// The parameter values it was built with (table order, model parameters only).
     pub(super) parameters: Vec<Value>,
     pub(super) increments: usize,
+    /// Increments of the step that reached the present state (0: no step since the analysis
+    /// was built or a state restored): the derivatives are the last increment's
+    /// (`derivatives.rs`), which are the step's only where this is 1 or the path did not
+    /// matter.
+    pub(super) step_increments: usize,
     /// The results of the state `checked_step` has just reached, already checked finite: the
     /// outputs are made of them (taken by `refresh_outputs`, so never stale).
     pub(super) checked: Option<Results>,
@@ -178,6 +183,7 @@ impl Instance {
             analysis,
             parameters: parameters_of(&self.description.variables, values),
             increments,
+            step_increments: 0,
             checked: None,
             warnings: vec![],
         })

@@ -106,6 +106,9 @@ impl Instance {
         };
         match checked_step(built, &targets, &angles, &loads, &self.logger) {
             Ok(report) => {
+                if let Some(b) = self.analysis.as_mut() {
+                    b.step_increments = report.iterations.len();
+                }
                 self.time = t + h;
                 self.phase = Phase::StepComplete;
                 self.discarded = None;
@@ -130,6 +133,7 @@ impl Instance {
             Err(e) => {
                 if let Some(before) = before {
                     built.analysis.set_state(before).map_err(Failure::error)?;
+                    built.step_increments = 0;
                 }
                 self.phase = Phase::StepFailed;
                 let message = format!(
