@@ -356,7 +356,7 @@ def cargo_version() -> str:
 # ---------------------------------------------------------------------------- packaging conventions (issue 47 item 10)
 
 
-def test_the_package_has_one_version_cargos_and_declares_its_types():
+def test_the_package_has_one_version_cargos_and_declares_its_types(tmp_path):
     import importlib.metadata
 
     import membrane_contact
@@ -365,6 +365,20 @@ def test_the_package_has_one_version_cargos_and_declares_its_types():
     if INSTALLED:
         assert importlib.metadata.version("membrane-contact") == cargo_version()
     assert (Path(membrane_contact.__file__).parent / "py.typed").is_file()
+    if not INSTALLED:
+        # taken from Cargo.toml, not written a second time: a checkout whose Cargo.toml says
+        # another version makes another __version__
+        import shutil
+
+        other = tmp_path / "checkout"
+        shutil.copytree(ROOT / "python" / "membrane_contact", other / "python" / "membrane_contact",
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        text = (ROOT / "Cargo.toml").read_text().replace(f'version = "{cargo_version()}"', 'version = "9.8.7"', 1)
+        (other / "Cargo.toml").write_text(text)
+        r = subprocess.run([sys.executable, "-c", "import membrane_contact; print(membrane_contact.__version__)"],
+                           cwd=tmp_path, capture_output=True, text=True,
+                           env={**package_env(), "PYTHONPATH": str(other / "python")})
+        assert r.returncode == 0 and r.stdout.strip() == "9.8.7", r.stderr
     # the public API is annotated
     import inspect
 
