@@ -171,7 +171,11 @@ def test_a_killed_study_resumes_running_each_case_once(fmu_path, tmp_path):
     assert not set(started_again) & first, "a stored case ran again"
     assert sorted(started_again) == sorted(set(range(16)) - first), "a case was lost or ran twice after the resume"
     stored = [json.loads(line)["case"] for line in (directory / "log.jsonl").read_text().splitlines()]
-    assert sorted(stored) == list(range(16))  # each case stored once
+    # each case stored once; the kill may fall between a case file's rename and its log line,
+    # so at most one case the first driver stored may lack its line (its file is there)
+    assert len(stored) == len(set(stored)) and set(stored) <= set(range(16))
+    unlogged = set(range(16)) - set(stored)
+    assert len(unlogged) <= 1 and unlogged <= first, unlogged
     design = factorial({"mu": [0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45], "film.prestressX": [0.5e6, 1e6]})
     path = {"time": [0.25, 0.5, 0.75, 1.0], "frame.dz": [-0.0375, -0.075, -0.1125, -0.15]}
     resumed = Study(fmu_path, design, path, ["G2.slip", "G4.slip"], {"solver.incrementsPerStep": 20},
