@@ -15,7 +15,9 @@ initialization, ``film.E``, ``archHeight``), an input (held over the whole path,
 
 Results go to a directory as they come, one Parquet file per case (written whole, then renamed:
 a killed study leaves no half file); run again on the same directory, a study runs only the
-cases that have no file and refuses a directory that holds another study. A case the FMU refuses
+cases that have no valid file (:func:`check_case`: a damaged or foreign file is moved aside and
+its case runs again, with a warning) and refuses a directory that holds another study. One
+driver at a time: a driver holds an OS lock on the directory (:func:`driver_lock`). A case the FMU refuses
 (a step refused after every halving, a parameter refused at initialization) is stored with the
 FMU's message and the study goes on. :meth:`Study.run` returns an ``xarray.Dataset`` (one
 variable per output over ``case × step``, the design as coordinates, ``status`` and ``message``
