@@ -718,6 +718,33 @@ def _assemble(description: dict, results: dict[int, dict]):
                                                   "parameters": json.dumps(description["parameters"])})
 
 
+def largest_slips(ds: Any, supports: dict[str, list[str]] | None = None, component: str = "slip") -> Any:
+    """The largest slip per support in each case of a study's dataset (:meth:`Study.dataset`):
+    an ``xarray.Dataset`` over ``case`` with, per support, its signed largest slip (m: the
+    largest ``|slip|`` over its gaps and the steps) and ``<support>.where`` (that gap).
+    ``supports``: ``{support: [gap, ...]}``; default: the gaps among the outputs
+    (``<gap>.<component>``) grouped by name without the trailing number (``N1`` … ``N13`` →
+    ``N``), as :meth:`Results.largest_slips <membrane_contact.Results.largest_slips>`."""
+    import xarray as xr
+
+    suffix = f".{component}"
+    if supports is None:
+        supports = {}
+        for name in ds.data_vars:
+            gap = str(name)[: -len(suffix)] if str(name).endswith(suffix) else None
+            if gap and re.fullmatch(r"\w+", gap):
+                supports.setdefault(re.sub(r"\d+$", "", gap) or gap, []).append(gap)
+    data = {}
+    for support, gaps in supports.items():
+        values = np.stack([ds[f"{g}{suffix}"].values for g in gaps], axis=-1)  # case × step × gap
+        flat = np.abs(np.nan_to_num(values, nan=0.0)).reshape(values.shape[0], -1)
+        k = np.argmax(flat, axis=1)
+        best = values.reshape(values.shape[0], -1)[np.arange(values.shape[0]), k]
+        data[support] = ("case", best)
+        data[f"{support}.where"] = ("case", np.asarray([gaps[j % len(gaps)] for j in k]))
+    return xr.Dataset(data, coords={"case": ds.case.values})
+
+
 def open_study(directory: str | os.PathLike) -> Any:
     """The dataset of the study stored in ``directory`` (its ``study.json`` and the cases stored
     so far), without the FMU."""

@@ -437,3 +437,19 @@ def test_a_second_driver_on_a_directory_is_refused_naming_the_first_ones_process
     # the killed driver's lock went with its process: a driver resumes the study
     ds = second.run(workers=1, progress=False)
     assert (ds.status == "ok").all()
+
+
+def test_the_largest_slip_per_support_of_each_case_is_the_largest_magnitude_over_its_gaps_and_steps(one_worker):
+    from membrane_contact.study import largest_slips
+
+    _, ds = one_worker
+    found = largest_slips(ds)
+    assert set(found.data_vars) == {"G", "G.where"}  # G2, G4, G6: the specimen's one support
+    gaps = ["G2", "G4", "G6"]
+    for case in range(ds.sizes["case"]):
+        values = np.stack([ds[f"{g}.slip"].values[case] for g in gaps], axis=1)
+        step, k = np.unravel_index(np.argmax(np.abs(values)), values.shape)
+        assert found["G"].values[case] == values[step, k] != 0.0
+        assert found["G.where"].values[case] == gaps[k]
+    mine = largest_slips(ds, {"edge": ["G2"], "middle": ["G4", "G6"]})
+    np.testing.assert_array_equal(np.abs(mine["edge"].values), np.max(np.abs(ds["G2.slip"].values), axis=1))
