@@ -19,8 +19,10 @@ Per mutation, with the default settings:
 2. if none failed, the whole Rust suite, `cargo test --release --locked` (stops at the first
    failing test target);
 3. if none failed and the mutation is visible through the FMU (`fmu` below), the FMU and the CLI
-   are built and packed and `pytest tests/python -x` runs (the checkout's `.venv`, made by
+   are built and packed (`fmu-pack -o target/fmu/ParallelArch.fmu --library ...`, checked to ship
+   the library just built) and `pytest tests/python -x` runs (the checkout's `.venv`, made by
    `fmu/prepare.sh`).
+A mutation of the Python package (a `.py` file) skips steps 1–2 and runs its `pytest` files.
 `--cargo ARGS` replaces steps 1–2 by one `cargo test --release --locked ARGS`; `--no-pytest` skips
 step 3; `--pytest "FILES"` runs those test files instead of all of tests/python.
 
@@ -65,6 +67,13 @@ class Mutation:
     first: list[str] = field(default_factory=list)
     # Visible through the FMU: the Python FMU tests run too when the Rust tests pass.
     fmu: bool = False
+    # pytest files that catch it (default: `--pytest`); a mutation of a Python file (python/)
+    # runs no cargo tests, only these.
+    pytest: str = ""
+
+    @property
+    def python(self) -> bool:
+        return self.file.endswith(".py")
 
 
 MUTATIONS = [
@@ -142,6 +151,16 @@ MUTATIONS = [
         )],
         first=["--lib fmi2::tests::derivatives"],
         fmu=True,
+    ),
+    Mutation(
+        "study-gaps",
+        "a study resume that skips the missing cases below the largest stored case id",
+        "python/membrane_contact/study.py",
+        [(
+            "        return [k for k in range(self.cases) if k not in stored]",
+            "        return [k for k in range(max(stored, default=-1) + 1, self.cases)]",
+        )],
+        pytest="tests/python/test_study.py",
     ),
 ]
 
@@ -274,18 +293,41 @@ def fmu_tests(copy: Path, files: str) -> str | None:
     python = copy / ".venv" / "bin" / "python"
     if not python.exists():
         raise HarnessError("no .venv in the checkout: run `bash fmu/prepare.sh` once, or --no-pytest")
+    # The output and the library named: a bare fmu-pack writes into the current directory when
+    # target/ holds no CACHEDIR.TAG (the scratch copy's target/ is seeded from target/release
+    # only), and pytest would load a stale target/fmu/ParallelArch.fmu.
+    fmu = copy / "target" / "fmu" / "ParallelArch.fmu"
+    library = copy / "target" / "release" / "libmembrane_contact.so"
     for cmd in (["cargo", "build", "--release", "--locked"],
-                ["cargo", "run", "--release", "--locked", "--quiet", "--bin", "fmu-pack"]):
+                [str(copy / "target" / "release" / "fmu-pack"), "-o", str(fmu), "--library", str(library)]):
         code, out = run(cmd, copy)
         if code != 0:
             raise HarnessError(f"{shlex.join(cmd)} failed:\n{out[-3000:]}")
+    if packed_library(fmu) != library.read_bytes():
+        raise HarnessError(f"{fmu} does not ship {library} as just built: the tests would load a stale FMU")
     code, out = run([str(python), "-m", "pytest", *shlex.split(files), "-x", "-q",
                      "-p", "no:cacheprovider"], copy, TIMEOUT[0])
     return None if code == 0 else ", ".join(failed_tests(out)[:3]) + "  [pytest]"
 
 
+def packed_library(fmu: Path) -> bytes | None:
+    """The shared library an FMU ships (`binaries/linux64/*.so`), or None."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(fmu) as z:
+            (name,) = [n for n in z.namelist() if n.startswith("binaries/linux64/") and n.endswith(".so")]
+            return z.read(name)
+    except (OSError, ValueError, zipfile.BadZipFile):
+        return None
+
+
 def check(copy: Path, m: Mutation, options) -> str | None:
     """What caught `m` (None: it survived)."""
+    if m.python:  # nothing of the crate changed: its pytest files only
+        if options.no_pytest:
+            raise HarnessError(f"{m.name} mutates {m.file}: only pytest can catch it (drop --no-pytest)")
+        return fmu_tests(copy, m.pytest or options.pytest)
     caught = None
     if options.cargo is not None:
         caught = cargo_tests(copy, options.cargo)

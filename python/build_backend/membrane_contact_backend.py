@@ -77,13 +77,73 @@ def stage_library() -> Path:
     return staged
 
 
+def console_scripts() -> dict[str, str]:
+    """``[tool.membrane-contact.scripts]`` of pyproject.toml: ``{name: "module:function"}``."""
+    try:
+        import tomllib
+    except ImportError:  # Python < 3.11
+        import tomli as tomllib
+
+    with open(PYTHON / "pyproject.toml", "rb") as f:
+        tool = tomllib.load(f).get("tool", {}).get("membrane-contact", {})
+    return dict(tool.get("scripts", {}))
+
+
+def add_console_scripts(wheel: Path, scripts: dict[str, str]) -> None:
+    """Writes ``scripts`` as the ``[console_scripts]`` of the wheel's ``entry_points.txt`` (its
+    ``.dist-info``), the RECORD updated: what maturin writes for ``[project.scripts]``, which it
+    refuses beside bin bindings."""
+    import base64
+    import hashlib
+    import zipfile
+
+    if not scripts:
+        return
+    with zipfile.ZipFile(wheel) as z:
+        entries = [(info, z.read(info)) for info in z.infolist()]
+    (dist_info,) = {info.filename.split("/", 1)[0] for info, _ in entries
+                    if info.filename.split("/", 1)[0].endswith(".dist-info")}
+    name = f"{dist_info}/entry_points.txt"
+    old = next((data.decode() for info, data in entries if info.filename == name), "")
+    if "[console_scripts]" in old:
+        raise RuntimeError(f"{wheel.name}: maturin already wrote console scripts: {old!r}")
+    text = (old.rstrip() + "\n\n" if old.strip() else "") + "[console_scripts]\n" + \
+        "".join(f"{k} = {v}\n" for k, v in sorted(scripts.items()))
+    data = text.encode()
+    digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
+    record = f"{dist_info}/RECORD"
+    tmp = wheel.with_suffix(".tmp")
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as out:
+        for info, content in entries:
+            if info.filename == name:
+                continue
+            if info.filename == record:
+                lines = [ln for ln in content.decode().splitlines() if ln and not ln.startswith(f"{name},")]
+                lines.insert(len(lines) - 1 if lines and lines[-1].startswith(f"{record},") else len(lines),
+                             f"{name},sha256={digest},{len(data)}")
+                content = ("\n".join(lines) + "\n").encode()
+                out.writestr(info, content)
+                continue
+            out.writestr(info, content)
+        info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+        info.external_attr = 0o644 << 16
+        info.compress_type = zipfile.ZIP_DEFLATED
+        out.writestr(info, data)
+    os.replace(tmp, wheel)
+
+
 def build_wheel(wheel_directory, config_settings=None, metadata_directory=None):
-    """PEP 517: the library staged, then maturin's wheel."""
+    """PEP 517: the library staged, then maturin's wheel, then the console scripts."""
     stage_library()
-    return maturin.build_wheel(wheel_directory, config_settings, metadata_directory)
+    name = maturin.build_wheel(wheel_directory, config_settings, metadata_directory)
+    add_console_scripts(Path(wheel_directory) / name, console_scripts())
+    return name
 
 
 def build_editable(wheel_directory, config_settings=None, metadata_directory=None):
-    """PEP 660 (``pip install -e ./python``): the library staged, then maturin's editable wheel."""
+    """PEP 660 (``pip install -e ./python``): the library staged, then maturin's editable wheel,
+    then the console scripts."""
     stage_library()
-    return maturin.build_editable(wheel_directory, config_settings, metadata_directory)
+    name = maturin.build_editable(wheel_directory, config_settings, metadata_directory)
+    add_console_scripts(Path(wheel_directory) / name, console_scripts())
+    return name

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -227,7 +228,34 @@ class CoupledSystem:
         if structure_solve not in ("exact", "linearized"):
             raise ValueError(f"structure_solve = '{structure_solve}': 'exact' or 'linearized'")
         film, structure = self.film, self.structure
+        if film.time != structure.time:
+            raise RuntimeError(f"the film is at t = {film.time:g} and the structure at t = {structure.time:g}: "
+                               "a coupling step starts with both FMUs at one time")
         rec = StepRecord(time=film.time, step=h, scheme=scheme)
+        # Both FMUs' states at the step's start: whatever ends the step other than success (a
+        # refusal of either FMU, a residual that diverges, an exception), both go back there, so
+        # that they are never left at different times (issue 47 item 3).
+        f0, s0 = film.save(), structure.save()
+        try:
+            try:
+                return self._step(rec, h, scheme, f0, s0, tolerance=tolerance, rtol=rtol,
+                                  max_iterations=max_iterations, omega=omega, divergence=divergence,
+                                  reuse=reuse, derivatives=derivatives, fd_step=fd_step,
+                                  structure_solve=structure_solve)
+            except BaseException:
+                rec.converged = False
+                film.restore(f0)
+                structure.restore(s0)
+                raise
+        finally:
+            film.free(f0)
+            structure.free(s0)
+
+    def _step(self, rec: StepRecord, h: float, scheme: str, f0, s0, *, tolerance, rtol, max_iterations, omega,
+              divergence, reuse, derivatives, fd_step, structure_solve) -> StepRecord:
+        """The step of :meth:`step` from the saved states ``f0``, ``s0`` (the caller restores
+        both when this raises)."""
+        film, structure = self.film, self.structure
         if scheme == "jacobi":
             y = self._step_film(self.x, h)
             xt = self._step_structure(self.y, h) if y is not None else None
@@ -237,117 +265,109 @@ class CoupledSystem:
             y = self._step_film(xt, h) if xt is not None else None
             return self._explicit(rec, y, xt, xt)
 
-        f0, s0 = film.save(), structure.save()
-        try:
-            def restore():
-                film.restore(f0)
-                structure.restore(s0)
-                rec.rollbacks += 1
-
-            def evaluate(x):
-                """Film at x, then the structure under its reactions; (y, x̃) or None."""
-                if rec.iterations > 0 or rec.extra_steps > 0:
-                    restore()
-                rec.iterations += 1
-                y = self._step_film(x, h)
-                if y is None:
-                    return None, None
-                return y, self._step_structure(y, h)
-
-            # Predictor: the structure under the last reactions (explicit Gauss-Seidel).
-            x_pred = self._step_structure(self.y, h)
-            structure.restore(s0)
-            x = x_pred if x_pred is not None else self.x.copy()
-            jf_start = None
-            if scheme == "newton" and structure_solve == "exact":
-                # Newton's predictor: the film linearized at the step's start (the last
-                # converged state), the structure solved exactly for it.
-                jf0 = (self._derivative(film, [a for a, _ in self.forces], [b for _, b in self.displacements])
-                       if derivatives == "fmu" else self._jf)
-                jf_start = jf0
-                if jf0 is not None and x_pred is not None:
-                    model = film_model(self._film_x, self.y, jf0, self._last_sample)
-                    x = self._solve_structure(model, self._film_x, None, None, h, s0, rec, tolerance, rtol)
-                    structure.restore(s0)
-            r_prev = xt_prev = x_prev = y_prev = jf_prev = None
-            halvings = 0
-            V, W = [], []
-            omega_k = min(omega, self._omega if self._omega is not None else omega)
-            r0 = None
-            while True:
-                y, xt = evaluate(x)
-                if y is None or xt is None:
-                    rec.reason = f"diverged: the {'film' if y is None else 'structure'} refused the step (fmi2Discard)"
-                    break
-                r = xt - x
-                norm = float(np.max(np.abs(r))) if len(r) else 0.0
-                rec.residuals.append(norm)
-                if not math.isfinite(norm):
-                    rec.reason = "diverged: residual not finite"
-                    break
-                if norm <= tolerance + rtol * float(np.max(np.abs(x))):
-                    rec.x, rec.y, rec.x_structure = list(x), list(y), list(xt)
-                    self._last_sample = (self._film_x, self.y, jf_start)
-                    self.x, self.y, self._film_x = xt, y, x
-                    if scheme == "aitken":
-                        self._omega = abs(omega_k)
-                    if scheme == "iqn-ils" and reuse > 0:
-                        self._reuse = (self._reuse + [(V, W)])[-reuse:]
-                    return rec
-                r0 = norm if r0 is None else r0
-                if norm > divergence * max(r0, tolerance):
-                    rec.reason = f"diverged: residual grew by {norm / r0:.3g}"
-                    break
-                if rec.iterations >= max_iterations:
-                    rec.reason = f"not converged in {max_iterations} iterations"
-                    break
-                if scheme == "newton" and r_prev is not None and norm >= (1 - 1e-4) * float(np.max(np.abs(r_prev))) \
-                        and halvings < 10:
-                    # No decrease: a full step across a kink (the valve opening, a gap closing)
-                    # overshot; halve it back toward the last iterate (damped Newton).
-                    halvings += 1
-                    x = x_prev + 0.5 * (x - x_prev)
-                    continue
-                halvings = 0
-                if scheme == "gauss-seidel":
-                    x_next = x + omega * r
-                elif scheme == "aitken":
-                    if r_prev is not None:
-                        dr = r - r_prev
-                        omega_k = -omega_k * float(r_prev @ dr) / float(dr @ dr) if dr @ dr > 0 else omega_k
-                    x_next = x + omega_k * r
-                elif scheme == "iqn-ils":
-                    if r_prev is not None:
-                        V.insert(0, r - r_prev)
-                        W.insert(0, xt - xt_prev)
-                    Vs = V + [v for old, _ in self._reuse for v in old]
-                    Ws = W + [w for _, old in self._reuse for w in old]
-                    if Vs:
-                        Vm, Wm = np.column_stack(Vs), np.column_stack(Ws)
-                        c = np.linalg.lstsq(Vm, -r, rcond=None)[0]
-                        x_next = xt + Wm @ c
-                    else:
-                        x_next = x + omega_k * r
-                else:  # newton
-                    Jf, Js = self._jacobians(x, y, h, derivatives, fd_step, rec, restore)
-                    if structure_solve == "exact":
-                        # the film's other sample of this step: the last iterate, or the
-                        # step's start (a rate-independent film stepped back to its last
-                        # input gives its last reactions)
-                        sample = (x_prev, y_prev, jf_prev) if x_prev is not None else (self._film_x, self.y, jf_start)
-                        model = film_model(x, y, Jf, sample)
-                        x_next = self._solve_structure(model, x, r, Js, h, s0, rec, tolerance, rtol)
-                    else:
-                        x_next = x - np.linalg.solve(Js @ Jf - np.eye(len(x)), r)
-                    jf_prev = Jf
-                r_prev, xt_prev, x_prev, y_prev, x = r, xt, x, y, x_next
-            rec.converged = False
+        def restore():
             film.restore(f0)
             structure.restore(s0)
-            raise CouplingFailed(rec, None)
-        finally:
-            film.free(f0)
-            structure.free(s0)
+            rec.rollbacks += 1
+
+        def evaluate(x):
+            """Film at x, then the structure under its reactions; (y, x̃) or None."""
+            if rec.iterations > 0 or rec.extra_steps > 0:
+                restore()
+            rec.iterations += 1
+            y = self._step_film(x, h)
+            if y is None:
+                return None, None
+            return y, self._step_structure(y, h)
+
+        # Predictor: the structure under the last reactions (explicit Gauss-Seidel).
+        x_pred = self._step_structure(self.y, h)
+        structure.restore(s0)
+        x = x_pred if x_pred is not None else self.x.copy()
+        jf_start = None
+        if scheme == "newton" and structure_solve == "exact":
+            # Newton's predictor: the film linearized at the step's start (the last
+            # converged state), the structure solved exactly for it.
+            jf0 = (self._derivative(film, [a for a, _ in self.forces], [b for _, b in self.displacements])
+                   if derivatives == "fmu" else self._jf)
+            jf_start = jf0
+            if jf0 is not None and x_pred is not None:
+                model = film_model(self._film_x, self.y, jf0, self._last_sample)
+                x = self._solve_structure(model, self._film_x, None, None, h, s0, rec, tolerance, rtol)
+                structure.restore(s0)
+        r_prev = xt_prev = x_prev = y_prev = jf_prev = None
+        halvings = 0
+        V, W = [], []
+        omega_k = min(omega, self._omega if self._omega is not None else omega)
+        r0 = None
+        while True:
+            y, xt = evaluate(x)
+            if y is None or xt is None:
+                rec.reason = f"diverged: the {'film' if y is None else 'structure'} refused the step (fmi2Discard)"
+                break
+            r = xt - x
+            norm = float(np.max(np.abs(r))) if len(r) else 0.0
+            rec.residuals.append(norm)
+            if not math.isfinite(norm):
+                rec.reason = "diverged: residual not finite"
+                break
+            if norm <= tolerance + rtol * float(np.max(np.abs(x))):
+                rec.x, rec.y, rec.x_structure = list(x), list(y), list(xt)
+                self._last_sample = (self._film_x, self.y, jf_start)
+                self.x, self.y, self._film_x = xt, y, x
+                if scheme == "aitken":
+                    self._omega = abs(omega_k)
+                if scheme == "iqn-ils" and reuse > 0:
+                    self._reuse = (self._reuse + [(V, W)])[-reuse:]
+                return rec
+            r0 = norm if r0 is None else r0
+            if norm > divergence * max(r0, tolerance):
+                rec.reason = f"diverged: residual grew by {norm / r0:.3g}"
+                break
+            if rec.iterations >= max_iterations:
+                rec.reason = f"not converged in {max_iterations} iterations"
+                break
+            if scheme == "newton" and r_prev is not None and norm >= (1 - 1e-4) * float(np.max(np.abs(r_prev))) \
+                    and halvings < 10:
+                # No decrease: a full step across a kink (the valve opening, a gap closing)
+                # overshot; halve it back toward the last iterate (damped Newton).
+                halvings += 1
+                x = x_prev + 0.5 * (x - x_prev)
+                continue
+            halvings = 0
+            if scheme == "gauss-seidel":
+                x_next = x + omega * r
+            elif scheme == "aitken":
+                if r_prev is not None:
+                    dr = r - r_prev
+                    omega_k = -omega_k * float(r_prev @ dr) / float(dr @ dr) if dr @ dr > 0 else omega_k
+                x_next = x + omega_k * r
+            elif scheme == "iqn-ils":
+                if r_prev is not None:
+                    V.insert(0, r - r_prev)
+                    W.insert(0, xt - xt_prev)
+                Vs = V + [v for old, _ in self._reuse for v in old]
+                Ws = W + [w for _, old in self._reuse for w in old]
+                if Vs:
+                    Vm, Wm = np.column_stack(Vs), np.column_stack(Ws)
+                    c = np.linalg.lstsq(Vm, -r, rcond=None)[0]
+                    x_next = xt + Wm @ c
+                else:
+                    x_next = x + omega_k * r
+            else:  # newton
+                Jf, Js = self._jacobians(x, y, h, derivatives, fd_step, rec, restore)
+                if structure_solve == "exact":
+                    # the film's other sample of this step: the last iterate, or the
+                    # step's start (a rate-independent film stepped back to its last
+                    # input gives its last reactions)
+                    sample = (x_prev, y_prev, jf_prev) if x_prev is not None else (self._film_x, self.y, jf_start)
+                    model = film_model(x, y, Jf, sample)
+                    x_next = self._solve_structure(model, x, r, Js, h, s0, rec, tolerance, rtol)
+                else:
+                    x_next = x - np.linalg.solve(Js @ Jf - np.eye(len(x)), r)
+                jf_prev = Jf
+            r_prev, xt_prev, x_prev, y_prev, x = r, xt, x, y, x_next
+        raise CouplingFailed(rec, None)
 
     def _jacobians(self, x, y, h, derivatives, fd_step, rec, restore):
         """``J_f = ∂y/∂x`` and ``J_s = ∂x̃/∂y`` at the state the iteration reached."""
@@ -480,7 +500,7 @@ class closing:
     def __enter__(self) -> CoupledSystem:
         return self.system
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> None:
         import shutil
 
         self.system.film.close()

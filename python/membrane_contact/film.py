@@ -23,11 +23,14 @@
 from __future__ import annotations
 
 import itertools
+import os
 import re
 import shutil
 import sys
 import warnings
 from ctypes import byref, c_double, c_int
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 from fmpy import calloc, extract, free, read_model_description
@@ -191,7 +194,7 @@ class Results:
             data.update({n: self[n] for n in self.input_names})
         return data
 
-    def to_pandas(self, inputs: bool = False):
+    def to_pandas(self, inputs: bool = False) -> Any:
         """A pandas DataFrame indexed by time (needs pandas): the outputs, and with ``inputs``
         the table's input columns as reached."""
         import pandas as pd
@@ -206,13 +209,45 @@ class Results:
         names = list(gaps) if gaps is not None else self.gap_names
         return names, np.stack([self[f"{g}.{component}"] for g in names], axis=1) if names else np.zeros((len(self), 0))
 
-    def report(self, path, *, title: str = "run", variables: dict | None = None, messages: list | None = None):
+    def report(self, path, *, title: str = "run", variables: dict | None = None, messages: list | None = None,
+               line_reactions: dict | None = None) -> Path:
         """Writes a Markdown run report of these results to ``path`` (``report.py``: load steps,
-        reactions, stresses, slips, warnings from ``messages``, solver statistics); returns the
-        path. :meth:`Film.report` fills in the model and the FMU's log."""
+        reactions, line reactions (``line_reactions``: from
+        :func:`membrane_contact.report.line_reactions` of a film VTK file), stresses, slips,
+        warnings from ``messages``, solver statistics); returns the path. :meth:`Film.report`
+        fills in the model and the FMU's log."""
         from .report import write
 
-        return write(self, path, title=title, variables=variables, messages=messages)
+        return write(self, path, title=title, variables=variables, messages=messages, line_reactions=line_reactions)
+
+    def largest_slips(self, supports: dict[str, list[str]] | None = None,
+                      component: str = "slip") -> dict[str, tuple[str, float, float]]:
+        """The largest slip per support over the run: ``{support: (where, slip, time)}``, ``where``
+        the gap or contact with the largest ``|slip|`` (signed value in m, at ``time``).
+        ``supports``: ``{support: [gap, ...]}``; default: each curved support's contacts
+        (``<support>.node<k>.slip``), and the gaps grouped by their name without its trailing
+        number (``N1`` … ``N13`` → ``N``; the specimen's ``G1`` … ``G9`` → ``G``)."""
+        if supports is None:
+            supports = {}
+            for g in self.gap_names:
+                supports.setdefault(re.sub(r"\d+$", "", g) or g, []).append(g)
+            for n in self.names:
+                m = re.match(r"(\w+)\.(node\d+)\.slip$", n)
+                if m and component == "slip":
+                    supports.setdefault(m[1], []).append(f"{m[1]}.{m[2]}")
+        found = {}
+        for support, members in supports.items():
+            best = None
+            for g in members:
+                values = self[f"{g}.{component}"]
+                if not len(values):
+                    continue
+                k = int(np.nanargmax(np.abs(values))) if np.isfinite(values).any() else 0
+                if best is None or abs(values[k]) > abs(best[1]):
+                    best = (g, float(values[k]), float(self.time[k]))
+            if best is not None:
+                found[support] = best
+        return found
 
     def reaction(self, group: str) -> np.ndarray:
         """Reaction ``[Rx, Ry, Rz]`` (N) of a group or support set over time (NaN for a component
@@ -258,8 +293,8 @@ class Film:
     """One instance of a membrane-contact FMU (or any FMI 2.0 co-simulation FMU), addressed by
     variable names. Use it as a context manager, or call :meth:`close`."""
 
-    def __init__(self, fmu=None, *, name: str | None = None, logging: bool = True, echo: bool = False,
-                 model: str | None = None, strict: bool = False, quiet: bool = False):
+    def __init__(self, fmu: str | os.PathLike | None = None, *, name: str | None = None, logging: bool = True,
+                 echo: bool = False, model: str | None = None, strict: bool = False, quiet: bool = False) -> None:
         self.path = find_fmu(fmu, model)
         self.md = read_model_description(str(self.path))
         self.variables = {v.name: v for v in self.md.modelVariables}
@@ -353,7 +388,7 @@ class Film:
                 raise SolverWarningError(text, self.time)
             warnings.warn(f"{self.name}: {text}", SolverWarning, stacklevel=4)
 
-    def close(self):
+    def close(self) -> None:
         """Frees the saved states and the instance and removes the unpacked FMU."""
         if self.fmu is not None:
             for state, *_ in self._states:
@@ -366,10 +401,10 @@ class Film:
             _ROUTES.pop(self.name, None)
             shutil.rmtree(self._unzipdir, ignore_errors=True)
 
-    def __enter__(self):
+    def __enter__(self) -> "Film":
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> None:
         self.close()
 
     # -- raw calls
@@ -385,7 +420,7 @@ class Film:
 
     # -- values
 
-    def set(self, values: dict | None = None, **named):
+    def set(self, values: dict | None = None, **named: Any) -> None:
         """Sets variables by name (``film.set({"frame.dz": -0.1})``; names without dots may be
         given as keywords), each with the setter of its type; a refused value raises
         :class:`FmuError` with the FMU's message."""
@@ -411,7 +446,7 @@ class Film:
         except FMICallException as e:
             raise FmuError(function, e.status, self.messages) from None
 
-    def get(self, *names):
+    def get(self, *names: str) -> Any:
         """Values by name: one name gives the value, several a list."""
         out = []
         for name in names:
@@ -448,12 +483,14 @@ class Film:
 
         return read
 
-    def report(self, results: Results, path):
+    def report(self, results: Results, path: str | os.PathLike, line_reactions: dict | None = None) -> Path:
         """Writes the run report of ``results`` (from :meth:`run`) to ``path``: the model from the
-        FMU's parameters, the FMU's warnings from its log; returns the path."""
+        FMU's parameters, the FMU's warnings from its log, and ``line_reactions`` when given
+        (:func:`membrane_contact.report.line_reactions` of a film VTK file); returns the path."""
         params = {n: self.get(n) for n in self.parameters if self.variables[n].type in ("Real", "Integer", "String")
                   and not n.endswith((".kn", ".ks"))}
-        return results.report(path, title=self.md.modelName, variables=params, messages=self.messages)
+        return results.report(path, title=self.md.modelName, variables=params, messages=self.messages,
+                              line_reactions=line_reactions)
 
     # -- stepping
 
@@ -472,14 +509,14 @@ class Film:
             self._reached = dict(self._set_inputs)
         return status
 
-    def save(self):
+    def save(self) -> Any:
         """The current state (fmi2GetFMUstate): give it to :meth:`restore` to roll back; it is
         freed by :meth:`free` or when the film closes."""
         state = self.fmu.getFMUstate()
         self._states.append((state, self.time, dict(self._reached), dict(self._set_inputs)))
         return state
 
-    def restore(self, state):
+    def restore(self, state: Any) -> None:
         """Rolls the instance back to ``state`` (its variables, time and analysis)."""
         for s, t, reached, set_inputs in self._states:
             if s is state:
@@ -488,7 +525,7 @@ class Film:
                 return
         raise ValueError("not a state saved by this film (or already freed)")
 
-    def free(self, state):
+    def free(self, state: Any) -> None:
         for k, (s, *_) in enumerate(self._states):
             if s is state:
                 self.fmu.freeFMUstate(state)

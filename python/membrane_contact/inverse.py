@@ -34,9 +34,8 @@ import numpy as np
 
 from fmpy import read_model_description
 
-from .film import Film
+from .cases import SCALE, read_path, simulate  # noqa: F401  (read_path: re-exported)
 from .fmu import find_fmu
-from .study import apply_values
 
 
 @dataclass
@@ -142,28 +141,21 @@ def measurement_scales(fmu, outputs: list[str], scales: dict[str, float] | None)
     return scales
 
 
-def read_path(path) -> dict[str, list[float]]:
-    """A load path table (CSV with a ``time`` column and input columns)."""
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
-    return {k.strip(): [float(r[k]) for r in rows] for k in rows[0]}
+def _run(fmu, path: dict, parameters: dict | None, unknowns: list[Unknown], values, outputs: list[str]) -> np.ndarray:
+    """The outputs at the end of ``path`` with the unknowns at ``values`` (one case:
+    :func:`membrane_contact.cases.simulate`)."""
 
-
-def _run(fmu, path, parameters, unknowns, values, outputs):
-    """The outputs at the end of ``path`` with the unknowns at ``values``."""
-    with Film(fmu, logging=False) as film:
-        causality = {**{n: "input" for n in film.inputs}, **{n: "parameter" for n in film.parameters}}
+    def check(causality):
         for u in unknowns:
-            if u.name.startswith("scale:"):
-                if u.name[len("scale:"):] not in path:
-                    raise KeyError(f"'{u.name}': the path has no column '{u.name[len('scale:'):]}'")
-            elif u.name not in causality:
+            if u.name.startswith(SCALE):
+                if u.name[len(SCALE):] not in path:
+                    raise KeyError(f"'{u.name}': the path has no column '{u.name[len(SCALE):]}'")
+            elif causality.get(u.name) not in ("input", "parameter"):
                 raise KeyError(f"unknown '{u.name}' is neither an input, a parameter nor scale:<column>")
-        table, params = apply_values({u.name: x for u, x in zip(unknowns, values)}, path, parameters or {},
-                                     causality)
-        film.initialize(parameters=params)
-        film.run(table, outputs=[])
-        return np.array([film[o] for o in outputs], dtype=float)
+
+    table, _ = simulate(fmu, {u.name: x for u, x in zip(unknowns, values)}, path, parameters or {}, outputs,
+                        check=check)
+    return np.array(table[-1], dtype=float)
 
 
 def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, parameters: dict | None = None,
@@ -173,7 +165,7 @@ def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, pa
     ``measured`` at the end of the staged ``path`` (a table for :meth:`Film.run`); ``scales``:
     each output's measurement scale in its unit (see :func:`measurement_scales`). ``client``: a
     ``dask.distributed.Client``; the sensitivity runs of each Jacobian (two per unknown) then run
-    in parallel on its workers (:class:`membrane_contact.study.Runner`: the FMU travels to them),
+    in parallel on its workers (:class:`membrane_contact.cluster.Runner`: the FMU travels to them),
     each the same run as in series, so the fit is the same."""
     outputs = list(measured)
     scales = measurement_scales(fmu, outputs, scales)
@@ -186,7 +178,7 @@ def fit(fmu, measured: dict[str, float], unknowns: list[Unknown], path: dict, pa
 
     runner = None
     if client is not None:
-        from .study import Runner
+        from .cluster import Runner
 
         runner = Runner(client, find_fmu(fmu))
 
@@ -277,7 +269,7 @@ def main(argv=None) -> int:
         with contextlib.ExitStack() as stack:
             client = None
             if a.scheduler or a.workers:
-                from .study import cluster
+                from .cluster import cluster
 
                 client = stack.enter_context(cluster(a.scheduler, a.workers))
             result = fit(a.fmu, read_measurements(a.measured), [Unknown.parse(u) for u in a.unknown],

@@ -36,15 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
-if __package__ in (None, ""):  # run as a script: python path/to/mesh.py
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from membrane_contact.arches import ArchError, gaps_on_curve, make_curve  # noqa: E402
-    from membrane_contact.fmu import installed_program, repository_root  # noqa: E402
-    from membrane_contact.tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes  # noqa: E402
-else:
-    from .arches import ArchError, gaps_on_curve, make_curve
-    from .fmu import installed_program, repository_root
-    from .tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes
+# A module of the package (``python -m membrane_contact.mesh``, or the console script
+# ``membrane-contact-import`` of [project.scripts]), not a script that patches sys.path.
+from .arches import ArchError, gaps_on_curve, make_curve
+from .fmu import installed_program, repository_root
+from .tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes
 
 
 class MeshImportError(ValueError):
@@ -765,13 +761,15 @@ class SolverCheck:
 def solver_check(model: dict) -> SolverCheck | None:
     """Runs the solver's own check of ``model`` (``membrane-contact check``, the one function the
     CLI, ``fmu-pack`` and the FMU use), or None when the program is not found (set
-    ``$MEMBRANE_CONTACT_CLI`` or build the checkout)."""
+    ``$MEMBRANE_CONTACT_CLI`` or build the checkout) or cannot be run (a
+    :class:`MeshImportWarning` says so: a wrong ``$MEMBRANE_CONTACT_CLI``)."""
     import os
     import shutil
     import subprocess
     import tempfile
 
-    program = os.environ.get(CLI_VARIABLE) or installed_program("membrane-contact")
+    given = os.environ.get(CLI_VARIABLE)
+    program = given or installed_program("membrane-contact")
     root = repository_root()
     if not program and root is not None and (root / "target" / "release" / "membrane-contact").is_file():
         program = str(root / "target" / "release" / "membrane-contact")
@@ -781,7 +779,14 @@ def solver_check(model: dict) -> SolverCheck | None:
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "model.json"
         path.write_text(json.dumps(model))
-        r = subprocess.run([program, "check", str(path)], capture_output=True, text=True)
+        try:
+            r = subprocess.run([program, "check", str(path)], capture_output=True, text=True)
+        except OSError as e:  # not there, not executable, not a program
+            where = f"${CLI_VARIABLE} = {given}" if given else program
+            warnings.warn(f"the solver's check is skipped: {where} cannot be run ({e.strerror or e}); "
+                          f"set ${CLI_VARIABLE} to the membrane-contact program, or unset it",
+                          MeshImportWarning, stacklevel=3)
+            return None
     found = SolverCheck([], [])
     for line in r.stderr.splitlines():
         if line.startswith("warning: "):

@@ -8,7 +8,9 @@ solver's statistics.
 The CLI writes the same sections from the core (``membrane-contact model … --report FILE.md``),
 with the reactions per unit length along each group (``--line-reactions``) that the FMU's
 outputs do not carry; the VTK film files do (point data ``line_reaction``), and
-:func:`line_reactions` reads them per group and support set.
+:func:`line_reactions` reads them per group and support set; given to :func:`markdown` (or
+:meth:`Results.report <membrane_contact.Results.report>`), they make the report's section
+"Line reactions".
 """
 
 from __future__ import annotations
@@ -45,10 +47,13 @@ def _prefixes(names: list[str], suffix: str) -> list[str]:
     return [n[: -len(suffix)] for n in names if n.endswith(suffix)]
 
 
-def markdown(results, *, title: str = "run", variables: dict | None = None, messages: list | None = None) -> str:
+def markdown(results, *, title: str = "run", variables: dict | None = None, messages: list | None = None,
+             line_reactions: dict[str, np.ndarray] | None = None) -> str:
     """The report text of ``results`` (a :class:`~membrane_contact.film.Results`).
     ``variables``: the FMU's ``{name: value}`` of its parameters (model summary);
-    ``messages``: the FMU's log ``(status, category, text)`` (warnings)."""
+    ``messages``: the FMU's log ``(status, category, text)`` (warnings); ``line_reactions``:
+    the reactions per unit length along each group and support set at the step a film VTK file
+    holds (:func:`line_reactions`), a section as the CLI's ``--line-reactions`` prints."""
     names = list(results.names)
     last = {n: results[n][-1] for n in names} if len(results) else {}
     out = [f"# Run report: {title}\n"]
@@ -86,6 +91,10 @@ def markdown(results, *, title: str = "run", variables: dict | None = None, mess
     if len(parts) == 1:
         parts.append("No reaction outputs recorded.\n")
     out.append("\n".join(parts))
+
+    # -- line reactions
+    if line_reactions:
+        out.append(line_reactions_markdown(line_reactions))
 
     # -- stresses
     rows = []
@@ -167,6 +176,32 @@ def line_reactions(vtu_file, model: dict) -> dict[str, np.ndarray]:
         if "name" in s and s["node"] not in owners.setdefault(s["name"], []):
             owners[s["name"]].append(s["node"])
     return {name: np.column_stack([np.asarray(vs, float), nodes[vs], field[vs]]) for name, vs in owners.items()}
+
+
+def line_reactions_markdown(lines: dict[str, np.ndarray]) -> str:
+    """The report's section on the reactions per unit length (``{name: rows}`` of
+    :func:`line_reactions`): per group or support set, the largest ``|q|`` and where, then one row
+    per node."""
+    parts = ["## Line reactions (N/m)\n"]
+    summary = []
+    for name, rows in lines.items():
+        rows = np.asarray(rows, dtype=float).reshape(-1, 7)
+        if not len(rows):
+            continue
+        q = np.linalg.norm(rows[:, 4:7], axis=1)
+        k = int(np.argmax(q))
+        summary.append([f"`{name}`", str(len(rows)), num(q[k]), str(int(rows[k, 0])),
+                        ", ".join(num(v) for v in rows[k, 1:4])])
+    if not summary:
+        return "## Line reactions (N/m)\n\nNone recorded.\n"
+    parts.append(_table(["line", "nodes", "largest \\|q\\| (N/m)", "at node", "x, y, z (m)"], summary))
+    for name, rows in lines.items():
+        rows = np.asarray(rows, dtype=float).reshape(-1, 7)
+        if not len(rows):
+            continue
+        body = [[str(int(r[0]))] + [num(v) for v in r[1:7]] + [num(np.linalg.norm(r[4:7]))] for r in rows]
+        parts.append(f"### `{name}`\n\n" + _table(["node", "x (m)", "y (m)", "z (m)", "qx", "qy", "qz", "\\|q\\|"], body))
+    return "\n".join(parts)
 
 
 def _status(v) -> str:

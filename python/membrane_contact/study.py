@@ -15,7 +15,9 @@ initialization, ``film.E``, ``archHeight``), an input (held over the whole path,
 
 Results go to a directory as they come, one Parquet file per case (written whole, then renamed:
 a killed study leaves no half file); run again on the same directory, a study runs only the
-cases that have no file and refuses a directory that holds another study. A case the FMU refuses
+cases that have no valid file (:func:`check_case`: a damaged or foreign file is moved aside and
+its case runs again, with a warning) and refuses a directory that holds another study. One
+driver at a time: a driver holds an OS lock on the directory (:func:`driver_lock`). A case the FMU refuses
 (a step refused after every halving, a parameter refused at initialization) is stored with the
 FMU's message and the study goes on. :meth:`Study.run` returns an ``xarray.Dataset`` (one
 variable per output over ``case × step``, the design as coordinates, ``status`` and ``message``
@@ -30,28 +32,30 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import csv
-import hashlib
 import itertools
 import json
 import math
 import os
+import re
 import socket
 import sys
-import tempfile
 import time as _time
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from statistics import NormalDist
+from typing import Any, Iterator
 
 import numpy as np
+
+# Re-exported from the modules below this one (membrane_contact.study.Runner, .cluster,
+# .apply_values, … keep working for user scripts).
+from .cases import SCALE, apply_values, read_columns, read_path, simulate  # noqa: F401
+from .cluster import FmuRef, Runner, call_with_fmu, cluster, local_fmu  # noqa: F401
 
 #: FMU parameter holding the solver's thread count: each case runs single-threaded (one worker
 #: per core does the parallel work), unless the study's parameters say otherwise.
 THREADS_PARAMETER = "solver.threads"
-#: Prefix of a design variable that multiplies a column of the load path.
-SCALE = "scale:"
 
 # ---------------------------------------------------------------------------- distributions
 
@@ -184,17 +188,16 @@ def monte_carlo(variables: dict, cases: int, seed: int = 0) -> dict[str, np.ndar
 def read_table(path) -> dict[str, np.ndarray]:
     """A user's design table: a CSV with one column per design variable, one row per case
     (``#`` lines are comments)."""
-    with open(path, newline="") as f:
-        rows = list(csv.DictReader(line for line in f if not line.lstrip().startswith("#")))
+    rows = read_columns(path, "design table")  # refuses a column named twice
     if not rows:
         raise ValueError(f"{path}: the design table has no rows")
     columns = {}
     for name in rows[0]:
-        texts = [r[name].strip() for r in rows]
+        texts = [r[name] for r in rows]
         try:
-            columns[name.strip()] = np.array([float(t) for t in texts])
+            columns[name] = np.array([float(t) for t in texts])
         except ValueError:
-            columns[name.strip()] = np.array(texts, dtype=str)
+            columns[name] = np.array(texts, dtype=str)
     return columns
 
 
@@ -227,117 +230,7 @@ def design_from_spec(spec: dict, base: Path = Path(".")) -> dict[str, np.ndarray
 # ---------------------------------------------------------------------------- the FMU on workers
 
 
-@dataclass(frozen=True)
-class FmuRef:
-    """Which FMU a worker runs: its content hash, its file name and, for a shared filesystem, a
-    path every worker reads (else the bytes travel with the tasks, sent once per worker)."""
-
-    sha256: str
-    name: str
-    shared_path: str | None = None
-
-    @classmethod
-    def of(cls, path, shared: bool = False) -> tuple["FmuRef", bytes]:
-        data = Path(path).read_bytes()
-        ref = cls(hashlib.sha256(data).hexdigest(), Path(path).name, str(Path(path).resolve()) if shared else None)
-        return ref, data
-
-
-_LOCAL_FMUS: dict[str, Path] = {}
-
-
-def local_fmu(ref: FmuRef, data: bytes | None) -> Path:
-    """The FMU on this machine: the shared path, or the bytes written once per process into the
-    temporary directory (``membrane-contact-fmus/<sha256>/``, checked against the hash)."""
-    if ref.shared_path is not None:
-        return Path(ref.shared_path)
-    path = _LOCAL_FMUS.get(ref.sha256)
-    if path is not None and path.is_file():
-        return path
-    if data is None:
-        raise RuntimeError(f"no bytes of the FMU {ref.name} reached this worker")
-    if hashlib.sha256(data).hexdigest() != ref.sha256:
-        raise RuntimeError(f"the bytes of the FMU {ref.name} reached this worker damaged (hash differs)")
-    folder = Path(tempfile.gettempdir()) / "membrane-contact-fmus" / ref.sha256
-    folder.mkdir(parents=True, exist_ok=True)
-    path = folder / ref.name
-    if not path.is_file():
-        fd, tmp = tempfile.mkstemp(dir=folder, suffix=".part")
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    _LOCAL_FMUS[ref.sha256] = path
-    return path
-
-
-def call_with_fmu(ref: FmuRef, data, function, *args):
-    """Runs ``function(fmu_path, *args)`` on a worker with the FMU at a local path."""
-    return function(local_fmu(ref, data), *args)
-
-
-class Runner:
-    """Runs functions of an FMU path on a Dask cluster: the machinery shared by :class:`Study`
-    and :func:`membrane_contact.inverse.fit`. The FMU's bytes are scattered once to every
-    worker (or, with ``shared=True``, its path is given to them)."""
-
-    def __init__(self, client, fmu, shared: bool = False):
-        self.client = client
-        self.fmu = Path(fmu)
-        self.ref, data = FmuRef.of(fmu, shared)
-        self._data = None if shared else client.scatter(data, broadcast=True, hash=False)
-
-    def submit(self, function, *args, key: str | None = None):
-        """A future of ``function(fmu_path, *args)`` on a worker."""
-        kwargs = {"pure": False}
-        if key is not None:
-            kwargs["key"] = key
-        return self.client.submit(call_with_fmu, self.ref, self._data, function, *args, **kwargs)
-
-    def map(self, function, arguments: list[tuple]) -> list:
-        """``[function(fmu_path, *a) for a in arguments]``, run in parallel, in order."""
-        futures = [self.submit(function, *a) for a in arguments]
-        return self.client.gather(futures)
-
-
-@contextlib.contextmanager
-def cluster(scheduler: str | None = None, workers: int | None = None):
-    """A ``dask.distributed.Client``: to ``scheduler`` (an address ``tcp://host:8786`` or the
-    path of a scheduler file), else to a new ``LocalCluster`` with ``workers`` worker processes
-    (default: one per core), one thread each. The local cluster ends with the block."""
-    from dask.distributed import Client, LocalCluster
-
-    if scheduler:
-        client = Client(scheduler_file=scheduler) if Path(scheduler).is_file() else Client(scheduler)
-        try:
-            yield client
-        finally:
-            client.close()
-        return
-    import logging
-
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    n = workers or cores or 1
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.CRITICAL) as local, Client(local) as client:
-        yield client
-
-
 # ---------------------------------------------------------------------------- one case
-
-
-def apply_values(variables: dict, path: dict, parameters: dict, names: dict[str, str]):
-    """Where each design value goes: the table ``path`` (an input held over the path, or a
-    column scaled by ``scale:<column>``) or the ``parameters``. ``names``: variable → causality."""
-    table = {k: np.asarray(v, dtype=float).copy() for k, v in path.items()}
-    params = dict(parameters)
-    for name, value in variables.items():
-        if name.startswith(SCALE):
-            table[name[len(SCALE):]] = table[name[len(SCALE):]] * float(value)
-        elif names.get(name) == "input":
-            table[name] = np.full(len(table["time"]), float(value))
-        else:
-            params[name] = value
-    return table, params
 
 
 def check_variables(fmu, design: dict, path: dict, parameters: dict, outputs: list[str]) -> dict[str, str]:
@@ -381,32 +274,25 @@ def run_case(fmu_path, case: int, variables: dict, path: dict, parameters: dict,
     parameter at initialization), "message", "values" (steps × outputs, step 0 the initial
     state, NaN past a refusal), "halvings", "warnings", "seconds" (wall), "cpu_seconds" (this
     process's CPU time), "worker"}``."""
-    from .film import Film, FmuError, StepRefused
+    from .film import FmuError, StepRefused
 
     started, cpu = _time.perf_counter(), _time.process_time()
     if run_log:
         with open(run_log, "a") as f:
             f.write(f"{case} start {socket.gethostname()}:{os.getpid()}\n")
-    table, params = apply_values(variables, path, parameters, causality)
-    times = table.pop("time")
-    values = np.full((len(times) + 1, len(outputs)), np.nan)
+    values = np.full((len(path["time"]) + 1, len(outputs)), np.nan)
     status, message, halvings, caught = "ok", "", 0, []
     try:
-        with warnings.catch_warnings(record=True) as caught, Film(fmu_path, logging=False, quiet=True) as film:
+        with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            film.initialize(parameters=params)
-            values[0] = [float(film.get(o)) for o in outputs]
-            for k, t in enumerate(times):
-                row = {"time": [t], **{n: [c[k]] for n, c in table.items()}}
-                results = film.run(row, outputs=outputs, max_halvings=max_halvings, dt=dt)
-                halvings += results.halvings
-                values[k + 1] = [results[o][-1] for o in outputs]
+            values, halvings = simulate(fmu_path, variables, path, parameters, outputs, causality,
+                                        max_halvings=max_halvings, dt=dt)
     except StepRefused as e:
-        status, message = "refused", str(e)
+        status, message, values, halvings = "refused", str(e), e.values, e.halvings
     except FmuError as e:
-        status, message = "error", str(e)
+        status, message, values = "error", str(e), getattr(e, "values", values)
     except (ValueError, RuntimeError) as e:
-        status, message = "error", f"{type(e).__name__}: {e}"
+        status, message, values = "error", f"{type(e).__name__}: {e}", getattr(e, "values", values)
     kinds = sorted({str(w.message) for w in caught or []})
     return {"case": case, "status": status, "message": message, "values": values, "halvings": halvings,
             "warnings": "\n".join(kinds), "seconds": _time.perf_counter() - started,
@@ -440,19 +326,149 @@ def write_case(directory: Path, result: dict, outputs: list[str], times: np.ndar
 
 
 def read_case(path: Path, outputs: list[str]) -> dict:
+    """One stored case file's result (``values``, ``status``, ``message``, ``case``, …)."""
     import pyarrow.parquet as pq
 
     table = pq.read_table(path)
-    meta = {k.decode()[len("study."):]: json.loads(v) for k, v in table.schema.metadata.items()
+    meta = {k.decode()[len("study."):]: json.loads(v) for k, v in (table.schema.metadata or {}).items()
             if k.decode().startswith("study.")}
     meta["values"] = np.stack([table.column(o).to_numpy() for o in outputs], axis=1)
     return meta
 
 
+#: A case file's name: ``case-<id>.parquet``.
+CASE_FILE = re.compile(r"case-(\d+)\.parquet")
+
+
+class InvalidCase(ValueError):
+    """A stored case file that cannot be this study's result of its case."""
+
+
+def check_case(path: Path, outputs: list[str], steps: int | None = None) -> dict:
+    """The stored result in ``path`` after checking it is one: a readable Parquet file whose
+    recorded case id is the one in its name, with every output over ``steps`` steps (the path's
+    rows + 1, when given) and a status. Raises :class:`InvalidCase` saying why not."""
+    match = CASE_FILE.fullmatch(Path(path).name)
+    if match is None:
+        raise InvalidCase(f"{path.name}: not a case file name (case-<id>.parquet)")
+    try:
+        result = read_case(path, outputs)
+    except Exception as e:  # truncated, empty, not Parquet, an output missing, metadata damaged
+        raise InvalidCase(f"{path.name} cannot be read ({type(e).__name__}: {e})") from None
+    if result.get("case") != int(match.group(1)):
+        raise InvalidCase(f"{path.name} holds the result of case {result.get('case')!r}, not of case "
+                          f"{int(match.group(1))}")
+    missing = [k for k in ("status", "message", "halvings") if k not in result]
+    if missing:
+        raise InvalidCase(f"{path.name} has no {', '.join(missing)}")
+    if steps is not None and result["values"].shape[0] != steps:
+        raise InvalidCase(f"{path.name} has {result['values'].shape[0]} steps, the study {steps}")
+    return result
+
+
+def case_files(directory) -> dict[int, Path]:
+    """``{case: path}`` of the files named like case files in ``directory/cases``."""
+    files = {}
+    for p in sorted((Path(directory) / "cases").glob("case-*.parquet")):
+        match = CASE_FILE.fullmatch(p.name)
+        if match is not None:
+            files[int(match.group(1))] = p
+    return files
+
+
 def stored_results(directory: Path, outputs: list[str]) -> dict[int, dict]:
-    """``{case: result}`` of every case file in ``directory``."""
-    return {int(p.stem.split("-")[1]): read_case(p, outputs)
-            for p in sorted((Path(directory) / "cases").glob("case-*.parquet"))}
+    """``{case: result}`` of every valid case file in ``directory`` (an invalid one, see
+    :func:`check_case`, is left out with a warning: its case counts as not run)."""
+    results = {}
+    for case, p in case_files(directory).items():
+        try:
+            results[case] = check_case(p, outputs)
+        except InvalidCase as e:
+            warnings.warn(f"study: {e}: case {case} counts as not run", stacklevel=2)
+    return results
+
+
+# ---------------------------------------------------------------------------- one driver
+
+
+class DirectoryLocked(RuntimeError):
+    """Another driver runs a study in this directory."""
+
+
+@contextlib.contextmanager
+def driver_lock(directory) -> Iterator[Path]:
+    """Holds an OS lock on the study directory's ``driver.lock`` while the block runs (one
+    driver per directory: two would both run every case and delete each other's partly written
+    files). The lock file records the holder's process id and host; a second driver gets
+    :class:`DirectoryLocked` naming them. The lock is ``fcntl.flock`` (POSIX) or
+    ``msvcrt.locking`` (Windows), released by the OS when the process dies, so a killed driver
+    leaves no stale lock."""
+    path = Path(directory) / "driver.lock"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        if not _try_lock(fd):
+            with contextlib.suppress(OSError):
+                os.lseek(fd, 0, os.SEEK_SET)
+            holder = os.read(fd, 200).decode(errors="replace").strip() or "a process that has not written its id yet"
+            raise DirectoryLocked(f"{directory} is in use by another study driver ({holder}): wait for it to "
+                                  "end, or stop it; two drivers on one directory would both run every case")
+        try:
+            os.ftruncate(fd, 0)
+            os.lseek(fd, 0, os.SEEK_SET)
+            os.write(fd, f"process {os.getpid()} on {socket.gethostname()}\n".encode())
+            yield path
+        finally:
+            _unlock(fd)
+    finally:
+        os.close(fd)
+
+
+#: Windows locks a byte range; this one lies past the holder's line, which a second driver reads.
+_LOCKED_BYTE = 4096
+
+
+def _try_lock(fd: int) -> bool:
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        import msvcrt
+
+        os.lseek(fd, _LOCKED_BYTE, os.SEEK_SET)
+        try:
+            msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+        except OSError:
+            return False
+        return True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True
+
+
+def _unlock(fd: int) -> None:
+    try:
+        import fcntl
+    except ImportError:
+        import msvcrt
+
+        os.lseek(fd, _LOCKED_BYTE, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_UNLCK, 1)
+        return
+    fcntl.flock(fd, fcntl.LOCK_UN)
+
+
+def same_description(a, b) -> bool:
+    """Two study descriptions (as JSON reads them) alike, NaN equal to NaN (a design may hold
+    NaN, which JSON writes as ``NaN``; ``nan != nan`` would make a study differ from itself)."""
+    if isinstance(a, float) and isinstance(b, float):
+        return a == b or (math.isnan(a) and math.isnan(b))
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_description(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(same_description(x, y) for x, y in zip(a, b))
+    return a == b
 
 
 # ---------------------------------------------------------------------------- progress
@@ -564,14 +580,17 @@ class Study:
                 "outputs": self.outputs, "max_halvings": self.max_halvings, "dt": self.dt}
 
     def _prepare_directory(self) -> set[int]:
-        """Creates the directory or checks it holds this study; returns the cases stored."""
+        """Creates the directory or checks it holds this study; returns the cases stored. Run
+        under :func:`driver_lock`. A stored case file that is not this study's result of its
+        case (:func:`check_case`: unreadable, truncated, empty, another case's) is moved aside
+        to ``case-<id>.parquet.invalid`` with a warning, and its case runs again."""
         d = self.directory
         (d / "cases").mkdir(parents=True, exist_ok=True)
         described = d / "study.json"
         mine = self.description()
         if described.is_file():
             theirs = json.loads(described.read_text())
-            differ = [k for k in mine if theirs.get(k) != mine[k]]
+            differ = [k for k in mine if not same_description(theirs.get(k), json.loads(json.dumps(mine[k])))]
             if differ:
                 raise ValueError(f"{d} holds another study (its {', '.join(differ)} differ{'s' if len(differ) == 1 else ''}): "
                                  "give another directory, or delete this one to start again")
@@ -581,7 +600,24 @@ class Study:
             os.replace(tmp, described)
         for stale in (d / "cases").glob("*.part"):
             stale.unlink()
-        return {int(p.stem.split("-")[1]) for p in (d / "cases").glob("case-*.parquet")}
+        stored = set()
+        for case, path in case_files(d).items():
+            try:
+                if case >= self.cases:
+                    raise InvalidCase(f"{path.name}: the study has cases 0 to {self.cases - 1}")
+                check_case(path, self.outputs, len(self.times))
+            except InvalidCase as e:
+                warnings.warn(f"study: {e}: moved aside to {path.name}.invalid, case {case} runs again",
+                              stacklevel=3)
+                os.replace(path, path.with_name(path.name + ".invalid"))
+                continue
+            stored.add(case)
+        return stored
+
+    def cases_to_run(self, stored: set[int]) -> list[int]:
+        """The cases without a stored result, in order: every id of ``range(cases)`` not in
+        ``stored``, wherever the gaps among the stored ids lie."""
+        return [k for k in range(self.cases) if k not in stored]
 
     # -- running
 
@@ -591,23 +627,30 @@ class Study:
                 self.dt, self.run_log)
 
     def run(self, client=None, *, scheduler: str | None = None, workers: int | None = None,
-            progress: bool = True, shared_fmu: bool = False):
+            progress: bool = True, shared_fmu: bool = False) -> Any:
         """Runs the cases not yet stored (all of them without a directory) and returns the
         dataset of every case (:meth:`dataset`). ``client``: a ``dask.distributed.Client``;
         else one to ``scheduler`` (an address or a scheduler file), else a ``LocalCluster`` of
         ``workers`` single-threaded processes (default: one per core), closed at the end.
-        ``shared_fmu``: workers read the FMU at its path instead of receiving its bytes."""
+        ``shared_fmu``: workers read the FMU at its path instead of receiving its bytes. With a
+        directory, the driver holds its lock (:func:`driver_lock`) throughout: a second driver
+        on the same directory is refused (:class:`DirectoryLocked`)."""
+        if self.directory is None:
+            return self._run(set(), client, scheduler, workers, progress, shared_fmu)
+        with driver_lock(self.directory):
+            return self._run(self._prepare_directory(), client, scheduler, workers, progress, shared_fmu)
+
+    def _run(self, stored: set[int], client, scheduler, workers, progress, shared_fmu):
         from dask.distributed import as_completed
 
-        stored = self._prepare_directory() if self.directory is not None else set()
-        todo = [k for k in range(self.cases) if k not in stored]
+        todo = self.cases_to_run(stored)
         if not todo:
             if progress:
                 print(f"study: all {self.cases} cases already stored in {self.directory}", file=sys.stderr)
             return self.dataset()
         if client is None:
             with cluster(scheduler, workers) as client:
-                return self.run(client, progress=progress, shared_fmu=shared_fmu)
+                return self._run(stored, client, scheduler, workers, progress, shared_fmu)
         self._results = {}
         bar = Progress(self.cases, len(stored), enabled=progress)
         runner = Runner(client, self.fmu, shared=shared_fmu)
@@ -638,7 +681,7 @@ class Study:
             return dict(getattr(self, "_results", {}))
         return stored_results(self.directory, self.outputs)
 
-    def dataset(self):
+    def dataset(self) -> Any:
         """The results as an ``xarray.Dataset``: one variable per output over ``(case, step)``
         (step 0: the initialized state; step k: row k of the path; NaN where a refused case did
         not get), the design's variables and ``time`` as coordinates, ``status`` ("ok",
@@ -675,7 +718,34 @@ def _assemble(description: dict, results: dict[int, dict]):
                                                   "parameters": json.dumps(description["parameters"])})
 
 
-def open_study(directory):
+def largest_slips(ds: Any, supports: dict[str, list[str]] | None = None, component: str = "slip") -> Any:
+    """The largest slip per support in each case of a study's dataset (:meth:`Study.dataset`):
+    an ``xarray.Dataset`` over ``case`` with, per support, its signed largest slip (m: the
+    largest ``|slip|`` over its gaps and the steps) and ``<support>.where`` (that gap).
+    ``supports``: ``{support: [gap, ...]}``; default: the gaps among the outputs
+    (``<gap>.<component>``) grouped by name without the trailing number (``N1`` … ``N13`` →
+    ``N``), as :meth:`Results.largest_slips <membrane_contact.Results.largest_slips>`."""
+    import xarray as xr
+
+    suffix = f".{component}"
+    if supports is None:
+        supports = {}
+        for name in ds.data_vars:
+            gap = str(name)[: -len(suffix)] if str(name).endswith(suffix) else None
+            if gap and re.fullmatch(r"\w+", gap):
+                supports.setdefault(re.sub(r"\d+$", "", gap) or gap, []).append(gap)
+    data = {}
+    for support, gaps in supports.items():
+        values = np.stack([ds[f"{g}{suffix}"].values for g in gaps], axis=-1)  # case × step × gap
+        flat = np.abs(np.nan_to_num(values, nan=0.0)).reshape(values.shape[0], -1)
+        k = np.argmax(flat, axis=1)
+        best = values.reshape(values.shape[0], -1)[np.arange(values.shape[0]), k]
+        data[support] = ("case", best)
+        data[f"{support}.where"] = ("case", np.asarray([gaps[j % len(gaps)] for j in k]))
+    return xr.Dataset(data, coords={"case": ds.case.values})
+
+
+def open_study(directory: str | os.PathLike) -> Any:
     """The dataset of the study stored in ``directory`` (its ``study.json`` and the cases stored
     so far), without the FMU."""
     directory = Path(directory)
@@ -712,8 +782,6 @@ def path_from_spec(spec: dict, base: Path) -> dict:
     ramped linearly from 0, time k/N)."""
     spec = dict(spec)
     if "csv" in spec:
-        from .inverse import read_path
-
         return read_path(base / spec["csv"])
     if "steps" in spec:
         n = int(spec["steps"])

@@ -4,8 +4,10 @@ Two modes. From the checkout (``tests/run.sh``'s ``.venv``), the package is this
 ``python/`` and the programs are the release build in ``target/release``; before any test, the
 session makes sure that build and ``target/fmu/ParallelArch.fmu`` are newer than every source they
 are built from (the ``.rs`` files of ``src/`` and ``fmu/``, ``Cargo.*``, ``modelDescription.xml.in``):
-when one is missing or older, it runs ``cargo build --release`` and ``fmu-pack`` (what
-``fmu/prepare.sh`` runs), so that a pytest run outside ``tests/run.sh`` never compares stale copies.
+when one is missing or older, it runs ``cargo build --release`` and ``fmu-pack -o
+target/fmu/ParallelArch.fmu --library target/release/libmembrane_contact.so`` (the output and the
+library named, whatever ``target/`` holds), and it checks that the FMU ships that library byte for
+byte, so that a pytest run outside ``tests/run.sh`` never compares stale copies.
 
 Installed (``MEMBRANE_CONTACT_INSTALLED=1``, set by ``tests/wheel/run.sh``: the wheel in a clean
 venv, no cargo on PATH), the package is the venv's, the programs are the venv's
@@ -53,6 +55,8 @@ else:
     CLI = TARGET / "release" / "membrane-contact"
     FMU_PACK = TARGET / "release" / "fmu-pack"
     PARALLEL_ARCH_FMU = TARGET / "fmu" / "ParallelArch.fmu"
+#: The FMU's shared library as the release build made it (what every FMU of the checkout ships).
+LIBRARY = TARGET / "release" / "libmembrane_contact.so"
 
 
 def package_env() -> dict:
@@ -134,9 +138,50 @@ def newest_source() -> float:
 
 
 def stale_artefacts() -> list[Path]:
-    """The CLI, fmu-pack and the ParallelArch FMU if missing or older than a source file."""
+    """The CLI, fmu-pack, the library and the ParallelArch FMU if missing or older than a source
+    file."""
     newest = newest_source()
-    return [p for p in (CLI, FMU_PACK, PARALLEL_ARCH_FMU) if not p.is_file() or p.stat().st_mtime < newest]
+    return [p for p in (CLI, FMU_PACK, LIBRARY, PARALLEL_ARCH_FMU) if not p.is_file() or p.stat().st_mtime < newest]
+
+
+def fmu_library(fmu: Path) -> bytes | None:
+    """The shared library an FMU ships (``binaries/linux64/<modelIdentifier>.so``), or None."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(fmu) as z:
+            (name,) = [n for n in z.namelist() if n.startswith("binaries/linux64/") and n.endswith(".so")]
+            return z.read(name)
+    except (OSError, ValueError, zipfile.BadZipFile):
+        return None
+
+
+def pack_specimen(fmu_pack: Path | None = None, fmu: Path | None = None, library: Path | None = None,
+                  cwd: Path = ROOT) -> str | None:
+    """Packs ``target/fmu/ParallelArch.fmu`` with the release build's ``fmu-pack``, its output
+    and library named explicitly (without them fmu-pack writes into the current directory when
+    ``target/`` holds no ``CACHEDIR.TAG``, and picks the newest library it finds), then checks
+    that the FMU ships the library just built, byte for byte. Returns what went wrong, or None.
+    (The arguments, defaulting to the checkout's, let a test run it elsewhere.)"""
+    fmu_pack, fmu, library = fmu_pack or FMU_PACK, fmu or PARALLEL_ARCH_FMU, library or LIBRARY
+    r = subprocess.run([str(fmu_pack), "-o", str(fmu), "--library", str(library)],
+                       cwd=cwd, capture_output=True, text=True)
+    if r.returncode != 0:
+        return f"fmu-pack -o {fmu} failed:\n{r.stderr}"
+    return specimen_mismatch(fmu, library)
+
+
+def specimen_mismatch(fmu: Path | None = None, library: Path | None = None) -> str | None:
+    """Why ``fmu`` (``target/fmu/ParallelArch.fmu``) is not the FMU of the release build (its
+    library is not ``library``, ``target/release/libmembrane_contact.so``, byte for byte), or
+    None."""
+    fmu, library = fmu or PARALLEL_ARCH_FMU, library or LIBRARY
+    shipped = fmu_library(fmu)
+    if shipped is None:
+        return f"{fmu} is missing or has no binaries/linux64/*.so"
+    if not library.is_file() or shipped != library.read_bytes():
+        return f"{fmu} ships another library than {library} (a stale FMU)"
+    return None
 
 
 def pytest_sessionstart(session):
@@ -149,14 +194,17 @@ def pytest_sessionstart(session):
                         "pip install the wheel (tests/wheel/run.sh)", returncode=1)
         return
     stale = stale_artefacts()
-    if not stale:
-        return
-    for args in (["build", "--release", "--locked"],
-                 ["run", "--release", "--locked", "--quiet", "--bin", "fmu-pack"]):
-        r = cargo(*args, check=False)
+    if stale:
+        r = cargo("build", "--release", "--locked", check=False)
         if r.returncode != 0:
-            pytest.exit(f"stale {', '.join(map(str, stale))}: cargo {' '.join(args)} failed:\n{r.stderr}",
+            pytest.exit(f"stale {', '.join(map(str, stale))}: cargo build --release --locked failed:\n{r.stderr}",
                         returncode=1)
+    # The FMU the tests load must ship the library just built: repack it when it does not (a
+    # copy packed elsewhere, or before the last build), and stop if that does not help.
+    if stale or specimen_mismatch():
+        wrong = pack_specimen()
+        if wrong:
+            pytest.exit(f"the specimen FMU is not the release build's: {wrong}", returncode=1)
 
 
 @pytest.fixture(scope="session")

@@ -657,3 +657,27 @@ def test_the_cli_import_command_runs_the_package_under_test(tmp_path):
     assert run.returncode == 0, run.stderr
     paths = seen.read_text().split(os.pathsep)
     assert (str(ROOT / "python") in paths) == (not INSTALLED), paths
+
+
+def test_the_importer_imports_and_runs_without_fmpy(tmp_path):
+    """python/README-import.md: the importer needs numpy and meshio, not fmpy (issue 47 item 8)."""
+    code = ("import sys; sys.modules['fmpy'] = None  # any import of fmpy fails\n"
+            "from membrane_contact.mesh import main\n"
+            f"sys.exit(main([{str(MSH22)!r}, {str(MAPPING)!r}, '-o', {str(tmp_path / 'm.json')!r}, '-q']))\n")
+    r = subprocess.run([sys.executable, "-c", code], env=package_env(), capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert json.loads((tmp_path / "m.json").read_text())["triangles"]
+
+
+def test_a_wrong_membrane_contact_cli_skips_the_solvers_check_with_a_warning_saying_so(tmp_path, monkeypatch):
+    """The docs say the check is skipped without the program; a wrong $MEMBRANE_CONTACT_CLI
+    crashed the import with a raw FileNotFoundError (issue 47 item 8)."""
+    monkeypatch.setenv("MEMBRANE_CONTACT_CLI", str(tmp_path / "no-such-program"))
+    with pytest.warns(MeshImportWarning, match=r"the solver's check is skipped: \$MEMBRANE_CONTACT_CLI = "
+                                               r".*no-such-program cannot be run"):
+        model = import_mesh(MSH22, MAPPING)
+    assert model["triangles"]
+    r = subprocess.run([sys.executable, "-m", "membrane_contact.mesh", str(MSH22), str(MAPPING), "-q"],
+                       env={**package_env(), "MEMBRANE_CONTACT_CLI": str(tmp_path)}, capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "note: the solver's check is skipped" in r.stderr and "Traceback" not in r.stderr

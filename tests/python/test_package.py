@@ -28,7 +28,7 @@ import sys
 import numpy as np
 import pandas as pd  # a test requirement (tests/python/requirements.txt): required, never skipped
 import pytest
-from conftest import INSTALLED, ROOT, pack
+from conftest import INSTALLED, ROOT, pack, package_env
 
 from membrane_contact import Film, FmuError, Results, StepRefused, build_fmu, find_fmu
 from membrane_contact.film import DISCARD, OK
@@ -41,7 +41,7 @@ def test_the_package_is_installed_in_the_venv_and_importable_from_anywhere(tmp_p
                         "membrane_contact.__version__)"], cwd=tmp_path, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     path, version = r.stdout.split()
-    assert "site-packages" in path and version == "0.1.0"
+    assert "site-packages" in path and version == cargo_version()
     r = subprocess.run([sys.executable, "-c", "import membrane_contact.mesh, membrane_contact.arches, "
                         "membrane_contact.plot"], cwd=tmp_path, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
@@ -345,3 +345,72 @@ def test_the_readme_python_package_block_runs_as_written(fmu_path, monkeypatch):
     exec(compile(block, "README.md", "exec"), scope)
     assert scope["names"] == [f"G{i}" for i in range(1, 10)] and scope["slips"].shape == (21, 9)
     np.testing.assert_allclose(scope["results"]["frame.dz"], -0.15 * scope["results"].time, rtol=1e-14)
+
+
+def cargo_version() -> str:
+    import re
+
+    return re.search(r'(?m)^version\s*=\s*"([^"]+)"', (ROOT / "Cargo.toml").read_text()).group(1)
+
+
+# ---------------------------------------------------------------------------- packaging conventions (issue 47 item 10)
+
+
+def test_the_package_has_one_version_cargos_and_declares_its_types(tmp_path):
+    import importlib.metadata
+
+    import membrane_contact
+
+    assert membrane_contact.__version__ == cargo_version()
+    if INSTALLED:
+        assert importlib.metadata.version("membrane-contact") == cargo_version()
+    assert (Path(membrane_contact.__file__).parent / "py.typed").is_file()
+    if not INSTALLED:
+        # taken from Cargo.toml, not written a second time: a checkout whose Cargo.toml says
+        # another version makes another __version__
+        import shutil
+
+        other = tmp_path / "checkout"
+        shutil.copytree(ROOT / "python" / "membrane_contact", other / "python" / "membrane_contact",
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        text = (ROOT / "Cargo.toml").read_text().replace(f'version = "{cargo_version()}"', 'version = "9.8.7"', 1)
+        (other / "Cargo.toml").write_text(text)
+        r = subprocess.run([sys.executable, "-c", "import membrane_contact; print(membrane_contact.__version__)"],
+                           cwd=tmp_path, capture_output=True, text=True,
+                           env={**package_env(), "PYTHONPATH": str(other / "python")})
+        assert r.returncode == 0 and r.stdout.strip() == "9.8.7", r.stderr
+    # the public API is annotated
+    import inspect
+
+    for name in ("find_fmu", "build_fmu"):
+        assert inspect.signature(getattr(membrane_contact, name)).return_annotation != inspect.Signature.empty, name
+
+
+def test_the_importer_is_a_console_script_of_the_distribution_not_a_patched_path():
+    import importlib.metadata
+
+    scripts = {e.name: e.value for e in importlib.metadata.entry_points(group="console_scripts")
+               if e.dist is not None and e.dist.name.replace("_", "-") == "membrane-contact"}
+    assert scripts.get("membrane-contact-import") == "membrane_contact.mesh:main", scripts
+    import membrane_contact.mesh as mesh
+
+    assert "sys.path.insert" not in Path(mesh.__file__).read_text()
+
+
+def test_study_and_inverse_import_neither_each_other_and_run_one_case_alike(fmu_path):
+    for first, second in (("inverse", "study"), ("study", "inverse")):
+        r = subprocess.run([sys.executable, "-c", f"import sys, membrane_contact.{first}; "
+                            f"print('membrane_contact.{second}' in sys.modules)"],
+                           capture_output=True, text=True, env=package_env())
+        assert r.returncode == 0 and r.stdout.strip() == "False", (first, second, r.stderr, r.stdout)
+    # the names user scripts import from study stay where they were
+    from membrane_contact import cases, cluster, inverse, study
+
+    assert study.Runner is cluster.Runner and study.cluster is cluster.cluster and study.apply_values is cases.apply_values
+    assert inverse.read_path is cases.read_path
+    # one case, one code: the inverse tool's model evaluation is the study's case
+    path = {"time": [0.5, 1.0], "frame.dz": [-0.05, -0.1]}
+    fitted = inverse._run(fmu_path, path, {}, [inverse.Unknown("mu", 0.25)], [0.25], ["G2.slip", "frame.Rz"])
+    case = study.run_case(fmu_path, 0, {"mu": 0.25}, path, {}, ["G2.slip", "frame.Rz"], {"mu": "input"})
+    assert case["status"] == "ok"
+    np.testing.assert_array_equal(case["values"][-1], fitted)

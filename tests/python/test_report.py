@@ -139,3 +139,31 @@ def test_line_reactions_of_the_fmus_vtk_film_file_are_the_stress_resultant(tmp_p
         np.testing.assert_allclose(rows[:, 5:], 0.0, atol=1e-8 * q)
     tributary = np.array([0.05, 0.15, 0.15, 0.2, 0.3, 0.15])
     assert (lines["pull"][:, 4] * tributary).sum() == pytest.approx(rx, rel=1e-12)
+    # The Python run report carries them as the CLI's --line-reactions does (issue 47 item 8).
+    report = results.report(tmp_path / "strip.md", title="Strip", line_reactions=lines)
+    md = report.read_text()
+    summary = {r[0]: r for r in rows_under(md, "## Line reactions (N/m)")}
+    assert set(summary) == {"`pull`", "`clamp`"}
+    for name in ("pull", "clamp"):
+        assert summary[f"`{name}`"][1] == "6" and close(summary[f"`{name}`"][2], q, rel=1e-5)
+        rows = rows_under(md, f"### `{name}`")
+        assert [int(r[0]) for r in rows] == [int(n) for n in lines[name][:, 0]]
+        for row, line in zip(rows, lines[name]):
+            assert all(close(c, v, rel=1e-5) for c, v in zip(row[1:7], line[1:7])), row
+
+
+def test_the_largest_slip_per_support_is_the_largest_magnitude_over_its_gaps_and_the_run(fmu_path):
+    with Film(fmu_path, quiet=True) as film:
+        film.initialize(parameters={"archHeight": 0.3})
+        results = film.run({"time": [1.0, 2.0, 3.0], "frame.dz": [-0.05, -0.1, -0.15]})
+    slips = np.stack([results[f"{g}.slip"] for g in results.gap_names], axis=1)
+    t, k = np.unravel_index(np.argmax(np.abs(slips)), slips.shape)
+    largest = results.largest_slips()
+    assert list(largest) == ["G"]  # the specimen's gaps G1 … G9: one support
+    assert largest["G"] == (results.gap_names[k], slips[t, k], results.time[t]) and largest["G"][1] != 0.0
+    # supports named by the user
+    halves = {"first": results.gap_names[:4], "rest": results.gap_names[4:]}
+    mine = results.largest_slips(halves)
+    for name, gaps in halves.items():
+        where, value, _ = mine[name]
+        assert where in gaps and abs(value) == max(np.max(np.abs(results[f"{g}.slip"])) for g in gaps)

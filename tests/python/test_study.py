@@ -171,7 +171,11 @@ def test_a_killed_study_resumes_running_each_case_once(fmu_path, tmp_path):
     assert not set(started_again) & first, "a stored case ran again"
     assert sorted(started_again) == sorted(set(range(16)) - first), "a case was lost or ran twice after the resume"
     stored = [json.loads(line)["case"] for line in (directory / "log.jsonl").read_text().splitlines()]
-    assert sorted(stored) == list(range(16))  # each case stored once
+    # each case stored once; the kill may fall between a case file's rename and its log line,
+    # so at most one case the first driver stored may lack its line (its file is there)
+    assert len(stored) == len(set(stored)) and set(stored) <= set(range(16))
+    unlogged = set(range(16)) - set(stored)
+    assert len(unlogged) <= 1 and unlogged <= first, unlogged
     design = factorial({"mu": [0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45], "film.prestressX": [0.5e6, 1e6]})
     path = {"time": [0.25, 0.5, 0.75, 1.0], "frame.dz": [-0.0375, -0.075, -0.1125, -0.15]}
     resumed = Study(fmu_path, design, path, ["G2.slip", "G4.slip"], {"solver.incrementsPerStep": 20},
@@ -323,3 +327,129 @@ def test_the_example_specs_name_variables_their_fmus_have(spec, fmu_path):
         return
     check_variables(fmu_path, design, path, loaded.get("parameters", {}), loaded["outputs"])
     assert len(design["mu"]) == 4 * 3 * 3
+
+
+# ---------------------------------------------------------------------------- a study directory cannot be corrupted
+# (issue 47 items 4 and 11)
+
+SMALL_PATH = {"time": [1.0], "frame.dz": [-0.1]}
+SMALL_DESIGN = {"mu": [0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45]}
+
+
+def started_cases(run_log: Path, after: int = 0) -> list[int]:
+    return [int(line.split()[0]) for line in run_log.read_text().splitlines()[after:]] if run_log.exists() else []
+
+
+@pytest.fixture(scope="module")
+def small_study(fmu_path, two_workers, tmp_path_factory):
+    """8 cases of one step, stored; the directory's files as they were (to copy for each test)."""
+    directory = tmp_path_factory.mktemp("small") / "study"
+    ds = Study(fmu_path, SMALL_DESIGN, SMALL_PATH, ["G2.slip", "frame.Rz"], directory=directory).run(
+        two_workers, progress=False)
+    assert (ds.status == "ok").all()
+    return directory, ds
+
+
+def small_copy(small_study, tmp_path) -> Path:
+    import shutil
+
+    directory = tmp_path / "study"
+    shutil.copytree(small_study[0], directory)
+    return directory
+
+
+def test_a_resume_runs_exactly_the_missing_cases_when_the_stored_case_ids_have_gaps(fmu_path, small_study,
+                                                                                   two_workers, tmp_path):
+    directory = small_copy(small_study, tmp_path)
+    for case in (1, 3, 4):  # gaps below the largest stored id (7)
+        (directory / "cases" / f"case-{case:06d}.parquet").unlink()
+    run_log = tmp_path / "run.log"
+    ds = Study(fmu_path, SMALL_DESIGN, SMALL_PATH, ["G2.slip", "frame.Rz"], directory=directory,
+               run_log=run_log).run(two_workers, progress=False)
+    assert sorted(started_cases(run_log)) == [1, 3, 4]
+    assert identical(ds, small_study[1])
+
+
+def test_a_damaged_or_foreign_case_file_is_run_again_with_a_warning_not_taken_as_done(fmu_path, small_study,
+                                                                                       two_workers, tmp_path):
+    directory = small_copy(small_study, tmp_path)
+    cases = directory / "cases"
+    truncated = cases / "case-000002.parquet"
+    truncated.write_bytes(truncated.read_bytes()[:100])
+    (cases / "case-000005.parquet").write_bytes(b"")
+    (cases / "case-000007.parquet").write_bytes((cases / "case-000000.parquet").read_bytes())  # case 0's result
+    run_log = tmp_path / "run.log"
+    with pytest.warns(UserWarning) as caught:
+        ds = Study(fmu_path, SMALL_DESIGN, SMALL_PATH, ["G2.slip", "frame.Rz"], directory=directory,
+                   run_log=run_log).run(two_workers, progress=False)
+    said = "\n".join(str(w.message) for w in caught)
+    assert "case-000002.parquet cannot be read" in said and "case-000005.parquet cannot be read" in said
+    assert "case-000007.parquet holds the result of case 0, not of case 7" in said
+    assert sorted(started_cases(run_log)) == [2, 5, 7]
+    assert identical(ds, small_study[1])
+    assert sorted(p.name for p in cases.glob("*.invalid")) == [f"case-00000{k}.parquet.invalid" for k in (2, 5, 7)]
+
+
+def test_a_nan_in_a_design_table_runs_on_a_fresh_directory_and_resumes_as_the_same_study(fmu_path, two_workers,
+                                                                                         tmp_path):
+    (tmp_path / "design.csv").write_text("mu\n0.3\nnan\n")
+    design = design_from_spec({"kind": "table", "csv": "design.csv"}, tmp_path)
+    ds = Study(fmu_path, design, SMALL_PATH, ["G2.slip"], directory=tmp_path / "s").run(two_workers, progress=False)
+    assert list(ds.status.values) == ["ok", "error"] and "not finite" in ds.message.values[1]
+    again = Study(fmu_path, design, SMALL_PATH, ["G2.slip"], directory=tmp_path / "s").run(two_workers, progress=False)
+    assert identical(again, ds)
+
+
+def test_a_design_table_naming_a_column_twice_is_refused_naming_it(tmp_path):
+    (tmp_path / "design.csv").write_text("mu,film.E,mu\n0.3,1e9,0.4\n")
+    with pytest.raises(ValueError, match="names the column 'mu' more than once"):
+        design_from_spec({"kind": "table", "csv": "design.csv"}, tmp_path)
+    (tmp_path / "path.csv").write_text("time,frame.dz,frame.dz\n1,-0.1,-0.2\n")
+    with pytest.raises(ValueError, match="names the column 'frame.dz' more than once"):
+        path_from_spec({"csv": "path.csv"}, tmp_path)
+
+
+def test_a_second_driver_on_a_directory_is_refused_naming_the_first_ones_process_and_touches_nothing(
+        fmu_path, tmp_path):
+    script = tmp_path / "resume.py"
+    script.write_text(RESUME)
+    directory, run_log = tmp_path / "study", tmp_path / "run.log"
+    args = [sys.executable, str(script), str(fmu_path), str(directory), str(run_log)]
+    first = subprocess.Popen(args, env=package_env(), start_new_session=True, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 60
+        while not started_cases(run_log):
+            assert first.poll() is None, first.stderr.read().decode()
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        design = factorial({"mu": [0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45], "film.prestressX": [0.5e6, 1e6]})
+        path = {"time": [0.25, 0.5, 0.75, 1.0], "frame.dz": [-0.0375, -0.075, -0.1125, -0.15]}
+        partial = directory / "cases" / "case-000099.part"  # stands for the first driver's file being written
+        partial.write_bytes(b"being written")
+        second = Study(fmu_path, design, path, ["G2.slip", "G4.slip"], {"solver.incrementsPerStep": 20},
+                       directory=directory, run_log=tmp_path / "second.log")
+        with pytest.raises(RuntimeError, match=rf"in use by another study driver \(process {first.pid} on "):
+            second.run(workers=1, progress=False)
+        assert partial.read_bytes() == b"being written" and not (tmp_path / "second.log").exists()
+    finally:
+        os.killpg(first.pid, signal.SIGKILL)
+        first.wait()
+    # the killed driver's lock went with its process: a driver resumes the study
+    ds = second.run(workers=1, progress=False)
+    assert (ds.status == "ok").all()
+
+
+def test_the_largest_slip_per_support_of_each_case_is_the_largest_magnitude_over_its_gaps_and_steps(one_worker):
+    from membrane_contact.study import largest_slips
+
+    _, ds = one_worker
+    found = largest_slips(ds)
+    assert set(found.data_vars) == {"G", "G.where"}  # G2, G4, G6: the specimen's one support
+    gaps = ["G2", "G4", "G6"]
+    for case in range(ds.sizes["case"]):
+        values = np.stack([ds[f"{g}.slip"].values[case] for g in gaps], axis=1)
+        step, k = np.unravel_index(np.argmax(np.abs(values)), values.shape)
+        assert found["G"].values[case] == values[step, k] != 0.0
+        assert found["G.where"].values[case] == gaps[k]
+    mine = largest_slips(ds, {"edge": ["G2"], "middle": ["G4", "G6"]})
+    np.testing.assert_array_equal(np.abs(mine["edge"].values), np.max(np.abs(ds["G2.slip"].values), axis=1))
