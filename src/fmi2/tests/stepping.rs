@@ -10,6 +10,23 @@
 
 use super::*;
 
+/// Issue 47 item 6: the step log of an ordinary step says nothing of enlarged increments (it
+/// said "0 enlarged (larger than 1/solver.incrementsPerStep because every smaller one
+/// failed)" on every step).
+#[test]
+fn an_ordinary_steps_log_says_nothing_of_enlarged_increments() {
+    let (u, log) = (Unpacked::specimen("ordinary log"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    assert_eq!(fmu.set_real("frame.dz", -0.001), 0);
+    assert_eq!(fmu.step(0.0, 0.05), 0);
+    let said = log.take();
+    assert!(
+        said.iter().any(|(_, _, m)| m.starts_with("step to t = ")),
+        "{said:?}"
+    );
+    assert!(!said.iter().any(|(_, _, m)| m.contains("enlarged")), "{said:?}");
+}
+
 #[test]
 fn a_step_that_cannot_converge_is_discarded_and_can_be_retried() {
     let (u, log) = (Unpacked::specimen("discard"), Log::default());
