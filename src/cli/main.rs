@@ -262,6 +262,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             .lifted_off
             .iter()
             .fold(largest_lift, |m, &f| m.max(f));
+        if let Some(w) = report.dissipation_warning() {
+            eprintln!("warning: step {step}: {w}");
+        }
         if report.continued > 0 || report.stabilized > 0 {
             let ratio = report.stabilization_ratio();
             if let Some(w) = report.stabilization_warning() {

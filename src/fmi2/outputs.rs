@@ -53,6 +53,9 @@ impl Instance {
         if let Some(w) = report.and_then(StepReport::jump_warning) {
             built.warnings.push(w);
         }
+        if let Some(w) = report.and_then(StepReport::dissipation_warning) {
+            built.warnings.push(w);
+        }
         let [_, wrinkled, slack] = state_counts(&results.elements);
         let plastic = results.plastic_summary();
         let count = |n: usize| Value::Integer(i32::try_from(n).unwrap_or(i32::MAX));

@@ -71,6 +71,8 @@ pub(in crate::mech) struct Workspace {
     /// continuation, and in all its corrections, over the current step (J).
     pub(super) stabilization: f64,
     pub(super) dissipated: f64,
+    /// Work of the viscous stabilization alone over the current step (J).
+    pub(super) viscous: f64,
     /// The work of the current increment's last correction (J).
     pub(super) last_work: f64,
     /// The first iterate of the next increment instead of the predictor's (taken by it): the
@@ -139,6 +141,7 @@ impl Analysis {
             pseudo_mass: mass,
             stabilization: 0.0,
             dissipated: 0.0,
+            viscous: 0.0,
             last_work: 0.0,
             guess: None,
             acceptance: Acceptance::Law,

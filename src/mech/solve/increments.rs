@@ -28,6 +28,7 @@ impl Analysis {
             });
         }
         (self.work.stabilization, self.work.dissipated) = (0.0, 0.0);
+        self.work.viscous = 0.0;
         let base = self.state.boundary.clone();
         let base_angles = self.state.angles.clone();
         let base_loads = self.state.loads.clone();
@@ -264,6 +265,7 @@ impl Analysis {
         self.work.stabilization += last_stabilized;
         report.stabilization_energy = std::mem::take(&mut self.work.stabilization);
         report.stabilization_dissipated = std::mem::take(&mut self.work.dissipated);
+        report.viscous_dissipated = std::mem::take(&mut self.work.viscous);
         report.strain_energy = self.strain_energy();
         Ok(report)
     }
@@ -426,6 +428,7 @@ impl Analysis {
             report.stabilized += 1;
             let (work, _) = self.parts.stabilization.work_and_force(&self.system, u);
             self.work.dissipated += work;
+            self.work.viscous += work;
             *last = work;
             // Adaptive, as Abaqus' adaptive stabilization: an increment that left more than the
             // bound makes the damping of the next ones ten times smaller.

@@ -72,6 +72,13 @@ pub struct StepReport {
     /// the way to the converged states (Abaqus' ALLSD).
     #[serde(default)]
     pub stabilization_dissipated: f64,
+    /// Of [`Self::stabilization_dissipated`], the viscous stabilization's work over all the
+    /// step's increments (J): the damping force's, which the path inside the step carries (the
+    /// continuation's pseudo-time term acts only on the iterations, never on a converged
+    /// state). Judged against the strain energy over the whole step
+    /// ([`Self::dissipation_warning`]).
+    #[serde(default)]
+    pub viscous_dissipated: f64,
     /// Elastic strain energy of the film at the end of the step (J), `Σ A t ½ (S − S0)·E`:
     /// the scale of [`Self::stabilization_ratio`].
     #[serde(default)]
@@ -83,7 +90,47 @@ pub struct StepReport {
 /// success: the dissipated-energy fraction of Abaqus' automatic stabilization, 2e-4.
 pub const STABILIZATION_BOUND: f64 = 2e-4;
 
+/// Largest ratio of the viscous stabilization's work over a whole step
+/// ([`StepReport::viscous_dissipated`]) to the strain energy at its end that is reported
+/// without a warning: Abaqus' accuracy tolerance of the adaptive stabilization (ALLSD against
+/// ALLIE), 0.05.
+pub const DISSIPATION_BOUND: f64 = 0.05;
+
 impl StepReport {
+    /// [`Self::viscous_dissipated`] over [`Self::strain_energy`] (0 without the viscous
+    /// stabilization).
+    pub fn dissipation_ratio(&self) -> f64 {
+        if self.viscous_dissipated == 0.0 {
+            0.0
+        } else {
+            self.viscous_dissipated / self.strain_energy.abs().max(f64::MIN_POSITIVE)
+        }
+    }
+
+    /// The warning of a step whose viscous stabilization took out more than
+    /// [`DISSIPATION_BOUND`] of the strain energy over the whole step (Abaqus compares ALLSD
+    /// with ALLIE over the step, not over its last increment): its path is the damped flow's,
+    /// and where the damping took out more than the film stores the state is the damping's
+    /// choice rather than the model's (None: within the bound).
+    pub fn dissipation_warning(&self) -> Option<String> {
+        let ratio = self.dissipation_ratio();
+        (ratio > DISSIPATION_BOUND).then(|| {
+            let verdict = if ratio > 1.0 {
+                "more than the film stores: the state reached is the damping's, not an equilibrium \
+                 the model determines; check the inputs (a rail driven into a support, a target \
+                 beyond the film's reach) and the reactions before using it"
+            } else {
+                "the path inside the step (slips, plastic flow) is the damped flow's, not a \
+                 quasi-static one"
+            };
+            format!(
+                "the viscous stabilization took out {:.3e} J over the step, {ratio:.2e} of the \
+                 strain energy {:.3e} J (bound {DISSIPATION_BOUND}): {verdict}",
+                self.viscous_dissipated, self.strain_energy
+            )
+        })
+    }
+
     /// [`Self::stabilization_energy`] over [`Self::strain_energy`] (0 without continuation).
     pub fn stabilization_ratio(&self) -> f64 {
         if self.stabilization_energy == 0.0 {
@@ -582,6 +629,31 @@ impl From<PatternError> for SetupError {
 #[cfg(test)]
 mod advice_tests {
     use super::*;
+
+    /// Issue 47 item 8: the ledger judges the whole step. A step whose viscous stabilization
+    /// took out more than 5 % of the strain energy warns, and one that took out more than the
+    /// film stores (the vault roof's 3.393e11 J) says its state is the damping's; the
+    /// continuation's work alone (in `stabilization_dissipated`) does not warn.
+    #[test]
+    fn the_stabilizations_work_over_the_whole_step_is_judged_against_the_strain_energy() {
+        let mut report = StepReport {
+            strain_energy: 2.0,
+            stabilization_dissipated: 1.0,
+            viscous_dissipated: 0.05,
+            ..StepReport::default()
+        };
+        assert!(report.dissipation_warning().is_none(), "within 5 %");
+        report.viscous_dissipated = 0.5;
+        let damped = report.dissipation_warning().expect("above 5 %");
+        assert!(damped.contains("damped flow's"), "{damped}");
+        report.viscous_dissipated = 3.393e11;
+        let wrong = report.dissipation_warning().expect("far above");
+        assert!(
+            wrong.contains("3.393e11 J") && wrong.contains("not an equilibrium"),
+            "{wrong}"
+        );
+        assert!(StepReport::default().dissipation_warning().is_none());
+    }
 
     /// A stall of a linear film with elements in compression names them and points to the
     /// tension-field film; without compressed elements the advice does not.
