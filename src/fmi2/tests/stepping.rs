@@ -24,7 +24,10 @@ fn an_ordinary_steps_log_says_nothing_of_enlarged_increments() {
         said.iter().any(|(_, _, m)| m.starts_with("step to t = ")),
         "{said:?}"
     );
-    assert!(!said.iter().any(|(_, _, m)| m.contains("enlarged")), "{said:?}");
+    assert!(
+        !said.iter().any(|(_, _, m)| m.contains("enlarged")),
+        "{said:?}"
+    );
 }
 
 #[test]
