@@ -45,6 +45,10 @@ impl Instance {
                 "no analysis yet: derivatives exist from fmi2ExitInitializationMode on".to_string(),
             ));
         };
+        // The response is linear in the seed: solved for the seed over its largest magnitude and
+        // scaled back, so that a seed of 1e-320 or 1e308 gets the answer a seed of 1 does (issue
+        // 47 item 6: both were refused as a singular matrix).
+        let scale = seed.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         let mut s = Seed::zero(&built.analysis);
         for (&r, &d) in knowns.iter().zip(seed) {
             let v = named(r)?;
@@ -54,6 +58,7 @@ impl Instance {
                     v.name
                 )));
             }
+            let d = if scale > 0.0 { d / scale } else { d };
             match v.binding {
                 Binding::GroupDisplacement { group, axis } => s.translation[group][axis] += d,
                 Binding::GroupAngle(g) => s.angles[g] += d,
@@ -72,11 +77,22 @@ impl Instance {
             .analysis
             .linear_response(&s)
             .map_err(|e| Failure::error(format!("no derivatives at this state: {e}")))?;
-        for (o, &r) in out.iter_mut().zip(unknowns) {
+        let mut values = Vec::with_capacity(unknowns.len());
+        for &r in unknowns {
             let binding = &variables[r as usize].binding;
-            *o = response
+            let unit = response
                 .derivative(|res| super::outputs::state_result(binding, res).unwrap_or(f64::NAN));
+            let value = unit * scale;
+            if unit.is_finite() && !value.is_finite() {
+                return Err(Failure::error(format!(
+                    "the derivative of {} is {value} for this seed (largest {scale:e}): it \
+                     overflows; scale the seed down",
+                    variables[r as usize].name
+                )));
+            }
+            values.push(value);
         }
+        out.iter_mut().zip(values).for_each(|(o, v)| *o = v);
         match path_dependent(built.step_increments, &response.points[1]) {
             Some(what) => Err(Failure::warning(format!(
                 "derivatives of the last of the step's {} increments, the earlier ones held: {what}, \

@@ -31,6 +31,11 @@ struct Sided {
 impl Fmu<'_> {
     /// `fmi2GetDirectionalDerivative` of `unknowns` along `known` (seed 1): status and values.
     fn derivative_status(&self, unknowns: &[&str], known: &str) -> (c_int, Vec<f64>) {
+        self.derivative_seeded(unknowns, known, 1.0)
+    }
+
+    /// `fmi2GetDirectionalDerivative` of `unknowns` along `known` with the seed `seed`.
+    fn derivative_seeded(&self, unknowns: &[&str], known: &str, seed: f64) -> (c_int, Vec<f64>) {
         let refs: Vec<u32> = unknowns.iter().map(|n| self.u.vr(n)).collect();
         let mut out = vec![f64::NAN; refs.len()];
         let status = unsafe {
@@ -40,7 +45,7 @@ impl Fmu<'_> {
                 refs.len(),
                 &self.u.vr(known),
                 1,
-                &1.0,
+                &seed,
                 out.as_mut_ptr(),
             )
         };
@@ -361,4 +366,43 @@ fn derivatives_after_a_step_of_several_increments_that_slid_contacts_are_flagged
         assert_eq!(fmu.derivative_status(&outputs, "frame.dx").0, 0);
         unsafe { assert_eq!(fmi2_free_fmu_state(fmu.c, &mut state), 0) };
     }
+}
+
+/// Issue 47 item 6: a seed of 1e-300 or 1e-320 gets the answer of a seed of 1 scaled by it (it
+/// was refused as "singular Newton matrix (zero pivot)"), a seed of 1e308 too where the product
+/// is finite, and where it overflows an fmi2Error saying so, never an infinite value; a zero
+/// seed gives zeros.
+#[test]
+fn tiny_and_huge_seeds_get_the_unit_seeds_answer_scaled() {
+    let (u, log) = (Unpacked::specimen("seed scale"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 1)]);
+    for k in 1..4 {
+        assert_eq!(fmu.set_real("frame.dz", -0.005 * k as f64), 0);
+        assert_eq!(fmu.step(k as f64 - 1.0, 1.0), 0);
+    }
+    let outputs = ["frame.Rz"];
+    let (status, unit) = fmu.derivative_seeded(&outputs, "frame.dz", 1.0);
+    assert_eq!(status, 0);
+    assert!(unit.iter().all(|d| d.is_finite() && *d != 0.0), "{unit:?}");
+    for seed in [1e-300, 1e-320, 1e-3, 0.0] {
+        let (status, out) = fmu.derivative_seeded(&outputs, "frame.dz", seed);
+        assert_eq!(status, 0, "seed {seed}: {:?}", log.take());
+        for (d, one) in out.iter().zip(&unit) {
+            let expected = one * seed;
+            let close = (d - expected).abs() <= 1e-9 * expected.abs().max(f64::MIN_POSITIVE)
+                || (seed < 1e-307 && (d / seed - one).abs() <= 1e-3 * one.abs());
+            assert!(close, "seed {seed}: {d:e} against {expected:e}");
+        }
+    }
+    // 1e308 × |∂Rz/∂dz| (N/m, far above 1) overflows: an error naming it, not an infinity.
+    let (status, out) = fmu.derivative_seeded(&["frame.Rz"], "frame.dz", 1e308);
+    assert_eq!(status, Status::Error.raw(), "{out:?}");
+    assert!(log.contains(Status::Error, "overflows"));
+    // Where the product is finite, a huge seed is answered.
+    let (status, out) = fmu.derivative_seeded(&outputs, "frame.dz", 1e300);
+    assert_eq!(status, 0);
+    assert!(
+        (out[0] / 1e300 - unit[0]).abs() <= 1e-9 * unit[0].abs(),
+        "{out:?}"
+    );
 }
