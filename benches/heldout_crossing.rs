@@ -1056,21 +1056,5 @@ fn main() {
         .zip(&results)
         .filter_map(|(p, r)| r.error.clone().map(|e| (p.name.clone(), e)))
         .collect();
-    println!("\nwall time {wall:.1} s");
-    if o.failures || (o.check && !failed.is_empty()) {
-        println!("\n### failed paths\n");
-        for (name, message) in &failed {
-            println!("- {name}: {message}");
-        }
-    }
-    if o.check {
-        if total.0 == 0 || !failed.is_empty() {
-            eprintln!(
-                "check failed: {} of {} load paths converge",
-                total.1, total.0
-            );
-            std::process::exit(1);
-        }
-        println!("\ncheck passed: all {} load paths converge", total.0);
-    }
+    o.conclude((total.0, total.1), wall, &failed);
 }

@@ -83,6 +83,13 @@ impl PathOptions {
             " |".repeat(blank),
             total.5
         );
+        self.conclude((total.0, total.1), wall, failed);
+    }
+
+    /// Prints the wall time and, when asked or when checking with failures, the `failed` paths
+    /// (name, message); with `--check`, exits with status 1 unless every path converged (`total`:
+    /// paths, converged).
+    pub fn conclude(&self, total: (usize, usize), wall: f64, failed: &[(String, String)]) {
         println!("\nwall time {wall:.1} s");
         if self.failures || (self.check && !failed.is_empty()) {
             println!("\n### failed paths\n");
