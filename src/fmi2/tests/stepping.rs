@@ -360,3 +360,35 @@ fn a_step_the_smoothing_homotopy_converges_is_carried_by_the_larger_dampings_wit
         }
     }
 }
+
+/// Issue 47 item 8: the `logIncrements` category carries a line per increment of a step (10 at
+/// the default `solver.incrementsPerStep`), status OK; `loggingOn = true` alone does not enable
+/// it (a line per increment), naming it does.
+#[test]
+fn log_increments_carries_a_line_per_increment_when_named() {
+    let (u, log) = (Unpacked::specimen("increment log"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    assert_eq!(fmu.set_real("frame.dz", -0.001), 0);
+    assert_eq!(fmu.step(0.0, 0.05), 0);
+    let of = |said: &[(i32, String, String)]| {
+        said.iter()
+            .filter(|(s, c, _)| *s == 0 && c == "logIncrements")
+            .map(|(_, _, m)| m.clone())
+            .collect::<Vec<_>>()
+    };
+    assert!(of(&log.take()).is_empty());
+    let named = [c"logIncrements".as_ptr()];
+    // SAFETY: see the module doc; `named` holds one NUL-terminated literal.
+    assert_eq!(
+        unsafe { fmi2_set_debug_logging(fmu.c, 1, 1, named.as_ptr()) },
+        0
+    );
+    assert_eq!(fmu.set_real("frame.dz", -0.002), 0);
+    assert_eq!(fmu.step(0.05, 0.05), 0);
+    let lines = of(&log.take());
+    assert_eq!(lines.len(), 10, "{lines:?}");
+    assert!(
+        lines[0].starts_with("increment 0.0000 → 0.1000 of the step: Newton in "),
+        "{lines:?}"
+    );
+}

@@ -4,6 +4,7 @@ use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
+use crate::mech::solve::progress::IncrementNote;
 use crate::mech::solve::report::{IncrementFailure, STABILIZATION_BOUND, StepError, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
@@ -99,10 +100,20 @@ impl Analysis {
             // Likewise the watchdog: after a cut-back, monotone backtracking only (a failed
             // excursion per halved increment was measured to turn a hard path into a failure).
             self.work.watchdog = report.cutbacks == 0;
+            let (continued, damped) = (report.continued, self.parts.stabilization.is_on());
             let attempt = self.solve_or_continue(&current, &at(next), &levels, &mut report);
             if let Ok((state, _)) = &attempt {
                 self.account_stabilized(&mut report, &state.displacement, &mut last_stabilized);
             }
+            let how = if report.continued > continued {
+                "continuation"
+            } else if damped {
+                "stabilized"
+            } else {
+                "Newton"
+            };
+            let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
+            self.note_increment(done, next, how, outcome, report.cutbacks);
             match attempt {
                 Ok((state, history)) => {
                     last_start = Some(std::mem::replace(&mut current, state));
@@ -132,6 +143,7 @@ impl Analysis {
                     // curved-support specimen's stick/slip states, tests/surfaces.rs).
                     let mut reached = None;
                     let mut held = false;
+                    let before = report.clone();
                     if !self.parts.curved.is_empty() {
                         self.parts.curved.active_set = true;
                         if let Ok(converged) = self.solve_increment(&current, &at(next), &levels) {
@@ -233,6 +245,8 @@ impl Analysis {
                     if !held {
                         report.enlarged += 1;
                     }
+                    let how = report.ladder_rung(&before);
+                    self.note_increment(done, next, how, Ok(&history), report.cutbacks);
                     self.account_stabilized(&mut report, &state.displacement, &mut last_stabilized);
                     last_start = Some(std::mem::replace(&mut current, state));
                     done = next;
@@ -273,6 +287,27 @@ impl Analysis {
     /// The increment from `start` to `motion` and `levels` by plain Newton, then, where that fails
     /// and the continuation is on, by the continuation (counted in `report.continued`, the
     /// artificial energy of its last correction added to the step's). Err: the last attempt's.
+    /// Tells the observer (`progress.rs`) how the increment from `from` to `to` of the step
+    /// ended: converged by `how`, or refused.
+    fn note_increment(
+        &self,
+        from: f64,
+        to: f64,
+        how: &'static str,
+        outcome: Result<&[f64], &IncrementFailure>,
+        cutbacks: usize,
+    ) {
+        self.observer.note(|| IncrementNote {
+            from,
+            to,
+            attempt: how,
+            iterations: outcome.map_or(0, |h| h.len().saturating_sub(1)),
+            residual: outcome.map_or(f64::NAN, |h| h.last().copied().unwrap_or(0.0)),
+            refused: outcome.err().map(IncrementFailure::phrase),
+            cutbacks,
+        });
+    }
+
     fn solve_or_continue(
         &mut self,
         start: &AnalysisState,
@@ -370,6 +405,8 @@ impl Analysis {
                 *l += a;
             }
             report.released += 1;
+            let how = "release at the step's end";
+            self.note_increment(1.0, 1.0, how, Ok(&history), report.cutbacks);
             report.iterations.push(history.len() - 1);
             report.residual = *history.last().unwrap_or(&0.0);
             report.residual_history = history;

@@ -10,6 +10,7 @@
 //! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
 //! | `increments` | the increment controller: cut-back, enlargement, predictor |
 //! | `newton` | Newton–Raphson for one increment |
+//! | [`progress`] | [`IncrementNote`]: each increment as it ends, for a front end's log |
 //! | `smoothing` | the smoothing homotopy of a refused increment with curved contacts |
 //! | `line_search` | backtracking line search with a watchdog |
 //! | [`settings`] | [`SolverSettings`] |
@@ -26,6 +27,7 @@ mod inputs;
 mod line_search;
 pub mod linear;
 mod newton;
+pub mod progress;
 pub mod report;
 mod sensitivity;
 pub mod settings;
@@ -34,6 +36,7 @@ pub mod state;
 
 pub use analysis::Analysis;
 pub use newton::max_abs;
+pub use progress::{IncrementNote, IncrementObserver};
 pub use report::{
     IncrementFailure, IterationRecord, SettingNames, SetupError, StepError, StepReport,
 };

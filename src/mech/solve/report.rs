@@ -343,6 +343,37 @@ pub enum IncrementFailure {
     },
 }
 
+impl StepReport {
+    /// Which attempt after the halvings carried an increment, from the counters' change since
+    /// `before` (a progress line's word for it).
+    pub(crate) fn ladder_rung(&self, before: &StepReport) -> &'static str {
+        if self.smoothed > before.smoothed {
+            "smoothing homotopy"
+        } else if self.damped_jumps > before.damped_jumps {
+            "larger dampings"
+        } else if self.stabilized > before.stabilized {
+            "stabilized"
+        } else if self.active_set > before.active_set {
+            "active set"
+        } else {
+            "enlarged increment"
+        }
+    }
+}
+
+impl IncrementFailure {
+    /// One phrase for a progress line (the [`fmt::Display`] text has the figures).
+    pub fn phrase(&self) -> &'static str {
+        match self {
+            Self::MaxIterations { .. } => "iteration limit",
+            Self::Stalled { .. } => "no progress",
+            Self::Diverged { .. } => "diverged",
+            Self::Singular { .. } => "singular matrix",
+            Self::Unsettled { .. } => "the damped flow did not settle",
+        }
+    }
+}
+
 /// `names` as a short list: the first few, then how many more.
 fn name_list(names: &[String]) -> String {
     const SHOWN: usize = 6;
