@@ -341,6 +341,7 @@ fn erection_then_service_unloads_elastically_and_keeps_the_slip_history() {
     };
     let mut model = spec.model().unwrap();
     model.loads.pressures.push(PressureSet {
+        kind: Default::default(),
         name: "snow".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: -500.0,

@@ -86,7 +86,7 @@ CONTACT_KEYS = {"normal_stiffness", "tangential_stiffness", "friction", "frictio
 # role → (required keys, optional keys)
 ROLES: dict[str, tuple[set[str], set[str]]] = {
     "element_set": (set(), {"name"}),
-    "pressure": ({"pressure"}, {"name", "towards"}),
+    "pressure": ({"pressure"}, {"name", "towards", "kind"}),
     "force": ({"force"}, {"name"}),
     "support": (set(), {"fixed", "set"}),
     "boundary": (set(), {"name", "target", "components"}),
@@ -544,7 +544,7 @@ class _Importer:
                 pressures.append({"name": _identifier(label("name"), where),
                                   "elements": self.group_triangles(name, role),
                                   "pressure": _number(entry["pressure"], f"{where}: pressure"),
-                                  **_towards(entry, where)})
+                                  **_towards(entry, where), **_pressure_kind(entry, where)})
             elif role == "force":
                 forces.append({"name": _identifier(label("name"), where), "nodes": self.nodes_of(name, role),
                                "force": _vector(entry["force"], f"{where}: force")})
@@ -743,6 +743,15 @@ def _towards(entry: dict, where: str) -> dict:
 
 
 SIDES = ("+x", "-x", "+y", "-y", "+z", "-z")
+
+
+def _pressure_kind(entry: dict, where: str) -> dict:
+    """A pressure entry's ``kind``: ``"follower"`` (the default, left out) or ``"plan"`` (a load
+    per plan area, snow)."""
+    kind = entry.get("kind", "follower")
+    if kind not in ("follower", "plan"):
+        _fail(f"{where}: kind '{kind}' is not 'follower' or 'plan'")
+    return {} if kind == "follower" else {"kind": kind}
 #: The solver's command line, run by :func:`solver_check` (default: the one installed with this
 #: package from the wheel, else the checkout's ``target/release/membrane-contact``, else
 #: ``membrane-contact`` on the PATH: the order in which ``build_fmu`` finds ``fmu-pack``).

@@ -681,3 +681,19 @@ def test_a_wrong_membrane_contact_cli_skips_the_solvers_check_with_a_warning_say
                        env={**package_env(), "MEMBRANE_CONTACT_CLI": str(tmp_path)}, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "note: the solver's check is skipped" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_a_pressure_group_of_kind_plan_becomes_a_load_per_plan_area(small_mesh):
+    """Issue 47 item 8: the roof's snow as a load per plan area (``"kind": "plan"``) passes
+    through the importer; a follower set writes no kind; an unknown kind is refused naming it."""
+    from membrane_contact.mesh import MeshImportError
+
+    m = small_mapping(LINEAR, film={"role": "pressure", "name": "snow", "pressure": 960.0, "kind": "plan"},
+                      left={"role": "support"}, top={"role": "support"}, bottom={"role": "support"})
+    model = import_mesh(small_mesh, m)
+    assert model["loads"]["pressures"] == [{"name": "snow", "elements": "all", "pressure": 960.0, "kind": "plan"}]
+    m["physical_groups"]["film"]["kind"] = "follower"
+    assert "kind" not in import_mesh(small_mesh, m)["loads"]["pressures"][0]
+    m["physical_groups"]["film"]["kind"] = "snow"
+    with pytest.raises(MeshImportError, match="kind 'snow' is not 'follower' or 'plan'"):
+        import_mesh(small_mesh, m)

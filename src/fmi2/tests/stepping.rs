@@ -403,6 +403,7 @@ fn the_loads_the_first_step_applies_are_named_at_the_end_of_initialization() {
     let mut model = crate::specimens::ParallelArch::default().model().unwrap();
     for (name, pressure) in [("snow", 960.0), ("suction", -600.0)] {
         model.loads.pressures.push(PressureSet {
+            kind: Default::default(),
             name: name.into(),
             elements: ElementSelection::All(AllElements::All),
             pressure,
