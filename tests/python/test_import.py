@@ -697,3 +697,25 @@ def test_a_pressure_group_of_kind_plan_becomes_a_load_per_plan_area(small_mesh):
     m["physical_groups"]["film"]["kind"] = "snow"
     with pytest.raises(MeshImportError, match="kind 'snow' is not 'follower' or 'plan'"):
         import_mesh(small_mesh, m)
+
+
+def test_a_rails_end_points_on_a_symmetry_plane_leave_the_plane_with_a_note(small_mesh):
+    """Issue 47 item 8: the vault roof's symmetry planes took in the end points of curves a rail
+    already holds, and the user wrote 14 lines to take them out. A node a boundary group
+    prescribes along a plane's normal now leaves the plane: where the group holds it at 0 along
+    the normal that is the same constraint (said so), else the group moves it off the plane (said
+    so); the model runs. A support that fixes what a group prescribes is still refused."""
+    from membrane_contact.mesh import MeshImportError, MeshImportWarning
+
+    for target, verdict in ((0.0, "the same constraint"), (0.01, "moves them by 0.01 m along x, off the plane")):
+        m = small_mapping(LINEAR, left={"role": "symmetry", "normal": "x"}, bottom={"role": "support"},
+                          top={"role": "boundary", "name": "rail", "target": [target, 0.0, -0.01]})
+        with pytest.warns(MeshImportWarning, match=verdict) as caught:
+            model = import_mesh(small_mesh, m)
+        (note,) = [str(w.message) for w in caught if "symmetry plane" in str(w.message)]
+        assert "symmetry plane 'left' (normal x): 1 nodes left out (20)" in note, note
+        (plane,) = model["symmetry"]
+        assert 20 not in plane["nodes"] and plane["nodes"] == [0, 5, 10, 15], plane
+    m = small_mapping(LINEAR, left={"role": "support"}, top={"role": "boundary", "name": "rail"})
+    with pytest.raises(MeshImportError, match="also fixed in x by support group 'left'"):
+        import_mesh(small_mesh, m)
