@@ -1068,3 +1068,33 @@ fn log_increments_writes_a_line_per_increment_off_a_terminal() {
     let (ok, _, quiet) = specimen(&[]);
     assert!(ok && !quiet.contains(": increment "), "{quiet}");
 }
+
+/// Issue 47 item 8: the summary prints the contacts' force on the film; on the unloaded
+/// specimen it balances the total reaction, and no share of a load is claimed.
+#[test]
+fn the_summary_prints_the_contact_force_on_the_film() {
+    let (ok, out, err) = specimen(&[]);
+    assert!(ok, "{err}");
+    let vector = |prefix: &str| -> Vec<f64> {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("{out}"));
+        let inside = &line[line.find(": (").unwrap() + 3..line.find(") N").unwrap()];
+        inside.split(", ").map(|v| v.parse().unwrap()).collect()
+    };
+    let (c, t) = (
+        vector("contact forces on the film"),
+        vector("total reaction"),
+    );
+    for k in 0..3 {
+        assert!(
+            (c[k] + t[k]).abs() < 2e-3 + 1e-4 * c[k].abs(),
+            "{c:?} vs {t:?}"
+        );
+    }
+    assert!(
+        out.contains("balancing the reactions (no load on the film)"),
+        "{out}"
+    );
+}

@@ -17,6 +17,7 @@ use membrane_contact::mech::{
 };
 use membrane_contact::specimens::ParallelArch;
 use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, etfe_plastic, table1};
+use nalgebra::Vector3;
 
 mod args;
 mod path;
@@ -711,6 +712,28 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
         t[1],
         t[2]
     );
+    if !model.gaps.is_empty() || !results.surface_contacts.is_empty() {
+        let (c, all) = (
+            results.contact_force(model),
+            results.film_support_force(model),
+        );
+        // The film's supports balance its loads: where those are ~0 the contacts only balance
+        // the reactions, and no share is defined.
+        let share = if all.norm() > 1e-3 * c.norm().max(Vector3::from(t).norm()) {
+            format!(
+                "carrying {:.1} % of the film's loads (along their resultant)",
+                100.0 * c.dot(&all) / all.norm_squared()
+            )
+        } else {
+            "balancing the reactions (no load on the film)".into()
+        };
+        out!(
+            "contact forces on the film (gaps, curved supports): ({:.3}, {:.3}, {:.3}) N, {share}",
+            c.x,
+            c.y,
+            c.z
+        );
+    }
     let (lo, hi) = results.von_mises_range();
     out!(
         "equivalent (von Mises) stress: {} … {} MPa",
