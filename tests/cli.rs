@@ -666,6 +666,53 @@ fn check_prints_the_warnings_and_the_orientation_of_each_pressure_set() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// TEST GOAL (issue 47 item 8): a prestressed film with free edges starts out of equilibrium
+/// (the vault roof: 302 of 728 elements wrinkled, a 100 s first stage) and `check` said
+/// nothing. `examples/crossing_supports.json` is such a film: 1.5 MPa both ways, rails on its
+/// 3 m edges only, so that its two 4 m edges (nodes 0–32 and 792–824) are free. `check` warns
+/// naming both chains and what holds them; with an edge cable along each it is silent again.
+#[test]
+fn check_warns_that_a_prestressed_film_with_free_edges_starts_out_of_equilibrium() {
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/crossing_supports.json"
+    );
+    let (ok, _, err) = cli(&["check", example]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(
+            "warning: the film's prestress pulls across 64 free edge segments in 2 chains (nodes \
+             0 to 32 (32 segments); nodes 792 to 824 (32 segments)) that no support, symmetry \
+             plane, group, gap, curved support or edge cable holds"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("hold each edge with an edge cable (cables), a group or supports"),
+        "{err}"
+    );
+    let mut model =
+        membrane_contact::mech::Model::from_json(&std::fs::read_to_string(example).unwrap())
+            .unwrap();
+    for (name, first) in [("cableS", 0), ("cableN", 792)] {
+        model.cables.push(membrane_contact::mech::model::CableSpec {
+            name: name.into(),
+            nodes: (first..=first + 32).collect(),
+            area: 1e-5,
+            youngs_modulus: 1.6e11,
+            prestress_force: 0.0,
+        });
+    }
+    let file = std::env::temp_dir().join(format!(
+        "membrane-contact-cabled-{}.json",
+        std::process::id()
+    ));
+    std::fs::write(&file, model.to_json()).unwrap();
+    let (ok, _, err) = cli(&["check", file.to_str().unwrap()]);
+    let _ = std::fs::remove_file(&file);
+    assert!(ok && err.is_empty(), "{err}");
+}
+
 /// TEST GOAL (issue 17, defect 4): a model without a free DOF runs from the command line (it
 /// was refused with "the model has no free DOF"): `examples/driven_gap.json` driven along
 /// `examples/driven_gap_path.csv` sticks at `k_s·dx`, slips at `μN` = 30 N and sticks again on

@@ -19,7 +19,8 @@ pub const SMALL_STRAIN_LIMIT: f64 = 0.05;
 pub const SUSPICIOUS_MODULUS: f64 = 1e5;
 
 /// Warnings about a model that validates but looks wrong (checked once, before any step): a
-/// Young's modulus that looks like MPa, pressure sets with triangles pushed against their
+/// Young's modulus that looks like MPa, a prestressed film with free edges
+/// ([`crate::mech::model::free_edges`]), pressure sets with triangles pushed against their
 /// neighbours ([`crate::mech::elements::load::orientation_warnings`]), and gaps whose `initial_gap` differs slightly (up to
 /// [`crate::mech::model::GAP_GEOMETRY_TOLERANCE`] of the size; beyond, validation refuses the model)
 /// from the distance along the gap's local z between film node and support (§4.3:
@@ -34,6 +35,7 @@ pub fn model_warnings(model: &Model) -> Vec<String> {
             message_number(e)
         ));
     }
+    warnings.extend(crate::mech::model::free_edges::free_edge_warning(model));
     warnings.extend(crate::mech::elements::load::orientation_warnings(model));
     let size = crate::mech::model::bounding_diagonal(&model.nodes);
     for gap in &model.gaps {
