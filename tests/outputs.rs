@@ -167,6 +167,70 @@ fn the_specimen_gives_no_model_warning() {
     }
 }
 
+/// TEST GOAL (issue 47 item 8): the vault roof's rails were driven into the curved supports'
+/// end caps and "converged" with contact forces of 1.14 MN on a film whose forces are kN,
+/// unflagged. `examples/driven_gap.json` (a triangle of 0.224 m, every node driven by group
+/// `Drive`; gap `G` under node 0, 1 mm away, `k_n` = 1e5 N/m) with a cylinder `pipe` (tube
+/// radius 20 mm, `k_n` = 1e6 N/m) 1 mm under node 1, driven down: 1 mm into both is nothing to
+/// warn of; 9 mm is beyond 1 % of the film's size (2.24 mm, the gap) and 10 % of the tube
+/// radius (2 mm, the pipe), and the pipe's 9 kN is beyond the film's scale E·t·L·5 % = 2.8 kN
+/// (the gap's 0.9 kN is not). Each warning names its contacts, worst first.
+#[test]
+fn contacts_pressed_far_into_their_supports_warn_naming_them() {
+    use membrane_contact::mech::elements::curved_contact::{Centreline, CurvedSupport};
+    use membrane_contact::mech::elements::gap::FrictionLaw;
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/driven_gap.json"
+    ))
+    .unwrap();
+    let mut model = Model::from_json(&text).unwrap();
+    model.curved_supports.push(CurvedSupport {
+        name: "pipe".into(),
+        centreline: Centreline::Line {
+            point: [0.2, 0.0, -0.021],
+            axis: [0.0, 1.0, 0.0],
+        },
+        tube_radius: 0.02,
+        nodes: vec![1],
+        normal_stiffness: 1e6,
+        tangential_stiffness: 1e5,
+        friction: 0.3,
+        friction_law: FrictionLaw::Isotropic,
+    });
+    model.validate().unwrap();
+    let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+    let mut pressed = |dz: f64| {
+        a.step_to(&[[0.0, 0.0, dz]], 1).unwrap();
+        let results = a.results();
+        let w = result_warnings(a.model(), &results);
+        (results, w)
+    };
+    let (results, w) = pressed(-0.002);
+    assert!((results.gaps[0].normal_force - 100.0).abs() < 1e-6);
+    assert!((results.surface_contacts[0].gap + 0.001).abs() < 1e-9);
+    assert_eq!(w, Vec::<String>::new());
+    let (results, w) = pressed(-0.010);
+    assert!((results.surface_contacts[0].normal_force - 9e3).abs() < 1e-3);
+    assert_eq!(w.len(), 2, "{w:#?}");
+    assert_eq!(
+        w[0],
+        "contact penetration far beyond what a rigid support allows at 2 contacts: pipe.node1 \
+         9.000e-3 m, gap 'G' 9.000e-3 m (limits: 1 % of the film's size 2.236e-1 m for a gap, 10 % \
+         of the tube radius for a curved support); the penalty holds the node only by being \
+         pressed in: check the prescribed displacements, the support's position and its \
+         normal_stiffness"
+    );
+    assert!(
+        w[1].starts_with(
+            "contact force far beyond the film's scale at 1 contact: pipe.node1 9.000e3 N \
+             (E·t·L·5 % = 2.795e3 N, what the whole film carries across its size L = 2.236e-1 m \
+             at 5 % strain)"
+        ),
+        "{w:#?}"
+    );
+}
+
 #[test]
 fn a_modulus_in_mpa_and_an_inconsistent_initial_gap_warn_naming_the_item() {
     let mut model = ParallelArch::default().model().unwrap();

@@ -79,10 +79,12 @@ pub fn model_warnings(model: &Model) -> Vec<String> {
 /// Warnings about a converged state outside the model's assumptions: a von Mises stress above
 /// the material's `yield_stress`, a principal strain above [`SMALL_STRAIN_LIMIT`] (an elastic
 /// film), yield over more than [`YIELDED_AREA_FRACTION`] of the film's area and an equivalent
-/// plastic strain past [`ETFE_RUPTURE_PLASTIC_STRAIN`] (a plastic film). One line per kind,
-/// naming the worst element.
+/// plastic strain past [`ETFE_RUPTURE_PLASTIC_STRAIN`] (a plastic film), penetrations and
+/// contact forces far outside the model's scale
+/// ([`crate::mech::results::contact_warnings`]). One line per kind, naming the worst element
+/// or contacts.
 pub fn result_warnings(model: &Model, results: &Results) -> Vec<String> {
-    let mut warnings = vec![];
+    let mut warnings = crate::mech::results::contact_warnings::contact_warnings(model, results);
     let worst = |f: &dyn Fn(&ElementStress) -> f64| {
         results
             .elements
