@@ -587,3 +587,55 @@ fn plastic_film_on_threads_is_bit_identical_to_serial() {
         }
     }
 }
+
+/// TEST GOAL (issue 47 item 8): the default ETFE curve had to be copied into the model file as
+/// numbers. `"hardening": "etfe-23C"` names it: the model gets exactly
+/// `etfe_datasheet_hardening()`, is written back by name and reads back equal; it runs like the
+/// table; an unknown name is refused naming the known ones.
+#[test]
+fn the_default_etfe_curve_is_accepted_by_name_and_an_unknown_name_is_refused() {
+    use membrane_contact::mech::elements::plasticity::etfe_datasheet_hardening;
+    let mut table = strip(2);
+    table.material.plasticity = Some(Plasticity {
+        hardening: etfe_datasheet_hardening(),
+    });
+    let text = table.to_json();
+    let rows = serde_json::to_string(&etfe_datasheet_hardening().rows()).unwrap();
+    let compact = text.split_whitespace().collect::<String>();
+    assert!(
+        compact.contains(&format!("\"hardening\":{rows}")),
+        "{compact}"
+    );
+    let named_text = compact.replace(&rows, "\"etfe-23C\"");
+    let named = Model::from_json(&named_text).unwrap();
+    let hardening = named.material.plasticity.unwrap().hardening;
+    assert_eq!(hardening.rows(), etfe_datasheet_hardening().rows());
+    assert_eq!(hardening.name(), Some("etfe-23C"));
+    let written = named.to_json();
+    assert!(written.contains("\"hardening\": \"etfe-23C\""), "{written}");
+    assert_eq!(Model::from_json(&written).unwrap(), named);
+    // It runs as the table does, bit for bit.
+    let pulled = |m: Model| {
+        let mut a = Analysis::new(m, Default::default()).unwrap();
+        a.step_to(&[[0.05 * L, 0.0, 0.0]], 2).unwrap();
+        assert!(
+            a.results().elements[0]
+                .plastic
+                .unwrap()
+                .equivalent_plastic_strain
+                > 0.0
+        );
+        a.results()
+    };
+    assert_eq!(pulled(named).elements, pulled(table).elements);
+    let err = Model::from_json(&compact.replace(&rows, "\"etfe-20C\""))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(
+            "hardening: unknown curve \"etfe-20C\"; the known names are \"etfe-23C\": ETFE's \
+             data-sheet curve at 23 °C"
+        ),
+        "{err}"
+    );
+}
