@@ -713,6 +713,58 @@ fn check_warns_that_a_prestressed_film_with_free_edges_starts_out_of_equilibrium
     assert!(ok && err.is_empty(), "{err}");
 }
 
+/// TEST GOAL (issue 47 item 8): contacts far outside the model's scale are said after each
+/// step, as the FMU says them, naming the contacts (the vault roof's rails "converged" with
+/// 1.14 MN on its end caps, unflagged). `examples/driven_gap.json` with a pipe (tube radius
+/// 20 mm, `k_n` = 1e6 N/m) 1 mm under node 1, the film driven 5 then 10 mm down in two steps:
+/// both steps warn of both contacts' penetration and of the pipe's force, with the step's
+/// number, and the end of the run does not say the last step's again.
+#[test]
+fn contacts_pressed_far_into_their_supports_are_said_after_each_step() {
+    use membrane_contact::mech::elements::curved_contact::{Centreline, CurvedSupport};
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/driven_gap.json");
+    let mut model =
+        membrane_contact::mech::Model::from_json(&std::fs::read_to_string(example).unwrap())
+            .unwrap();
+    model.groups[0].target = [0.0, 0.0, -0.01];
+    model.curved_supports.push(CurvedSupport {
+        name: "pipe".into(),
+        centreline: Centreline::Line {
+            point: [0.2, 0.0, -0.021],
+            axis: [0.0, 1.0, 0.0],
+        },
+        tube_radius: 0.02,
+        nodes: vec![1],
+        normal_stiffness: 1e6,
+        tangential_stiffness: 1e5,
+        friction: 0.3,
+        friction_law: Default::default(),
+    });
+    let file = std::env::temp_dir().join(format!(
+        "membrane-contact-pressed-{}.json",
+        std::process::id()
+    ));
+    std::fs::write(&file, model.to_json()).unwrap();
+    let (ok, _, err) = cli(&["model", file.to_str().unwrap(), "--steps", "2", "--quiet"]);
+    let _ = std::fs::remove_file(&file);
+    assert!(ok, "{err}");
+    for step in [1, 2] {
+        let said = format!(
+            "warning: step {step}: contact penetration far beyond what a rigid support allows at \
+             2 contacts: pipe.node1 {0}e-3 m, gap 'G' {0}e-3 m",
+            ["4.000", "9.000"][step - 1]
+        );
+        assert!(err.contains(&said), "{said}\n{err}");
+        let said = format!(
+            "warning: step {step}: contact force far beyond the film's scale at 1 contact: \
+             pipe.node1 {}e3 N",
+            ["4.000", "9.000"][step - 1]
+        );
+        assert!(err.contains(&said), "{said}\n{err}");
+    }
+    assert_eq!(err.matches("contact force").count(), 2, "{err}");
+}
+
 /// TEST GOAL (issue 17, defect 4): a model without a free DOF runs from the command line (it
 /// was refused with "the model has no free DOF"): `examples/driven_gap.json` driven along
 /// `examples/driven_gap_path.csv` sticks at `k_s·dx`, slips at `μN` = 30 N and sticks again on
