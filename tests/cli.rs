@@ -7,6 +7,8 @@
 use std::io::Read;
 use std::process::{Command, Stdio};
 
+mod common;
+
 #[test]
 fn closed_pipe_ends_the_program_quietly() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
@@ -721,25 +723,8 @@ fn check_warns_that_a_prestressed_film_with_free_edges_starts_out_of_equilibrium
 /// number, and the end of the run does not say the last step's again.
 #[test]
 fn contacts_pressed_far_into_their_supports_are_said_after_each_step() {
-    use membrane_contact::mech::elements::curved_contact::{Centreline, CurvedSupport};
-    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/driven_gap.json");
-    let mut model =
-        membrane_contact::mech::Model::from_json(&std::fs::read_to_string(example).unwrap())
-            .unwrap();
+    let mut model = common::driven_gap_over_a_pipe();
     model.groups[0].target = [0.0, 0.0, -0.01];
-    model.curved_supports.push(CurvedSupport {
-        name: "pipe".into(),
-        centreline: Centreline::Line {
-            point: [0.2, 0.0, -0.021],
-            axis: [0.0, 1.0, 0.0],
-        },
-        tube_radius: 0.02,
-        nodes: vec![1],
-        normal_stiffness: 1e6,
-        tangential_stiffness: 1e5,
-        friction: 0.3,
-        friction_law: Default::default(),
-    });
     let file = std::env::temp_dir().join(format!(
         "membrane-contact-pressed-{}.json",
         std::process::id()

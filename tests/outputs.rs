@@ -13,6 +13,8 @@ use membrane_contact::mech::{Analysis, LoadLevels, Material, Model, SolverSettin
 use membrane_contact::specimens::ParallelArch;
 use membrane_contact::specimens::scenarios::CircularMembrane;
 
+mod common;
+
 /// A 4-ring disc of radius 1 m, the specimen's ETFE film prestressed to 1 MPa, 100 Pa.
 fn disc(pressure: f64) -> CircularMembrane {
     CircularMembrane {
@@ -177,28 +179,7 @@ fn the_specimen_gives_no_model_warning() {
 /// (the gap's 0.9 kN is not). Each warning names its contacts, worst first.
 #[test]
 fn contacts_pressed_far_into_their_supports_warn_naming_them() {
-    use membrane_contact::mech::elements::curved_contact::{Centreline, CurvedSupport};
-    use membrane_contact::mech::elements::gap::FrictionLaw;
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/driven_gap.json"
-    ))
-    .unwrap();
-    let mut model = Model::from_json(&text).unwrap();
-    model.curved_supports.push(CurvedSupport {
-        name: "pipe".into(),
-        centreline: Centreline::Line {
-            point: [0.2, 0.0, -0.021],
-            axis: [0.0, 1.0, 0.0],
-        },
-        tube_radius: 0.02,
-        nodes: vec![1],
-        normal_stiffness: 1e6,
-        tangential_stiffness: 1e5,
-        friction: 0.3,
-        friction_law: FrictionLaw::Isotropic,
-    });
-    model.validate().unwrap();
+    let model = common::driven_gap_over_a_pipe();
     let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
     let mut pressed = |dz: f64| {
         a.step_to(&[[0.0, 0.0, dz]], 1).unwrap();
