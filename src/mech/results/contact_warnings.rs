@@ -36,7 +36,7 @@ pub const CONTACT_FORCE_STRAIN: f64 = SMALL_STRAIN_LIMIT;
 const LISTED_CONTACTS: usize = 3;
 
 /// One line per kind (penetration, force), naming the worst contacts first, up to
-/// [`LISTED_CONTACTS`] of them, and how many there are.
+/// three of them, and how many there are.
 pub fn contact_warnings(model: &Model, results: &Results) -> Vec<String> {
     let size = bounding_diagonal(&model.nodes);
     let m = model.material.at_temperature();
