@@ -235,6 +235,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     // Increments solved by the smoothing homotopy, and of them accepted on the law's residual.
     let (mut smoothed, mut on_residual) = (0, 0);
     let count = path.steps.len();
+    // The contact warnings of the last step (said with its number, not again at the end).
+    let mut last_contacts = vec![];
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
         logged_step.store(step, std::sync::atomic::Ordering::Relaxed);
@@ -315,6 +317,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             csv.write_step(step, time, analysis.model(), results)?;
             outputs.step(step, time, inputs, &report, &analysis, results)?;
         }
+        last_contacts = contact_step_warnings(&mut analysis, results.as_ref());
+        for w in &last_contacts {
+            eprintln!("warning: step {step}: {w}");
+        }
         progress.step(step);
     }
     progress.finish();
@@ -326,7 +332,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
     for w in membrane_contact::mech::results::warnings::result_warnings(analysis.model(), &results)
     {
-        eprintln!("warning: {w}");
+        if !last_contacts.contains(&w) {
+            eprintln!("warning: {w}");
+        }
     }
     let total: usize = iterations.iter().sum();
     out!(
@@ -529,6 +537,25 @@ struct VtkWritten {
 
 /// Writes the last state of `steps` (`(fraction, step)` pairs) as the film and gaps `.vtu` files
 /// in `dir` and rewrites both `.pvd` collections.
+/// The contact warnings of the state a step reached
+/// ([`membrane_contact::mech::results::contact_warnings`]), said after each step as the FMU
+/// says them: from `results` when the step gathered them, else gathered here; none without
+/// gaps or curved supports.
+fn contact_step_warnings(analysis: &mut Analysis, results: Option<&Results>) -> Vec<String> {
+    use membrane_contact::mech::results::contact_warnings::contact_warnings;
+    let model = analysis.model();
+    if model.gaps.is_empty() && model.curved_supports.is_empty() {
+        return vec![];
+    }
+    match results {
+        Some(r) => contact_warnings(analysis.model(), r),
+        None => {
+            let r = analysis.results();
+            contact_warnings(analysis.model(), &r)
+        }
+    }
+}
+
 fn write_vtk(
     dir: &std::path::Path,
     analysis: &Analysis,

@@ -253,7 +253,8 @@ fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
 /// `solver.smoothedIncrements` counts the homotopy's increments. With it off, the viscous
 /// stabilization's larger dampings, tried after the homotopy, carry the step instead (nothing
 /// smoothed; before them the step was discarded), with the warning that the film jumped. The
-/// state after the smoothed step round-trips.
+/// state after the smoothed step round-trips. (The panel's long edges are free: its
+/// initialization warns of them.)
 #[test]
 fn a_step_the_smoothing_homotopy_converges_is_carried_by_the_larger_dampings_without_it() {
     let data = |f: &str| {
@@ -275,7 +276,19 @@ fn a_step_the_smoothing_homotopy_converges_is_carried_by_the_larger_dampings_wit
             assert_eq!(fmi2_enter_initialization_mode(fmu.c), 0);
         }
         assert_eq!(fmu.set_boolean("solver.smoothing", smoothing), 0);
-        assert_eq!(unsafe { fmi2_exit_initialization_mode(fmu.c) }, 0);
+        // The panel is a prestressed film held on its rails only: its two long edges are free
+        // and the prestress pulls them in (issue 47 item 8), a model warning at initialization.
+        assert_eq!(
+            unsafe { fmi2_exit_initialization_mode(fmu.c) },
+            Status::Warning.raw()
+        );
+        let logged = log.take();
+        assert!(
+            logged.iter().any(|(_, _, m)| m.contains(
+                "the model looks wrong: the film's prestress pulls across 40 free edge segments"
+            )),
+            "{logged:?}"
+        );
         let mut status = 0;
         for k in 1..=4 {
             let f = k as f64 / steps;
