@@ -16,6 +16,7 @@
 #    the frame down, read the Real outputs, serialize and restore a state, free) on the
 #    specimen FMU's library for linux64 natively, win64 under wine, aarch64-linux under
 #    qemu-aarch64, and compares each with linux64 (tests/platforms/compare.py: 1e-9 relative);
+#    the same for the jack FMU (its force raised; its state kept in memory, not serialized);
 # 5. runs `fmpy validate` on the multi-platform FMUs.
 #
 # Needs (Debian): gcc-mingw-w64-x86-64 wine64 gcc-aarch64-linux-gnu qemu-user, and
@@ -98,16 +99,6 @@ echo "modelDescription.xml of the multi-platform FMU = that of linux64 alone (GU
 import sys, zipfile, re; print(re.search(r'guid=\"([^\"]*)', zipfile.ZipFile(sys.argv[1]).read('modelDescription.xml').decode()).group(1))" "$OUT/ParallelArch.fmu"))"
 
 echo "== harness: linux64 native, win64 under wine, aarch64-linux under qemu =="
-unzip -q "$OUT/ParallelArch.fmu" -d "$OUT/ParallelArch"
-MD=$OUT/ParallelArch/modelDescription.xml
-GUID=$(python3 -c "import sys, xml.etree.ElementTree as E; print(E.parse(sys.argv[1]).getroot().get('guid'))" "$MD")
-DZ_VR=$(python3 -c "
-import sys, xml.etree.ElementTree as E
-print(*[v.get('valueReference') for v in E.parse(sys.argv[1]).getroot().iter('ScalarVariable') if v.get('name') == 'frame.dz'])" "$MD")
-REALS=$(python3 -c "
-import sys, xml.etree.ElementTree as E
-print(*[v.get('valueReference') for v in E.parse(sys.argv[1]).getroot().iter('ScalarVariable')
-        if v.get('causality') == 'output' and v.find('Real') is not None])" "$MD")
 H=tests/platforms/harness.c
 gcc -O1 -Wall -o "$OUT/harness-linux64" $H -ldl
 x86_64-w64-mingw32-gcc -O1 -Wall -D__USE_MINGW_ANSI_STDIO=1 -static -o "$OUT/harness-win64.exe" $H
@@ -115,19 +106,39 @@ x86_64-w64-mingw32-gcc -O1 -Wall -D__USE_MINGW_ANSI_STDIO=1 -static -o "$OUT/har
 # stand-in beside the harness, for wine only (tests/platforms/bcryptprimitives.c)
 x86_64-w64-mingw32-gcc -O1 -Wall -shared -o "$OUT/bcryptprimitives.dll" tests/platforms/bcryptprimitives.c -ladvapi32
 aarch64-linux-gnu-gcc -O1 -Wall -o "$OUT/harness-aarch64" $H -ldl
-BIN=$OUT/ParallelArch/binaries
-URI=file://$OUT/ParallelArch/resources
-# shellcheck disable=SC2086 # REALS: one argument per value reference
-run() { local name=$1; shift; echo "-- $name"; /usr/bin/time -f "$name: %e s" "$@" "$GUID" "$DZ_VR" "$DZ" "$STEPS" $REALS \
-  >"$OUT/$name.txt" 2>"$OUT/$name.log" || { cat "$OUT/$name.log"; echo "$name: harness failed" >&2; exit 1; }
-  tail -1 "$OUT/$name.log"; }
-run linux64 "$OUT/harness-linux64" "$BIN/linux64/ParallelArch.so" "$URI"
 export WINEPREFIX=$OUT/wine WINEDEBUG=-all
-WIN_URI="file:///$(winepath -w "$OUT/ParallelArch/resources" 2>/dev/null | tr '\\' /)"
-run win64 wine "$OUT/harness-win64.exe" "$(winepath -w "$BIN/win64/ParallelArch.dll" 2>/dev/null)" "$WIN_URI"
-run aarch64-linux qemu-aarch64 -L /usr/aarch64-linux-gnu "$OUT/harness-aarch64" "$BIN/aarch64-linux/ParallelArch.so" "$URI"
-grep -E "^(version|state bytes)" "$OUT/linux64.txt"
-python3 tests/platforms/compare.py "$MD" "$OUT/linux64.txt" "$OUT/win64.txt" "$OUT/aarch64-linux.txt"
+
+# harness FMU INPUT PER_STEP: the harness on the FMU's library on the three platforms (STEPS
+# steps, the input INPUT set to k * PER_STEP before step k, every Real output), compared
+with_harness() {
+  local fmu=$1 input=$2 per_step=$3 name dir md guid vr reals id
+  name=$(basename "$fmu" .fmu) dir=$OUT/$(basename "$fmu" .fmu)
+  unzip -q -o "$fmu" -d "$dir"
+  md=$dir/modelDescription.xml
+  read -r guid id vr reals < <(python3 -c "
+import sys, xml.etree.ElementTree as E
+root = E.parse(sys.argv[1]).getroot()
+variables = list(root.iter('ScalarVariable'))
+print(root.get('guid'), root.find('CoSimulation').get('modelIdentifier'),
+      *[v.get('valueReference') for v in variables if v.get('name') == sys.argv[2]],
+      *[v.get('valueReference') for v in variables if v.get('causality') == 'output' and v.find('Real') is not None])
+" "$md" "$input")
+  local uri=file://$dir/resources win_uri
+  win_uri="file:///$(winepath -w "$dir/resources" 2>/dev/null | tr '\\' /)"
+  echo "-- $name: $input = k * $per_step, k = 1..$STEPS; $(wc -w <<<"$reals") Real outputs"
+  # shellcheck disable=SC2086 # reals: one argument per value reference
+  run() { local platform=$1; shift; /usr/bin/time -f "$name on $platform: %e s" "$@" "$guid" "$vr" "$per_step" "$STEPS" $reals \
+    >"$OUT/$name-$platform.txt" 2>"$OUT/$name-$platform.log" || { cat "$OUT/$name-$platform.log"; echo "$name on $platform: harness failed" >&2; exit 1; }
+    tail -1 "$OUT/$name-$platform.log"; }
+  run linux64 "$OUT/harness-linux64" "$dir/binaries/linux64/$id.so" "$uri"
+  run win64 wine "$OUT/harness-win64.exe" "$(winepath -w "$dir/binaries/win64/$id.dll" 2>/dev/null)" "$win_uri"
+  run aarch64-linux qemu-aarch64 -L /usr/aarch64-linux-gnu "$OUT/harness-aarch64" "$dir/binaries/aarch64-linux/$id.so" "$uri"
+  grep -E "^(version|state bytes)" "$OUT/$name-linux64.txt" || true
+  python3 tests/platforms/compare.py "$md" "$OUT/$name-linux64.txt" "$OUT/$name-win64.txt" "$OUT/$name-aarch64-linux.txt"
+}
+with_harness "$OUT/ParallelArch.fmu" frame.dz "$DZ"
+# the jack: its force raised by 200 N a step; it cannot serialize its state (kept in memory)
+HARNESS_SERIALIZE=0 with_harness "$OUT/HydraulicJack.fmu" force 200
 
 echo "== fmpy validate =="
 if [ -x .venv/bin/fmpy ]; then FMPY=.venv/bin/fmpy; else

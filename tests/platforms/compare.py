@@ -56,7 +56,7 @@ def main(argv):
         failed |= not ok
         at = f" at {where[0]} {where[1]} {table.get(where[2], where[2])}" if where else ""
         print(f"{path}: {len(other)} values, {bitwise} bitwise equal to linux64, largest relative "
-              f"difference {worst:.3g}{at}, replay from serialized state identical: "
+              f"difference {worst:.3g}{at}, replay from the restored state identical: "
               f"{'yes' if same_replay else 'NO'} -> {'agrees' if ok else 'DIFFERS'} (tolerance {TOLERANCE:g})")
     return 1 if failed else 0
 
