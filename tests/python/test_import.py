@@ -712,7 +712,7 @@ def test_a_rails_end_points_on_a_symmetry_plane_leave_the_plane_with_a_note(smal
                           top={"role": "boundary", "name": "rail", "target": [target, 0.0, -0.01]})
         with pytest.warns(MeshImportWarning, match=verdict) as caught:
             model = import_mesh(small_mesh, m)
-        (note,) = [str(w.message) for w in caught if "symmetry plane" in str(w.message)]
+        (note,) = [str(w.message) for w in caught if "symmetry plane 'left'" in str(w.message)]
         assert "symmetry plane 'left' (normal x): 1 nodes left out (20)" in note, note
         (plane,) = model["symmetry"]
         assert 20 not in plane["nodes"] and plane["nodes"] == [0, 5, 10, 15], plane
