@@ -1117,6 +1117,19 @@ fn a_load_per_plan_area_totals_its_value_times_the_projected_area_along_its_dire
     let mut rng = Random(5);
     let moved: Vec<f64> = still.iter().map(|_| 0.05 * rng.next()).collect();
     assert_eq!(total(&model, &moved), total(&model, &still), "a dead load");
+    // Its tangent is zero: every DOF's residual is the same at any displacement (the central
+    // difference of the force is 0 in every component), and it adds nothing to the matrix.
+    let system = System::new(&model, false).unwrap();
+    let loads = Loads::new(&model, &system);
+    let levels = LoadLevels::of_model(&model);
+    let residual_at = |u: &[f64]| {
+        let mut r = vec![0.0; u.len()];
+        let mut values = vec![0.0; system.nonzeros()];
+        loads.add_to(&system, &levels, u, &mut r, Some(&mut values));
+        assert!(values.iter().all(|&v| v == 0.0), "plan load stiffness");
+        r
+    };
+    assert_eq!(residual_at(&moved), residual_at(&still));
     // Along towards: the area projected on the plane normal to it.
     let mut along_y = model.clone();
     along_y.loads.pressures[0].towards = Some(Towards::Side(Side::PlusY));
