@@ -732,6 +732,19 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             r.slack_segments
         );
     }
+    for c in &results.chambers {
+        out!(
+            "chamber {}: pressure {:.3} Pa, volume {:.6} m³ ({})",
+            c.name,
+            c.pressure,
+            c.volume,
+            if c.sealed {
+                "enclosed air"
+            } else {
+                "held by its supply"
+            }
+        );
+    }
     let t = results.total_reaction;
     out!(
         "total reaction (supports, symmetry planes, groups): ({:.3}, {:.3}, {:.3}) N",
