@@ -72,9 +72,10 @@ pub enum Kind {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 4]); 10] = [
+pub const UNITS: [(&str, [i32; 4]); 11] = [
     ("m", [0, 1, 0, 0]),
     ("m2", [0, 2, 0, 0]),
+    ("m3", [0, 3, 0, 0]),
     ("m/s2", [0, 1, -2, 0]),
     ("kg/m3", [1, -3, 0, 0]),
     ("N", [1, 1, -2, 0]),
@@ -187,6 +188,7 @@ pub fn step_inputs(
             }
             (Binding::GroupAngle(group), &Value::Real(x)) => inputs.angles[group] = x,
             (Binding::Pressure(set), &Value::Real(x)) => inputs.loads.pressure[set] = x,
+            (Binding::ChamberSupply(k), &Value::Real(x)) => inputs.loads.chambers[k] = x,
             (Binding::NodalForce { set, axis }, &Value::Real(x)) => {
                 inputs.loads.force[set][axis] = x
             }
@@ -277,6 +279,19 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 ),
             },
             Binding::Pressure(set),
+        );
+    }
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.input(
+            &format!("{}.supplyPressure", c.name),
+            c.pressure,
+            "Pa",
+            &format!(
+                "gauge pressure the supply holds in chamber '{}', reached at the end of a step \
+                 (ignored while its air is enclosed)",
+                c.name
+            ),
+            Binding::ChamberSupply(k),
         );
     }
     for (set, f) in model.loads.forces.iter().enumerate() {
@@ -672,6 +687,20 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "N",
             &format!("largest axial force of cable '{}' (0 when slack)", c.name),
             Binding::CableForce(cable),
+        );
+    }
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.output(
+            &format!("{}.pressure", c.name),
+            "Pa",
+            &format!("gauge pressure of the air in chamber '{}'", c.name),
+            Binding::ChamberPressure(k),
+        );
+        table.output(
+            &format!("{}.volume", c.name),
+            "m3",
+            &format!("volume of chamber '{}'", c.name),
+            Binding::ChamberVolume(k),
         );
     }
     for (point, p) in model.outputs.points.iter().enumerate() {

@@ -159,6 +159,10 @@ impl Contribution for Chambers {
         self.start.clone_from(&start.chambers);
     }
 
+    fn at_converged(&mut self, state: &AnalysisState) {
+        self.start.clone_from(&state.chambers);
+    }
+
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], mut values: Option<&mut [f64]>) {
         if self.geometry.is_empty() {
             return;
@@ -168,7 +172,8 @@ impl Contribution for Chambers {
         self.low_rank.clear();
         let system = at.system;
         for (k, g) in self.geometry.iter().enumerate() {
-            let gas = self.start[k];
+            // Before any restore (a first evaluation) the air is the reference's, supplied.
+            let gas = self.start.get(k).copied().unwrap_or_default();
             let v = volumes[k];
             let law = &self.laws[k];
             let p = if gas.sealed {
