@@ -14,7 +14,7 @@ use membrane_contact::specimens::scenarios::CircularMembrane;
 use nalgebra::DMatrix;
 
 mod common;
-use common::{dense, film, hencky, worst_fd_mismatch};
+use common::{assert_example_file, dense, film, hencky, worst_fd_mismatch};
 
 /// Two identical discs of radius `a` in `rings` rings welded at their rim (held by the group
 /// `rim`): the top layer's triangles (the first half) face +Z, the bottom's −Z; one chamber
@@ -302,4 +302,39 @@ fn bisect(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
         }
     }
     0.5 * (lo + hi)
+}
+
+/// `examples/cushion_air.json`: `examples/cushion.json` (2 m round ETFE cushion, two 250 µm
+/// layers welded at the rim) with its air as a chamber `air` supplied at 300 Pa instead of a
+/// pressure set. Its golden numbers (CLI `model examples/cushion_air.json --steps 5`): volume
+/// 0.19604 m³, crown rise 60.74 mm.
+#[test]
+fn cushion_air_example_encloses_0_196_cubic_metres_at_300_pa() {
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion.json");
+    let mut model = Model::from_json(&std::fs::read_to_string(example).unwrap()).unwrap();
+    model.name = "CushionAir".into();
+    model.description = "ETFE cushion, 2 m diameter, its air a chamber supplied at 300 Pa \
+                         (examples/cushion_air.json)"
+        .into();
+    model.loads.pressures.clear();
+    model.chambers = vec![ChamberSpec {
+        name: "air".into(),
+        elements: ElementSelection::All(AllElements::All),
+        closed_by_plane: None,
+        pressure: 300.0,
+        sealed: false,
+        kappa: 1.0,
+        atmosphere: 101_325.0,
+    }];
+    assert_example_file("cushion_air.json", &model);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for k in 1..=5 {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(k as f64 / 5.0), 10)
+            .unwrap();
+    }
+    let r = analysis.results();
+    assert!((r.chambers[0].volume - 0.19604).abs() < 2e-5, "{}", r.chambers[0].volume);
+    assert!((analysis.node_displacement(0).z - 0.06074).abs() < 2e-5);
 }
