@@ -335,6 +335,77 @@ fn cushion_air_example_encloses_0_196_cubic_metres_at_300_pa() {
             .unwrap();
     }
     let r = analysis.results();
-    assert!((r.chambers[0].volume - 0.19604).abs() < 2e-5, "{}", r.chambers[0].volume);
+    assert!(
+        (r.chambers[0].volume - 0.19604).abs() < 2e-5,
+        "{}",
+        r.chambers[0].volume
+    );
     assert!((analysis.node_displacement(0).z - 0.06074).abs() < 2e-5);
+}
+
+/// A three-layer cushion (issue 43 item 2): two chambers share the middle layer, which carries
+/// their pressure difference. Supplied at 300 Pa above and 400 Pa below, each layer is a
+/// Föppl–Hencky membrane under its own net pressure: the top rises under 300 Pa, the middle
+/// under 100 Pa, the bottom sags under 400 Pa, each crown within 1 % (24 rings a layer), and the
+/// chambers' volumes are the differences of the layers' (within 1 %).
+#[test]
+fn the_middle_layer_of_a_three_layer_cushion_carries_the_chambers_pressure_difference() {
+    let (a, rings) = (1.0, 24);
+    let material = film(1.0e6);
+    let mut model = cushion(a, rings, material, 300.0);
+    let per_layer = model.triangles.len() / 2;
+    let disc_nodes = 1 + 3 * rings * (rings + 1);
+    // A middle layer: the top's interior copied once more, the rim shared, facing +Z.
+    let first = model.nodes.len();
+    let rim = disc_nodes - 6 * rings;
+    let middle = |v: usize| if v >= rim { v } else { first + v };
+    for v in 0..rim {
+        model.nodes.push(model.nodes[v]);
+    }
+    let top: Vec<[usize; 3]> = model.triangles[..per_layer].to_vec();
+    model.triangles.extend(top.iter().map(|t| t.map(middle)));
+    let (upper, lower): (Vec<usize>, Vec<usize>) = (
+        (0..per_layer).chain(2 * per_layer..3 * per_layer).collect(),
+        (per_layer..3 * per_layer).collect(),
+    );
+    let mut lower_air = model.chambers[0].clone();
+    lower_air.name = "lower".into();
+    lower_air.elements = ElementSelection::List(lower);
+    lower_air.pressure = 400.0;
+    model.chambers[0].name = "upper".into();
+    model.chambers[0].elements = ElementSelection::List(upper);
+    model.chambers.push(lower_air);
+    model.validate().unwrap();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(f), 4)
+            .unwrap();
+    }
+    let rise = |v: usize| analysis.node_displacement(v).z;
+    let reference = |q: f64| layer_volume(&material, a, q);
+    let (top, mid, bottom) = (reference(300.0), reference(100.0), reference(-400.0));
+    let measured = [rise(0), rise(first), rise(disc_nodes)];
+    for (name, fe, hencky) in [
+        ("top", measured[0], top.1),
+        ("middle", measured[1], mid.1),
+        ("bottom", measured[2], bottom.1),
+    ] {
+        println!("{name}: crown {fe:.5e} m vs Föppl–Hencky {hencky:.5e} m");
+        assert!((fe / hencky - 1.0).abs() < 0.01, "{name}");
+    }
+    let r = analysis.results();
+    let (v_upper, v_lower) = (r.chambers[0].volume, r.chambers[1].volume);
+    println!(
+        "volumes {v_upper:.5e}, {v_lower:.5e} m³ vs {:.5e}, {:.5e}",
+        top.0 - mid.0,
+        mid.0 - bottom.0
+    );
+    assert!((v_upper / (top.0 - mid.0) - 1.0).abs() < 0.01);
+    assert!((v_lower / (mid.0 - bottom.0) - 1.0).abs() < 0.01);
+    assert_eq!(
+        (r.chambers[0].pressure, r.chambers[1].pressure),
+        (300.0, 400.0)
+    );
 }
