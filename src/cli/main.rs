@@ -119,6 +119,7 @@ fn load_path(
                 .collect(),
             loads: loads.scaled(f),
             mu: None,
+            sealed: model.chambers.iter().map(|c| c.sealed).collect(),
         })
         .collect();
     Ok(StagedPath { times, steps: rows })

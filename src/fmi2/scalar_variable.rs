@@ -221,6 +221,8 @@ pub enum Binding {
     SurfaceFrictionForce(usize),
     /// Input: the supply's gauge pressure of a chamber (ignored once its air is enclosed).
     ChamberSupply(usize),
+    /// Input: whether a chamber's air is enclosed (its valve closed).
+    ChamberSealed(usize),
     /// Gauge pressure of a chamber's air.
     ChamberPressure(usize),
     /// Volume of a chamber.

@@ -162,6 +162,8 @@ pub struct StepInputs {
     /// Pressures and nodal forces from the inputs; gravity from the model (a parameter).
     pub loads: LoadLevels,
     pub mu: Option<f64>,
+    /// Whether each chamber's air is to be enclosed from this step on.
+    pub sealed: Vec<bool>,
 }
 
 /// Reads the step's targets from the input values of `table` (`values[i]` belongs to
@@ -179,6 +181,7 @@ pub fn step_inputs(
         angles: vec![0.0; model.groups.len()],
         loads: LoadLevels::zero(model),
         mu: None,
+        sealed: model.chambers.iter().map(|c| c.sealed).collect(),
     };
     inputs.loads.gravity = model.loads.gravity;
     for (v, x) in table.iter().zip(values) {
@@ -189,6 +192,7 @@ pub fn step_inputs(
             (Binding::GroupAngle(group), &Value::Real(x)) => inputs.angles[group] = x,
             (Binding::Pressure(set), &Value::Real(x)) => inputs.loads.pressure[set] = x,
             (Binding::ChamberSupply(k), &Value::Real(x)) => inputs.loads.chambers[k] = x,
+            (Binding::ChamberSealed(k), &Value::Boolean(b)) => inputs.sealed[k] = b,
             (Binding::NodalForce { set, axis }, &Value::Real(x)) => {
                 inputs.loads.force[set][axis] = x
             }
@@ -292,6 +296,19 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 c.name
             ),
             Binding::ChamberSupply(k),
+        );
+        table.push(
+            &format!("{}.sealed", c.name),
+            VarType::Boolean,
+            Causality::Input,
+            Some(Value::Boolean(c.sealed)),
+            None,
+            &format!(
+                "true: the air of chamber '{}' is enclosed at its pressure and volume when the next \
+                 step starts and follows Boyle's law; false: a supply holds supplyPressure",
+                c.name
+            ),
+            Binding::ChamberSealed(k),
         );
     }
     for (set, f) in model.loads.forces.iter().enumerate() {

@@ -7,6 +7,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::mech::solve::analysis::Analysis;
+use crate::mech::solve::contributions::ChamberState;
 use crate::mech::solve::linear::FactorizationError;
 
 /// `Σ a_i b_i`.
@@ -56,7 +57,34 @@ impl Analysis {
     /// inflation unit's valve closes): from the next step on its pressure follows the gas law
     /// `(p + p_a) V^κ = C`. Err names a chamber that encloses no volume.
     pub fn seal_chambers(&mut self) -> Result<(), String> {
-        self.state.chambers = self.parts.chambers.sealed(&self.state)?;
+        self.set_chambers_sealed(&vec![true; self.state.chambers.len()])
+    }
+
+    /// Encloses the air of each chamber whose `sealed` is true and not yet enclosed (see
+    /// [`Self::seal_chambers`]), and hands back to its supply each one whose `sealed` is false
+    /// (the valve opens: the supply's pressure level applies from the next step on). Err names
+    /// a chamber that encloses no volume, or a list of the wrong length.
+    pub fn set_chambers_sealed(&mut self, sealed: &[bool]) -> Result<(), String> {
+        if sealed.len() != self.state.chambers.len() {
+            return Err(format!(
+                "{} sealed flags for {} chambers",
+                sealed.len(),
+                self.state.chambers.len()
+            ));
+        }
+        let mut chambers = self.state.chambers.clone();
+        for (k, (c, &want)) in chambers.iter_mut().zip(sealed).enumerate() {
+            *c = match (c.sealed, want) {
+                (false, true) => self.parts.chambers.enclosed(k, c)?,
+                (true, false) => ChamberState {
+                    sealed: false,
+                    constant: 0.0,
+                    ..*c
+                },
+                _ => *c,
+            };
+        }
+        self.state.chambers = chambers;
         Ok(())
     }
 }

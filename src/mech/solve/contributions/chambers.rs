@@ -105,31 +105,23 @@ impl Chambers {
             .collect()
     }
 
-    /// The state with each supplied chamber's gas enclosed at its converged pressure and volume
-    /// (the inflation unit's valve closes); Err where a chamber encloses no volume.
-    pub fn sealed(&self, state: &AnalysisState) -> Result<Vec<ChamberState>, String> {
-        state
-            .chambers
-            .iter()
-            .zip(&self.laws)
-            .zip(&self.names)
-            .map(|((c, law), name)| {
-                if c.sealed {
-                    return Ok(*c);
-                }
-                if !(c.volume > 0.0) {
-                    return Err(format!(
-                        "chamber '{name}' encloses no volume ({:e} m³): it cannot be sealed",
-                        c.volume
-                    ));
-                }
-                Ok(ChamberState {
-                    sealed: true,
-                    constant: law.constant(c.pressure, c.volume),
-                    ..*c
-                })
-            })
-            .collect()
+    /// Chamber `k`'s air `c` enclosed at its converged pressure and volume (the inflation
+    /// unit's valve closes; unchanged if enclosed already); Err where it encloses no volume.
+    pub fn enclosed(&self, k: usize, c: &ChamberState) -> Result<ChamberState, String> {
+        if c.sealed {
+            return Ok(*c);
+        }
+        if !(c.volume > 0.0) {
+            return Err(format!(
+                "chamber '{}' encloses no volume ({:e} m³): it cannot be sealed",
+                self.names[k], c.volume
+            ));
+        }
+        Ok(ChamberState {
+            sealed: true,
+            constant: self.laws[k].constant(c.pressure, c.volume),
+            ..*c
+        })
     }
 
     /// Whether the model has a sealed chamber now (a pneumatic stiffness to add).
