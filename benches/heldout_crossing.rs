@@ -827,6 +827,7 @@ fn run(path: &Path, increments: usize) -> Outcome {
             pressure: stage.pressure.clone(),
             force: s.loads.force.clone(),
             gravity: stage.gravity,
+            chambers: vec![],
         };
         for k in 1..=stage.steps {
             let f = k as f64 / stage.steps as f64;

@@ -119,6 +119,7 @@ fn load_path(
                 .collect(),
             loads: loads.scaled(f),
             mu: None,
+            sealed: model.chambers.iter().map(|c| c.sealed).collect(),
         })
         .collect();
     Ok(StagedPath { times, steps: rows })
@@ -730,6 +731,19 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             c.name,
             r.max_force,
             r.slack_segments
+        );
+    }
+    for c in &results.chambers {
+        out!(
+            "chamber {}: pressure {:.3} Pa, volume {:.6} m³ ({})",
+            c.name,
+            c.pressure,
+            c.volume,
+            if c.sealed {
+                "enclosed air"
+            } else {
+                "held by its supply"
+            }
         );
     }
     let t = results.total_reaction;

@@ -148,6 +148,8 @@ pub(super) fn state_result(binding: &Binding, results: &Results) -> Option<f64> 
         Binding::SurfaceFrictionForce(c) => results.surface_contacts[c].friction_force,
         Binding::PointDisplacement { point, axis } => results.points[point][axis],
         Binding::SetSummary { set, quantity } => quantity.of(&results.sets[set]),
+        Binding::ChamberPressure(k) => results.chambers[k].pressure,
+        Binding::ChamberVolume(k) => results.chambers[k].volume,
         _ => return None,
     })
 }
@@ -172,5 +174,7 @@ pub(super) fn is_state_result(binding: &Binding) -> bool {
             | Binding::SurfaceFrictionForce(_)
             | Binding::PointDisplacement { .. }
             | Binding::SetSummary { .. }
+            | Binding::ChamberPressure(_)
+            | Binding::ChamberVolume(_)
     )
 }

@@ -77,6 +77,7 @@ impl Instance {
             angles,
             mut loads,
             mu,
+            sealed,
         } = step_inputs(
             &self.description.model,
             &self.description.variables,
@@ -89,21 +90,32 @@ impl Instance {
             .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
         // Gravity is a parameter: the built model holds it, and the first step ramps it in.
         loads.gravity = built.analysis.model().loads.gravity;
-        // μ changes the state's friction (gaps and curved-support contacts) before the step; a
-        // refused step must not keep it.
+        // μ changes the state's friction (gaps and curved-support contacts) and a chamber's
+        // valve its air before the step; a refused step must not keep either.
         let state = built.analysis.state();
         let changes = |mu: f64| {
             let contacts = state.contacts.iter().map(|c| &c.friction);
             state.friction.iter().chain(contacts).any(|&f| f != mu)
         };
-        let before = match mu {
-            Some(mu) if changes(mu) => {
-                let before = built.analysis.state().clone();
-                built.analysis.set_friction(mu).map_err(Failure::error)?;
-                Some(before)
+        let valves = state
+            .chambers
+            .iter()
+            .zip(&sealed)
+            .any(|(c, &s)| c.sealed != s);
+        let before = (mu.is_some_and(changes) || valves).then(|| state.clone());
+        if let Some(mu) = mu.filter(|&mu| changes(mu)) {
+            built.analysis.set_friction(mu).map_err(Failure::error)?;
+        }
+        // A chamber's valve closes (or opens) as the step starts; a refused step reopens it.
+        if valves && let Err(e) = built.analysis.set_chambers_sealed(&sealed) {
+            if let Some(b) = &before {
+                built
+                    .analysis
+                    .set_state(b.clone())
+                    .map_err(Failure::error)?;
             }
-            _ => None,
-        };
+            return Err(Failure::error(e));
+        }
         match checked_step(built, &targets, &angles, &loads, &self.logger) {
             Ok(report) => {
                 if let Some(b) = self.analysis.as_mut() {

@@ -72,9 +72,10 @@ pub enum Kind {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 4]); 10] = [
+pub const UNITS: [(&str, [i32; 4]); 11] = [
     ("m", [0, 1, 0, 0]),
     ("m2", [0, 2, 0, 0]),
+    ("m3", [0, 3, 0, 0]),
     ("m/s2", [0, 1, -2, 0]),
     ("kg/m3", [1, -3, 0, 0]),
     ("N", [1, 1, -2, 0]),
@@ -161,6 +162,8 @@ pub struct StepInputs {
     /// Pressures and nodal forces from the inputs; gravity from the model (a parameter).
     pub loads: LoadLevels,
     pub mu: Option<f64>,
+    /// Whether each chamber's air is to be enclosed from this step on.
+    pub sealed: Vec<bool>,
 }
 
 /// Reads the step's targets from the input values of `table` (`values[i]` belongs to
@@ -178,6 +181,7 @@ pub fn step_inputs(
         angles: vec![0.0; model.groups.len()],
         loads: LoadLevels::zero(model),
         mu: None,
+        sealed: model.chambers.iter().map(|c| c.sealed).collect(),
     };
     inputs.loads.gravity = model.loads.gravity;
     for (v, x) in table.iter().zip(values) {
@@ -187,6 +191,8 @@ pub fn step_inputs(
             }
             (Binding::GroupAngle(group), &Value::Real(x)) => inputs.angles[group] = x,
             (Binding::Pressure(set), &Value::Real(x)) => inputs.loads.pressure[set] = x,
+            (Binding::ChamberSupply(k), &Value::Real(x)) => inputs.loads.chambers[k] = x,
+            (Binding::ChamberSealed(k), &Value::Boolean(b)) => inputs.sealed[k] = b,
             (Binding::NodalForce { set, axis }, &Value::Real(x)) => {
                 inputs.loads.force[set][axis] = x
             }
@@ -277,6 +283,32 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 ),
             },
             Binding::Pressure(set),
+        );
+    }
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.input(
+            &format!("{}.supplyPressure", c.name),
+            c.pressure,
+            "Pa",
+            &format!(
+                "gauge pressure the supply holds in chamber '{}', reached at the end of a step \
+                 (ignored while its air is enclosed)",
+                c.name
+            ),
+            Binding::ChamberSupply(k),
+        );
+        table.push(
+            &format!("{}.sealed", c.name),
+            VarType::Boolean,
+            Causality::Input,
+            Some(Value::Boolean(c.sealed)),
+            None,
+            &format!(
+                "true: the air of chamber '{}' is enclosed at its pressure and volume when the next \
+                 step starts and follows Boyle's law; false: a supply holds supplyPressure",
+                c.name
+            ),
+            Binding::ChamberSealed(k),
         );
     }
     for (set, f) in model.loads.forces.iter().enumerate() {
@@ -672,6 +704,20 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "N",
             &format!("largest axial force of cable '{}' (0 when slack)", c.name),
             Binding::CableForce(cable),
+        );
+    }
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.output(
+            &format!("{}.pressure", c.name),
+            "Pa",
+            &format!("gauge pressure of the air in chamber '{}'", c.name),
+            Binding::ChamberPressure(k),
+        );
+        table.output(
+            &format!("{}.volume", c.name),
+            "m3",
+            &format!("volume of chamber '{}'", c.name),
+            Binding::ChamberVolume(k),
         );
     }
     for (point, p) in model.outputs.points.iter().enumerate() {

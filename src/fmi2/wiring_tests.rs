@@ -194,6 +194,12 @@ fn edit(run: &mut CoreRun, name: &str, value: &Value) -> Result<(), String> {
         (_, "pressure") if loads("pressures").is_some() => {
             format!("/loads/pressures/{}/pressure", loads("pressures").unwrap())
         }
+        (_, "supplyPressure") if position("chambers").is_some() => {
+            format!("/chambers/{}/pressure", position("chambers").unwrap())
+        }
+        (_, "sealed") if position("chambers").is_some() => {
+            format!("/chambers/{}/sealed", position("chambers").unwrap())
+        }
         (_, "Fx" | "Fy" | "Fz") if loads("forces").is_some() => format!(
             "/loads/forces/{}/force/{}",
             loads("forces").unwrap(),
@@ -310,6 +316,12 @@ fn expected(name: &str, model: &Model, r: &Results, report: &StepReport) -> Valu
             _ => None,
         }
         .map(Value::Real)
+    } else if let Some(c) = model.chambers.iter().position(|c| c.name == prefix) {
+        match suffix {
+            "pressure" => Some(Value::Real(r.chambers[c].pressure)),
+            "volume" => Some(Value::Real(r.chambers[c].volume)),
+            _ => None,
+        }
     } else if let Some((support, node)) = prefix.split_once(".node") {
         // Curved-support contacts in model order: supports, then their nodes.
         let mut k = 0;
@@ -705,6 +717,29 @@ fn every_parameter_and_input_of_the_circular_membrane_reaches_the_solver() {
             NEVER_WRINKLES,
             FULL_NEWTON_STEPS,
             PLAIN_NEWTON_CONVERGES,
+        ],
+    );
+}
+
+/// `examples/cushion_air.json` (issue 43): the chamber's supply pressure and its valve reach
+/// the solver (sealed at the flat start, the air encloses nothing: both refuse the step), and
+/// its pressure and volume are the core's.
+#[test]
+fn every_parameter_and_input_of_the_cushion_with_a_chamber_reaches_the_solver() {
+    check_every_variable(
+        "cushion air",
+        Source::Model(example("cushion_air.json")),
+        &[("solver.incrementsPerStep", Value::Integer(2))],
+        &[
+            NOTHING_SLIDES,
+            NEVER_WRINKLES,
+            FULL_NEWTON_STEPS,
+            PLAIN_NEWTON_CONVERGES,
+            (
+                "solver.displacementTolerance",
+                "Newton converges quadratically on the inflated cushion: a correction criterion \
+                 1000 times tighter is met at the same iteration",
+            ),
         ],
     );
 }

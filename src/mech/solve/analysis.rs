@@ -128,6 +128,7 @@ impl Analysis {
             last_increment: Vec::new(),
             landing: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
+            chambers: parts.chambers.initial_states(&model),
             plastic: system
                 .material
                 .plastic_film()

@@ -48,6 +48,9 @@ pub struct AnalysisState {
     /// [`crate::mech::elements::gap::GapLaw::evaluate_landing`]). Empty in a converged state.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub landing: Vec<usize>,
+    /// The gas of each chamber ([`crate::mech::solve::contributions::ChamberState`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chambers: Vec<crate::mech::solve::contributions::ChamberState>,
 }
 
 impl AnalysisState {
