@@ -201,6 +201,36 @@ impl ChamberGeometry {
     }
 }
 
+/// One line per chamber of `model` for `check`: its triangles, what closes it, the volume it
+/// encloses in the reference geometry and its air.
+pub fn chamber_report(model: &Model) -> Vec<String> {
+    let x: Vec<Vector3<f64>> = model.nodes.iter().map(|&p| Vector3::from(p)).collect();
+    model
+        .chambers
+        .iter()
+        .map(|c| {
+            let closed = match &c.closed_by_plane {
+                None => "closed by its own triangles".to_string(),
+                Some(p) => format!(
+                    "closed by the plane through {:?} with normal {:?} into it",
+                    p.point, p.normal
+                ),
+            };
+            let volume = ChamberGeometry::new(model, c).map_or(f64::NAN, |g| g.volume(&x));
+            let air = if c.sealed {
+                format!("air enclosed at {} Pa (κ {})", c.pressure, c.kappa)
+            } else {
+                format!("air held by a supply at {} Pa", c.pressure)
+            };
+            format!(
+                "chamber '{}': {} triangles, {closed}, {volume:.6} m³ in the reference geometry, {air}",
+                c.name,
+                model.selected_triangles(&c.elements).len()
+            )
+        })
+        .collect()
+}
+
 /// Orientation signs of `triangles` (+1 keeps the node order) so that every edge two of them
 /// share is traversed once each way: a flood over shared edges from the first triangle of each
 /// connected part. Err names an edge of three triangles or one that cannot be made consistent.
