@@ -55,6 +55,8 @@ fn cushion(a: f64, rings: usize, material: Material, pressure: f64) -> Model {
         sealed: false,
         kappa: 1.0,
         atmosphere: 101_325.0,
+        temperature: 293.15,
+        heating: 0.0,
     }];
     m.validate().unwrap();
     m
@@ -235,15 +237,7 @@ fn two_layer_cushion_under_snow_matches_foppl_hencky_with_boyles_law() {
             (p + pa) * (v_ref(p).0 + v_ref(p - s).0) - gas
         })
     };
-    let settings = SolverSettings::default();
-    let mut analysis = Analysis::new(model.clone(), settings).unwrap();
-    let mut levels = LoadLevels::zero(&model);
-    for f in [0.25, 0.5, 1.0] {
-        levels.chambers[0] = f * p0;
-        analysis
-            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
-            .unwrap();
-    }
+    let (mut analysis, mut levels) = inflated(&model, p0);
     let (_, w_inflated) = v_ref(p0);
     let crown_top = analysis.node_displacement(0).z;
     // The bottom layer's first node, the copy of the top's centre (node 0).
@@ -325,6 +319,8 @@ fn cushion_air_example_encloses_0_196_cubic_metres_at_300_pa() {
         sealed: false,
         kappa: 1.0,
         atmosphere: 101_325.0,
+        temperature: 293.15,
+        heating: 0.0,
     }];
     assert_example_file("cushion_air.json", &model);
     let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
@@ -408,4 +404,55 @@ fn the_middle_layer_of_a_three_layer_cushion_carries_the_chambers_pressure_diffe
         (r.chambers[0].pressure, r.chambers[1].pressure),
         (300.0, 400.0)
     );
+}
+
+/// The analysis of `model` with its first chamber supplied up to `p0` in three steps, and the
+/// load levels it ends at.
+fn inflated(model: &Model, p0: f64) -> (Analysis, LoadLevels) {
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let mut levels = LoadLevels::zero(model);
+    for f in [0.25, 0.5, 1.0] {
+        levels.chambers[0] = f * p0;
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+            .unwrap();
+    }
+    (analysis, levels)
+}
+
+/// The sun on a sealed two-layer cushion: its air heated by 30 K at the enclosed mass raises the
+/// pressure by Gay-Lussac and Boyle together, `(p + p_a) 2 V(p) = (p0 + p_a) 2 V(p0) T1/T0`, with
+/// each layer's `V` from Föppl–Hencky: pressure and rise within 0.5 %, the air's mass unchanged
+/// (ideal gas) and its temperature reported.
+#[test]
+fn a_sealed_cushion_heated_by_30_k_matches_foppl_hencky_with_the_ideal_gas() {
+    let (a, p0, pa, t0) = (1.0, 300.0, 101_325.0, 293.15);
+    let material = film(1.0e6);
+    let model = cushion(a, 24, material, p0);
+    let (mut analysis, mut levels) = inflated(&model, p0);
+    analysis.seal_chambers().unwrap();
+    let mass = analysis.results().chambers[0].mass;
+    for f in [0.5, 1.0] {
+        levels.heating[0] = 30.0 * f;
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+            .unwrap();
+    }
+    let v_ref = |q: f64| layer_volume(&material, a, q);
+    let gas = (p0 + pa) * 2.0 * v_ref(p0).0 * (t0 + 30.0) / t0;
+    let p = bisect(p0, 100.0 * p0, |p| (p + pa) * 2.0 * v_ref(p).0 - gas);
+    let r = analysis.results();
+    let c = &r.chambers[0];
+    let (rise, w) = (analysis.node_displacement(0).z, v_ref(p).1);
+    println!(
+        "heated 30 K: p {:.3} Pa vs {p:.3} Pa ({:+.3}%), crown {rise:.5e} vs {w:.5e} m ({:+.3}%), mass {:.6e} kg (sealed {mass:.6e})",
+        c.pressure,
+        100.0 * (c.pressure / p - 1.0),
+        100.0 * (rise / w - 1.0),
+        c.mass
+    );
+    assert!((c.pressure / p - 1.0).abs() < 0.005);
+    assert!((rise / w - 1.0).abs() < 0.005);
+    assert!((c.mass / mass - 1.0).abs() < 1e-9);
+    assert!((c.temperature - (t0 + 30.0)).abs() < 1e-12);
 }

@@ -940,7 +940,7 @@ fn import(
 }
 
 /// `membrane-contact check FILE`: validates the model, prints its warnings on stderr (as a run
-/// does) and how each pressure set faces on stdout.
+/// does), how each pressure set faces and what each chamber encloses on stdout.
 fn check(file: &std::path::Path) -> Result<(), String> {
     let name = file.display();
     let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
@@ -950,6 +950,9 @@ fn check(file: &std::path::Path) -> Result<(), String> {
     }
     out!("{}", size_line(&model, ": valid,"));
     for line in membrane_contact::mech::elements::load::orientation_report(&model) {
+        out!("{line}");
+    }
+    for line in membrane_contact::mech::elements::chamber::chamber_report(&model) {
         out!("{line}");
     }
     Ok(())

@@ -150,6 +150,8 @@ pub(super) fn state_result(binding: &Binding, results: &Results) -> Option<f64> 
         Binding::SetSummary { set, quantity } => quantity.of(&results.sets[set]),
         Binding::ChamberPressure(k) => results.chambers[k].pressure,
         Binding::ChamberVolume(k) => results.chambers[k].volume,
+        Binding::ChamberTemperature(k) => results.chambers[k].temperature,
+        Binding::ChamberMass(k) => results.chambers[k].mass,
         _ => return None,
     })
 }
@@ -176,5 +178,7 @@ pub(super) fn is_state_result(binding: &Binding) -> bool {
             | Binding::SetSummary { .. }
             | Binding::ChamberPressure(_)
             | Binding::ChamberVolume(_)
+            | Binding::ChamberTemperature(_)
+            | Binding::ChamberMass(_)
     )
 }

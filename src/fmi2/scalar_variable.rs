@@ -223,6 +223,12 @@ pub enum Binding {
     ChamberSupply(usize),
     /// Input: whether a chamber's air is enclosed (its valve closed).
     ChamberSealed(usize),
+    /// Input: a chamber's air temperature rise above its reference (K).
+    ChamberHeating(usize),
+    /// A chamber's air temperature (K).
+    ChamberTemperature(usize),
+    /// A chamber's air mass (kg).
+    ChamberMass(usize),
     /// Gauge pressure of a chamber's air.
     ChamberPressure(usize),
     /// Volume of a chamber.

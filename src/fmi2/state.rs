@@ -183,6 +183,11 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             loads.chambers.len(),
             model.chambers.len(),
         ),
+        (
+            "chamber heating levels",
+            loads.heating.len(),
+            model.chambers.len(),
+        ),
         ("chambers' air", state.chambers.len(), model.chambers.len()),
     ];
     for (what, have, want) in load_sizes {

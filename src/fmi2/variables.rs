@@ -72,18 +72,20 @@ pub enum Kind {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 4]); 11] = [
-    ("m", [0, 1, 0, 0]),
-    ("m2", [0, 2, 0, 0]),
-    ("m3", [0, 3, 0, 0]),
-    ("m/s2", [0, 1, -2, 0]),
-    ("kg/m3", [1, -3, 0, 0]),
-    ("N", [1, 1, -2, 0]),
-    ("N.m", [1, 2, -2, 0]),
-    ("Pa", [1, -1, -2, 0]),
-    ("N/m", [1, 0, -2, 0]),
-    ("rad", [0, 0, 0, 1]),
-    ("1", [0, 0, 0, 0]),
+pub const UNITS: [(&str, [i32; 5]); 13] = [
+    ("m", [0, 1, 0, 0, 0]),
+    ("m2", [0, 2, 0, 0, 0]),
+    ("m3", [0, 3, 0, 0, 0]),
+    ("m/s2", [0, 1, -2, 0, 0]),
+    ("kg/m3", [1, -3, 0, 0, 0]),
+    ("N", [1, 1, -2, 0, 0]),
+    ("N.m", [1, 2, -2, 0, 0]),
+    ("Pa", [1, -1, -2, 0, 0]),
+    ("N/m", [1, 0, -2, 0, 0]),
+    ("rad", [0, 0, 0, 0, 1]),
+    ("K", [0, 0, 0, 1, 0]),
+    ("kg", [1, 0, 0, 0, 0]),
+    ("1", [0, 0, 0, 0, 0]),
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
@@ -193,6 +195,7 @@ pub fn step_inputs(
             (Binding::Pressure(set), &Value::Real(x)) => inputs.loads.pressure[set] = x,
             (Binding::ChamberSupply(k), &Value::Real(x)) => inputs.loads.chambers[k] = x,
             (Binding::ChamberSealed(k), &Value::Boolean(b)) => inputs.sealed[k] = b,
+            (Binding::ChamberHeating(k), &Value::Real(x)) => inputs.loads.heating[k] = x,
             (Binding::NodalForce { set, axis }, &Value::Real(x)) => {
                 inputs.loads.force[set][axis] = x
             }
@@ -309,6 +312,17 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 c.name
             ),
             Binding::ChamberSealed(k),
+        );
+        table.input(
+            &format!("{}.heating", c.name),
+            c.heating,
+            "K",
+            &format!(
+                "temperature rise of the air in chamber '{}' above its reference {} K (the sun), \
+                 reached at the end of a step",
+                c.name, c.temperature
+            ),
+            Binding::ChamberHeating(k),
         );
     }
     for (set, f) in model.loads.forces.iter().enumerate() {
@@ -718,6 +732,18 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "m3",
             &format!("volume of chamber '{}'", c.name),
             Binding::ChamberVolume(k),
+        );
+        table.output(
+            &format!("{}.temperature", c.name),
+            "K",
+            &format!("temperature of the air in chamber '{}'", c.name),
+            Binding::ChamberTemperature(k),
+        );
+        table.output(
+            &format!("{}.mass", c.name),
+            "kg",
+            &format!("mass of the air in chamber '{}' (ideal gas)", c.name),
+            Binding::ChamberMass(k),
         );
     }
     for (point, p) in model.outputs.points.iter().enumerate() {

@@ -200,6 +200,9 @@ fn edit(run: &mut CoreRun, name: &str, value: &Value) -> Result<(), String> {
         (_, "sealed") if position("chambers").is_some() => {
             format!("/chambers/{}/sealed", position("chambers").unwrap())
         }
+        (_, "heating") if position("chambers").is_some() => {
+            format!("/chambers/{}/heating", position("chambers").unwrap())
+        }
         (_, "Fx" | "Fy" | "Fz") if loads("forces").is_some() => format!(
             "/loads/forces/{}/force/{}",
             loads("forces").unwrap(),
@@ -320,6 +323,8 @@ fn expected(name: &str, model: &Model, r: &Results, report: &StepReport) -> Valu
         match suffix {
             "pressure" => Some(Value::Real(r.chambers[c].pressure)),
             "volume" => Some(Value::Real(r.chambers[c].volume)),
+            "temperature" => Some(Value::Real(r.chambers[c].temperature)),
+            "mass" => Some(Value::Real(r.chambers[c].mass)),
             _ => None,
         }
     } else if let Some((support, node)) = prefix.split_once(".node") {
@@ -525,6 +530,7 @@ fn changed(v: &Variable, x: &Value, directory: &Path) -> (Value, Vec<(&'static s
             Some("N") => 1.0,
             Some("m/s2") => 2.0,
             Some("kg/m3") => 1750.0,
+            Some("K") => 10.0,
             unit => panic!("{}: no change of a zero in {unit:?}", v.name),
         })),
         (_, Value::Integer(n)) if *n > 1 => alone(Value::Integer(n / 2)),

@@ -264,6 +264,8 @@ fn a_chamber_inflates_seals_and_opens_through_the_fmu_and_its_state_round_trips(
         sealed: false,
         kappa: 1.0,
         atmosphere: 101_325.0,
+        temperature: 293.15,
+        heating: 0.0,
     }];
     let (u, log) = (
         Unpacked::new("chamber", Source::Model(model)),

@@ -54,30 +54,43 @@ fn skew(v: &Vector3<f64>) -> Matrix3<f64> {
     Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
 
-/// The enclosed gas's law `(p + p_a) V^κ = C` (Boyle–Mariotte for `κ = 1`, isothermal; the
-/// adiabatic law for `κ = 1.4`), `p` the gauge pressure (Pa), `p_a` the atmosphere's.
+/// The enclosed gas's law `(p + p_a) V^κ = C T/T₀` (Boyle–Mariotte and Gay-Lussac for `κ = 1`,
+/// isothermal; the adiabatic law for `κ = 1.4`), `p` the gauge pressure (Pa), `p_a` the
+/// atmosphere's, `T` the air's temperature and `C` the gas's constant at its reference
+/// temperature `T₀`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GasLaw {
     /// Polytropic exponent `κ` (1: isothermal, 1.4: adiabatic air).
     pub kappa: f64,
     /// Atmospheric pressure `p_a` (Pa).
     pub atmosphere: f64,
+    /// Reference temperature `T₀` of the constant (K).
+    pub temperature: f64,
 }
 
+/// The specific gas constant of dry air (J/(kg K)).
+pub const AIR_GAS_CONSTANT: f64 = 287.05;
+
 impl GasLaw {
-    /// `C = (p + p_a) V^κ` of gas at gauge pressure `p` in volume `v`.
-    pub fn constant(&self, p: f64, v: f64) -> f64 {
-        (p + self.atmosphere) * v.powf(self.kappa)
+    /// `C` of gas at gauge pressure `p` in volume `v` at temperature `t`.
+    pub fn constant(&self, p: f64, v: f64, t: f64) -> f64 {
+        (p + self.atmosphere) * v.powf(self.kappa) * self.temperature / t
     }
 
-    /// The gauge pressure `C / V^κ − p_a` of the gas of constant `c` in volume `v`.
-    pub fn pressure(&self, c: f64, v: f64) -> f64 {
-        c / v.powf(self.kappa) - self.atmosphere
+    /// The gauge pressure `C (T/T₀) / V^κ − p_a` of the gas of constant `c` in volume `v` at
+    /// temperature `t`.
+    pub fn pressure(&self, c: f64, v: f64, t: f64) -> f64 {
+        c * (t / self.temperature) / v.powf(self.kappa) - self.atmosphere
     }
 
-    /// `dp/dV = −κ C / V^{κ+1}` (negative: compressing the gas raises its pressure).
-    pub fn slope(&self, c: f64, v: f64) -> f64 {
-        -self.kappa * c / v.powf(self.kappa + 1.0)
+    /// `dp/dV = −κ C (T/T₀) / V^{κ+1}` (negative: compressing the gas raises its pressure).
+    pub fn slope(&self, c: f64, v: f64, t: f64) -> f64 {
+        -self.kappa * c * (t / self.temperature) / v.powf(self.kappa + 1.0)
+    }
+
+    /// The mass of air (kg) at gauge pressure `p` in volume `v` at temperature `t` (ideal gas).
+    pub fn mass(&self, p: f64, v: f64, t: f64) -> f64 {
+        (p + self.atmosphere) * v / (AIR_GAS_CONSTANT * t)
     }
 }
 
@@ -199,6 +212,36 @@ impl ChamberGeometry {
             .zip(&self.corners)
             .map(|(&(e, sign), &c)| (e, sign, c))
     }
+}
+
+/// One line per chamber of `model` for `check`: its triangles, what closes it, the volume it
+/// encloses in the reference geometry and its air.
+pub fn chamber_report(model: &Model) -> Vec<String> {
+    let x: Vec<Vector3<f64>> = model.nodes.iter().map(|&p| Vector3::from(p)).collect();
+    model
+        .chambers
+        .iter()
+        .map(|c| {
+            let closed = match &c.closed_by_plane {
+                None => "closed by its own triangles".to_string(),
+                Some(p) => format!(
+                    "closed by the plane through {:?} with normal {:?} into it",
+                    p.point, p.normal
+                ),
+            };
+            let volume = ChamberGeometry::new(model, c).map_or(f64::NAN, |g| g.volume(&x));
+            let air = if c.sealed {
+                format!("air enclosed at {} Pa (κ {})", c.pressure, c.kappa)
+            } else {
+                format!("air held by a supply at {} Pa", c.pressure)
+            };
+            format!(
+                "chamber '{}': {} triangles, {closed}, {volume:.6} m³ in the reference geometry, {air}",
+                c.name,
+                model.selected_triangles(&c.elements).len()
+            )
+        })
+        .collect()
 }
 
 /// Orientation signs of `triangles` (+1 keeps the node order) so that every edge two of them
@@ -343,23 +386,36 @@ mod tests {
         }
     }
 
-    /// Boyle–Mariotte at κ = 1: `p V` of the absolute pressure is constant; the slope is the
-    /// derivative of the pressure (central difference), negative.
+    /// Boyle–Mariotte at κ = 1: `p V` of the absolute pressure is constant, and proportional to
+    /// the temperature (Gay-Lussac); the slope is the derivative of the pressure (central
+    /// difference), negative; the mass is the ideal gas's.
     #[test]
-    fn the_gas_law_keeps_p_v_kappa_and_its_slope_is_the_derivative() {
+    fn the_gas_law_keeps_p_v_kappa_over_t_and_its_slope_is_the_derivative() {
         for kappa in [1.0, 1.4] {
             let law = GasLaw {
                 kappa,
                 atmosphere: 101_325.0,
+                temperature: 293.15,
             };
-            let c = law.constant(300.0, 2.0);
-            assert!((law.pressure(c, 2.0) - 300.0).abs() < 1e-9);
+            let c = law.constant(300.0, 2.0, 293.15);
+            assert!((law.pressure(c, 2.0, 293.15) - 300.0).abs() < 1e-9);
             let v = 1.9;
             let expected = (300.0 + 101_325.0) * (2.0_f64 / v).powf(kappa) - 101_325.0;
-            assert!((law.pressure(c, v) - expected).abs() < 1e-8);
+            assert!((law.pressure(c, v, 293.15) - expected).abs() < 1e-8);
+            let hot = (expected + 101_325.0) * 323.15 / 293.15 - 101_325.0;
+            assert!((law.pressure(c, v, 323.15) - hot).abs() < 1e-8);
+            let warm = law.constant(300.0, 2.0, 303.15);
+            assert!((law.pressure(warm, 2.0, 303.15) - 300.0).abs() < 1e-9);
             let h = 1e-6;
-            let fd = (law.pressure(c, v + h) - law.pressure(c, v - h)) / (2.0 * h);
-            assert!((fd - law.slope(c, v)).abs() < 1e-5 * fd.abs() && fd < 0.0);
+            let fd = (law.pressure(c, v + h, 300.0) - law.pressure(c, v - h, 300.0)) / (2.0 * h);
+            assert!((fd - law.slope(c, v, 300.0)).abs() < 1e-5 * fd.abs() && fd < 0.0);
         }
+        let law = GasLaw {
+            kappa: 1.0,
+            atmosphere: 101_325.0,
+            temperature: 293.15,
+        };
+        // 1 m³ of air at 1 atm and 20 °C: 1.204 kg.
+        assert!((law.mass(0.0, 1.0, 293.15) - 1.2041).abs() < 1e-4);
     }
 }

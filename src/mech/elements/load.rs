@@ -48,6 +48,9 @@ pub struct LoadLevels {
     /// Supply pressure of each chamber (Pa), model order (a sealed chamber's is its gas's).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<f64>,
+    /// Temperature rise of each chamber's air above its reference temperature (K), model order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub heating: Vec<f64>,
 }
 
 impl LoadLevels {
@@ -58,6 +61,7 @@ impl LoadLevels {
             force: vec![[0.0; 3]; model.loads.forces.len()],
             gravity: [0.0; 3],
             chambers: vec![0.0; model.chambers.len()],
+            heating: vec![0.0; model.chambers.len()],
         }
     }
 
@@ -68,6 +72,7 @@ impl LoadLevels {
             force: model.loads.forces.iter().map(|f| f.force).collect(),
             gravity: model.loads.gravity,
             chambers: model.chambers.iter().map(|c| c.pressure).collect(),
+            heating: model.chambers.iter().map(|c| c.heating).collect(),
         }
     }
 
@@ -94,6 +99,12 @@ impl LoadLevels {
                 .zip(&target.chambers)
                 .map(|(&a, &b)| lerp(a, b))
                 .collect(),
+            heating: self
+                .heating
+                .iter()
+                .zip(&target.heating)
+                .map(|(&a, &b)| lerp(a, b))
+                .collect(),
         }
     }
 
@@ -104,6 +115,7 @@ impl LoadLevels {
             force: self.force.iter().map(|f| f.map(|v| v * factor)).collect(),
             gravity: self.gravity.map(|g| g * factor),
             chambers: self.chambers.iter().map(|p| p * factor).collect(),
+            heating: self.heating.iter().map(|t| t * factor).collect(),
         }
     }
 
@@ -114,6 +126,7 @@ impl LoadLevels {
             .chain(self.force.iter().flatten())
             .chain(&self.gravity)
             .chain(&self.chambers)
+            .chain(&self.heating)
             .copied()
     }
 
@@ -127,6 +140,7 @@ impl LoadLevels {
         self.pressure.len() == model.loads.pressures.len()
             && self.force.len() == model.loads.forces.len()
             && self.chambers.len() == model.chambers.len()
+            && self.heating.len() == model.chambers.len()
     }
 }
 

@@ -512,6 +512,20 @@ pub struct ChamberSpec {
     /// Atmospheric pressure (Pa), default 101 325.
     #[serde(default = "default_atmosphere")]
     pub atmosphere: f64,
+    /// The air's temperature in the reference state (K), default 293.15.
+    #[serde(default = "default_air_temperature")]
+    pub temperature: f64,
+    /// The air's temperature rise in a standard run (K; the sun on a cushion), default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub heating: f64,
+}
+
+fn default_air_temperature() -> f64 {
+    293.15
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// A plane closing a chamber: a point on it and its normal pointing into the chamber.

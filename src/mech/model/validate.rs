@@ -525,6 +525,18 @@ impl Model {
             if !(c.atmosphere > 0.0 && c.atmosphere.is_finite()) {
                 return Err(error(format!("atmosphere = {} must be > 0", c.atmosphere)));
             }
+            if !(c.temperature > 0.0 && c.temperature.is_finite()) {
+                return Err(error(format!(
+                    "temperature = {} K must be > 0",
+                    c.temperature
+                )));
+            }
+            if !(c.heating.is_finite() && c.temperature + c.heating > 0.0) {
+                return Err(error(format!(
+                    "heating = {} K must leave the air above 0 K",
+                    c.heating
+                )));
+            }
             if c.pressure + c.atmosphere <= 0.0 {
                 return Err(error("the absolute pressure must be positive".into()));
             }

@@ -233,6 +233,7 @@ impl Analysis {
                     .collect(),
                 gravity: end.loads.gravity,
                 chambers: end.loads.chambers.clone(),
+                heating: end.loads.heating.clone(),
             };
             (motion, levels, s * seed.friction)
         };
@@ -271,6 +272,7 @@ impl Analysis {
                 force: seed.force.clone(),
                 gravity: [0.0; 3],
                 chambers: vec![0.0; end.loads.chambers.len()],
+                heating: vec![0.0; end.loads.heating.len()],
             };
             self.parts
                 .loads

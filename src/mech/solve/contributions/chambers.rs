@@ -20,12 +20,16 @@ use crate::mech::solve::state::AnalysisState;
 pub struct ChamberState {
     /// Whether the gas is enclosed (else a supply holds the load level's pressure).
     pub sealed: bool,
-    /// `C = (p + p_a) V^κ` of the enclosed gas (Pa m^{3κ}; 0 while supplied).
+    /// `C = (p + p_a) V^κ` of the enclosed gas at the chamber's reference temperature
+    /// (Pa m^{3κ}; 0 while supplied).
     pub constant: f64,
-    /// Gauge pressure (Pa) and volume (m³) at convergence.
+    /// Gauge pressure (Pa) at convergence.
     pub pressure: f64,
     /// Volume (m³) at convergence.
     pub volume: f64,
+    /// The air's temperature (K) at convergence (0 in a state written before it was kept).
+    #[serde(default)]
+    pub temperature: f64,
 }
 
 /// One chamber's result.
@@ -39,6 +43,10 @@ pub struct ChamberResult {
     pub volume: f64,
     /// Whether the gas is enclosed.
     pub sealed: bool,
+    /// The air's temperature (K).
+    pub temperature: f64,
+    /// The air's mass (kg, ideal gas).
+    pub mass: f64,
 }
 
 /// The chambers of a model with their state at the start of the increment and at the last
@@ -73,6 +81,7 @@ impl Chambers {
                 .map(|c| GasLaw {
                     kappa: c.kappa,
                     atmosphere: c.atmosphere,
+                    temperature: c.temperature,
                 })
                 .collect(),
             names: model.chambers.iter().map(|c| c.name.clone()).collect(),
@@ -94,12 +103,13 @@ impl Chambers {
                 ChamberState {
                     sealed: c.sealed,
                     constant: if c.sealed {
-                        law.constant(c.pressure, volume)
+                        law.constant(c.pressure, volume, c.temperature)
                     } else {
                         0.0
                     },
                     pressure: if c.sealed { c.pressure } else { 0.0 },
                     volume,
+                    temperature: c.temperature,
                 }
             })
             .collect()
@@ -119,7 +129,7 @@ impl Chambers {
         }
         Ok(ChamberState {
             sealed: true,
-            constant: self.laws[k].constant(c.pressure, c.volume),
+            constant: self.laws[k].constant(c.pressure, c.volume, c.temperature),
             ..*c
         })
     }
@@ -168,14 +178,16 @@ impl Contribution for Chambers {
             let gas = self.start.get(k).copied().unwrap_or_default();
             let v = volumes[k];
             let law = &self.laws[k];
+            let t = law.temperature + at.levels.heating.get(k).copied().unwrap_or(0.0);
             let p = if gas.sealed {
-                law.pressure(gas.constant, v)
+                law.pressure(gas.constant, v, t)
             } else {
                 at.levels.chambers.get(k).copied().unwrap_or(0.0)
             };
             self.last.push(ChamberState {
                 pressure: p,
                 volume: v,
+                temperature: t,
                 ..gas
             });
             let mut gradient = gas.sealed.then(|| vec![0.0; system.free_count]);
@@ -196,7 +208,7 @@ impl Contribution for Chambers {
                 }
             }
             if let (Some(grad), true) = (gradient, values.is_some()) {
-                let a = -law.slope(gas.constant, v);
+                let a = -law.slope(gas.constant, v, t);
                 self.low_rank.push((a, grad));
             }
         }
@@ -219,11 +231,14 @@ impl Contribution for Chambers {
             .chambers
             .iter()
             .zip(&self.names)
-            .map(|(c, name)| ChamberResult {
+            .zip(&self.laws)
+            .map(|((c, name), law)| ChamberResult {
                 name: name.clone(),
                 pressure: c.pressure,
                 volume: c.volume,
                 sealed: c.sealed,
+                temperature: c.temperature,
+                mass: law.mass(c.pressure, c.volume, c.temperature),
             })
             .collect();
     }
