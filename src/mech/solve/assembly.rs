@@ -645,13 +645,13 @@ pub fn node_vector(u: &[f64], v: usize) -> Vector3<f64> {
 /// `/proc/self/task` after about 40 % of the FMU's calls on the shared 2-core machine
 /// (`tests/threads.rs`). So on Linux a worker reports its task id, and the caller waits, after
 /// the join, until that task is gone (a few microseconds; bounded).
-mod worker {
+pub(crate) mod worker {
     /// Longest wait for the kernel to remove a joined thread's task.
     #[cfg(target_os = "linux")]
     const LONGEST_WAIT: std::time::Duration = std::time::Duration::from_millis(200);
 
     /// The calling thread's task id (`/proc/thread-self` → `<pid>/task/<tid>`), Linux only.
-    pub fn own_task() -> Option<std::ffi::OsString> {
+    pub(crate) fn own_task() -> Option<std::ffi::OsString> {
         #[cfg(target_os = "linux")]
         {
             std::fs::read_link("/proc/thread-self")
@@ -664,7 +664,7 @@ mod worker {
 
     /// Waits until the joined thread's `task` has left `/proc/self/task` (at most
     /// [`LONGEST_WAIT`]: beyond it the thread's code has ended anyway).
-    pub fn wait_until_gone(task: Option<std::ffi::OsString>) {
+    pub(crate) fn wait_until_gone(task: Option<std::ffi::OsString>) {
         #[cfg(target_os = "linux")]
         if let Some(task) = task {
             let path = std::path::Path::new("/proc/self/task").join(task);
