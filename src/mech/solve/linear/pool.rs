@@ -14,11 +14,12 @@ use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{Par, Side};
 
-use crate::mech::solve::assembly::worker;
+use crate::mech::solve::assembly::{idle_cores, worker};
 
-/// Factors of at least this many values are factorized on the available cores when the thread
-/// count is automatic (below, one thread: the pool's start costs more than it gains).
-pub const PARALLEL_MIN_FACTOR: usize = 1 << 20;
+/// Factors of at least this many values (128 MiB, the sheet from about 100 k DOF) are
+/// factorized on the idle cores when the thread count is automatic; below, one thread (on
+/// 20 k DOF a second thread lost 1.1–1.7× on the shared machine).
+pub const PARALLEL_MIN_FACTOR: usize = 1 << 24;
 
 /// The parallelism of a factorization on `threads` threads.
 pub(super) fn par(threads: usize) -> Par {
@@ -30,11 +31,11 @@ pub(super) fn par(threads: usize) -> Par {
 }
 
 /// The thread count `requested` resolves to for a factor of `factor_len` values: itself when
-/// positive, else the available cores from [`PARALLEL_MIN_FACTOR`] values, else 1.
+/// positive, else the idle cores ([`idle_cores`]) from [`PARALLEL_MIN_FACTOR`] values, else 1.
 pub(super) fn resolve(requested: usize, factor_len: usize) -> usize {
     match requested {
         0 if factor_len < PARALLEL_MIN_FACTOR => 1,
-        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        0 => idle_cores(),
         n => n,
     }
 }
