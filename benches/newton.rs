@@ -18,7 +18,8 @@
 //! LDLᵀ of its symmetric part and the solve) at each thread count, alternating, twice, best of
 //! each, the answers compared bit for bit, and the peak RSS. `-- --sheet-solve 259 --threads
 //! 1,2` times the whole solve (centre pushed 50 mm in 5 steps of one increment), alternating,
-//! with the default ordering. Each prints one table.
+//! with the default ordering. Each prints one table. `-- --iteration R --ordering amd|nd` runs
+//! the specimen's iteration row under either ordering (the default: automatic).
 
 use std::time::{Duration, Instant};
 
@@ -73,7 +74,7 @@ fn parse_method(name: &str) -> UnsymmetricMethod {
 /// 10 mm behind), without running the analysis there: assembly of the consistent tangent plus
 /// our solve (`LinearSolver` with the symmetric part), twice, against the bare LDLᵀ of the same
 /// pattern's lower triangle, twice; best of each.
-fn iteration(r: usize) {
+fn iteration(r: usize, ordering: FillOrdering) {
     let spec = ParallelArch {
         refinement: r,
         ..ParallelArch::with_height(0.3)
@@ -92,7 +93,7 @@ fn iteration(r: usize) {
     let mut run = |lower_only: bool| -> (Duration, Duration, [usize; 4], usize, usize, usize) {
         let system = System::new(&model, lower_only).unwrap();
         free = system.free_count;
-        let mut linear = LinearSolver::new(&system, true).unwrap();
+        let mut linear = LinearSolver::with_ordering(&system, true, ordering).unwrap();
         let mut internal = vec![0.0; model.dof_count()];
         let mut values = vec![0.0; system.nonzeros()];
         let p = system.pattern();
@@ -141,7 +142,8 @@ fn iteration(r: usize) {
     let (ours_time, ours_factor, counts, columns, ours, factor) = run(false);
     let (_, bare, _, _, _, _) = run(true);
     println!(
-        "| {r} | {} | {:?} | {columns} | {:.0} ms | {:.0} ms | {:.0} ms | **{:.2}** | {:.0} MiB | {:.0} MiB | {:.2} | {:.0} MiB |",
+        "| {r} | {ordering:?} | {:.1} M | {} | {:?} | {columns} | {:.0} ms | {:.0} ms | {:.0} ms | **{:.2}** | {:.0} MiB | {:.0} MiB | {:.2} | {:.0} MiB |",
+        factor as f64 / 8e6,
         free,
         counts,
         ms(ours_time),
@@ -479,7 +481,8 @@ fn main() {
         return;
     }
     if let Some(r) = option("--iteration") {
-        iteration(r.parse().unwrap());
+        let ordering = parse_ordering(&option("--ordering").unwrap_or_default());
+        iteration(r.parse().unwrap(), ordering);
         return;
     }
     if let Some(r) = option("--lu-symbolic") {

@@ -316,7 +316,11 @@ impl LinearSolver {
     /// automatic (the available cores for factors of [`PARALLEL_MIN_FACTOR`] values or more,
     /// else 1). Each factorization starts its threads and joins them before it returns.
     pub fn set_threads(&mut self, requested: usize) {
-        self.threads = pool::resolve(requested, self.factor_len());
+        let threads = pool::resolve(requested, self.factor_len());
+        if threads == self.threads {
+            return;
+        }
+        self.threads = threads;
         self.scratch = MemBuffer::new(self.scratch_req());
         if let Kind::Full {
             symmetric: Some(part),

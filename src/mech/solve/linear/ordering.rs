@@ -14,8 +14,8 @@
 //!   vertex (George–Liu): the level whose weight sum crosses half the part's, kept only where
 //!   it touches the next level (the level's other vertices join the first half). Among the
 //!   levels whose halves stay within [`BALANCE`], the one with the smallest separator is taken.
-//! * Parts of at most [`LEAF_WEIGHT`] DOFs are ordered by faer's AMD; a part the level
-//!   structure does not reach (another connected component) is ordered on its own.
+//! * Parts of at most [`LEAF_WEIGHT`] DOFs are ordered by faer's AMD; a part of several
+//!   connected components is split into them, each ordered on its own.
 
 use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -195,6 +195,7 @@ pub fn nested_dissection(pattern: SymbolicSparseColMatRef<'_, usize>) -> (Vec<us
                     tasks.push(Task::Cut(b));
                     tasks.push(Task::Cut(a));
                 }
+                Cut::Components(parts) => tasks.extend(parts.into_iter().rev().map(Task::Cut)),
             },
         }
     }
@@ -216,10 +217,12 @@ enum Task {
     Place(Vec<u32>),
 }
 
-/// A part cut in two halves and a separator, or a leaf.
+/// A part cut in two halves and a separator, a part of several connected components (each
+/// ordered on its own), or a leaf.
 enum Cut {
     Leaf,
     Split(Vec<u32>, Vec<u32>, Vec<u32>),
+    Components(Vec<Vec<u32>>),
 }
 
 /// The work arrays of a dissection: the part each vertex is in (a stamp), its level, and the
@@ -293,22 +296,39 @@ impl<'a> Dissection<'a> {
         }
         let (visited, starts) = self.pseudo_peripheral(part[0]);
         if visited.len() < part.len() {
-            // Another connected component: the reached one and the rest, no separator.
-            for &v in &visited {
-                self.part[v as usize] = self.stamp + 1;
-            }
-            let rest = part
-                .iter()
-                .copied()
-                .filter(|&v| self.part[v as usize] == self.stamp)
-                .collect();
-            return Cut::Split(visited, rest, vec![]);
+            return Cut::Components(self.components(part));
         }
         let levels = starts.len() - 1;
         if levels < 3 {
             return Cut::Leaf;
         }
         self.split_at_best_level(&visited, &starts)
+    }
+
+    /// The connected components of the part stamped `self.stamp` (in one sweep: a model with
+    /// many separate pieces costs no more than one).
+    fn components(&mut self, part: &[u32]) -> Vec<Vec<u32>> {
+        let mut components = Vec::new();
+        for &root in part {
+            if self.part[root as usize] != self.stamp {
+                continue;
+            }
+            self.part[root as usize] = self.stamp + 1;
+            let mut component = vec![root];
+            let mut head = 0;
+            while head < component.len() {
+                let v = component[head] as usize;
+                head += 1;
+                for &w in self.graph.neighbours(v) {
+                    if self.part[w as usize] == self.stamp {
+                        self.part[w as usize] = self.stamp + 1;
+                        component.push(w);
+                    }
+                }
+            }
+            components.push(component);
+        }
+        components
     }
 
     /// Repeated level structures from a vertex of least degree in the last level, while the
