@@ -1,7 +1,8 @@
 //! Sparse factorization of the Newton matrix with the symbolic analysis done once per analysis.
 //!
 //! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer` supernodal/simplicial Cholesky structure,
-//!   AMD ordering), which also handles the indefinite matrices of compressed films;
+//!   AMD ordering, nested dissection from 100 k equations: `ordering.rs`), which also handles
+//!   the indefinite matrices of compressed films;
 //! * the consistent tangent `A` (full pattern): one pass over its lower triangle forms the
 //!   symmetric part `S = (A + Aᵀ)/2` through a transpose map built once, the row sums of `|A|`
 //!   and the entries of the skew part `K = (A − Aᵀ)/2` above `1e-12` of the largest entry; then
@@ -38,6 +39,8 @@
 //! | `woodbury` | the Woodbury correction for a skew part on few DOFs |
 //! | `gmres` | GMRES right-preconditioned by that LDLᵀ |
 //! | `lu` | LU with partial pivoting, the checked fallback |
+//! | `ordering` | the fill-reducing ordering of the LDLᵀ analyses: AMD, or nested dissection from 100 k equations |
+//! | `pool` | the LDLᵀ numeric factorization on a scoped thread pool ([`LinearSolver::set_threads`]) |
 //! | `tests` | the solver's tests |
 
 use std::sync::Arc;

@@ -298,11 +298,20 @@ impl<'a> Dissection<'a> {
         if visited.len() < part.len() {
             return Cut::Components(self.components(part));
         }
-        let levels = starts.len() - 1;
-        if levels < 3 {
+        if starts.len() < 4 {
             return Cut::Leaf;
         }
-        self.split_at_best_level(&visited, &starts)
+        // The structures from both ends of the pseudo-diameter cut across it at different
+        // places: the smaller separator wins.
+        let (root, far) = (visited[0], visited[visited.len() - 1]);
+        let (k, size) = self.best_level(&visited, &starts);
+        let (other, other_starts) = self.levels(far);
+        let (k_far, size_far) = self.best_level(&other, &other_starts);
+        if size_far < size {
+            return self.split_at(&other, &other_starts, k_far);
+        }
+        let (visited, starts) = self.levels(root);
+        self.split_at(&visited, &starts, k)
     }
 
     /// The connected components of the part stamped `self.stamp` (in one sweep: a model with
@@ -357,8 +366,9 @@ impl<'a> Dissection<'a> {
     }
 
     /// Among the levels that leave each half at least [`BALANCE`] of the weight, the one whose
-    /// separator (its vertices touching the next level) weighs least.
-    fn split_at_best_level(&mut self, visited: &[u32], starts: &[usize]) -> Cut {
+    /// separator (its vertices touching the next level) weighs least, and that weight (else
+    /// the median level).
+    fn best_level(&self, visited: &[u32], starts: &[usize]) -> (usize, usize) {
         let total = self.weight(visited) as f64;
         let levels = starts.len() - 1;
         let (mut below, mut best, mut median) = (0.0, None::<(usize, usize)>, None);
@@ -375,7 +385,18 @@ impl<'a> Dissection<'a> {
                 }
             }
         }
-        let k = best.map(|(k, _)| k).or(median).unwrap_or(levels / 2);
+        best.unwrap_or_else(|| {
+            let k = median.unwrap_or(levels / 2);
+            (
+                k,
+                self.separator_weight(&visited[starts[k]..starts[k + 1]], k as u32),
+            )
+        })
+    }
+
+    /// Splits the level structure at level `k`: the levels before and the vertices of level `k`
+    /// not touching level `k + 1`, the levels after, and the separator.
+    fn split_at(&self, visited: &[u32], starts: &[usize], k: usize) -> Cut {
         let mut a = visited[..starts[k]].to_vec();
         let mut separator = Vec::new();
         for &v in &visited[starts[k]..starts[k + 1]] {

@@ -438,8 +438,8 @@ fn nested_dissection_solves_the_sheet_like_amd_to_1e_10() {
 
 #[test]
 fn nested_dissection_fills_the_200k_dof_sheet_within_15_percent_of_amd() {
-    // The symbolic analyses alone (198 146 DOF): measured 29.4 M values against AMD's 26.4 M
-    // (30.6 M with the centre node's z prescribed: AMD's fill moves by 15 % with one node).
+    // The symbolic analyses alone (198 146 DOF). AMD gave 26.4 M values here and 30.6 M with
+    // the centre node's z prescribed (its fill moves by 15 % with one node); ND 28.6 M there.
     let (system, _) = sheet(259, false);
     let len = |ordering| {
         LinearSolver::with_ordering(&system, true, ordering)
