@@ -107,8 +107,9 @@ impl Analysis {
         let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
         let mut system = System::new(&model, lower_only)?;
         system.set_threads(settings.threads);
-        let linear = LinearSolver::new(&system, settings.symmetric_factorization)
+        let mut linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
+        linear.set_threads(settings.threads);
         // Computed once: the workspace (Levenberg–Marquardt shift, continuation) and the viscous
         // stabilization both use them.
         let (diagonal, mass) = (diagonal_slots(&system), pseudo_mass(&system));
@@ -225,6 +226,7 @@ impl Analysis {
             return Err("the iteration matrix is fixed when the analysis is created".into());
         }
         self.system.set_threads(settings.threads);
+        self.linear.set_threads(settings.threads);
         self.settings = settings;
         Ok(())
     }
