@@ -30,7 +30,7 @@
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation`, `solver.stabilization`, `solver.smoothing` | | parameter | | Newton settings (`solver.smoothing` is appended after `solver.liftOffReleases`) |
-//! | `solver.threads` | Integer | parameter | | threads of the element assembly (0: automatic); results identical for every count |
+//! | `solver.threads` | Integer | parameter | | threads of the element assembly and the factorization (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
@@ -538,8 +538,9 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "threads",
             Value::Integer(saturating_i32(solver.threads)),
             None,
-            "threads of the element assembly, ended before each call returns (0: automatic, one on meshes \
-             below 100 000 triangles, else up to two); the results are identical for every count",
+            "threads of the element assembly and the LDLT factorization, ended before each call returns \
+             (0: automatic, the idle cores, one on meshes below 100 000 triangles and factors below \
+             2^24 values); the results are identical for every count",
             Binding::Threads,
         ),
     ];
