@@ -155,6 +155,77 @@ pub fn check_names(model: &Model) -> Result<(), String> {
     Ok(())
 }
 
+/// Each chamber's inputs: the supply's pressure, the valve, the heating.
+fn chamber_inputs(table: &mut TableBuilder, model: &Model) {
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.input(
+            &format!("{}.supplyPressure", c.name),
+            c.pressure,
+            "Pa",
+            &format!(
+                "gauge pressure the supply holds in chamber '{}', reached at the end of a step \
+                 (ignored while its air is enclosed)",
+                c.name
+            ),
+            Binding::ChamberSupply(k),
+        );
+        table.push(
+            &format!("{}.sealed", c.name),
+            VarType::Boolean,
+            Causality::Input,
+            Some(Value::Boolean(c.sealed)),
+            None,
+            &format!(
+                "true: the air of chamber '{}' is enclosed at its pressure and volume when the next \
+                 step starts and follows Boyle's law; false: a supply holds supplyPressure",
+                c.name
+            ),
+            Binding::ChamberSealed(k),
+        );
+        table.input(
+            &format!("{}.heating", c.name),
+            c.heating,
+            "K",
+            &format!(
+                "temperature rise of the air in chamber '{}' above its reference {} K (the sun), \
+                 reached at the end of a step",
+                c.name, c.temperature
+            ),
+            Binding::ChamberHeating(k),
+        );
+    }
+}
+
+/// Each chamber's outputs: the air's pressure, volume, temperature and mass.
+fn chamber_outputs(table: &mut TableBuilder, model: &Model) {
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.output(
+            &format!("{}.pressure", c.name),
+            "Pa",
+            &format!("gauge pressure of the air in chamber '{}'", c.name),
+            Binding::ChamberPressure(k),
+        );
+        table.output(
+            &format!("{}.volume", c.name),
+            "m3",
+            &format!("volume of chamber '{}'", c.name),
+            Binding::ChamberVolume(k),
+        );
+        table.output(
+            &format!("{}.temperature", c.name),
+            "K",
+            &format!("temperature of the air in chamber '{}'", c.name),
+            Binding::ChamberTemperature(k),
+        );
+        table.output(
+            &format!("{}.mass", c.name),
+            "kg",
+            &format!("mass of the air in chamber '{}' (ideal gas)", c.name),
+            Binding::ChamberMass(k),
+        );
+    }
+}
+
 /// What the inputs ask of the next step: where the groups go (translations and hinge angles),
 /// the load levels, and `μ` (only once it has been set).
 #[derive(Clone, Debug, PartialEq)]
@@ -288,43 +359,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::Pressure(set),
         );
     }
-    for (k, c) in model.chambers.iter().enumerate() {
-        table.input(
-            &format!("{}.supplyPressure", c.name),
-            c.pressure,
-            "Pa",
-            &format!(
-                "gauge pressure the supply holds in chamber '{}', reached at the end of a step \
-                 (ignored while its air is enclosed)",
-                c.name
-            ),
-            Binding::ChamberSupply(k),
-        );
-        table.push(
-            &format!("{}.sealed", c.name),
-            VarType::Boolean,
-            Causality::Input,
-            Some(Value::Boolean(c.sealed)),
-            None,
-            &format!(
-                "true: the air of chamber '{}' is enclosed at its pressure and volume when the next \
-                 step starts and follows Boyle's law; false: a supply holds supplyPressure",
-                c.name
-            ),
-            Binding::ChamberSealed(k),
-        );
-        table.input(
-            &format!("{}.heating", c.name),
-            c.heating,
-            "K",
-            &format!(
-                "temperature rise of the air in chamber '{}' above its reference {} K (the sun), \
-                 reached at the end of a step",
-                c.name, c.temperature
-            ),
-            Binding::ChamberHeating(k),
-        );
-    }
+    chamber_inputs(&mut table, model);
     for (set, f) in model.loads.forces.iter().enumerate() {
         for (axis, a) in ["Fx", "Fy", "Fz"].iter().enumerate() {
             table.input(
@@ -721,32 +756,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::CableForce(cable),
         );
     }
-    for (k, c) in model.chambers.iter().enumerate() {
-        table.output(
-            &format!("{}.pressure", c.name),
-            "Pa",
-            &format!("gauge pressure of the air in chamber '{}'", c.name),
-            Binding::ChamberPressure(k),
-        );
-        table.output(
-            &format!("{}.volume", c.name),
-            "m3",
-            &format!("volume of chamber '{}'", c.name),
-            Binding::ChamberVolume(k),
-        );
-        table.output(
-            &format!("{}.temperature", c.name),
-            "K",
-            &format!("temperature of the air in chamber '{}'", c.name),
-            Binding::ChamberTemperature(k),
-        );
-        table.output(
-            &format!("{}.mass", c.name),
-            "kg",
-            &format!("mass of the air in chamber '{}' (ideal gas)", c.name),
-            Binding::ChamberMass(k),
-        );
-    }
+    chamber_outputs(&mut table, model);
     for (point, p) in model.outputs.points.iter().enumerate() {
         for (axis, a) in ["ux", "uy", "uz"].iter().enumerate() {
             table.output(

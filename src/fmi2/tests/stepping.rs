@@ -289,7 +289,16 @@ fn a_chamber_inflates_seals_and_opens_through_the_fmu_and_its_state_round_trips(
     );
     assert!((volumes[1] - 0.196).abs() < 1e-3, "{volumes:?}");
     assert!(fmu.real("crownTop.uz") > 0.05);
-    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, saved) }, 0);
+    // Serialized and read back: the air travels with the state's bytes.
+    let bytes = serialized(&fmu, saved);
+    let mut restored: Fmi2FmuState = std::ptr::null_mut();
+    let size = bytes.len();
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr(), size, &mut restored) },
+        0
+    );
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, restored) }, 0);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut restored) }, 0);
     assert_eq!(
         fmu.real("air.volume"),
         volumes[0],
