@@ -61,6 +61,30 @@ pub enum Command {
         /// The model file (JSON).
         file: PathBuf,
     },
+    /// Finds the shape in which the film carries its prestress (the model's, or --prestress)
+    /// with the boundary held where the model puts it (updated reference strategy,
+    /// docs/mechanics.md "Form finding and patterning"); writes the model with the found
+    /// geometry and the target prestress.
+    FormFind {
+        /// The model file (JSON).
+        file: PathBuf,
+        /// The model file to write (default: standard output).
+        #[arg(short, long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// Target prestress `SX,SY[,TXY]` in MPa in each element's frame (e1 along global X
+        /// projected); default: the model's `material.prestress`.
+        #[arg(long, value_name = "SX,SY[,TXY]", value_parser = parse_prestress, allow_negative_numbers = true)]
+        prestress: Option<[f64; 3]>,
+        /// Start from the force density shape (Schek 1974) instead of the model's geometry.
+        #[arg(long)]
+        force_density_start: bool,
+        /// Largest out-of-balance force accepted, relative to t·|σ|·(mean edge length).
+        #[arg(long, value_name = "TOL", default_value_t = 1e-4)]
+        tolerance: f64,
+        /// Most reference updates.
+        #[arg(long, value_name = "N", default_value_t = 5000)]
+        max_steps: usize,
+    },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {
         #[command(flatten)]
@@ -225,6 +249,19 @@ pub struct RunArgs {
     /// was refused, its iterations and residual, the cut-backs so far.
     #[arg(long)]
     pub log_increments: bool,
+}
+
+/// `SX,SY[,TXY]` in MPa → Pa.
+fn parse_prestress(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y] => Ok([x * 1e6, y * 1e6, 0.0]),
+        [x, y, t] => Ok([x * 1e6, y * 1e6, t * 1e6]),
+        _ => Err("two or three numbers: SX,SY[,TXY] (MPa)".into()),
+    }
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {
