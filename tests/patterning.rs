@@ -10,6 +10,14 @@
 //! which falls as the mesh is refined (0.5 % of the rim's height); the step matrix is the derivative of the membrane
 //! element's own force with the prestress alone (central differences, an orthotropic prestress
 //! with shear); a found shape keeps its prestress within 1e-3 in the project's own analysis.
+//! Patterning: a strip of a cylinder (developable) flattens to its exact size with no strain; a
+//! strip of a sphere reports its strain, and the relaxation lowers it below the conformal map's;
+//! the relaxation's Jacobian is the derivative of its residual; seam planes and seam node lines
+//! along the same meridians cut the same strips; the prestress compensation of an isotropic
+//! prestress is `σ(1 − ν)/E` both ways; the SVG names every strip with its length.
+//!
+//! MESHES (patterning): a quarter cylinder `R = 1 m`, 2 m long, 12 × 8 cells; a strip of the
+//! unit sphere, polar angle 30°–150°, 40° wide, 12 × 4 cells.
 //!
 //! MESHES: catenoid: `NT` nodes around × `NZ` cells along, rings at `z = ±h/2` (one boundary
 //! group each, all components held), started as the cylinder `r = R`. Scherk: a square
@@ -29,6 +37,14 @@ use membrane_contact::mech::formfinding::update_reference::{
 };
 use membrane_contact::mech::formfinding::{form_found_model, held_dofs};
 use membrane_contact::mech::model::{BoundaryGroup, Model};
+use membrane_contact::mech::patterning::Strip;
+use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
+use membrane_contact::mech::patterning::flatten::conformal_map;
+use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
+use membrane_contact::mech::patterning::relax::{relax_strains, strain_measure, strain_residual};
+use membrane_contact::mech::patterning::seams::{
+    SeamPlane, strips_by_node_lines, strips_by_planes,
+};
 use membrane_contact::mech::{Analysis, SolverSettings};
 use nalgebra::{SVector, Vector3};
 
@@ -324,4 +340,166 @@ fn catenoid_example_form_finds_through_the_cli_to_its_golden_waist() {
     eprintln!("example waist {waist:.6} (a = {:.6})", catenoid_a(1.0, 1.0));
     assert!((waist - 0.84668).abs() < 2e-5, "{waist}");
     assert_eq!(found.material.prestress, ISOTROPIC);
+}
+
+/// A grid of `nu × nv` cells on `point(u, v)`, `u, v ∈ [0, 1]`, as a film model.
+fn surface_grid(nu: usize, nv: usize, point: impl Fn(f64, f64) -> [f64; 3]) -> Model {
+    let id = |i: usize, j: usize| j * (nu + 1) + i;
+    let mut nodes = vec![];
+    for j in 0..=nv {
+        for i in 0..=nu {
+            nodes.push(point(i as f64 / nu as f64, j as f64 / nv as f64));
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..nv {
+        for i in 0..nu {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    film_model("Strip", nodes, triangles)
+}
+
+fn quarter_cylinder() -> Model {
+    surface_grid(12, 8, |u, v| {
+        let phi = 0.5 * std::f64::consts::PI * u;
+        [phi.cos(), phi.sin(), 2.0 * v]
+    })
+}
+
+fn sphere_strip() -> Model {
+    surface_grid(4, 12, |u, v| {
+        let (theta, phi) = ((30.0 + 120.0 * v).to_radians(), (40.0 * u).to_radians());
+        [
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ]
+    })
+}
+
+fn whole(model: &Model) -> Vec<Vec<usize>> {
+    vec![(0..model.triangles.len()).collect()]
+}
+
+#[test]
+fn developable_cylinder_strip_flattens_to_its_size_with_no_strain() {
+    let model = quarter_cylinder();
+    let cut = cut_pattern(&model, whole(&model), Compensation::Uniform([0.0; 2])).unwrap();
+    let width = 12.0 * 2.0 * (std::f64::consts::PI / 48.0).sin();
+    let d = cut[0].distortion;
+    eprintln!(
+        "cylinder strip: max strain {:.2e}, rms {:.2e}, size {:?} (exact [2, {width:.6}])",
+        d.max_strain, d.rms_strain, cut[0].size
+    );
+    assert!(d.max_strain < 1e-9, "{d:?}");
+    assert!(
+        (cut[0].size[0] - 2.0).abs() < 1e-9 && (cut[0].size[1] - width).abs() < 1e-9,
+        "{:?}",
+        cut[0].size
+    );
+}
+
+#[test]
+fn doubly_curved_sphere_strip_reports_strain_and_relaxation_lowers_it() {
+    let model = sphere_strip();
+    let mut strip = Strip::new(&model, whole(&model).remove(0));
+    let elements = strip.elements(&model, &model.nodes).unwrap();
+    conformal_map(&mut strip, &elements, &model.nodes).unwrap();
+    let conformal = strain_measure(&elements, &strip.flat);
+    let relaxed = relax_strains(&mut strip, &elements, 100).unwrap();
+    let cut = cut_pattern(&model, whole(&model), Compensation::Uniform([0.0; 2])).unwrap();
+    let d = cut[0].distortion;
+    eprintln!(
+        "sphere strip: Φ conformal {conformal:.3e} → relaxed {relaxed:.3e}; max strain {:.3e}, rms {:.3e}",
+        d.max_strain, d.rms_strain
+    );
+    assert!(
+        d.max_strain > 1e-3 && d.rms_strain > 1e-4 && d.rms_strain < d.max_strain,
+        "{d:?}"
+    );
+    assert!(relaxed < 0.5 * conformal, "{conformal} → {relaxed}");
+}
+
+#[test]
+fn relaxation_jacobian_is_the_derivative_of_its_residual() {
+    let model = sphere_strip();
+    let mut strip = Strip::new(&model, vec![5]);
+    let elements = strip.elements(&model, &model.nodes).unwrap();
+    strip.flat = vec![[0.1, 0.05], [0.3, 0.02], [0.12, 0.31]];
+    let (_, j) = strain_residual(&elements[0], &strip.flat);
+    let h = 1e-7;
+    for col in 0..6 {
+        let shifted = |s: f64| {
+            let mut y = strip.flat.clone();
+            y[col / 2][col % 2] += s;
+            strain_residual(&elements[0], &y).0
+        };
+        let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+        assert!(
+            (fd - j.column(col)).norm() < 1e-7 * j.norm(),
+            "column {col}: {fd} vs {}",
+            j.column(col)
+        );
+    }
+}
+
+#[test]
+fn seam_planes_and_seam_node_lines_along_the_same_meridians_cut_the_same_strips() {
+    let model = catenoid_example();
+    let planes = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]].map(|normal| SeamPlane {
+        point: [0.0; 3],
+        normal,
+    });
+    let mut by_planes = strips_by_planes(&model, &planes);
+    let lines: Vec<Vec<usize>> = [0, 8, 16, 24]
+        .iter()
+        .map(|&i| (0..=16).map(|j| j * 32 + i).collect())
+        .collect();
+    let mut by_lines = strips_by_node_lines(&model, &lines);
+    by_planes.sort();
+    by_lines.sort();
+    assert_eq!(by_planes.len(), 4);
+    assert!(
+        by_planes
+            .iter()
+            .all(|s| s.len() == model.triangles.len() / 4)
+    );
+    assert_eq!(by_planes, by_lines);
+}
+
+#[test]
+fn isotropic_prestress_compensation_is_sigma_one_minus_nu_over_e_and_the_svg_dimensions_each_strip()
+{
+    let mut model = sphere_strip();
+    model.material.prestress = ISOTROPIC;
+    let strips = vec![(0..48).collect(), (48..96).collect()];
+    let cut = cut_pattern(&model, strips, Compensation::Prestress).unwrap();
+    let m = &model.material;
+    let expected = ISOTROPIC[0] * (1.0 - m.poisson_ratio) / m.youngs_modulus;
+    for c in &cut {
+        assert!(
+            c.compensation
+                .iter()
+                .all(|c| (c - expected).abs() < 1e-12 * expected),
+            "{:?} vs {expected}",
+            c.compensation
+        );
+    }
+    let labels: Vec<OutlineLabel> = (0..2)
+        .map(|k| OutlineLabel {
+            name: format!("strip {k}"),
+            compensation: cut[k].compensation,
+        })
+        .collect();
+    let strips: Vec<Strip> = cut.iter().map(|c| c.strip.clone()).collect();
+    let text = svg(&model, &strips, &labels);
+    assert_eq!(text.matches("<g id=").count(), 2);
+    for c in &cut {
+        assert!(
+            text.contains(&format!("L = {:.1} mm", 1000.0 * c.size[0])),
+            "{text}"
+        );
+    }
 }

@@ -85,6 +85,26 @@ pub enum Command {
         #[arg(long, value_name = "N", default_value_t = 5000)]
         max_steps: usize,
     },
+    /// Cuts a (form found) model's film into strips along seams, flattens each with the least
+    /// distortion, compensates it and prints each strip's size and distortion
+    /// (docs/mechanics.md "Form finding and patterning").
+    Pattern {
+        /// The model file (JSON).
+        file: PathBuf,
+        /// A seam plane through a point with a normal (m); repeat for more seams.
+        #[arg(long, value_name = "PX,PY,PZ,NX,NY,NZ", value_parser = parse_plane, allow_negative_numbers = true)]
+        seam_plane: Vec<[f64; 6]>,
+        /// A seam along a line of mesh nodes; repeat for more seams.
+        #[arg(long, value_name = "N1,N2,…")]
+        seam_nodes: Vec<String>,
+        /// `prestress` (the strain of the model's prestress, D⁻¹σ, along and across each strip) or
+        /// the compensation in percent, `C` or `CX,CY` (along, across).
+        #[arg(long, value_name = "prestress|C[,C]", default_value = "prestress")]
+        compensation: String,
+        /// Write the strips' outlines with their dimensions as SVG (mm).
+        #[arg(long, value_name = "FILE")]
+        svg: Option<PathBuf>,
+    },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {
         #[command(flatten)]
@@ -262,6 +282,16 @@ fn parse_prestress(s: &str) -> Result<[f64; 3], String> {
         [x, y, t] => Ok([x * 1e6, y * 1e6, t * 1e6]),
         _ => Err("two or three numbers: SX,SY[,TXY] (MPa)".into()),
     }
+}
+
+/// `PX,PY,PZ,NX,NY,NZ` → a plane's point and normal.
+fn parse_plane(s: &str) -> Result<[f64; 6], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    v.try_into()
+        .map_err(|_| "six numbers: PX,PY,PZ,NX,NY,NZ".to_string())
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {

@@ -1,4 +1,5 @@
-//! The design commands (issue 46): `form-find` (the shape that carries a target prestress).
+//! The design commands (issue 46): `form-find` (the shape that carries a target prestress) and
+//! `pattern` (its cutting pattern).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -7,6 +8,11 @@ use membrane_contact::mech::Model;
 use membrane_contact::mech::formfinding::force_density::force_density_shape;
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
+use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
+use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
+use membrane_contact::mech::patterning::seams::{
+    SeamPlane, strips_by_node_lines, strips_by_planes,
+};
 
 /// What `form-find` is asked.
 pub struct FormFindArgs<'a> {
@@ -66,4 +72,106 @@ pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
     );
     let result = form_found_model(&model, found.nodes, prestress);
     write_text(a.out, &(result.to_json() + "\n"))
+}
+
+/// What `pattern` is asked.
+pub struct PatternArgs<'a> {
+    pub file: &'a Path,
+    pub seam_planes: &'a [[f64; 6]],
+    pub seam_nodes: &'a [String],
+    pub compensation: &'a str,
+    pub svg: Option<&'a PathBuf>,
+}
+
+/// `prestress`, or `C` / `CX,CY` in percent.
+fn compensation(text: &str) -> Result<Compensation, String> {
+    if text == "prestress" {
+        return Ok(Compensation::Prestress);
+    }
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .map_err(|e| format!("--compensation {p:?}: {e}"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [c] => Ok(Compensation::Uniform([c / 100.0; 2])),
+        [cx, cy] => Ok(Compensation::Uniform([cx / 100.0, cy / 100.0])),
+        _ => Err("--compensation: prestress, C or CX,CY (percent)".into()),
+    }
+}
+
+/// The strips the seams cut (planes, then node lines within them; none: the whole film).
+fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String> {
+    let planes: Vec<SeamPlane> = a
+        .seam_planes
+        .iter()
+        .map(|p| SeamPlane {
+            point: [p[0], p[1], p[2]],
+            normal: [p[3], p[4], p[5]],
+        })
+        .collect();
+    let lines: Vec<Vec<usize>> = a
+        .seam_nodes
+        .iter()
+        .map(|l| {
+            l.split(',')
+                .map(|n| match n.trim().parse::<usize>() {
+                    Ok(v) if v < model.nodes.len() => Ok(v),
+                    _ => Err(format!("--seam-nodes: {n:?} is not a node of the model")),
+                })
+                .collect()
+        })
+        .collect::<Result<_, _>>()?;
+    let by_lines = strips_by_node_lines(model, &lines);
+    let by_planes = strips_by_planes(model, &planes);
+    // A strip is a set of triangles on the same side of every plane and connected across
+    // non-seam edges.
+    let mut strips: Vec<Vec<usize>> = Vec::new();
+    for p in &by_planes {
+        for l in &by_lines {
+            let both: Vec<usize> = p
+                .iter()
+                .copied()
+                .filter(|t| l.binary_search(t).is_ok())
+                .collect();
+            if !both.is_empty() {
+                strips.push(both);
+            }
+        }
+    }
+    Ok(strips)
+}
+
+/// `membrane-contact pattern FILE`: one line per strip on stdout, the outlines as SVG.
+pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
+    let model = read_model(a.file)?;
+    let started = Instant::now();
+    let cut = cut_pattern(&model, strips(&model, &a)?, compensation(a.compensation)?)?;
+    for (k, c) in cut.iter().enumerate() {
+        println!(
+            "strip {k}: {} triangles, cut {:.4} × {:.4} m, compensation {:.3} % × {:.3} %, distortion max {:.3} %, rms {:.3} %",
+            c.strip.triangles.len(),
+            c.size[0],
+            c.size[1],
+            100.0 * c.compensation[0],
+            100.0 * c.compensation[1],
+            100.0 * c.distortion.max_strain,
+            100.0 * c.distortion.rms_strain
+        );
+    }
+    eprintln!("patterned: {} strips, {:.2?}", cut.len(), started.elapsed());
+    if let Some(file) = a.svg {
+        let labels: Vec<OutlineLabel> = (0..cut.len())
+            .map(|k| OutlineLabel {
+                name: format!("strip {k}"),
+                compensation: cut[k].compensation,
+            })
+            .collect();
+        let strips: Vec<_> = cut.into_iter().map(|c| c.strip).collect();
+        write_text(Some(file), &svg(&model, &strips, &labels))?;
+    }
+    Ok(())
 }

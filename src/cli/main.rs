@@ -999,6 +999,19 @@ fn main() -> ExitCode {
                 max_steps: *max_steps,
             },
         }),
+        Command::Pattern {
+            file,
+            seam_plane,
+            seam_nodes,
+            compensation,
+            svg,
+        } => design::pattern(design::PatternArgs {
+            file,
+            seam_planes: seam_plane,
+            seam_nodes,
+            compensation,
+            svg: svg.as_ref(),
+        }),
         Command::ExportSpecimen {
             specimen: args,
             path_out,
