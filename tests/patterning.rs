@@ -41,7 +41,10 @@ use membrane_contact::mech::patterning::Strip;
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::flatten::conformal_map;
 use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
-use membrane_contact::mech::patterning::relax::{relax_strains, strain_measure, strain_residual};
+use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
+use membrane_contact::mech::patterning::relax::{
+    StrainTerm, relax_strains, strain_measure, strain_residual,
+};
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
 };
@@ -322,7 +325,7 @@ fn catenoid_example() -> Model {
 }
 
 #[test]
-fn catenoid_example_form_finds_through_the_cli_to_its_golden_waist() {
+fn catenoid_example_form_finds_and_patterns_through_the_cli_to_its_golden_waist() {
     common::assert_example_file("catenoid.json", &catenoid_example());
     let out = std::env::temp_dir().join(format!("catenoid-found-{}.json", std::process::id()));
     let path = format!("{}/examples/catenoid.json", env!("CARGO_MANIFEST_DIR"));
@@ -333,7 +336,43 @@ fn catenoid_example_form_finds_through_the_cli_to_its_golden_waist() {
         .unwrap();
     assert!(status.success());
     let found = Model::from_json(&std::fs::read_to_string(&out).unwrap()).unwrap();
-    std::fs::remove_file(&out).ok();
+    // The found film cut into quarters: one line per strip, the SVG and the erection model.
+    let (svg_file, erection) = (
+        out.with_extension("svg"),
+        out.with_extension("erection.json"),
+    );
+    let pattern = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .arg("pattern")
+        .arg(&out)
+        .args([
+            "--seam-plane",
+            "0,0,0,1,0,0",
+            "--seam-plane",
+            "0,0,0,0,1,0",
+            "--svg",
+        ])
+        .arg(&svg_file)
+        .arg("--erection-model")
+        .arg(&erection)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8(pattern.stdout).unwrap();
+    assert!(
+        pattern.status.success() && stdout.lines().count() == 4,
+        "{stdout}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(&svg_file)
+            .unwrap()
+            .matches("<g id=")
+            .count(),
+        4
+    );
+    let erection = Model::from_json(&std::fs::read_to_string(&erection).unwrap()).unwrap();
+    assert_eq!(erection.groups.len(), 64);
+    for file in [&out, &svg_file, &out.with_extension("erection.json")] {
+        std::fs::remove_file(file).ok();
+    }
     // The waist ring is the ninth of seventeen; its mean radius is the README's golden number.
     let ring = &found.nodes[8 * 32..9 * 32];
     let waist = ring.iter().map(|p| p[0].hypot(p[1])).sum::<f64>() / 32.0;
@@ -407,7 +446,8 @@ fn doubly_curved_sphere_strip_reports_strain_and_relaxation_lowers_it() {
     let mut strip = Strip::new(&model, whole(&model).remove(0));
     let elements = strip.elements(&model, &model.nodes).unwrap();
     conformal_map(&mut strip, &elements, &model.nodes).unwrap();
-    let conformal = strain_measure(&elements, &strip.flat);
+    let terms: Vec<StrainTerm> = elements.iter().map(StrainTerm::from).collect();
+    let conformal = strain_measure(&terms, &strip.flat, 0.0, &strip.flat);
     let relaxed = relax_strains(&mut strip, &elements, 100).unwrap();
     let cut = cut_pattern(&model, whole(&model), Compensation::Uniform([0.0; 2])).unwrap();
     let d = cut[0].distortion;
@@ -423,25 +463,35 @@ fn doubly_curved_sphere_strip_reports_strain_and_relaxation_lowers_it() {
 }
 
 #[test]
-fn relaxation_jacobian_is_the_derivative_of_its_residual() {
+fn relaxation_jacobian_is_the_derivative_of_its_residual_flat_and_in_space() {
     let model = sphere_strip();
-    let mut strip = Strip::new(&model, vec![5]);
-    let elements = strip.elements(&model, &model.nodes).unwrap();
-    strip.flat = vec![[0.1, 0.05], [0.3, 0.02], [0.12, 0.31]];
-    let (_, j) = strain_residual(&elements[0], &strip.flat);
+    let strip = Strip::new(&model, vec![5]);
+    let term = StrainTerm::from(&strip.elements(&model, &model.nodes).unwrap()[0]);
+    check_strain_jacobian(&term, [[0.1, 0.05], [0.3, 0.02], [0.12, 0.31]]);
+    check_strain_jacobian(
+        &term,
+        [[0.1, 0.05, 0.2], [0.3, 0.02, -0.1], [0.12, 0.31, 0.05]],
+    );
+}
+
+/// Central differences of [`strain_residual`] against its Jacobian at the positions `y`.
+fn check_strain_jacobian<const D: usize>(term: &StrainTerm, y: [[f64; D]; 3]) {
+    let (_, j) = strain_residual(term, &y);
     let h = 1e-7;
-    for col in 0..6 {
-        let shifted = |s: f64| {
-            let mut y = strip.flat.clone();
-            y[col / 2][col % 2] += s;
-            strain_residual(&elements[0], &y).0
-        };
-        let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
-        assert!(
-            (fd - j.column(col)).norm() < 1e-7 * j.norm(),
-            "column {col}: {fd} vs {}",
-            j.column(col)
-        );
+    for k in 0..3 {
+        for c in 0..D {
+            let shifted = |s: f64| {
+                let mut y = y;
+                y[k][c] += s;
+                strain_residual(term, &y).0
+            };
+            let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+            let exact = Vector3::new(j[0][k][c], j[1][k][c], j[2][k][c]);
+            assert!(
+                (fd - exact).norm() < 1e-7 * (1.0 + exact.norm()),
+                "node {k} axis {c}: {fd} vs {exact}"
+            );
+        }
     }
 }
 
@@ -502,4 +552,68 @@ fn isotropic_prestress_compensation_is_sigma_one_minus_nu_over_e_and_the_svg_dim
             "{text}"
         );
     }
+}
+
+/// A flat 2 m × 1 m film, 8 × 4 cells, rim held (one group), 2 MPa isotropic: its own found shape.
+fn flat_film() -> Model {
+    let (nodes, triangles) = common::flat_grid(8, 4, 2.0, 1.0);
+    let rim = (0..nodes.len())
+        .filter(|&v| {
+            let p = nodes[v];
+            p[0] == 0.0 || p[0] == 2.0 || p[1] == 0.0 || p[1] == 1.0
+        })
+        .collect();
+    let mut model = film_model("FlatFilm", nodes, triangles);
+    model.groups = vec![group("rim", rim)];
+    model.material.prestress = ISOTROPIC;
+    model.material.wrinkling = Wrinkling::None;
+    model
+}
+
+/// Largest and mean `|σ − σ0|/|σ0|` (x and y) after erecting `cut` of the found `model`.
+fn erected_stress_error(
+    model: &Model,
+    cut: &[membrane_contact::mech::patterning::cut::CutStrip],
+) -> (f64, f64) {
+    let reference = reference_geometry(model, cut).unwrap();
+    let erection = erection_model(model, reference);
+    let targets: Vec<[f64; 3]> = erection.groups.iter().map(|g| g.target).collect();
+    let mut analysis = Analysis::new(erection, SolverSettings::default()).unwrap();
+    analysis.step_to(&targets, 2).unwrap();
+    let sigma = model.material.prestress[0];
+    let errors: Vec<f64> = analysis
+        .results()
+        .elements
+        .iter()
+        .map(|e| ((e.stress[0] - sigma).abs()).max((e.stress[1] - sigma).abs()) / sigma)
+        .collect();
+    (
+        errors.iter().fold(0.0, |m, &e| f64::max(m, e)),
+        errors.iter().sum::<f64>() / errors.len() as f64,
+    )
+}
+
+#[test]
+fn erecting_the_prestress_compensated_cut_of_a_flat_film_gives_the_target_prestress() {
+    let model = flat_film();
+    let strips = strips_by_planes(
+        &model,
+        &[SeamPlane {
+            point: [1.0, 0.0, 0.0],
+            normal: [1.0, 0.0, 0.0],
+        }],
+    );
+    let cut = cut_pattern(&model, strips.clone(), Compensation::Prestress).unwrap();
+    let (max, mean) = erected_stress_error(&model, &cut);
+    // Without compensation the erected film carries no stress at all.
+    let uncompensated = cut_pattern(&model, strips, Compensation::Uniform([0.0; 2])).unwrap();
+    let (max0, _) = erected_stress_error(&model, &uncompensated);
+    eprintln!(
+        "flat film erected: stress error max {:.3} %, mean {:.3} % (uncompensated: {:.1} %)",
+        100.0 * max,
+        100.0 * mean,
+        100.0 * max0
+    );
+    assert!(max < 0.005, "{max}");
+    assert!(max0 > 0.9);
 }

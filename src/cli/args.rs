@@ -104,6 +104,10 @@ pub enum Command {
         /// Write the strips' outlines with their dimensions as SVG (mm).
         #[arg(long, value_name = "FILE")]
         svg: Option<PathBuf>,
+        /// Write the erection model: the film's compensated reference geometry (fitted to the
+        /// cut strips), no prestress, each held node driven back to its place by its own group.
+        #[arg(long, value_name = "FILE")]
+        erection_model: Option<PathBuf>,
     },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {

@@ -10,6 +10,7 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
+use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
 };
@@ -81,6 +82,7 @@ pub struct PatternArgs<'a> {
     pub seam_nodes: &'a [String],
     pub compensation: &'a str,
     pub svg: Option<&'a PathBuf>,
+    pub erection_model: Option<&'a PathBuf>,
 }
 
 /// `prestress`, or `C` / `CX,CY` in percent.
@@ -163,6 +165,13 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
         );
     }
     eprintln!("patterned: {} strips, {:.2?}", cut.len(), started.elapsed());
+    if let Some(file) = a.erection_model {
+        let reference = reference_geometry(&model, &cut)?;
+        write_text(
+            Some(file),
+            &(erection_model(&model, reference).to_json() + "\n"),
+        )?;
+    }
     if let Some(file) = a.svg {
         let labels: Vec<OutlineLabel> = (0..cut.len())
             .map(|k| OutlineLabel {

@@ -1005,12 +1005,14 @@ fn main() -> ExitCode {
             seam_nodes,
             compensation,
             svg,
+            erection_model,
         } => design::pattern(design::PatternArgs {
             file,
             seam_planes: seam_plane,
             seam_nodes,
             compensation,
             svg: svg.as_ref(),
+            erection_model: erection_model.as_ref(),
         }),
         Command::ExportSpecimen {
             specimen: args,

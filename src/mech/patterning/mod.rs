@@ -7,10 +7,11 @@
 //! | [`seams`] | strips from seam planes or seam node lines |
 //! | [`cut`] | the whole pattern: every strip flattened, measured and compensated |
 //! | [`flatten`] | least-squares conformal map of a strip (Lévy et al. 2002, eq. 4) |
-//! | [`relax`] | least-squares strain relaxation of the flat strip (Gauss–Newton) |
+//! | [`relax`] | least-squares strain relaxation (Gauss–Newton), flat or in space |
 //! | [`distortion`] | the Green strain of the flat strip against the 3-D strip |
 //! | [`compensate`] | uniform compensation, or from the target prestress `ε = D⁻¹σ` |
 //! | [`outline`] | the strips' outlines as SVG, with dimensions |
+//! | [`reference`] | the film's compensated reference geometry and its erection model |
 //!
 //! Symbols: a strip's 3-D triangle has shape gradients `∇N_k` in its local frame
 //! ([`MembraneTriangle`]); `y_k` are its flat node positions; `F = Σ y_k ∇N_kᵀ` (2×2) maps the
@@ -21,6 +22,7 @@ pub mod cut;
 pub mod distortion;
 pub mod flatten;
 pub mod outline;
+pub mod reference;
 pub mod relax;
 pub mod seams;
 
