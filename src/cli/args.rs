@@ -104,6 +104,17 @@ pub enum Command {
         /// Write the strips' outlines with their dimensions as SVG (mm).
         #[arg(long, value_name = "FILE")]
         svg: Option<PathBuf>,
+        /// Compensate by erection: erect the cut with the model's own supports, contacts and
+        /// friction (the analysis), correct each strip's compensation by the prestress missed,
+        /// at most N erections (0: none); the compensation given is the first.
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        erect: usize,
+        /// Stop the erections when the area-mean prestress error is below this (percent).
+        #[arg(long, value_name = "PERCENT", default_value_t = 1.0)]
+        erect_tolerance: f64,
+        /// Increments of each erection.
+        #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+        erect_increments: u32,
         /// Write the erection model: the film's compensated reference geometry (fitted to the
         /// cut strips), no prestress, each held node driven back to its place by its own group.
         #[arg(long, value_name = "FILE")]

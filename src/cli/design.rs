@@ -9,6 +9,7 @@ use membrane_contact::mech::formfinding::force_density::force_density_shape;
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
+use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::seams::{
@@ -83,6 +84,8 @@ pub struct PatternArgs<'a> {
     pub compensation: &'a str,
     pub svg: Option<&'a PathBuf>,
     pub erection_model: Option<&'a PathBuf>,
+    /// Erections at most, the mean error to stop at, increments per erection.
+    pub erect: (usize, f64, usize),
 }
 
 /// `prestress`, or `C` / `CX,CY` in percent.
@@ -147,11 +150,46 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
     Ok(strips)
 }
 
+/// The erection iterations, one line each on stdout; the last erection's compensation.
+fn compensate_with_erections(
+    model: &Model,
+    strips: Vec<Vec<usize>>,
+    start: Compensation,
+    (iterations, tolerance, increments): (usize, f64, usize),
+) -> Result<Compensation, String> {
+    let mut erect = |m: Model| erect_by_analysis(m, increments);
+    let history =
+        compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
+    for (k, h) in history.iter().enumerate() {
+        let worst = (0..h.element_errors.len())
+            .max_by(|&i, &j| h.element_errors[i].total_cmp(&h.element_errors[j]));
+        let per_strip: Vec<String> = h
+            .compensation
+            .iter()
+            .map(|c| format!("{:.3}/{:.3}", 100.0 * c[0], 100.0 * c[1]))
+            .collect();
+        println!(
+            "erection {k}: prestress error mean {:.3} %, max {:.3} % (triangle {}), compensation % {}",
+            100.0 * h.mean_error,
+            100.0 * h.max_error,
+            worst.unwrap_or(0),
+            per_strip.join(" ")
+        );
+    }
+    let last = history.last().ok_or("no erection was made")?;
+    Ok(Compensation::PerStrip(last.compensation.clone()))
+}
+
 /// `membrane-contact pattern FILE`: one line per strip on stdout, the outlines as SVG.
 pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let model = read_model(a.file)?;
     let started = Instant::now();
-    let cut = cut_pattern(&model, strips(&model, &a)?, compensation(a.compensation)?)?;
+    let strips = strips(&model, &a)?;
+    let mut compensation = compensation(a.compensation)?;
+    if a.erect.0 > 0 {
+        compensation = compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
+    }
+    let cut = cut_pattern(&model, strips, compensation)?;
     for (k, c) in cut.iter().enumerate() {
         println!(
             "strip {k}: {} triangles, cut {:.4} × {:.4} m, compensation {:.3} % × {:.3} %, distortion max {:.3} %, rms {:.3} %",

@@ -1006,6 +1006,9 @@ fn main() -> ExitCode {
             compensation,
             svg,
             erection_model,
+            erect,
+            erect_tolerance,
+            erect_increments,
         } => design::pattern(design::PatternArgs {
             file,
             seam_planes: seam_plane,
@@ -1013,6 +1016,7 @@ fn main() -> ExitCode {
             compensation,
             svg: svg.as_ref(),
             erection_model: erection_model.as_ref(),
+            erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
         }),
         Command::ExportSpecimen {
             specimen: args,

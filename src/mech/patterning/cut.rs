@@ -9,12 +9,14 @@ use super::{Strip, outline::bounds};
 use crate::mech::model::Model;
 
 /// How the strips are compensated.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Compensation {
     /// The same `[c_x, c_y]` (along and across each strip) for every strip.
     Uniform([f64; 2]),
     /// The strain of the model's target prestress along each strip's axes ([`prestress_compensation`]).
     Prestress,
+    /// `[c_x, c_y]` of each strip (the friction-aware iteration's, [`super::erection`]).
+    PerStrip(Vec<[f64; 2]>),
 }
 
 /// A cut strip.
@@ -52,8 +54,9 @@ pub fn cut_pattern(
                 .map_err(|e| format!("strip {k}: relaxation: {e}"))?;
             align(&mut strip.flat);
             let measured = distortion(&elements, &strip.flat);
-            let c = match compensation {
-                Compensation::Uniform(c) => c,
+            let c = match &compensation {
+                Compensation::Uniform(c) => *c,
+                Compensation::PerStrip(c) => c[k],
                 Compensation::Prestress => prestress_compensation(
                     &model.material,
                     model.material.prestress,

@@ -10,6 +10,7 @@
 //! | [`relax`] | least-squares strain relaxation (Gauss–Newton), flat or in space |
 //! | [`distortion`] | the Green strain of the flat strip against the 3-D strip |
 //! | [`compensate`] | uniform compensation, or from the target prestress `ε = D⁻¹σ` |
+//! | [`erection`] | compensation by erection: erect, compare with the target, correct each strip |
 //! | [`outline`] | the strips' outlines as SVG, with dimensions |
 //! | [`reference`] | the film's compensated reference geometry and its erection model |
 //!
@@ -20,6 +21,7 @@
 pub mod compensate;
 pub mod cut;
 pub mod distortion;
+pub mod erection;
 pub mod flatten;
 pub mod outline;
 pub mod reference;
@@ -68,6 +70,30 @@ impl Strip {
             nodes,
             flat,
         }
+    }
+
+    /// Each of the strip's model nodes → its index in [`Strip::nodes`].
+    pub fn local_index(&self) -> std::collections::HashMap<usize, usize> {
+        self.nodes
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (v, i))
+            .collect()
+    }
+
+    /// Model triangle `t` of the strip as cut: its flat positions (z = 0), in the model's node
+    /// order (`local` from [`Strip::local_index`]).
+    pub fn flat_element(
+        &self,
+        model: &Model,
+        local: &std::collections::HashMap<usize, usize>,
+        t: usize,
+    ) -> Result<MembraneTriangle, String> {
+        let flat = model.triangles[t].map(|v| {
+            let p = self.flat[local[&v]];
+            Vector3::new(p[0], p[1], 0.0)
+        });
+        MembraneTriangle::new(flat).map_err(|_| format!("cut triangle {t} has no area"))
     }
 
     /// The strip's triangles in its own numbering, on the 3-D positions `x`.

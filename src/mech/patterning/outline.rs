@@ -20,12 +20,7 @@ pub struct OutlineLabel {
 
 /// The boundary edges of a strip as pairs of its local node indices.
 pub fn boundary_edges(model: &Model, strip: &Strip) -> Vec<[usize; 2]> {
-    let index: HashMap<usize, usize> = strip
-        .nodes
-        .iter()
-        .enumerate()
-        .map(|(i, &v)| (v, i))
-        .collect();
+    let index = strip.local_index();
     let mut count: HashMap<[usize; 2], usize> = HashMap::new();
     for &t in &strip.triangles {
         let tri = model.triangles[t].map(|v| index[&v]);

@@ -8,11 +8,8 @@
 //! A seam is welded: its node takes one position for the strips on both sides, so the fit
 //! spreads what the strips' distortion leaves; that residual is not kept as a prestress.
 
-use nalgebra::Vector3;
-
 use super::cut::CutStrip;
 use super::relax::{StrainTerm, least_strain};
-use crate::mech::elements::triangle::MembraneTriangle;
 use crate::mech::model::restraint::held_axes;
 use crate::mech::model::{Axis, BoundaryGroup, Model};
 
@@ -20,23 +17,11 @@ use crate::mech::model::{Axis, BoundaryGroup, Model};
 fn cut_terms(model: &Model, cut: &[CutStrip]) -> Result<Vec<StrainTerm>, String> {
     let mut terms = Vec::new();
     for c in cut {
-        let local: std::collections::HashMap<usize, usize> = c
-            .strip
-            .nodes
-            .iter()
-            .enumerate()
-            .map(|(i, &v)| (v, i))
-            .collect();
+        let local = c.strip.local_index();
         for &t in &c.strip.triangles {
-            let nodes = model.triangles[t];
-            let flat = nodes.map(|v| {
-                let p = c.strip.flat[local[&v]];
-                Vector3::new(p[0], p[1], 0.0)
-            });
-            let element =
-                MembraneTriangle::new(flat).map_err(|_| format!("cut triangle {t} has no area"))?;
+            let element = c.strip.flat_element(model, &local, t)?;
             terms.push(StrainTerm {
-                nodes,
+                nodes: model.triangles[t],
                 gradients: element.shape_gradients(),
                 area: element.area(),
             });
