@@ -48,12 +48,11 @@ pub fn reference_geometry(model: &Model, cut: &[CutStrip]) -> Result<Vec<[f64; 3
 /// The erection model: the `reference` geometry, no prestress, every node `found` holds
 /// driven by its own group `node<k>` to its found place (the held components only).
 pub fn erection_model(found: &Model, reference: Vec<[f64; 3]>) -> Model {
-    // Symmetry planes stay; the supports and groups become one group per node.
-    let held = held_axes(&Model {
-        symmetry: vec![],
-        ..found.clone()
-    });
+    // Supports, symmetry planes and groups become one group per node: the cut film's nodes
+    // start off those planes and lines, and are driven onto them.
+    let held = held_axes(found);
     let mut model = found.clone();
+    model.symmetry.clear();
     model.name = format!("{}Erection", found.name);
     model.material.prestress = [0.0; 3];
     model.supports.clear();
