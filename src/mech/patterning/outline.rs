@@ -1,7 +1,7 @@
 //! The strips' cutting outlines as SVG (1 user unit = 1 mm): each strip's boundary edges (the
 //! edges of one of its triangles only), its length and width (bounding box of the aligned,
 //! compensated strip) drawn as dimension lines, and its name with its compensation. The strips
-//! are stacked in `y`, 100 mm apart.
+//! are stacked down the page, 100 mm apart, `y` up (not mirrored).
 
 use std::collections::HashMap;
 use std::fmt::Write;
@@ -57,8 +57,10 @@ pub fn svg(model: &Model, strips: &[Strip], labels: &[OutlineLabel]) -> String {
     let (mut body, mut top, mut width) = (String::new(), 60.0, 0.0f64);
     for (strip, label) in strips.iter().zip(labels) {
         let [x0, y0, x1, y1] = bounds(&strip.flat).map(|v| v * mm);
-        let (dx, dy) = (40.0 - x0, top - y0);
-        let p = |i: usize| (strip.flat[i][0] * mm + dx, strip.flat[i][1] * mm + dy);
+        // SVG's y points down: y is mirrored so that the outline is the strip seen from the
+        // side its triangles' normals (node order) point to, not its mirror image.
+        let (dx, dy) = (40.0 - x0, top + y1);
+        let p = |i: usize| (strip.flat[i][0] * mm + dx, dy - strip.flat[i][1] * mm);
         let _ = writeln!(
             body,
             "<g id=\"{}\" fill=\"none\" stroke=\"black\" stroke-width=\"0.5\">",
@@ -72,7 +74,7 @@ pub fn svg(model: &Model, strips: &[Strip], labels: &[OutlineLabel]) -> String {
             );
         }
         let (l, w) = (x1 - x0, y1 - y0);
-        let (bx0, bx1, by0, by1) = (x0 + dx, x1 + dx, y0 + dy, y1 + dy);
+        let (bx0, bx1, by0, by1) = (x0 + dx, x1 + dx, dy - y1, dy - y0);
         let _ = writeln!(
             body,
             "<line x1=\"{bx0:.2}\" y1=\"{:.2}\" x2=\"{bx1:.2}\" y2=\"{:.2}\" stroke=\"blue\"/>",
