@@ -488,7 +488,14 @@ fn element_results_are_written_as_csv() {
 fn help_lists_every_command_and_the_solver_options() {
     let (ok, out, _) = cli(&["--help"]);
     assert!(ok);
-    for command in ["specimen", "model", "check", "export-specimen"] {
+    for command in [
+        "specimen",
+        "model",
+        "check",
+        "export-specimen",
+        "form-find",
+        "pattern",
+    ] {
         assert!(out.contains(command), "{out}");
     }
     let (ok, out, _) = cli(&["model", "--help"]);

@@ -20,6 +20,7 @@ use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, etfe_
 use nalgebra::Vector3;
 
 mod args;
+mod design;
 mod path;
 mod report;
 
@@ -981,6 +982,42 @@ fn main() -> ExitCode {
             output,
             python,
         } => import(mesh, mapping, output.as_deref(), python.as_deref()),
+        Command::FormFind {
+            file,
+            out,
+            prestress,
+            force_density_start,
+            tolerance,
+            max_steps,
+        } => design::form_find(design::FormFindArgs {
+            file,
+            out: out.as_ref(),
+            prestress: *prestress,
+            force_density_start: *force_density_start,
+            settings: membrane_contact::mech::formfinding::update_reference::UpdateSettings {
+                tolerance: *tolerance,
+                max_steps: *max_steps,
+            },
+        }),
+        Command::Pattern {
+            file,
+            seam_plane,
+            seam_nodes,
+            compensation,
+            svg,
+            erection_model,
+            erect,
+            erect_tolerance,
+            erect_increments,
+        } => design::pattern(design::PatternArgs {
+            file,
+            seam_planes: seam_plane,
+            seam_nodes,
+            compensation,
+            svg: svg.as_ref(),
+            erection_model: erection_model.as_ref(),
+            erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
+        }),
         Command::ExportSpecimen {
             specimen: args,
             path_out,

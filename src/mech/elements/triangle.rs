@@ -127,6 +127,11 @@ impl MembraneTriangle {
         self.area
     }
 
+    /// Shape-function gradients `∇N_k` in the local frame (eq. 2.2's `G`, per node).
+    pub fn shape_gradients(&self) -> [Vector2<f64>; 3] {
+        self.gradients
+    }
+
     /// Unit vectors `(e1, e2)` of the local frame the strains and stresses are given in.
     pub fn local_axes(&self) -> (Vector3<f64>, Vector3<f64>) {
         (
