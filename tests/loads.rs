@@ -54,6 +54,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         cables: vec![],
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
     }
 }
 
@@ -491,6 +492,7 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
         force: vec![],
         gravity: [0.0; 3],
         chambers: vec![],
+        layers: vec![],
         heating: vec![],
     };
     analysis

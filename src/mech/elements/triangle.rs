@@ -88,6 +88,8 @@ pub struct MembraneTriangle {
     gradients: [Vector2<f64>; 3],
     /// Initial area `A0` (m²).
     area: f64,
+    /// Its layer's thickness (m; `"layers"` of the model file), None: the material's.
+    layer_thickness: Option<f64>,
 }
 
 impl MembraneTriangle {
@@ -119,12 +121,31 @@ impl MembraneTriangle {
             initial_frame: Matrix3x2::from_columns(&[e1, e2]),
             gradients: [g0, g1, g2],
             area: 0.5 * doubled_area,
+            layer_thickness: None,
         })
+    }
+
+    /// The element with the thickness `t` (m) of its layer instead of the material's.
+    pub fn with_thickness(self, t: f64) -> Self {
+        Self {
+            layer_thickness: Some(t),
+            ..self
+        }
     }
 
     /// Initial area `A0` (m²).
     pub fn area(&self) -> f64 {
         self.area
+    }
+
+    /// Initial thickness `t0` (m): its layer's, else the material's.
+    pub fn thickness(&self, material: &Material) -> f64 {
+        self.layer_thickness.unwrap_or(material.thickness)
+    }
+
+    /// Initial volume `A0 t0` (m³).
+    pub fn volume(&self, material: &Material) -> f64 {
+        self.area * self.thickness(material)
     }
 
     /// Unit vectors `(e1, e2)` of the local frame the strains and stresses are given in.
@@ -251,7 +272,7 @@ impl MembraneTriangle {
         with_tangent: bool,
         tangent: impl FnOnce() -> Matrix3<f64>,
     ) -> (ElementVector, ElementMatrix) {
-        let volume = self.area * material.thickness;
+        let volume = self.volume(material);
         let S = Matrix2::new(s.x, s.z, s.z, s.y);
         let FS = f * S;
         let mut r = ElementVector::zeros();
@@ -345,7 +366,7 @@ impl MembraneTriangle {
             tension_direction,
             plastic: Some(PlasticOutput {
                 equivalent_plastic_strain: r.history.equivalent_plastic_strain,
-                thickness: material.thickness * r.thickness_ratio,
+                thickness: self.thickness(material) * r.thickness_ratio,
             }),
         }
     }
