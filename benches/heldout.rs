@@ -543,7 +543,6 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
             force: stage.force.clone().unwrap_or_else(|| s.loads.force.clone()),
             gravity: stage.gravity,
             chambers: vec![],
-            layers: vec![],
             heating: vec![],
         };
         for k in 1..=stage.steps {

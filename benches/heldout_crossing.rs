@@ -828,7 +828,6 @@ fn run(path: &Path, increments: usize) -> Outcome {
             force: s.loads.force.clone(),
             gravity: stage.gravity,
             chambers: vec![],
-            layers: vec![],
             heating: vec![],
         };
         for k in 1..=stage.steps {

@@ -492,7 +492,6 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
         force: vec![],
         gravity: [0.0; 3],
         chambers: vec![],
-        layers: vec![],
         heating: vec![],
     };
     analysis

@@ -1027,7 +1027,6 @@ fn run_staged_from(
             },
             gravity: [gravity[0], gravity[1], gravity[2]],
             chambers: vec![],
-            layers: vec![],
             heating: vec![],
         };
         let steps = stage["steps"].as_u64().unwrap() as usize;

@@ -209,7 +209,6 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
         force: vec![[0.0, 0.0, -2.0]],
         gravity: [0.0, 0.0, -9.81],
         chambers: vec![],
-        layers: vec![],
         heating: vec![],
     };
     analysis
@@ -315,7 +314,6 @@ fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
         force: vec![],
         gravity: model.loads.gravity,
         chambers: vec![],
-        layers: vec![],
         heating: vec![],
     };
     analysis

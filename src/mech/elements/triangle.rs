@@ -410,6 +410,41 @@ mod tests {
         ElementVector::from_fn(|i, _| scale * ((i as f64 * 1.7 + 0.3).sin()))
     }
 
+    /// A layer's own thickness scales the element's force and tangent as the material's would,
+    /// and its tangent matches central differences of its force.
+    #[test]
+    fn a_layer_thickness_acts_as_the_materials_and_its_tangent_matches_finite_differences() {
+        let mat = etfe();
+        let layered = skew_triangle().with_thickness(3.0 * mat.thickness);
+        let thick = Material {
+            thickness: 3.0 * mat.thickness,
+            ..mat.clone()
+        };
+        let u = pseudo_random_displacement(0.05);
+        assert_eq!(layered.thickness(&mat), thick.thickness);
+        let (f, k) = (
+            layered.internal_force(&mat, &u),
+            layered.tangent_stiffness(&mat, &u),
+        );
+        let (f3, k3) = (
+            skew_triangle().internal_force(&thick, &u),
+            skew_triangle().tangent_stiffness(&thick, &u),
+        );
+        assert!((f - f3).amax() <= 1e-12 * f3.amax() && (k - k3).amax() <= 1e-12 * k3.amax());
+        let h = 1e-7;
+        for j in 0..9 {
+            let (mut up, mut um) = (u, u);
+            up[j] += h;
+            um[j] -= h;
+            let column =
+                (layered.internal_force(&mat, &up) - layered.internal_force(&mat, &um)) / (2.0 * h);
+            assert!(
+                (column - k.column(j)).amax() < 1e-6 * k.amax(),
+                "column {j}"
+            );
+        }
+    }
+
     #[test]
     fn tangent_matches_finite_difference() {
         let (tri, mat) = (skew_triangle(), etfe());
