@@ -941,7 +941,8 @@ fn import(
 }
 
 /// `membrane-contact check FILE`: validates the model, prints its warnings on stderr (as a run
-/// does), how each pressure set faces and what each chamber encloses on stdout.
+/// does), how each pressure set faces, what each chamber encloses and each layer's thickness on
+/// stdout.
 fn check(file: &std::path::Path) -> Result<(), String> {
     let name = file.display();
     let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
@@ -955,6 +956,15 @@ fn check(file: &std::path::Path) -> Result<(), String> {
     }
     for line in membrane_contact::mech::elements::chamber::chamber_report(&model) {
         out!("{line}");
+    }
+    for l in &model.layers {
+        out!(
+            "layer {}: {} triangles, thickness {:.1} µm (the material's: {:.1} µm)",
+            l.name,
+            model.selected_triangles(&l.elements).len(),
+            l.thickness * 1e6,
+            model.material.thickness * 1e6
+        );
     }
     Ok(())
 }
