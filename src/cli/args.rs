@@ -119,6 +119,10 @@ pub enum Command {
         /// cut strips), no prestress, each held node driven back to its place by its own group.
         #[arg(long, value_name = "FILE")]
         erection_model: Option<PathBuf>,
+        /// Write what the strip lines and erection lines say as JSON (for scripts: the Python
+        /// package's `membrane_contact.design.pattern` reads it).
+        #[arg(long, value_name = "FILE")]
+        report: Option<PathBuf>,
     },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {

@@ -8,7 +8,7 @@ use membrane_contact::mech::Model;
 use membrane_contact::mech::formfinding::force_density::force_density_shape;
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
-use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
+use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
@@ -86,6 +86,8 @@ pub struct PatternArgs<'a> {
     pub erection_model: Option<&'a PathBuf>,
     /// Erections at most, the mean error to stop at, increments per erection.
     pub erect: (usize, f64, usize),
+    /// Where to write the report as JSON.
+    pub report: Option<&'a PathBuf>,
 }
 
 /// `prestress`, or `C` / `CX,CY` in percent.
@@ -150,13 +152,14 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
     Ok(strips)
 }
 
-/// The erection iterations, one line each on stdout; the last erection's compensation.
+/// The erection iterations, one line each on stdout; the last erection's compensation and the
+/// erections as JSON (mean and largest prestress error, each strip's compensation).
 fn compensate_with_erections(
     model: &Model,
     strips: Vec<Vec<usize>>,
     start: Compensation,
     (iterations, tolerance, increments): (usize, f64, usize),
-) -> Result<Compensation, String> {
+) -> Result<(Compensation, Vec<serde_json::Value>), String> {
     let mut erect = |m: Model| erect_by_analysis(m, increments);
     let history =
         compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
@@ -177,7 +180,27 @@ fn compensate_with_erections(
         );
     }
     let last = history.last().ok_or("no erection was made")?;
-    Ok(Compensation::PerStrip(last.compensation.clone()))
+    let report = history
+        .iter()
+        .map(|h| {
+            serde_json::json!({
+                "mean_error": h.mean_error,
+                "max_error": h.max_error,
+                "compensation": h.compensation,
+            })
+        })
+        .collect();
+    Ok((Compensation::PerStrip(last.compensation.clone()), report))
+}
+
+/// A cut strip as JSON: its triangles, size (m), compensation and distortion (strains).
+fn strip_json(c: &CutStrip) -> serde_json::Value {
+    serde_json::json!({
+        "triangles": c.strip.triangles,
+        "size": c.size,
+        "compensation": c.compensation,
+        "distortion": { "max": c.distortion.max_strain, "rms": c.distortion.rms_strain },
+    })
 }
 
 /// `membrane-contact pattern FILE`: one line per strip on stdout, the outlines as SVG.
@@ -186,10 +209,19 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let started = Instant::now();
     let strips = strips(&model, &a)?;
     let mut compensation = compensation(a.compensation)?;
+    let mut erections = Vec::new();
     if a.erect.0 > 0 {
-        compensation = compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
+        (compensation, erections) =
+            compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
     }
     let cut = cut_pattern(&model, strips, compensation)?;
+    if let Some(file) = a.report {
+        let report = serde_json::json!({
+            "strips": cut.iter().map(strip_json).collect::<Vec<_>>(),
+            "erections": erections,
+        });
+        write_text(Some(file), &(report.to_string() + "\n"))?;
+    }
     for (k, c) in cut.iter().enumerate() {
         println!(
             "strip {k}: {} triangles, cut {:.4} × {:.4} m, compensation {:.3} % × {:.3} %, distortion max {:.3} %, rms {:.3} %",

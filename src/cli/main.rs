@@ -1019,6 +1019,7 @@ fn main() -> ExitCode {
             erect,
             erect_tolerance,
             erect_increments,
+            report,
         } => design::pattern(design::PatternArgs {
             file,
             seam_planes: seam_plane,
@@ -1027,6 +1028,7 @@ fn main() -> ExitCode {
             svg: svg.as_ref(),
             erection_model: erection_model.as_ref(),
             erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
+            report: report.as_ref(),
         }),
         Command::ExportSpecimen {
             specimen: args,
