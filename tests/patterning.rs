@@ -45,7 +45,7 @@ use membrane_contact::mech::patterning::Strip;
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
-use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
+use membrane_contact::mech::patterning::outline::{OutlineLabel, boundary_edges, bounds, dxf, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::relax::{
     StrainTerm, relax_strains, strain_measure, strain_residual,
@@ -556,6 +556,73 @@ fn isotropic_prestress_compensation_is_sigma_one_minus_nu_over_e_and_the_svg_dim
             text.contains(&format!("L = {:.1} mm", 1000.0 * c.size[0])),
             "{text}"
         );
+    }
+}
+
+/// The DXF drawing holds each strip's boundary edges as LINEs on its own layer, in mm, placed
+/// so that its outline spans the strip's length and width, and a TEXT with them.
+#[test]
+fn dxf_outline_draws_each_strips_boundary_on_its_layer_with_its_dimensions() {
+    let model = sphere_strip();
+    let strips = vec![(0..48).collect(), (48..96).collect()];
+    let cut = cut_pattern(&model, strips, Compensation::Uniform([0.0, 0.0])).unwrap();
+    let labels: Vec<OutlineLabel> = (0..2)
+        .map(|k| OutlineLabel {
+            name: format!("strip {k}"),
+            compensation: cut[k].compensation,
+        })
+        .collect();
+    let strips: Vec<Strip> = cut.iter().map(|c| c.strip.clone()).collect();
+    let text = dxf(&model, &strips, &labels);
+    assert!(text.starts_with("0\nSECTION\n2\nHEADER\n") && text.ends_with("0\nEOF\n"));
+    let lines: Vec<&str> = text.lines().collect();
+    for (k, c) in cut.iter().enumerate() {
+        let layer = format!("STRIP_{k}");
+        // Each LINE entity: 0 LINE 8 layer 10 x1 20 y1 30 z 11 x2 21 y2 31 z.
+        let (mut xs, mut ys) = (Vec::new(), Vec::new());
+        let at = |i: usize| lines[i].parse::<f64>().unwrap();
+        for i in 0..lines.len() {
+            if lines[i] == "LINE" && lines[i + 2] == layer {
+                xs.extend([at(i + 4), at(i + 10)]);
+                ys.extend([at(i + 6), at(i + 12)]);
+            }
+        }
+        let edges = boundary_edges(&model, &c.strip).len();
+        assert_eq!(xs.len(), 2 * edges, "{layer}");
+        let span = |v: &[f64]| {
+            v.iter().fold(f64::MIN, |m, x| m.max(*x)) - v.iter().fold(f64::MAX, |m, x| m.min(*x))
+        };
+        for (axis, v) in [&xs, &ys].into_iter().enumerate() {
+            let size = 1000.0 * c.size[axis];
+            assert!(
+                (span(v) - size).abs() < 1e-2,
+                "{layer} {axis}: {} vs {size}",
+                span(v)
+            );
+        }
+        // Its first line is its first boundary edge, the strip's corner at the origin (strip 0).
+        if k == 0 {
+            let [x0, y0, _, _] = bounds(&c.strip.flat);
+            let [a, b] = boundary_edges(&model, &c.strip)[0];
+            let at = |v: usize| {
+                [
+                    1000.0 * (c.strip.flat[v][0] - x0),
+                    1000.0 * (c.strip.flat[v][1] - y0),
+                ]
+            };
+            let drawn = [[xs[0], ys[0]], [xs[1], ys[1]]];
+            for (d, e) in drawn.iter().zip([at(a), at(b)]) {
+                assert!(
+                    (d[0] - e[0]).abs() < 1e-3 && (d[1] - e[1]).abs() < 1e-3,
+                    "{d:?} vs {e:?}"
+                );
+            }
+        }
+        assert!(text.contains(&format!(
+            "strip {k}: L = {:.1} mm, W = {:.1} mm",
+            1000.0 * c.size[0],
+            1000.0 * c.size[1]
+        )));
     }
 }
 

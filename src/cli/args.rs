@@ -104,6 +104,10 @@ pub enum Command {
         /// Write the strips' outlines with their dimensions as SVG (mm).
         #[arg(long, value_name = "FILE")]
         svg: Option<PathBuf>,
+        /// Write the strips' outlines as DXF (R12, mm; one layer per strip) for a cutting
+        /// plotter or CAD.
+        #[arg(long, value_name = "FILE")]
+        dxf: Option<PathBuf>,
         /// Compensate by erection: erect the cut with the model's own supports, contacts and
         /// friction (the analysis), correct each strip's compensation by the prestress missed,
         /// at most N erections (0: none); the compensation given is the first.

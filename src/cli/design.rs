@@ -10,7 +10,7 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
-use membrane_contact::mech::patterning::outline::{OutlineLabel, svg};
+use membrane_contact::mech::patterning::outline::{OutlineLabel, dxf, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
@@ -83,6 +83,7 @@ pub struct PatternArgs<'a> {
     pub seam_nodes: &'a [String],
     pub compensation: &'a str,
     pub svg: Option<&'a PathBuf>,
+    pub dxf: Option<&'a PathBuf>,
     pub erection_model: Option<&'a PathBuf>,
     /// Erections at most, the mean error to stop at, increments per erection.
     pub erect: (usize, f64, usize),
@@ -242,15 +243,18 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
             &(erection_model(&model, reference).to_json() + "\n"),
         )?;
     }
+    let labels: Vec<OutlineLabel> = (0..cut.len())
+        .map(|k| OutlineLabel {
+            name: format!("strip {k}"),
+            compensation: cut[k].compensation,
+        })
+        .collect();
+    let strips: Vec<_> = cut.into_iter().map(|c| c.strip).collect();
     if let Some(file) = a.svg {
-        let labels: Vec<OutlineLabel> = (0..cut.len())
-            .map(|k| OutlineLabel {
-                name: format!("strip {k}"),
-                compensation: cut[k].compensation,
-            })
-            .collect();
-        let strips: Vec<_> = cut.into_iter().map(|c| c.strip).collect();
         write_text(Some(file), &svg(&model, &strips, &labels))?;
+    }
+    if let Some(file) = a.dxf {
+        write_text(Some(file), &dxf(&model, &strips, &labels))?;
     }
     Ok(())
 }

@@ -110,3 +110,45 @@ pub fn svg(model: &Model, strips: &[Strip], labels: &[OutlineLabel]) -> String {
         "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width:.0}mm\" height=\"{top:.0}mm\" viewBox=\"0 0 {width:.0} {top:.0}\">\n{body}</svg>\n"
     )
 }
+
+/// The strips' outlines as a DXF drawing (AutoCAD R12 ASCII, 1 unit = 1 mm, `$INSUNITS` 4), the
+/// format cutting plotters read: each strip's boundary edges as `LINE` entities on a layer of
+/// its own (`STRIP_<k>`), its length and width as `TEXT` beside it, stacked in `y` 100 mm apart.
+pub fn dxf(model: &Model, strips: &[Strip], labels: &[OutlineLabel]) -> String {
+    let mm = 1000.0;
+    let mut out = String::from("0\nSECTION\n2\nHEADER\n9\n$INSUNITS\n70\n4\n0\nENDSEC\n");
+    out += "0\nSECTION\n2\nENTITIES\n";
+    let mut base = 0.0;
+    for (k, (strip, label)) in strips.iter().zip(labels).enumerate() {
+        let [x0, y0, x1, y1] = bounds(&strip.flat).map(|v| v * mm);
+        let layer = format!("STRIP_{k}");
+        let p = |i: usize| {
+            (
+                strip.flat[i][0] * mm - x0,
+                strip.flat[i][1] * mm - y0 + base,
+            )
+        };
+        for [a, b] in boundary_edges(model, strip) {
+            let ((xa, ya), (xb, yb)) = (p(a), p(b));
+            let _ = write!(
+                out,
+                "0\nLINE\n8\n{layer}\n10\n{xa:.3}\n20\n{ya:.3}\n30\n0.0\n11\n{xb:.3}\n21\n{yb:.3}\n31\n0.0\n"
+            );
+        }
+        let text = format!(
+            "{}: L = {:.1} mm, W = {:.1} mm, compensation {:.3} % x {:.3} %",
+            label.name,
+            x1 - x0,
+            y1 - y0,
+            100.0 * label.compensation[0],
+            100.0 * label.compensation[1]
+        );
+        let _ = write!(
+            out,
+            "0\nTEXT\n8\n{layer}\n10\n0.0\n20\n{:.3}\n30\n0.0\n40\n12.0\n1\n{text}\n",
+            base - 20.0
+        );
+        base += y1 - y0 + 100.0;
+    }
+    out + "0\nENDSEC\n0\nEOF\n"
+}
