@@ -1,0 +1,146 @@
+//! The instance as the shared glue's [`Core`]: what the FMI 3.0 C layer (`src/fmi3`, exported
+//! by `fmi_glue::export_fmi3!`) calls. Each method forwards to the instance's own, the one the
+//! FMI 2.0 functions call, so both versions drive the same code.
+
+use std::path::Path;
+
+use fmi_glue::core::{Core, Instantiation};
+
+use super::instance::Instance;
+use super::logger::Logger;
+use super::phase::{Outcome, Phase};
+use super::resources::resource_dir;
+use super::types::{FMI2_CO_SIMULATION, FMI2_TERMINATED, Status};
+
+impl Core for Instance {
+    fn instantiate(args: Instantiation<'_>) -> Result<Self, String> {
+        let logger = Logger::with_sink(args.sink, args.logging_on);
+        if args.fmi_version == 2 {
+            let (name, token) = (args.name, args.token);
+            return Instance::instantiate(name, FMI2_CO_SIMULATION, token, args.resources, logger);
+        }
+        let token = args.token.ok_or("instantiationToken is NULL")?;
+        // FMI 3.0 §2.3.1: resourcePath is a path ending in a separator, not a URI (a file: URI
+        // is read as one all the same, as some importers of the draft standard sent them).
+        let dir = match args.resources.filter(|p| !p.is_empty()) {
+            None => return Err("resourcePath is NULL or empty: the FMU needs its resources".into()),
+            Some(uri) if uri.starts_with("file:") => resource_dir(uri)?,
+            Some(path) => Path::new(path).to_path_buf(),
+        };
+        Instance::instantiate_in(&dir, token, logger)
+    }
+
+    fn phase(&self) -> Phase {
+        Instance::phase(self)
+    }
+
+    fn mark_fatal(&mut self) {
+        Instance::mark_fatal(self);
+    }
+
+    fn log(&self, status: Status, message: &str) {
+        self.logger.log(status, message);
+    }
+
+    fn set_debug_logging(&mut self, on: bool, names: &[&str]) -> Outcome {
+        Instance::set_debug_logging(self, on, names)
+    }
+
+    fn setup_experiment(&mut self, start: f64, stop: Option<f64>) -> Outcome {
+        Instance::setup_experiment(self, start, stop)
+    }
+
+    fn enter_initialization_mode(&mut self) -> Outcome {
+        Instance::enter_initialization_mode(self)
+    }
+
+    fn exit_initialization_mode(&mut self) -> Outcome {
+        Instance::exit_initialization_mode(self)
+    }
+
+    fn terminate(&mut self) -> Outcome {
+        Instance::terminate(self)
+    }
+
+    fn reset(&mut self) -> Outcome {
+        Instance::reset(self)
+    }
+
+    fn get_real(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome {
+        Instance::get_real(self, vr, values)
+    }
+
+    fn set_real(&mut self, vr: &[u32], values: &[f64]) -> Outcome {
+        Instance::set_real(self, vr, values)
+    }
+
+    fn get_integer(&mut self, vr: &[u32], values: &mut [i32]) -> Outcome {
+        Instance::get_integer(self, vr, values)
+    }
+
+    fn set_integer(&mut self, vr: &[u32], values: &[i32]) -> Outcome {
+        Instance::set_integer(self, vr, values)
+    }
+
+    fn get_boolean(&mut self, vr: &[u32], values: &mut [bool]) -> Outcome {
+        let mut ints = vec![0; values.len()];
+        Instance::get_boolean(self, vr, &mut ints)?;
+        values.iter_mut().zip(ints).for_each(|(b, i)| *b = i != 0);
+        Ok(())
+    }
+
+    fn set_boolean(&mut self, vr: &[u32], values: &[bool]) -> Outcome {
+        let ints: Vec<i32> = values.iter().map(|&b| i32::from(b)).collect();
+        Instance::set_boolean(self, vr, &ints)
+    }
+
+    fn get_string(&mut self, vr: &[u32], values: &mut [*const core::ffi::c_char]) -> Outcome {
+        Instance::get_string(self, vr, values)
+    }
+
+    fn set_string(&mut self, vr: &[u32], values: &[&str]) -> Outcome {
+        Instance::set_string(self, vr, values)
+    }
+
+    fn do_step(&mut self, t: f64, h: f64) -> Outcome {
+        Instance::do_step(self, t, h)
+    }
+
+    fn last_successful_time(&self) -> f64 {
+        self.time
+    }
+
+    fn terminate_requested(&self) -> bool {
+        self.get_boolean_status(FMI2_TERMINATED).unwrap_or(false)
+    }
+
+    fn get_fmu_state(&mut self, handle: usize) -> Outcome<usize> {
+        Instance::get_fmu_state(self, handle)
+    }
+
+    fn set_fmu_state(&mut self, handle: usize) -> Outcome {
+        Instance::set_fmu_state(self, handle)
+    }
+
+    fn free_fmu_state(&mut self, handle: usize) -> Outcome {
+        Instance::free_fmu_state(self, handle)
+    }
+
+    fn serialize_fmu_state(&mut self, handle: usize) -> Outcome<Vec<u8>> {
+        Instance::serialize_fmu_state(self, handle)
+    }
+
+    fn deserialize_fmu_state(&mut self, bytes: &[u8], handle: usize) -> Outcome<usize> {
+        Instance::deserialize_fmu_state(self, bytes, handle)
+    }
+
+    fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome {
+        Instance::directional_derivative(self, unknowns, knowns, seed, out)
+    }
+}
