@@ -144,7 +144,7 @@ fn fill<'a>(template: &str, value: impl Fn(&str) -> Option<&'a str>) -> Result<S
     Ok(out)
 }
 
-fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
+pub(crate) fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
     w.create_element("UnitDefinitions")
         .write_inner_content(|w| {
             for (name, [kg, m, s, k, rad]) in UNITS {
@@ -178,7 +178,7 @@ fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
     Ok(())
 }
 
-fn write_log_categories(w: &mut Writer<Vec<u8>>, _: &[Variable]) -> io::Result<()> {
+pub(crate) fn write_log_categories(w: &mut Writer<Vec<u8>>, _: &[Variable]) -> io::Result<()> {
     w.create_element("LogCategories").write_inner_content(|w| {
         for (name, description) in CATEGORIES {
             w.create_element("Category")

@@ -1,0 +1,192 @@
+"""The FMI 3.0 Co-Simulation FMU (``fmu-pack --fmi-version 3``) against the FMI 2.0 one.
+
+TEST GOAL: the FMI 3.0 archives of the specimen and of a user model pass ``fmpy validate``; fmpy's
+FMI 3.0 importer (``fmpy.fmi3``) gets outputs bit-identical to the FMI 2.0 FMU's on the same
+inputs (the same library and instance drive both); FMU states saved, serialized and read back
+into a fresh FMI 3.0 instance continue bit for bit; a refused step (``fmi3Discard``) keeps the last
+converged state and tells its time; the directional derivatives equal FMI 2.0's; a wrong
+instantiation token is refused.
+
+BOUNDARY CONDITIONS: the group's ``dz`` ramped to -0.02 m over [0, 1], mu = 0.3, steps of 0.1.
+"""
+
+from __future__ import annotations
+
+import zipfile
+
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+from fmpy.validation import validate_fmu
+
+from conftest import fmu_pack
+
+
+def pack3(out_dir, *model) -> str:
+    """Packs the FMI 3.0 FMU of ``model`` (none: the specimen) into ``out_dir``."""
+    r = fmu_pack(*model, "--fmi-version", "3", "--out", out_dir)
+    assert r.returncode == 0, r.stderr
+    (path,) = [p for p in out_dir.iterdir() if p.name.endswith("_fmi3.fmu")]
+    return str(path)
+
+
+@pytest.fixture(scope="module")
+def specimen3(tmp_path_factory):
+    return pack3(tmp_path_factory.mktemp("fmi3-specimen"))
+
+
+@pytest.fixture(scope="module")
+def custom3(custom_model, tmp_path_factory):
+    return pack3(tmp_path_factory.mktemp("fmi3-custom"), custom_model)
+
+
+def dz_input(fmu) -> str:
+    """The first group's ``dz`` input of ``fmu``."""
+    names = [v.name for v in read_model_description(fmu).modelVariables if v.causality == "input"]
+    return next(n for n in names if n.endswith(".dz"))
+
+
+def test_fmi3_archives_pass_fmpy_validate_with_the_library_in_the_fmi3_folder(specimen3, custom3):
+    for fmu in (specimen3, custom3):
+        assert validate_fmu(fmu) == [], fmu
+        with zipfile.ZipFile(fmu) as z:
+            assert any(n.startswith("binaries/x86_64-linux/") for n in z.namelist())
+        d = read_model_description(fmu)
+        assert d.fmiVersion == "3.0" and d.coSimulation is not None
+
+
+def test_fmi3_keeps_the_fmi2_variables_value_references_and_token(fmu_path, specimen3):
+    d2, d3 = read_model_description(str(fmu_path)), read_model_description(specimen3)
+    assert d3.instantiationToken == d2.guid
+    types = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
+    rows = lambda d, t: [(v.name, v.valueReference, t(v.type), v.causality, v.variability, v.start, v.unit)
+                         for v in d.modelVariables]
+    assert rows(d2, types.get) == rows(d3, str)
+
+
+@pytest.mark.parametrize("which", ["specimen", "user model"])
+def test_fmi3_outputs_are_bit_identical_to_fmi2_on_the_same_inputs(which, fmu_path, custom_fmu, specimen3, custom3):
+    fmu2, fmu3 = (str(fmu_path), specimen3) if which == "specimen" else (str(custom_fmu), custom3)
+    name = dz_input(fmu2)
+    ramp = np.array([(0.0, 0.0), (1.0, -0.02)], dtype=[("time", np.float64), (name, np.float64)])
+    run = lambda fmu: simulate_fmu(fmu, stop_time=0.5, output_interval=0.1, input=ramp,
+                                   start_values={"mu": 0.3})
+    r2, r3 = run(fmu2), run(fmu3)
+    assert r2.dtype.names == r3.dtype.names and len(r2) == len(r3) == 6
+    for column in r2.dtype.names:
+        assert np.array_equal(r2[column], r3[column]), column
+    assert any(r2[c][-1] != 0.0 for c in r2.dtype.names if c.endswith(".Rz")), "the film was loaded"
+
+
+class Film3:
+    """An FMI 3.0 instance of ``fmu`` past initialization, with ``vr`` by name."""
+
+    def __init__(self, fmu, name="film3", integers=None, booleans=None):
+        self.d = read_model_description(fmu)
+        self.vr = {v.name: v.valueReference for v in self.d.modelVariables}
+        self.outputs = [v.valueReference for v in self.d.modelVariables if v.causality == "output"
+                        and v.type == "Float64"]
+        from fmpy import extract
+        self.dir = extract(fmu)
+        self.fmu = FMU3Slave(guid=self.d.instantiationToken, unzipDirectory=self.dir,
+                             modelIdentifier=self.d.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu.instantiate()
+        self.fmu.enterInitializationMode(startTime=0.0)
+        self.fmu.setFloat64([self.vr["mu"]], [0.3])
+        for names, setter in [(integers or {}, self.fmu.setInt32), (booleans or {}, self.fmu.setBoolean)]:
+            if names:
+                setter([self.vr[n] for n in names], list(names.values()))
+        self.fmu.exitInitializationMode()
+        self.t = 0.0
+
+    def step(self, dz, h=0.1):
+        self.fmu.setFloat64([self.vr["frame.dz"]], [dz])
+        result = self.fmu.doStep(self.t, h)
+        self.t += h
+        return result
+
+    def values(self):
+        return self.fmu.getFloat64(self.outputs)
+
+    def close(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+
+
+def test_fmi3_states_serialized_into_a_fresh_instance_continue_bit_for_bit(specimen3):
+    a = Film3(specimen3)
+    for k in range(3):
+        a.step(-0.005 * (k + 1))
+    state = a.fmu.getFMUState()
+    blob = a.fmu.serializeFMUState(state)
+    a.fmu.freeFMUState(state)
+    at_save = a.values()
+    for k in range(3, 6):
+        a.step(-0.005 * (k + 1))
+    reference = a.values()
+    a.close()
+
+    b = Film3(specimen3, "fresh")
+    restored = b.fmu.deserializeFMUState(blob)
+    b.fmu.setFMUState(restored)
+    b.fmu.freeFMUState(restored)
+    assert b.values() == at_save
+    b.t = 0.3
+    for k in range(3, 6):
+        b.step(-0.005 * (k + 1))
+    assert b.values() == reference
+    b.close()
+
+
+def test_fmi3_do_step_never_returns_early_and_a_refused_step_keeps_the_last_state(specimen3):
+    # One increment, no cut-back, no stabilization: -0.15 m in one step cannot converge
+    # (test_package.py's HARD settings), set through fmi3SetInt32 and fmi3SetBoolean.
+    hard = {"solver.incrementsPerStep": 1, "solver.maxCutbacks": 0, "solver.maxIterations": 10}
+    f = Film3(specimen3, integers=hard, booleans={"solver.stabilization": False})
+    assert f.fmu.getInt32([f.vr[n] for n in hard]) == list(hard.values())
+    assert f.fmu.getBoolean([f.vr["solver.stabilization"]]) == [False]
+    assert f.step(-0.005) == (False, False, False, 0.1)
+    before = f.values()
+    f.fmu.setFloat64([f.vr["frame.dz"]], [-0.15])
+    with pytest.raises(FMICallException) as refused:
+        f.fmu.doStep(0.1, 1.0)
+    assert refused.value.status == 2  # fmi3Discard
+    assert f.values() == before
+    f.t = 0.1
+    assert f.step(-0.006)[3] == pytest.approx(0.2)
+    f.close()
+
+
+def test_fmi3_directional_derivatives_equal_fmi2s(fmu_path, specimen3):
+    f3 = Film3(specimen3)
+    d2 = read_model_description(str(fmu_path))
+    f2 = FMU2Slave(guid=d2.guid, unzipDirectory=__import__("fmpy").extract(str(fmu_path)),
+                   modelIdentifier=d2.coSimulation.modelIdentifier, instanceName="film2")
+    f2.instantiate()
+    f2.setupExperiment(startTime=0.0)
+    f2.enterInitializationMode()
+    f2.setReal([f3.vr["mu"]], [0.3])
+    f2.exitInitializationMode()
+    for k in range(2):
+        f3.step(-0.005 * (k + 1))
+        f2.setReal([f3.vr["frame.dz"]], [-0.005 * (k + 1)])
+        f2.doStep(0.1 * k, 0.1)
+    unknowns, knowns = [f3.vr["frame.Rz"]], [f3.vr["frame.dz"]]
+    d3 = f3.fmu.getDirectionalDerivative(unknowns, knowns, [1.0])
+    assert d3 == list(f2.getDirectionalDerivative(unknowns, knowns, [1.0]))
+    assert d3[0] != 0.0
+    f3.close()
+    f2.terminate()
+    f2.freeInstance()
+
+
+def test_fmi3_refuses_a_wrong_instantiation_token(specimen3):
+    from fmpy import extract
+    d = read_model_description(specimen3)
+    fmu = FMU3Slave(guid="{00000000-0000-0000-0000-000000000000}", unzipDirectory=extract(specimen3),
+                    modelIdentifier=d.coSimulation.modelIdentifier, instanceName="wrong")
+    with pytest.raises(Exception, match="nstantiat"):
+        fmu.instantiate()
