@@ -8,9 +8,11 @@ use fmi_glue::core::{Core, Instantiation};
 
 use super::instance::Instance;
 use super::logger::Logger;
-use super::phase::{Outcome, Phase};
+use super::phase::{Failure, Outcome, Phase};
 use super::resources::resource_dir;
 use super::types::{FMI2_CO_SIMULATION, FMI2_TERMINATED, Status};
+use crate::fmi3::arrays::{Arrays, Field};
+use crate::mech::Results;
 
 impl Core for Instance {
     fn instantiate(args: Instantiation<'_>) -> Result<Self, String> {
@@ -72,6 +74,36 @@ impl Core for Instance {
 
     fn set_real(&mut self, vr: &[u32], values: &[f64]) -> Outcome {
         Instance::set_real(self, vr, values)
+    }
+
+    fn get_float64(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome {
+        let (nodes, state) = (self.description.model.nodes.len(), self.converged_if(vr)?);
+        let read = |r: u32, field: Field| {
+            let (u, results) = state.as_ref().expect("read for an array");
+            field
+                .float64(nodes, u, results)
+                .ok_or_else(|| not_of_type(r, "Float64"))
+        };
+        self.gather(vr, values, Instance::get_real, read)
+    }
+
+    fn get_int32(&mut self, vr: &[u32], values: &mut [i32]) -> Outcome {
+        let state = self.converged_if(vr)?;
+        let read = |r: u32, field: Field| {
+            let (_, results) = state.as_ref().expect("read for an array");
+            field.int32(results).ok_or_else(|| not_of_type(r, "Int32"))
+        };
+        self.gather(vr, values, Instance::get_integer, read)
+    }
+
+    fn get_uint64(&mut self, vr: &[u32], values: &mut [u64]) -> Outcome {
+        let arrays = Arrays::of(&self.description);
+        fmi_glue::core::scalars(vr.len(), values.len())?;
+        for (&r, v) in vr.iter().zip(values.iter_mut()) {
+            let count = arrays.field(r).and_then(|f| arrays.count(f));
+            *v = count.ok_or_else(|| not_of_type(r, "UInt64"))?;
+        }
+        Ok(())
     }
 
     fn get_integer(&mut self, vr: &[u32], values: &mut [i32]) -> Outcome {
@@ -142,5 +174,59 @@ impl Core for Instance {
         out: &mut [f64],
     ) -> Outcome {
         Instance::directional_derivative(self, unknowns, knowns, seed, out)
+    }
+}
+
+/// The failure of reading `vr` with a getter of another type.
+fn not_of_type(vr: u32, kind: &str) -> Failure {
+    Failure::error(format!("value reference {vr} is not a {kind} variable"))
+}
+
+impl Instance {
+    /// The displacement and results of the converged state (the analysis built first in
+    /// initialization mode), if one of `vr` is an array of the FMI 3.0 interface.
+    fn converged_if(&mut self, vr: &[u32]) -> Outcome<Option<(Vec<f64>, Results)>> {
+        let arrays = Arrays::of(&self.description);
+        if !vr.iter().any(|&r| arrays.field(r).is_some()) {
+            return Ok(None);
+        }
+        self.initial_outputs()?;
+        let built = self.analysis.as_mut().expect("built by initial_outputs");
+        let u = built.analysis.state().displacement.clone();
+        Ok(Some((u, built.analysis.results())))
+    }
+
+    /// The values of `vr` one after another into `values` (`nValues` of them): scalars with
+    /// `scalar`, the arrays of the FMI 3.0 interface with `array`.
+    fn gather<T: Copy + Default>(
+        &mut self,
+        vr: &[u32],
+        values: &mut [T],
+        scalar: fn(&mut Instance, &[u32], &mut [T]) -> Outcome,
+        array: impl Fn(u32, Field) -> Outcome<Vec<T>>,
+    ) -> Outcome {
+        let arrays = Arrays::of(&self.description);
+        let mut out = Vec::with_capacity(values.len());
+        for &r in vr {
+            match arrays.field(r) {
+                Some(field) if arrays.count(field).is_none() => out.extend(array(r, field)?),
+                Some(_) => return Err(not_of_type(r, "Float64 or Int32")),
+                None => {
+                    let mut one = [T::default()];
+                    scalar(self, &[r], &mut one)?;
+                    out.push(one[0]);
+                }
+            }
+        }
+        if out.len() != values.len() {
+            return Err(Failure::error(format!(
+                "nValues = {}, but the {} variables hold {} values",
+                values.len(),
+                vr.len(),
+                out.len()
+            )));
+        }
+        values.copy_from_slice(&out);
+        Ok(())
     }
 }

@@ -14,6 +14,7 @@
 //! FMU states and their serialization, `fmi3GetDirectionalDerivative`. Not yet: arrays,
 //! `fmi3GetAdjointDerivative`, terminals (see `docs/fmu.md`).
 
+pub mod arrays;
 pub mod description;
 
 use crate::fmi2::instance::Instance;

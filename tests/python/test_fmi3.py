@@ -58,13 +58,21 @@ def test_fmi3_archives_pass_fmpy_validate_with_the_library_in_the_fmi3_folder(sp
         assert d.fmiVersion == "3.0" and d.coSimulation is not None
 
 
-def test_fmi3_keeps_the_fmi2_variables_value_references_and_token(fmu_path, specimen3):
+ARRAYS = ["film.nodeCount", "film.gapCount", "film.displacement", "film.reaction", "film.gapSlipX",
+          "film.gapSlipY", "film.gapNormalForce", "film.gapStatus"]
+
+
+def test_fmi3_keeps_the_fmi2_variables_value_references_and_token_and_adds_the_arrays(fmu_path, specimen3):
     d2, d3 = read_model_description(str(fmu_path)), read_model_description(specimen3)
     assert d3.instantiationToken == d2.guid
     types = {"Real": "Float64", "Integer": "Int32", "Boolean": "Boolean", "String": "String"}
     rows = lambda d, t: [(v.name, v.valueReference, t(v.type), v.causality, v.variability, v.start, v.unit)
                          for v in d.modelVariables]
-    assert rows(d2, types.get) == rows(d3, str)
+    n = len(d2.modelVariables)
+    assert rows(d2, types.get) == rows(d3, str)[:n]
+    extra = d3.modelVariables[n:]
+    assert [v.name for v in extra] == ARRAYS
+    assert [v.valueReference for v in extra] == list(range(n, n + len(ARRAYS)))
 
 
 @pytest.mark.parametrize("which", ["specimen", "user model"])
@@ -75,7 +83,7 @@ def test_fmi3_outputs_are_bit_identical_to_fmi2_on_the_same_inputs(which, fmu_pa
     run = lambda fmu: simulate_fmu(fmu, stop_time=0.5, output_interval=0.1, input=ramp,
                                    start_values={"mu": 0.3})
     r2, r3 = run(fmu2), run(fmu3)
-    assert r2.dtype.names == r3.dtype.names and len(r2) == len(r3) == 6
+    assert set(r3.dtype.names) - set(r2.dtype.names) <= set(ARRAYS) and len(r2) == len(r3) == 6
     for column in r2.dtype.names:
         assert np.array_equal(r2[column], r3[column]), column
     assert any(r2[c][-1] != 0.0 for c in r2.dtype.names if c.endswith(".Rz")), "the film was loaded"
@@ -84,11 +92,11 @@ def test_fmi3_outputs_are_bit_identical_to_fmi2_on_the_same_inputs(which, fmu_pa
 class Film3:
     """An FMI 3.0 instance of ``fmu`` past initialization, with ``vr`` by name."""
 
-    def __init__(self, fmu, name="film3", integers=None, booleans=None):
+    def __init__(self, fmu, name="film3", integers=None, booleans=None, strings=None):
         self.d = read_model_description(fmu)
         self.vr = {v.name: v.valueReference for v in self.d.modelVariables}
         self.outputs = [v.valueReference for v in self.d.modelVariables if v.causality == "output"
-                        and v.type == "Float64"]
+                        and v.type == "Float64" and not v.dimensions]
         from fmpy import extract
         self.dir = extract(fmu)
         self.fmu = FMU3Slave(guid=self.d.instantiationToken, unzipDirectory=self.dir,
@@ -96,7 +104,8 @@ class Film3:
         self.fmu.instantiate()
         self.fmu.enterInitializationMode(startTime=0.0)
         self.fmu.setFloat64([self.vr["mu"]], [0.3])
-        for names, setter in [(integers or {}, self.fmu.setInt32), (booleans or {}, self.fmu.setBoolean)]:
+        for names, setter in [(integers or {}, self.fmu.setInt32), (booleans or {}, self.fmu.setBoolean),
+                              (strings or {}, self.fmu.setString)]:
             if names:
                 setter([self.vr[n] for n in names], list(names.values()))
         self.fmu.exitInitializationMode()
@@ -190,3 +199,56 @@ def test_fmi3_refuses_a_wrong_instantiation_token(specimen3):
                     modelIdentifier=d.coSimulation.modelIdentifier, instanceName="wrong")
     with pytest.raises(Exception, match="nstantiat"):
         fmu.instantiate()
+
+
+def test_fmi3_arrays_equal_the_vtk_fields_bit_for_bit(specimen3, tmp_path):
+    import meshio
+    f = Film3(specimen3, strings={"results.directory": str(tmp_path)})
+    n = f.fmu.getUInt64([f.vr["film.nodeCount"], f.vr["film.gapCount"]])
+    assert n == [121, 9]
+    for k in range(3):
+        f.step(-0.01 * (k + 1))
+    nodes, gaps = n
+    u = np.array(f.fmu.getFloat64([f.vr["film.displacement"]], 3 * nodes)).reshape(nodes, 3)
+    r = np.array(f.fmu.getFloat64([f.vr["film.reaction"]], 3 * nodes)).reshape(nodes, 3)
+    gap = {name: np.array(f.fmu.getFloat64([f.vr[name]], gaps))
+           for name in ["film.gapSlipX", "film.gapSlipY", "film.gapNormalForce"]}
+    status = np.array(f.fmu.getInt32([f.vr["film.gapStatus"]], gaps))
+    # An array and a scalar in one call: their values one after the other.
+    both = f.fmu.getFloat64([f.vr["frame.Rz"], f.vr["film.gapSlipX"]], 1 + gaps)
+    assert both[1:] == list(gap["film.gapSlipX"]) and both[0] == f.fmu.getFloat64([f.vr["frame.Rz"]])[0]
+    f.close()
+    film = meshio.read(tmp_path / "ParallelArch_film_0003.vtu")
+    lines = meshio.read(tmp_path / "ParallelArch_gaps_0003.vtu")
+    assert np.array_equal(u, film.point_data["displacement"]) and np.abs(u).max() > 0
+    assert np.array_equal(r, film.point_data["reaction"]) and np.abs(r).max() > 0
+    for name, field in [("film.gapSlipX", "gap_slip_x"), ("film.gapSlipY", "gap_slip_y"),
+                        ("film.gapNormalForce", "gap_normal_force")]:
+        assert np.array_equal(gap[name], lines.cell_data[field][0]), name
+    assert np.array_equal(status, lines.cell_data["gap_status"][0]) and status.any()
+    assert np.abs(gap["film.gapSlipX"]).max() > 0
+
+
+def test_fmi3_refuses_an_array_read_with_the_wrong_number_of_values(specimen3):
+    f = Film3(specimen3)
+    with pytest.raises(FMICallException):
+        f.fmu.getFloat64([f.vr["film.displacement"]], 5)
+    with pytest.raises(FMICallException):
+        f.fmu.getInt32([f.vr["film.gapSlipX"]], 9)
+    f.close()
+
+
+def test_the_fmi3_shape_example_plots_the_film_lowered_by_the_frame(specimen3, tmp_path):
+    import os
+    import subprocess
+    import sys
+    from conftest import CLI, ROOT
+    r = subprocess.run([sys.executable, str(ROOT / "examples" / "fmi3_shape.py"), "--fmu", specimen3,
+                        "--out", str(tmp_path), "--steps", "2", "--depth", "0.01"],
+                       capture_output=True, text=True, timeout=120,
+                       env={**os.environ, "MEMBRANE_CONTACT_CLI": str(CLI)})
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "fmi3_shape.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    x = np.loadtxt(tmp_path / "fmi3_shape.csv", delimiter=",", skiprows=1)
+    assert x.shape == (121, 3)
+    assert x[:, 2].min() == pytest.approx(0.3 - 0.01)  # the frame's nodes went down with it

@@ -52,6 +52,26 @@ pub trait Core: Sized {
     fn get_real(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome;
     /// `fmi2SetReal` / `fmi3SetFloat64` of scalars.
     fn set_real(&mut self, vr: &[u32], values: &[f64]) -> Outcome;
+    /// `fmi3GetFloat64` of variables that may be arrays: `values` holds their values one after
+    /// another (`nValues`); without arrays, [`Core::get_real`] of as many scalars.
+    fn get_float64(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome {
+        scalars(vr.len(), values.len())?;
+        self.get_real(vr, values)
+    }
+    /// `fmi3GetInt32` of variables that may be arrays (as [`Core::get_float64`]).
+    fn get_int32(&mut self, vr: &[u32], values: &mut [i32]) -> Outcome {
+        scalars(vr.len(), values.len())?;
+        self.get_integer(vr, values)
+    }
+    /// `fmi3GetString`: scalars only (`nValues = nvr`).
+    fn get_strings(&mut self, vr: &[u32], values: &mut [*const c_char]) -> Outcome {
+        scalars(vr.len(), values.len())?;
+        self.get_string(vr, values)
+    }
+    /// `fmi3GetUInt64` (structural parameters).
+    fn get_uint64(&mut self, vr: &[u32], _values: &mut [u64]) -> Outcome {
+        no_variables(vr, "UInt64")
+    }
     /// `fmi2GetInteger` / `fmi3GetInt32`.
     fn get_integer(&mut self, vr: &[u32], _values: &mut [i32]) -> Outcome {
         no_variables(vr, "Integer")
@@ -115,6 +135,17 @@ pub trait Core: Sized {
         _out: &mut [f64],
     ) -> Outcome {
         Err(not_supported("directional derivatives"))
+    }
+}
+
+/// `nValues` of a call on scalars only: it must equal `nvr`.
+pub fn scalars(nvr: usize, n_values: usize) -> Outcome {
+    if n_values == nvr {
+        Ok(())
+    } else {
+        Err(Failure::error(format!(
+            "nValues = {n_values}, but {nvr} value references of scalars were given"
+        )))
     }
 }
 

@@ -7,7 +7,9 @@
 //! barrier, values, FMU states) are called with the FMI 3.0 function names. What differs:
 //! * `fmi3Boolean` is a C `bool` (one byte): read as `u8`, any non-zero value is true, so that
 //!   no byte from the importer can become an invalid Rust `bool`;
-//! * getters and setters take `nValues`; this FMU has scalars only, so it must equal `nvr`;
+//! * getters and setters take `nValues`: a getter of Float64, Int32 or UInt64 may read arrays
+//!   (`Core::get_float64`, …: their values one after another), a setter takes scalars only
+//!   (`nValues = nvr`);
 //! * `fmi3EnterInitializationMode` carries what `fmi2SetupExperiment` did;
 //! * `fmi3DoStep` never returns early, and tells the last successful time and whether the FMU
 //!   asks to stop through its out-arguments.
@@ -20,8 +22,8 @@
 
 use core::ffi::{c_char, c_int, c_uint, c_void};
 
-use crate::core::{Core, Instantiation, no_variables};
-use crate::ffi::{input, out_ref, output, string};
+use crate::core::{Core, Instantiation, no_variables, scalars};
+use crate::ffi::{input, out_ref, output, string, strings};
 use crate::fmi2::{instantiate_with, with};
 use crate::logger::{Fmi3LoggerFn, Sink};
 use crate::phase::{Failure, Outcome, allowed};
@@ -83,19 +85,9 @@ pub unsafe fn enter_initialization_mode<C: Core>(
     }
 }
 
-/// `nValues` of a getter or setter: equal to `nvr` (every variable is a scalar).
-fn scalars(nvr: usize, n_values: usize) -> Outcome {
-    if n_values == nvr {
-        Ok(())
-    } else {
-        Err(Failure::error(format!(
-            "nValues = {n_values}, but {nvr} value references of scalars were given"
-        )))
-    }
-}
-
-/// `fmi3GetFloat64`, `fmi3GetInt32`, `fmi3GetString`: `get` fills `nvr` values.
-pub unsafe fn get<C: Core, T>(
+/// `fmi3GetFloat64`, `fmi3GetInt32`, `fmi3GetUInt64`, `fmi3GetString`: `get` fills `nValues`
+/// values, arrays included.
+pub unsafe fn get_values<C: Core, T>(
     c: *mut c_void,
     function: &str,
     (vr, nvr): (*const c_uint, usize),
@@ -105,7 +97,6 @@ pub unsafe fn get<C: Core, T>(
     // SAFETY: contract: `vr` holds `nvr` elements, `values` `nValues`.
     unsafe {
         with::<C>(c, function, allowed::GET, |i| {
-            scalars(nvr, n_values)?;
             get(
                 i,
                 input(vr, nvr, "vr")?,
@@ -128,6 +119,23 @@ pub unsafe fn set<C: Core, T>(
         with::<C>(c, function, allowed::SET, |i| {
             scalars(nvr, n_values)?;
             set(i, input(vr, nvr, "vr")?, input(values, n_values, "values")?)
+        })
+    }
+}
+
+/// `fmi3SetString`: scalars only; the strings are copied.
+pub unsafe fn set_string<C: Core>(
+    c: *mut c_void,
+    vr: *const c_uint,
+    nvr: usize,
+    values: *const *const c_char,
+    n_values: usize,
+) -> c_int {
+    // SAFETY: contract: `vr` holds `nvr` elements, `values` `nValues` NUL-terminated strings.
+    unsafe {
+        with::<C>(c, "fmi3SetString", allowed::SET, |i| {
+            scalars(nvr, n_values)?;
+            i.set_string(input(vr, nvr, "vr")?, &strings(values, n_values, "values")?)
         })
     }
 }
@@ -303,21 +311,23 @@ macro_rules! export_fmi3 {
                     = g2::transition::<C>(c, "fmi3Terminate", allowed::TERMINATE, C::terminate);
                 "fmi3Reset" reset(c: *mut c_void) -> c_int = g2::transition::<C>(c, "fmi3Reset", allowed::RESET, C::reset);
                 "fmi3GetFloat64" get_float64(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut f64, nv: usize) -> c_int
-                    = g::get::<C, f64>(c, "fmi3GetFloat64", (vr, n), (v, nv), C::get_real);
+                    = g::get_values::<C, f64>(c, "fmi3GetFloat64", (vr, n), (v, nv), C::get_float64);
                 "fmi3SetFloat64" set_float64(c: *mut c_void, vr: *const c_uint, n: usize, v: *const f64, nv: usize) -> c_int
                     = g::set::<C, f64>(c, "fmi3SetFloat64", (vr, n), (v, nv), C::set_real);
                 "fmi3GetInt32" get_int32(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut i32, nv: usize) -> c_int
-                    = g::get::<C, i32>(c, "fmi3GetInt32", (vr, n), (v, nv), C::get_integer);
+                    = g::get_values::<C, i32>(c, "fmi3GetInt32", (vr, n), (v, nv), C::get_int32);
                 "fmi3SetInt32" set_int32(c: *mut c_void, vr: *const c_uint, n: usize, v: *const i32, nv: usize) -> c_int
                     = g::set::<C, i32>(c, "fmi3SetInt32", (vr, n), (v, nv), C::set_integer);
+                "fmi3GetUInt64" get_uint64(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut u64, nv: usize) -> c_int
+                    = g::get_values::<C, u64>(c, "fmi3GetUInt64", (vr, n), (v, nv), C::get_uint64);
                 "fmi3GetBoolean" get_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut u8, nv: usize) -> c_int
                     = g::get_boolean::<C>(c, vr, n, v, nv);
                 "fmi3SetBoolean" set_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *const u8, nv: usize) -> c_int
                     = g::set_boolean::<C>(c, vr, n, v, nv);
                 "fmi3GetString" get_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut *const c_char, nv: usize) -> c_int
-                    = g::get::<C, *const c_char>(c, "fmi3GetString", (vr, n), (v, nv), C::get_string);
+                    = g::get_values::<C, *const c_char>(c, "fmi3GetString", (vr, n), (v, nv), C::get_strings);
                 "fmi3SetString" set_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *const *const c_char, nv: usize) -> c_int
-                    = if n == nv { g2::set_string::<C>(c, "fmi3SetString", vr, n, v) } else { g::none::<C>(c, "fmi3SetString(nValues != nvr)", vr, n) };
+                    = g::set_string::<C>(c, vr, n, v, nv);
                 "fmi3GetFMUState" get_fmu_state(c: *mut c_void, s: *mut *mut c_void) -> c_int = g2::get_fmu_state::<C>(c, "fmi3GetFMUState", s);
                 "fmi3SetFMUState" set_fmu_state(c: *mut c_void, s: *mut c_void) -> c_int = g2::set_fmu_state::<C>(c, "fmi3SetFMUState", s);
                 "fmi3FreeFMUState" free_fmu_state(c: *mut c_void, s: *mut *mut c_void) -> c_int = g2::free_fmu_state::<C>(c, "fmi3FreeFMUState", s);
@@ -340,7 +350,7 @@ macro_rules! export_fmi3 {
                 "fmi3GetUInt16" get_uint16(v: *mut u16, nv: usize); "fmi3SetUInt16" set_uint16(v: *const u16, nv: usize);
                 "fmi3GetUInt32" get_uint32(v: *mut u32, nv: usize); "fmi3SetUInt32" set_uint32(v: *const u32, nv: usize);
                 "fmi3GetInt64" get_int64(v: *mut i64, nv: usize); "fmi3SetInt64" set_int64(v: *const i64, nv: usize);
-                "fmi3GetUInt64" get_uint64(v: *mut u64, nv: usize); "fmi3SetUInt64" set_uint64(v: *const u64, nv: usize);
+                "fmi3SetUInt64" set_uint64(v: *const u64, nv: usize);
                 "fmi3GetBinary" get_binary(s: *mut usize, v: *mut *const u8, nv: usize);
                 "fmi3SetBinary" set_binary(s: *const usize, v: *const *const u8, nv: usize);
                 "fmi3GetClock" get_clock(v: *mut u8); "fmi3SetClock" set_clock(v: *const u8);
