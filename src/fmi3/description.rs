@@ -47,7 +47,7 @@ pub fn model_description(d: &Description) -> String {
     canGetAndSetFMUState="true"
     canSerializeFMUState="true"
     providesDirectionalDerivatives="true"
-    providesAdjointDerivatives="false"
+    providesAdjointDerivatives="true"
     canHandleVariableCommunicationStepSize="true"
     maxOutputDerivativeOrder="0"
     providesIntermediateUpdate="false"

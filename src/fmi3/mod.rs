@@ -9,10 +9,12 @@
 //! FMU of either version refuses the resources of another model alike.
 //!
 //! What the 3.0 interface has: Float64/Int32/Boolean/String scalars with the FMI 2.0 value
-//! references (which are unique across types, as 3.0 requires), `fmi3DoStep` without early
-//! return (a refused step returns `fmi3Discard` and keeps the last converged state, as in 2.0),
-//! FMU states and their serialization, `fmi3GetDirectionalDerivative`. Not yet: arrays,
-//! `fmi3GetAdjointDerivative`, terminals (see `docs/fmu.md`).
+//! references (which are unique across types, as 3.0 requires), the film's fields as arrays
+//! sized by structural parameters ([`arrays`]), `fmi3DoStep` without early return (a refused
+//! step returns `fmi3Discard` and keeps the last converged state, as in 2.0), FMU states and
+//! their serialization, `fmi3GetDirectionalDerivative` and `fmi3GetAdjointDerivative` (J's
+//! columns, the glue's default). Not yet: the adjoint from the held factorization, terminals
+//! (see `docs/fmu.md`).
 
 pub mod arrays;
 pub mod description;

@@ -136,6 +136,38 @@ pub trait Core: Sized {
     ) -> Outcome {
         Err(not_supported("directional derivatives"))
     }
+    /// `GetAdjointDerivative`: `out = Jᵀ seed` (a seed per unknown, a value per known), J as
+    /// [`Core::directional_derivative`] gives it. By default J's columns, one directional
+    /// derivative per known, contracted with the seed: J's exact transpose, at the cost of
+    /// `knowns.len()` directional derivatives. A warning of one of them (the film's
+    /// path-dependent derivatives) is passed on once the whole product is written.
+    fn adjoint_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome {
+        let (mut column, mut result) = (vec![0.0; unknowns.len()], vec![0.0; knowns.len()]);
+        let mut warning = None;
+        for (j, &known) in knowns.iter().enumerate() {
+            match self.directional_derivative(unknowns, &[known], &[1.0], &mut column) {
+                Ok(()) => {}
+                Err(f) if f.status == Status::Warning => warning = Some(f),
+                Err(f) => return Err(f),
+            }
+            result[j] = column.iter().zip(seed).map(|(c, v)| c * v).sum();
+        }
+        if let Some((j, _)) = result.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+            return Err(Failure::error(format!(
+                "the adjoint derivative with respect to value reference {} overflows: scale the \
+                 seed down",
+                knowns[j]
+            )));
+        }
+        out.copy_from_slice(&result);
+        warning.map_or(Ok(()), Err)
+    }
 }
 
 /// `nValues` of a call on scalars only: it must equal `nvr`.

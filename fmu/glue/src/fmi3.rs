@@ -1,7 +1,8 @@
 //! The FMI 3.0 Co-Simulation C layer over any [`Core`], and [`export_fmi3!`](crate::export_fmi3)
 //! that exports every `fmi3*` function of `fmi3Functions.h` for one type: the Co-Simulation
-//! ones and the common ones work, those of Model Exchange, Scheduled Execution, clocks, event
-//! mode and configuration mode log and return `fmi3Error` (the FMU declares none of them).
+//! ones, the common ones and `fmi3GetAdjointDerivative` work; those of Model Exchange,
+//! Scheduled Execution, clocks, event mode and configuration mode log and return `fmi3Error`
+//! (the FMU declares none of them).
 //!
 //! The generic functions of [`crate::fmi2`] that do not depend on the version (the panic
 //! barrier, values, FMU states) are called with the FMI 3.0 function names. What differs:
@@ -228,36 +229,44 @@ pub unsafe fn do_step<C: Core>(
     }
 }
 
-/// `fmi3GetDirectionalDerivative`: `nSeed = nKnowns`, `nSensitivity = nUnknowns` (scalars).
-#[allow(clippy::too_many_arguments)]
-pub unsafe fn directional_derivative<C: Core>(
+/// `fmi3GetDirectionalDerivative` (`adjoint` false: `nSeed = nKnowns`, `nSensitivity =
+/// nUnknowns`) and `fmi3GetAdjointDerivative` (true: `nSeed = nUnknowns`, `nSensitivity =
+/// nKnowns`); every variable is a scalar.
+pub unsafe fn derivative<C: Core>(
     c: *mut c_void,
+    adjoint: bool,
     (unknowns, n_unknowns): (*const c_uint, usize),
     (knowns, n_knowns): (*const c_uint, usize),
     (seed, n_seed): (*const f64, usize),
     (sensitivity, n_sensitivity): (*mut f64, usize),
 ) -> c_int {
+    let (function, sizes) = if adjoint {
+        ("fmi3GetAdjointDerivative", (n_unknowns, n_knowns))
+    } else {
+        ("fmi3GetDirectionalDerivative", (n_knowns, n_unknowns))
+    };
     // SAFETY: contract: the arrays hold the announced numbers of elements.
     unsafe {
-        with::<C>(
-            c,
-            "fmi3GetDirectionalDerivative",
-            allowed::DIRECTIONAL_DERIVATIVE,
-            |i| {
-                if n_seed != n_knowns || n_sensitivity != n_unknowns {
-                    return Err(Failure::error(format!(
-                        "nSeed = {n_seed} and nSensitivity = {n_sensitivity} must equal nKnowns = \
-                         {n_knowns} and nUnknowns = {n_unknowns} (every variable is a scalar)"
-                    )));
-                }
-                i.directional_derivative(
-                    input(unknowns, n_unknowns, "unknowns")?,
-                    input(knowns, n_knowns, "knowns")?,
-                    input(seed, n_seed, "seed")?,
-                    output(sensitivity, n_sensitivity, "sensitivity")?,
-                )
-            },
-        )
+        with::<C>(c, function, allowed::DIRECTIONAL_DERIVATIVE, |i| {
+            if (n_seed, n_sensitivity) != sizes {
+                return Err(Failure::error(format!(
+                    "nSeed = {n_seed} and nSensitivity = {n_sensitivity} must be {} and {} \
+                     (nKnowns = {n_knowns}, nUnknowns = {n_unknowns}; every variable is a scalar)",
+                    sizes.0, sizes.1
+                )));
+            }
+            let (unknowns, knowns) = (
+                input(unknowns, n_unknowns, "unknowns")?,
+                input(knowns, n_knowns, "knowns")?,
+            );
+            let seed = input(seed, n_seed, "seed")?;
+            let sensitivity = output(sensitivity, n_sensitivity, "sensitivity")?;
+            if adjoint {
+                i.adjoint_derivative(unknowns, knowns, seed, sensitivity)
+            } else {
+                i.directional_derivative(unknowns, knowns, seed, sensitivity)
+            }
+        })
     }
 }
 
@@ -338,7 +347,9 @@ macro_rules! export_fmi3 {
                 "fmi3DeserializeFMUState" deserialize(c: *mut c_void, b: *const c_char, n: usize, s: *mut *mut c_void) -> c_int
                     = g2::deserialize::<C>(c, "fmi3DeserializeFMUState", b, n, s);
                 "fmi3GetDirectionalDerivative" get_directional_derivative(c: *mut c_void, u: *const c_uint, nu: usize, k: *const c_uint, nk: usize, s: *const f64, ns: usize, o: *mut f64, no: usize) -> c_int
-                    = g::directional_derivative::<C>(c, (u, nu), (k, nk), (s, ns), (o, no));
+                    = g::derivative::<C>(c, false, (u, nu), (k, nk), (s, ns), (o, no));
+                "fmi3GetAdjointDerivative" get_adjoint_derivative(c: *mut c_void, u: *const c_uint, nu: usize, k: *const c_uint, nk: usize, s: *const f64, ns: usize, o: *mut f64, no: usize) -> c_int
+                    = g::derivative::<C>(c, true, (u, nu), (k, nk), (s, ns), (o, no));
                 "fmi3DoStep" do_step(c: *mut c_void, t: f64, h: f64, _no_prior: u8, event: *mut u8, stop: *mut u8, early: *mut u8, last: *mut f64) -> c_int
                     = g::do_step::<C>(c, t, h, event, stop, early, last);
             );
@@ -356,7 +367,6 @@ macro_rules! export_fmi3 {
                 "fmi3GetClock" get_clock(v: *mut u8); "fmi3SetClock" set_clock(v: *const u8);
             );
             $crate::export_fmi2!(@refused
-                "fmi3GetAdjointDerivative" get_adjoint_derivative(_u: *const c_uint, _nu: usize, _k: *const c_uint, _nk: usize, _s: *const f64, _ns: usize, _o: *mut f64, _no: usize);
                 "fmi3GetNumberOfVariableDependencies" get_number_of_variable_dependencies(_vr: c_uint, _n: *mut usize);
                 "fmi3GetVariableDependencies" get_variable_dependencies(_d: c_uint, _e: *mut usize, _i: *mut c_uint, _ei: *mut usize, _k: *mut c_int, _n: usize);
                 "fmi3EnterConfigurationMode" enter_configuration_mode();

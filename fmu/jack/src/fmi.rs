@@ -185,3 +185,62 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod adjoint_tests {
+    //! The glue's adjoint derivative on a model whose derivatives are exact (the jack's are
+    //! analytic, so linear in the seed to the last bit).
+    use fmi_glue::core::{Core, Instantiation};
+    use fmi_glue::logger::Sink;
+
+    use super::Instance;
+    use crate::{GUID, vr};
+
+    #[test]
+    fn the_adjoint_is_the_transpose_of_the_directional_derivative_to_1e_12() {
+        let mut i = Instance::instantiate(Instantiation {
+            name: "jack",
+            token: Some(GUID),
+            resources: None,
+            sink: Sink::None,
+            logging_on: false,
+            fmi_version: 3,
+        })
+        .unwrap();
+        i.setup_experiment(0.0, None).unwrap();
+        i.enter_initialization_mode().unwrap();
+        i.exit_initialization_mode().unwrap();
+        // In the valve's band, so that every derivative is non-zero.
+        i.set_real(&[vr::FORCE, vr::RELIEF], &[-550.0, 600.0])
+            .unwrap();
+        i.do_step(0.0, 5.0).unwrap();
+        let (unknowns, knowns) = (
+            [vr::DZ, vr::PISTON, vr::SPEED],
+            [vr::FORCE, vr::STIFFNESS, vr::RELIEF],
+        );
+        for (s, v) in [
+            ([1.0, -2.0, 0.5], [0.3, 1.0, -4.0]),
+            ([1e-3, 7.0, -2.0], [2.0, -0.1, 1.0]),
+        ] {
+            let (mut js, mut jtv) = ([0.0; 3], [0.0; 3]);
+            i.directional_derivative(&unknowns, &knowns, &s, &mut js)
+                .unwrap();
+            i.adjoint_derivative(&unknowns, &knowns, &v, &mut jtv)
+                .unwrap();
+            let left: f64 = v.iter().zip(js).map(|(a, b)| a * b).sum();
+            let right: f64 = jtv.iter().zip(s).map(|(a, b)| a * b).sum();
+            assert!(
+                left != 0.0 && (left - right).abs() <= 1e-12 * left.abs(),
+                "{left} vs {right}"
+            );
+        }
+        // A seed per unknown, a value per known: the column of FORCE seen through v = e_DZ is
+        // d dz / d force.
+        let (mut column, mut row) = ([0.0; 1], [0.0; 1]);
+        i.directional_derivative(&[vr::DZ], &[vr::FORCE], &[1.0], &mut column)
+            .unwrap();
+        i.adjoint_derivative(&[vr::DZ, vr::PISTON], &[vr::FORCE], &[1.0, 0.0], &mut row)
+            .unwrap();
+        assert_eq!(column, row);
+    }
+}
