@@ -28,7 +28,9 @@
 //!
 //! With `--fmi-version 3` the description is the FMI 3.0 one rendered from the same variable
 //! table (`membrane_contact::fmi3::description`, its instantiation token the 2.0 GUID), the
-//! binaries go to FMI 3.0's `<arch>-<os>` folders (`x86_64-linux`, …), and the default file name
+//! archive has `terminalsAndIcons/terminalsAndIcons.xml` (a terminal per boundary group,
+//! `membrane_contact::fmi3::terminals`), the binaries go to FMI 3.0's `<arch>-<os>` folders
+//! (`x86_64-linux`, …), and the default file name
 //! is `<modelIdentifier>_fmi3.fmu`, so that it never replaces the FMI 2.0 FMU. The library is
 //! the same: it exports both interfaces.
 //!
@@ -381,9 +383,18 @@ fn write_fmu(
             binary,
         )
     });
+    let terminals = match fmi_version {
+        3 => membrane_contact::fmi3::terminals::terminals_and_icons(d),
+        _ => None,
+    };
+    let terminals = terminals.as_ref().map(|t| {
+        let name = "terminalsAndIcons/terminalsAndIcons.xml".to_string();
+        (name, t.as_bytes(), text)
+    });
     let entries: Vec<(String, &[u8], SimpleFileOptions)> =
         std::iter::once(("modelDescription.xml".into(), xml.as_bytes(), text))
             .chain(binaries)
+            .chain(terminals)
             .chain([
                 (
                     format!("resources/{resource_name}"),
@@ -503,11 +514,17 @@ fn run(o: &Options) -> Result<(), String> {
     }
     write_fmu(&path, &description, &source, &libraries, o.fmi_version)?;
     let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-    let version = if o.fmi_version == 3 { " FMI 3.0," } else { "" };
+    let (version, arrays) = match o.fmi_version {
+        3 => {
+            let arrays = membrane_contact::fmi3::arrays::Arrays::of(&description);
+            (" FMI 3.0,", arrays.fields().count())
+        }
+        _ => ("", 0),
+    };
     println!(
         "{}:{version} {} variables, GUID {}, {:.1} MB (library {})",
         path.display(),
-        description.variables.len(),
+        description.variables.len() + arrays,
         description.guid,
         size as f64 / 1e6,
         shipped.join("; ")

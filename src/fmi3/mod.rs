@@ -13,11 +13,12 @@
 //! sized by structural parameters ([`arrays`]), `fmi3DoStep` without early return (a refused
 //! step returns `fmi3Discard` and keeps the last converged state, as in 2.0), FMU states and
 //! their serialization, `fmi3GetDirectionalDerivative` and `fmi3GetAdjointDerivative` (J's
-//! columns, the glue's default). Not yet: the adjoint from the held factorization, terminals
-//! (see `docs/fmu.md`).
+//! columns, the glue's default), a terminal per boundary group ([`terminals`]). Not yet: the
+//! adjoint from the held factorization (see `docs/fmu.md`).
 
 pub mod arrays;
 pub mod description;
+pub mod terminals;
 
 use crate::fmi2::instance::Instance;
 

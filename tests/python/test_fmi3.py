@@ -276,3 +276,23 @@ def test_fmi3_adjoint_is_the_transpose_of_the_film_jacobian_and_of_its_direction
     with pytest.raises(FMICallException):  # the default sensitivity size (one per unknown)
         f.fmu.getAdjointDerivative(unknowns, knowns, list(v))
     f.close()
+
+
+def test_fmi3_archives_have_a_schema_valid_terminal_per_boundary_group(specimen3, custom3):
+    from pathlib import Path
+    import fmpy
+    from lxml import etree
+    schema = etree.XMLSchema(etree.parse(str(Path(fmpy.__file__).parent / "schema" / "fmi3" /
+                                             "fmi3TerminalsAndIcons.xsd")))
+    for fmu, group in [(specimen3, "frame"), (custom3, "rim")]:
+        with zipfile.ZipFile(fmu) as z:
+            doc = etree.fromstring(z.read("terminalsAndIcons/terminalsAndIcons.xml"))
+        schema.assertValid(doc)
+        (terminal,) = doc.iter("Terminal")
+        assert terminal.get("name") == group and terminal.get("matchingRule") == "plug"
+        causality = {v.name: v.causality for v in read_model_description(fmu).modelVariables}
+        members = {m.get("memberName"): m.get("variableName") for m in terminal.iter("TerminalMemberVariable")}
+        assert list(members) == ["dx", "dy", "dz", "Rx", "Ry", "Rz"]
+        for member, variable in members.items():
+            assert variable == f"{group}.{member}"
+            assert causality[variable] == ("input" if member.startswith("d") else "output")
