@@ -88,6 +88,20 @@ impl Sink {
     }
 }
 
+/// The log categories the FMI standard names (FMI 2.0 §2.2.4, FMI 3.0 §2.4.5).
+pub const STANDARD_CATEGORIES: [&str; 10] = [
+    "logEvents",
+    "logSingularLinearSystems",
+    "logNonlinearSystems",
+    "logDynamicStateSelection",
+    "logStatusWarning",
+    "logStatusDiscard",
+    "logStatusError",
+    "logStatusFatal",
+    "logStatusPending",
+    "logAll",
+];
+
 /// The standard category a message of `status` goes to.
 pub fn standard_category(status: Status) -> &'static str {
     match status {
@@ -128,11 +142,14 @@ impl Logger {
         }
     }
 
-    /// `fmiXSetDebugLogging`: switch all categories (`names` empty) or the named ones; an unknown
-    /// name changes nothing and is reported.
+    /// `fmiXSetDebugLogging`: switch all categories (`names` empty) or the named ones. A
+    /// standard category the FMU does not declare ([`STANDARD_CATEGORIES`]) has nothing to
+    /// switch and is passed over (masters ask for `logStatusWarning` of every FMU); any other
+    /// unknown name changes nothing and is reported.
     pub fn set_debug_logging(&mut self, on: bool, names: &[&str]) -> Result<(), String> {
         let position = |name: &&str| self.categories.iter().position(|(c, _)| c == name);
-        if let Some(unknown) = names.iter().find(|n| position(n).is_none()) {
+        let unknown = |n: &&&str| position(n).is_none() && !STANDARD_CATEGORIES.contains(n);
+        if let Some(unknown) = names.iter().find(unknown) {
             let known: Vec<&str> = self.categories.iter().map(|(c, _)| *c).collect();
             return Err(format!(
                 "unknown log category '{unknown}' (declared: {})",
