@@ -63,6 +63,25 @@ pub struct Description {
     pub initial_unknowns: &'static [Dependencies],
 }
 
+impl Variable {
+    /// Its attributes as both versions write them: name to description (FMI 2.0's
+    /// `ScalarVariable`), and unit and start (FMI 2.0's `Real`); FMI 3.0's `Float64` has both.
+    fn attributes(&self) -> (String, String) {
+        let start = self
+            .start
+            .map_or(String::new(), |s| format!(" start=\"{s}\""));
+        let head = format!(
+            "name=\"{}\" valueReference=\"{}\" causality=\"{}\" variability=\"{}\" description=\"{}\"",
+            escape(self.name),
+            self.vr,
+            causality(self.causality),
+            variability(self.variability),
+            escape(self.description)
+        );
+        (head, format!("unit=\"{}\"{start}", escape(self.unit)))
+    }
+}
+
 impl Description {
     /// The variable of value reference `vr`.
     pub fn variable(&self, vr: u32) -> Option<&'static Variable> {
@@ -109,17 +128,11 @@ impl Description {
         self.units_and_categories(&mut x);
         x.push_str("  <ModelVariables>\n");
         for (i, v) in self.variables.iter().enumerate() {
-            let start = v.start.map_or(String::new(), |s| format!(" start=\"{s}\""));
+            let (head, unit) = v.attributes();
             let _ = writeln!(
                 x,
-                "    <!-- {} --><ScalarVariable name=\"{}\" valueReference=\"{}\" causality=\"{}\" variability=\"{}\" description=\"{}\"><Real unit=\"{}\"{start}/></ScalarVariable>",
-                i + 1,
-                escape(v.name),
-                v.vr,
-                causality(v.causality),
-                variability(v.variability),
-                escape(v.description),
-                escape(v.unit)
+                "    <!-- {} --><ScalarVariable {head}><Real {unit}/></ScalarVariable>",
+                i + 1
             );
         }
         x.push_str("  </ModelVariables>\n  <ModelStructure>\n");
@@ -132,6 +145,61 @@ impl Description {
                 let _ = writeln!(x, "      <Unknown {}/>", self.unknown(d));
             }
             let _ = writeln!(x, "    </{tag}>");
+        }
+        x.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
+        x
+    }
+
+    /// The value reference of the FMI 3.0 description's independent variable `time` (FMI 3.0
+    /// requires one): the one after the table's last.
+    pub fn time_vr(&self) -> u32 {
+        self.variables.iter().map(|v| v.vr + 1).max().unwrap_or(0)
+    }
+
+    /// The FMI 3.0 `modelDescription.xml`: the same table as Float64 variables, `time` added
+    /// ([`Self::time_vr`]), the token as `instantiationToken`, dependencies by value reference.
+    pub fn fmi3_xml(&self) -> String {
+        let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
+        let _ = writeln!(
+            x,
+            "<fmiModelDescription fmiVersion=\"3.0\" modelName=\"{}\" instantiationToken=\"{}\"\n  description=\"{}\"\n  generationTool=\"{}\" variableNamingConvention=\"structured\">",
+            escape(self.model_name),
+            escape(self.token),
+            escape(self.description),
+            escape(self.generation_tool)
+        );
+        let _ = writeln!(
+            x,
+            "  <CoSimulation modelIdentifier=\"{}\" canHandleVariableCommunicationStepSize=\"true\"\n    canGetAndSetFMUState=\"{}\" providesDirectionalDerivatives=\"{d}\" providesAdjointDerivatives=\"{d}\" hasEventMode=\"false\"/>",
+            self.model_identifier,
+            self.can_get_and_set_fmu_state,
+            d = self.provides_directional_derivative
+        );
+        self.units_and_categories(&mut x);
+        x.push_str("  <ModelVariables>\n");
+        let _ = writeln!(
+            x,
+            "    <Float64 name=\"time\" valueReference=\"{}\" causality=\"independent\" variability=\"continuous\" description=\"simulation time\"/>",
+            self.time_vr()
+        );
+        for v in self.variables {
+            let (head, unit) = v.attributes();
+            let _ = writeln!(x, "    <Float64 {head} {unit}/>");
+        }
+        x.push_str("  </ModelVariables>\n  <ModelStructure>\n");
+        for (tag, list) in [
+            ("Output", self.outputs),
+            ("InitialUnknown", self.initial_unknowns),
+        ] {
+            for d in list {
+                let on: Vec<String> = d.on.iter().map(|vr| vr.to_string()).collect();
+                let _ = writeln!(
+                    x,
+                    "    <{tag} valueReference=\"{}\" dependencies=\"{}\"/>",
+                    d.output,
+                    on.join(" ")
+                );
+            }
         }
         x.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
         x

@@ -146,12 +146,20 @@ impl<M: ScalarModel> Core for Scalar<M> {
         Ok(())
     }
 
+    /// The table's variables, and `time` ([`Description::time_vr`], FMI 3.0's independent
+    /// variable).
     fn get_real(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome {
-        if let Some(r) = vr.iter().find(|&&r| M::description().variable(r).is_none()) {
+        let d = M::description();
+        let known = |r: u32| r == d.time_vr() || d.variable(r).is_some();
+        if let Some(r) = vr.iter().find(|&&r| !known(r)) {
             return Err(Failure::error(format!("unknown value reference {r}")));
         }
         for (v, &r) in values.iter_mut().zip(vr) {
-            *v = self.model.get(r);
+            *v = if r == d.time_vr() {
+                self.model.time()
+            } else {
+                self.model.get(r)
+            };
         }
         Ok(())
     }

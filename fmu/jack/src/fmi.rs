@@ -1,6 +1,7 @@
 //! The jack as the shared glue (`fmu/glue`) sees it: a [`ScalarModel`] whose instance core
-//! ([`Scalar`]) and FMI 2.0 C layer ([`fmi_glue::export_fmi2!`]) are the glue's. The 44
-//! `fmi2*` functions are exported from here; the phases, the checks of value references, the
+//! ([`Scalar`]) and FMI 2.0 and 3.0 C layers ([`fmi_glue::export_fmi2!`],
+//! [`fmi_glue::export_fmi3!`]) are the glue's. The `fmi2*` and `fmi3*` functions are exported
+//! from here; the phases, the checks of value references, the
 //! refused step that keeps the last state, the FMU states and the log are the glue's.
 
 use fmi_glue::description::Description;
@@ -54,6 +55,7 @@ impl ScalarModel for Jack {
 pub type Instance = Scalar<Jack>;
 
 fmi_glue::export_fmi2!(Instance);
+fmi_glue::export_fmi3!(Instance);
 
 #[cfg(test)]
 mod tests {

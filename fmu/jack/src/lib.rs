@@ -219,6 +219,12 @@ pub fn model_description() -> String {
     DESCRIPTION.fmi2_xml()
 }
 
+/// The FMI 3.0 `modelDescription.xml` of the jack, generated from [`DESCRIPTION`]
+/// (`fmu/jack/modelDescription3.xml` is this text, checked by a test).
+pub fn model_description_fmi3() -> String {
+    DESCRIPTION.fmi3_xml()
+}
+
 /// Default values (the model description's `start`), by value reference; outputs 0.
 pub const START: [f64; vr::COUNT] = [0.0, 1.0e5, 600.0, 0.85, 5.0e-4, 5.0e-4, 0.15, 0.0, 0.0, 0.0];
 
