@@ -293,7 +293,10 @@ pub unsafe fn get_real_status<C: Core>(c: *mut c_void, kind: c_int, value: *mut 
         with::<C>(c, "fmi2GetRealStatus", allowed::STATUS, |i| {
             let value = out_ref(value, "value")?;
             match kind {
-                2 => Ok(*value = i.last_successful_time()),
+                2 => {
+                    *value = i.last_successful_time();
+                    Ok(())
+                }
                 _ => Err(Failure::discard(format!(
                     "status kind {kind}: no Real status"
                 ))),
@@ -309,7 +312,10 @@ pub unsafe fn get_boolean_status<C: Core>(c: *mut c_void, kind: c_int, value: *m
         with::<C>(c, "fmi2GetBooleanStatus", allowed::STATUS, |i| {
             let value = out_ref(value, "value")?;
             match kind {
-                3 => Ok(*value = c_int::from(i.terminate_requested())),
+                3 => {
+                    *value = c_int::from(i.terminate_requested());
+                    Ok(())
+                }
                 _ => Err(Failure::discard(format!(
                     "status kind {kind}: no Boolean status"
                 ))),

@@ -301,7 +301,7 @@ macro_rules! export_fmi3 {
             #[unsafe(export_name = "fmi3InstantiateScheduledExecution")]
             pub extern "C" fn instantiate_scheduled_execution(
                 _n: *const c_char, _t: *const c_char, _r: *const c_char, _v: u8, _l: u8,
-                _e: *mut c_void, _m: *mut c_void, _c: *mut c_void, _lock: *mut c_void,
+                _e: *mut c_void, _m: *mut c_void, _clock: *mut c_void, _lock: *mut c_void,
                 _unlock: *mut c_void,
             ) -> *mut c_void {
                 ::std::ptr::null_mut()
@@ -375,15 +375,15 @@ macro_rules! export_fmi3 {
                 "fmi3EnterStepMode" enter_step_mode();
                 "fmi3GetOutputDerivatives" get_output_derivatives(_r: *const c_uint, _n: usize, _o: *const i32, _v: *mut f64, _nv: usize);
                 "fmi3GetIntervalDecimal" get_interval_decimal(_r: *const c_uint, _n: usize, _i: *mut f64, _q: *mut c_int);
-                "fmi3GetIntervalFraction" get_interval_fraction(_r: *const c_uint, _n: usize, _c: *mut u64, _res: *mut u64, _q: *mut c_int);
+                "fmi3GetIntervalFraction" get_interval_fraction(_r: *const c_uint, _n: usize, _counters: *mut u64, _res: *mut u64, _q: *mut c_int);
                 "fmi3GetShiftDecimal" get_shift_decimal(_r: *const c_uint, _n: usize, _s: *mut f64);
-                "fmi3GetShiftFraction" get_shift_fraction(_r: *const c_uint, _n: usize, _c: *mut u64, _res: *mut u64);
+                "fmi3GetShiftFraction" get_shift_fraction(_r: *const c_uint, _n: usize, _counters: *mut u64, _res: *mut u64);
                 "fmi3SetIntervalDecimal" set_interval_decimal(_r: *const c_uint, _n: usize, _i: *const f64);
-                "fmi3SetIntervalFraction" set_interval_fraction(_r: *const c_uint, _n: usize, _c: *const u64, _res: *const u64);
+                "fmi3SetIntervalFraction" set_interval_fraction(_r: *const c_uint, _n: usize, _counters: *const u64, _res: *const u64);
                 "fmi3SetShiftDecimal" set_shift_decimal(_r: *const c_uint, _n: usize, _s: *const f64);
-                "fmi3SetShiftFraction" set_shift_fraction(_r: *const c_uint, _n: usize, _c: *const u64, _res: *const u64);
+                "fmi3SetShiftFraction" set_shift_fraction(_r: *const c_uint, _n: usize, _counters: *const u64, _res: *const u64);
                 "fmi3EvaluateDiscreteStates" evaluate_discrete_states();
-                "fmi3UpdateDiscreteStates" update_discrete_states(_a: *mut u8, _b: *mut u8, _c: *mut u8, _d: *mut u8, _e: *mut u8, _f: *mut f64);
+                "fmi3UpdateDiscreteStates" update_discrete_states(_a: *mut u8, _b: *mut u8, _nc: *mut u8, _d: *mut u8, _e: *mut u8, _f: *mut f64);
                 "fmi3EnterContinuousTimeMode" enter_continuous_time_mode();
                 "fmi3CompletedIntegratorStep" completed_integrator_step(_a: u8, _b: *mut u8, _d: *mut u8);
                 "fmi3SetTime" set_time(_t: f64);
