@@ -556,6 +556,32 @@ mod tests {
     }
 
     #[test]
+    fn every_platform_has_its_fmi3_folder_arch_then_os() {
+        let folders: Vec<(&str, &str)> = PLATFORMS
+            .iter()
+            .map(|p| (p.folder, p.fmi3_folder))
+            .collect();
+        assert_eq!(
+            folders,
+            [
+                ("linux64", "x86_64-linux"),
+                ("win64", "x86_64-windows"),
+                ("aarch64-linux", "aarch64-linux"),
+                ("darwin64", "x86_64-darwin"),
+                ("aarch64-darwin", "aarch64-darwin"),
+            ]
+        );
+        for p in PLATFORMS {
+            let (arch, os) = p.fmi3_folder.split_once('-').unwrap();
+            assert!(
+                p.triple.starts_with(arch) && p.triple.contains(os),
+                "{}",
+                p.triple
+            );
+        }
+    }
+
+    #[test]
     fn fmi_version_defaults_to_2_and_takes_only_2_or_3() {
         assert_eq!(options(&[]).unwrap().fmi_version, 2);
         assert_eq!(options(&["--fmi-version", "3"]).unwrap().fmi_version, 3);
