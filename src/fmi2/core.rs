@@ -11,8 +11,7 @@ use super::logger::Logger;
 use super::phase::{Failure, Outcome, Phase};
 use super::resources::resource_dir;
 use super::types::{FMI2_CO_SIMULATION, FMI2_TERMINATED, Status};
-use crate::fmi3::arrays::{Arrays, Field};
-use crate::mech::Results;
+use crate::fmi3::arrays::{Arrays, Field, State};
 
 impl Core for Instance {
     fn instantiate(args: Instantiation<'_>) -> Result<Self, String> {
@@ -77,11 +76,11 @@ impl Core for Instance {
     }
 
     fn get_float64(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome {
-        let (nodes, state) = (self.description.model.nodes.len(), self.converged_if(vr)?);
+        let state = self.converged_if(vr)?;
         let read = |r: u32, field: Field| {
-            let (u, results) = state.as_ref().expect("read for an array");
+            let state = state.as_ref().expect("read for an array");
             field
-                .float64(nodes, u, results)
+                .float64(state)
                 .ok_or_else(|| not_of_type(r, "Float64"))
         };
         self.gather(vr, values, Instance::get_real, read)
@@ -90,8 +89,8 @@ impl Core for Instance {
     fn get_int32(&mut self, vr: &[u32], values: &mut [i32]) -> Outcome {
         let state = self.converged_if(vr)?;
         let read = |r: u32, field: Field| {
-            let (_, results) = state.as_ref().expect("read for an array");
-            field.int32(results).ok_or_else(|| not_of_type(r, "Int32"))
+            let state = state.as_ref().expect("read for an array");
+            field.int32(state).ok_or_else(|| not_of_type(r, "Int32"))
         };
         self.gather(vr, values, Instance::get_integer, read)
     }
@@ -183,9 +182,9 @@ fn not_of_type(vr: u32, kind: &str) -> Failure {
 }
 
 impl Instance {
-    /// The displacement and results of the converged state (the analysis built first in
-    /// initialization mode), if one of `vr` is an array of the FMI 3.0 interface.
-    fn converged_if(&mut self, vr: &[u32]) -> Outcome<Option<(Vec<f64>, Results)>> {
+    /// The converged state as the arrays read it (the analysis built first in initialization
+    /// mode), if one of `vr` is an array of the FMI 3.0 interface.
+    fn converged_if(&mut self, vr: &[u32]) -> Outcome<Option<State>> {
         let arrays = Arrays::of(&self.description);
         if !vr.iter().any(|&r| arrays.field(r).is_some()) {
             return Ok(None);
@@ -193,7 +192,8 @@ impl Instance {
         self.initial_outputs()?;
         let built = self.analysis.as_mut().expect("built by initial_outputs");
         let u = built.analysis.state().displacement.clone();
-        Ok(Some((u, built.analysis.results())))
+        let results = built.analysis.results();
+        Ok(Some(State::new(built.analysis.model(), u, results)))
     }
 
     /// The values of `vr` one after another into `values` (`nValues` of them): scalars with

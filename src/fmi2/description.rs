@@ -145,10 +145,19 @@ fn fill<'a>(template: &str, value: impl Fn(&str) -> Option<&'a str>) -> Result<S
 }
 
 pub(crate) fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
+    write_units_used(w, &|name| table.iter().any(|v| v.unit == Some(name)))
+}
+
+/// `<UnitDefinitions>` of the units for which `used` is true (FMI 3.0: the table's and the
+/// arrays').
+pub(crate) fn write_units_used(
+    w: &mut Writer<Vec<u8>>,
+    used: &dyn Fn(&str) -> bool,
+) -> io::Result<()> {
     w.create_element("UnitDefinitions")
         .write_inner_content(|w| {
             for (name, [kg, m, s, k, rad]) in UNITS {
-                if !table.iter().any(|v| v.unit == Some(name)) {
+                if !used(name) {
                     continue;
                 }
                 w.create_element("Unit")

@@ -10,7 +10,9 @@ use std::io;
 
 use quick_xml::Writer;
 
-use crate::fmi2::description::{Description, attribute_text, write_log_categories, write_units};
+use crate::fmi2::description::{
+    Description, attribute_text, write_log_categories, write_units_used,
+};
 use crate::fmi2::scalar_variable::{Causality, Value, VarType, Variable};
 use crate::fmi3::arrays::Arrays;
 
@@ -18,9 +20,9 @@ use crate::fmi3::arrays::Arrays;
 pub fn model_description(d: &Description) -> String {
     let version = env!("CARGO_PKG_VERSION");
     let table = &d.variables;
-    let generated = |f: fn(&mut Writer<Vec<u8>>, &[Variable]) -> io::Result<()>| -> String {
+    let generated = |f: &dyn Fn(&mut Writer<Vec<u8>>) -> io::Result<()>| -> String {
         let mut w = Writer::new_with_indent(Vec::new(), b' ', 2);
-        f(&mut w, table).expect("writing to a Vec cannot fail");
+        f(&mut w).expect("writing to a Vec cannot fail");
         let text = String::from_utf8(w.into_inner()).expect("the writer emits UTF-8");
         let lines: Vec<String> = text.lines().map(|l| format!("  {l}")).collect();
         lines.join("\n")
@@ -64,9 +66,15 @@ pub fn model_description(d: &Description) -> String {
         token = d.guid,
         description = attribute_text(&d.model.description),
         id = d.model_identifier,
-        units = generated(write_units),
-        categories = generated(write_log_categories),
-        variables = generated(write_variables).replace(
+        units = generated(&|w| {
+            let array_units = arrays.units();
+            let used = |name: &str| {
+                table.iter().any(|v| v.unit == Some(name)) || array_units.contains(&name)
+            };
+            write_units_used(w, &used)
+        }),
+        categories = generated(&|w| write_log_categories(w, table)),
+        variables = generated(&|w| write_variables(w, table)).replace(
             "  </ModelVariables>",
             &format!("{}  </ModelVariables>", arrays.xml_variables()),
         ),

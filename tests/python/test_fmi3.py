@@ -59,7 +59,7 @@ def test_fmi3_archives_pass_fmpy_validate_with_the_library_in_the_fmi3_folder(sp
 
 
 ARRAYS = ["film.nodeCount", "film.gapCount", "film.displacement", "film.reaction", "film.gapSlipX",
-          "film.gapSlipY", "film.gapNormalForce", "film.gapStatus"]
+          "film.gapSlipY", "film.gapNormalForce", "film.gapStatus", "film.lineReaction"]
 
 
 def test_fmi3_keeps_the_fmi2_variables_value_references_and_token_and_adds_the_arrays(fmu_path, specimen3):
@@ -211,6 +211,7 @@ def test_fmi3_arrays_equal_the_vtk_fields_bit_for_bit(specimen3, tmp_path):
     nodes, gaps = n
     u = np.array(f.fmu.getFloat64([f.vr["film.displacement"]], 3 * nodes)).reshape(nodes, 3)
     r = np.array(f.fmu.getFloat64([f.vr["film.reaction"]], 3 * nodes)).reshape(nodes, 3)
+    q = np.array(f.fmu.getFloat64([f.vr["film.lineReaction"]], 3 * nodes)).reshape(nodes, 3)
     gap = {name: np.array(f.fmu.getFloat64([f.vr[name]], gaps))
            for name in ["film.gapSlipX", "film.gapSlipY", "film.gapNormalForce"]}
     status = np.array(f.fmu.getInt32([f.vr["film.gapStatus"]], gaps))
@@ -222,6 +223,7 @@ def test_fmi3_arrays_equal_the_vtk_fields_bit_for_bit(specimen3, tmp_path):
     lines = meshio.read(tmp_path / "ParallelArch_gaps_0003.vtu")
     assert np.array_equal(u, film.point_data["displacement"]) and np.abs(u).max() > 0
     assert np.array_equal(r, film.point_data["reaction"]) and np.abs(r).max() > 0
+    assert np.array_equal(q, film.point_data["line_reaction"]) and np.abs(q).max() > 0
     for name, field in [("film.gapSlipX", "gap_slip_x"), ("film.gapSlipY", "gap_slip_y"),
                         ("film.gapNormalForce", "gap_normal_force")]:
         assert np.array_equal(gap[name], lines.cell_data[field][0]), name
@@ -318,3 +320,34 @@ def test_the_jack_on_the_shared_glue_runs_as_fmi3_bit_identical_to_its_fmi2_fmu(
     for column in r2.dtype.names:
         assert np.array_equal(r2[column], r3[column]), column
     assert r2["speed"].min() < 0.0 < r2["speed"].max(), "pumping and yielding back through the valve"
+
+
+def test_fmi3_contact_arrays_of_curved_supports_equal_the_vtk_contacts_fields(tmp_path):
+    """The specimen on curved supports (no gaps): film.contactCount and the contact arrays, and
+    no gap arrays."""
+    import json
+    import meshio
+    import subprocess
+    from conftest import CLI
+    model = json.loads(subprocess.run([str(CLI), "export-specimen", "--contact", "curved-support"],
+                                      check=True, capture_output=True, text=True).stdout)
+    (tmp_path / "curved.json").write_text(json.dumps(model))
+    fmu = tmp_path / "curved_fmi3.fmu"
+    r = fmu_pack(tmp_path / "curved.json", "--fmi-version", "3", "-o", fmu)
+    assert r.returncode == 0, r.stderr
+    assert validate_fmu(str(fmu)) == []
+    out = tmp_path / "vtk"
+    f = Film3(str(fmu), strings={"results.directory": str(out)})
+    assert "film.gapCount" not in f.vr and "film.gapSlipX" not in f.vr
+    (n,) = f.fmu.getUInt64([f.vr["film.contactCount"]])
+    assert n == 9
+    for k in range(3):
+        f.step(-0.01 * (k + 1))
+    slip = f.fmu.getFloat64([f.vr["film.contactSlip"]], n)
+    force = f.fmu.getFloat64([f.vr["film.contactNormalForce"]], n)
+    status = f.fmu.getInt32([f.vr["film.contactStatus"]], n)
+    f.close()
+    lines = meshio.read(out / "ParallelArch_contacts_0003.vtu")
+    assert np.array_equal(slip, lines.cell_data["contact_slip"][0]) and np.abs(slip).max() > 0
+    assert np.array_equal(force, lines.cell_data["contact_normal_force"][0]) and np.abs(force).max() > 0
+    assert np.array_equal(status, lines.cell_data["contact_status"][0]) and any(status)
