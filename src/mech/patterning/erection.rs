@@ -13,10 +13,10 @@
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use super::cut::{Compensation, CutStrip, cut_pattern};
+use super::element_compensation::erect_with_contacts;
 use super::reference::{erection_model, reference_geometry};
 use crate::mech::elements::triangle::{ElementStress, MembraneTriangle};
 use crate::mech::model::Model;
-use crate::mech::{Analysis, SolverSettings};
 
 /// One erection of the iteration.
 #[derive(Clone, Debug, PartialEq)]
@@ -84,13 +84,7 @@ fn correction(
 
 /// Erects `model` by the project's analysis, every group to its target in `increments`.
 pub fn erect_by_analysis(model: Model, increments: usize) -> Result<Vec<ElementStress>, String> {
-    let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
-    let mut analysis = Analysis::new(model, SolverSettings::default())
-        .map_err(|e| format!("erection model: {e}"))?;
-    analysis
-        .step_to(&targets, increments)
-        .map_err(|e| format!("erection: {e}"))?;
-    Ok(analysis.results().elements)
+    erect_with_contacts(model, increments).map(|e| e.elements)
 }
 
 /// Cuts, erects with `erect`, corrects each strip's compensation and repeats (at most

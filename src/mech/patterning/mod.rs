@@ -11,6 +11,7 @@
 //! | [`distortion`] | the Green strain of the flat strip against the 3-D strip |
 //! | [`compensate`] | uniform compensation, or from the target prestress `ε = D⁻¹σ` |
 //! | [`erection`] | compensation by erection: erect, compare with the target, correct each strip |
+//! | [`element_compensation`] | compensation by erection element by element: a fixed point on each triangle's reference metric |
 //! | [`outline`] | the strips' outlines as SVG, with dimensions |
 //! | [`reference`] | the film's compensated reference geometry and its erection model |
 //!
@@ -21,6 +22,7 @@
 pub mod compensate;
 pub mod cut;
 pub mod distortion;
+pub mod element_compensation;
 pub mod erection;
 pub mod flatten;
 pub mod outline;

@@ -156,16 +156,36 @@ pub fn relax_strains(
     elements: &[StripTriangle],
     iterations: usize,
 ) -> Result<f64, String> {
-    let (a, b) = pinned_pair(&strip.flat);
-    let mut held = vec![[false; 2]; strip.flat.len()];
-    held[a] = [true; 2];
-    let (dx, dy) = (
-        strip.flat[b][0] - strip.flat[a][0],
-        strip.flat[b][1] - strip.flat[a][1],
-    );
-    held[b][if dx.abs() >= dy.abs() { 1 } else { 0 }] = true;
     let terms: Vec<StrainTerm> = elements.iter().map(StrainTerm::from).collect();
-    least_strain(&terms, &mut strip.flat, &held, 0.0, iterations)
+    relax_flat(&mut strip.flat, &terms, iterations)
+}
+
+/// Relaxes the flat positions `flat` to the least strain against the stress-free shapes of
+/// `terms` (nodes in the numbering of `flat`; one node held, a second one held across the line
+/// between them, so that only the rigid motions are held); returns `Φ`.
+pub fn relax_flat(
+    flat: &mut [[f64; 2]],
+    terms: &[StrainTerm],
+    iterations: usize,
+) -> Result<f64, String> {
+    let (a, b) = pinned_pair(flat);
+    let mut held = vec![[false; 2]; flat.len()];
+    held[a] = [true; 2];
+    held[b][1] = true;
+    // Turned so that a → b runs along x, holding b's y holds the rotation only (not a length).
+    let origin = flat[a];
+    let angle = (flat[b][1] - origin[1]).atan2(flat[b][0] - origin[0]);
+    let turn = |flat: &mut [[f64; 2]], angle: f64| {
+        let (s, c) = angle.sin_cos();
+        for p in flat.iter_mut() {
+            let (x, y) = (p[0] - origin[0], p[1] - origin[1]);
+            *p = [origin[0] + c * x - s * y, origin[1] + s * x + c * y];
+        }
+    };
+    turn(flat, -angle);
+    let phi = least_strain(terms, flat, &held, 0.0, iterations);
+    turn(flat, angle);
+    phi
 }
 
 /// The two flat nodes farthest apart along the flat strip's longer bounding-box side.

@@ -1,0 +1,346 @@
+//! Friction-aware compensation element by element (issue 46, step 3): a fixed point on the
+//! reference metric of every triangle.
+//!
+//! Each triangle `t` of the found film has a target stress-free metric `M_t` (2×2, in the found
+//! triangle's local frame: the metric its cut shape should have; at the start the metric of the
+//! compensated cut, `M = FᵀF` with `F` the map of the found triangle onto its cut triangle). The
+//! strips are flattened to these metrics in the least-squares sense (`relax::relax_flat` on the
+//! stress-free shapes `x = M^{1/2} X`, whose shape gradients are `M^{-1/2} ∇N`), fitted in space
+//! (`reference`), erected by the analysis, and each metric is corrected by the strain its element
+//! misses,
+//!
+//! `M_t ← M_t − 2 F_tᵀ ΔE_t F_t`, `ΔE_t = D⁻¹(σ_target − S_t)` (a tensor: `γ/2` off the diagonal),
+//!
+//! with `S_t` the second Piola–Kirchhoff stress after erection in the frame of the erection
+//! model's triangle (its reference) and `F_t` the map of the found triangle's frame onto that
+//! triangle's frame. Why: the erected strain is `E = ½(F_xᵀF_x − G)` in the reference's
+//! coordinates, so if the erected shape did not move when the reference does (a film held by its
+//! boundary and pressed onto its supports nearly does not), the reference metric `G − 2ΔE` gives
+//! the strain `E + ΔE` and the stress `S + DΔE = σ_target`: the step is exact to first order.
+//! Friction makes the erected shape depend on the reference (a stuck node keeps the place where
+//! it first touched, a sliding one carries `μN` whatever the cut), so the step is repeated; an
+//! element whose error does not halve in the last step and that touches a node friction holds
+//! on a support at the end (sticking, or sliding against friction) is reported as held by
+//! friction.
+
+use nalgebra::{Matrix2, Matrix3x2, SymmetricEigen, Vector3};
+
+use super::compensate::align;
+use super::cut::{Compensation, CutStrip, cut_pattern};
+use super::outline::bounds;
+use super::reference::{erection_model, reference_geometry};
+use super::relax::{StrainTerm, relax_flat};
+use super::{StripTriangle, flat_gradient};
+use crate::mech::elements::gap::GapStatus;
+use crate::mech::elements::triangle::{ElementStress, MembraneTriangle};
+use crate::mech::model::Model;
+use crate::mech::{Analysis, SolverSettings};
+
+/// What an erection gives the correction.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Erected {
+    /// Strain and stress of each triangle after erection (in the erection model's frames).
+    pub elements: Vec<ElementStress>,
+    /// Per node: in contact and held by friction at the end, on a curved support or a gap:
+    /// sticking, or sliding against a friction force.
+    pub frictional: Vec<bool>,
+}
+
+/// Erects a model by the analysis and returns its stresses and the nodes friction holds.
+pub type ErectContacts<'a> = dyn FnMut(Model) -> Result<Erected, String> + 'a;
+
+/// Erects `model` by the project's analysis (every group to its target in `increments`) and
+/// reports which nodes friction holds on a curved support or gap at the end.
+pub fn erect_with_contacts(model: Model, increments: usize) -> Result<Erected, String> {
+    let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
+    let mut analysis = Analysis::new(model, SolverSettings::default())
+        .map_err(|e| format!("erection model: {e}"))?;
+    analysis
+        .step_to(&targets, increments)
+        .map_err(|e| format!("erection: {e}"))?;
+    let results = analysis.results();
+    let model = analysis.model();
+    let held = |status: GapStatus, friction: f64| {
+        status == GapStatus::Stick || (status == GapStatus::Slip && friction > 0.0)
+    };
+    let mut frictional = vec![false; model.nodes.len()];
+    let contact_nodes = model.curved_supports.iter().flat_map(|s| s.nodes.iter());
+    for (&v, c) in contact_nodes.zip(&results.surface_contacts) {
+        frictional[v] |= held(c.status, c.friction_force);
+    }
+    for (g, r) in model.gaps.iter().zip(&results.gaps) {
+        frictional[g.film_node] |= held(r.status, r.friction_force);
+    }
+    Ok(Erected {
+        elements: results.elements,
+        frictional,
+    })
+}
+
+/// The stress-free shape of metric `m` (in the frame of the 3-D triangle `t`) as a strain term:
+/// `x = U X` with `U = M^{1/2}`, so `∇N = U⁻¹ ∇N_X` and the area is `det U · A`.
+pub fn metric_term(t: &StripTriangle, m: &Matrix2<f64>) -> Option<StrainTerm> {
+    let eigen = SymmetricEigen::new(*m);
+    if !eigen.eigenvalues.iter().all(|&l| l > 0.0 && l.is_finite()) {
+        return None;
+    }
+    let v = eigen.eigenvectors;
+    let root = eigen.eigenvalues.map(f64::sqrt);
+    let u_inv = v * Matrix2::from_diagonal(&root.map(|r| 1.0 / r)) * v.transpose();
+    Some(StrainTerm {
+        nodes: t.local,
+        gradients: t.element.shape_gradients().map(|g| u_inv * g),
+        area: t.element.area() * root.x * root.y,
+    })
+}
+
+/// The metric `M = FᵀF` of every cut triangle in its found triangle's frame (`F` the map of the
+/// found triangle onto the flat one), indexed by the model's triangles.
+pub fn cut_metrics(found: &Model, cut: &[CutStrip]) -> Result<Vec<Matrix2<f64>>, String> {
+    let mut metrics = vec![Matrix2::identity(); found.triangles.len()];
+    for (k, c) in cut.iter().enumerate() {
+        let elements = c
+            .strip
+            .elements(found, &found.nodes)
+            .map_err(|e| format!("strip {k}: {e}"))?;
+        for (e, &t) in elements.iter().zip(&c.strip.triangles) {
+            let f = flat_gradient(e, &c.strip.flat);
+            metrics[t] = f.transpose() * f;
+        }
+    }
+    Ok(metrics)
+}
+
+/// Flattens each strip again to the target `metrics` (least strain, from its present flat
+/// positions), turns it to its long axis ([`align`]) and updates its size and its compensation, `c_a = L_a/ℓ_a − 1` with `L_a` the
+/// uncompensated length `uncut[k][a]` and `ℓ_a` the new one.
+pub fn refit_strips(
+    found: &Model,
+    cut: &mut [CutStrip],
+    metrics: &[Matrix2<f64>],
+    uncut: &[[f64; 2]],
+) -> Result<(), String> {
+    for (k, c) in cut.iter_mut().enumerate() {
+        let elements = c
+            .strip
+            .elements(found, &found.nodes)
+            .map_err(|e| format!("strip {k}: {e}"))?;
+        let terms = elements
+            .iter()
+            .zip(&c.strip.triangles)
+            .map(|(e, &t)| {
+                metric_term(e, &metrics[t]).ok_or_else(|| {
+                    format!("strip {k}: triangle {t}: the corrected metric is not positive definite (the correction asks more than the film can shrink)")
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        relax_flat(&mut c.strip.flat, &terms, 100).map_err(|e| format!("strip {k}: {e}"))?;
+        align(&mut c.strip.flat);
+        let b = bounds(&c.strip.flat);
+        c.size = [b[2] - b[0], b[3] - b[1]];
+        c.compensation = [0, 1].map(|a| uncut[k][a] / c.size[a] - 1.0);
+    }
+    Ok(())
+}
+
+/// The correction `−2 Fᵀ ΔE F` of triangle `t`'s target metric from its erected `stress`
+/// (`ΔE = D⁻¹(σ_target − S)`, `F` the found triangle's frame onto the `reference` triangle's).
+pub fn metric_correction(
+    found: &Model,
+    reference: &[[f64; 3]],
+    t: usize,
+    stress: &ElementStress,
+) -> Option<Matrix2<f64>> {
+    let tri = found.triangles[t];
+    let on = |x: &[[f64; 3]]| MembraneTriangle::new(tri.map(|v| Vector3::from(x[v]))).ok();
+    let (found_element, reference_element) = (on(&found.nodes)?, on(reference)?);
+    let g = found_element.shape_gradients();
+    let f3 = (0..3).fold(Matrix3x2::zeros(), |f, k| {
+        f + Vector3::from(reference[tri[k]]) * g[k].transpose()
+    });
+    let (e1, e2) = reference_element.local_axes();
+    let f = Matrix2::from_rows(&[(e1.transpose() * f3), (e2.transpose() * f3)]);
+    let d_inv = found.material.elasticity().try_inverse()?;
+    let target = Vector3::from(found.material.prestress);
+    let deficit = d_inv * (target - Vector3::from(stress.stress));
+    let de = Matrix2::new(deficit.x, 0.5 * deficit.z, 0.5 * deficit.z, deficit.y);
+    Some(-2.0 * f.transpose() * de * f)
+}
+
+/// Each triangle's error `max(|σx − σx*|, |σy − σy*|)/max(|σx*|, |σy*|)` after erection.
+pub fn element_errors(found: &Model, elements: &[ElementStress]) -> Vec<f64> {
+    let target = found.material.prestress;
+    let size = target[0].abs().max(target[1].abs()).max(f64::MIN_POSITIVE);
+    elements
+        .iter()
+        .map(|e| {
+            (e.stress[0] - target[0])
+                .abs()
+                .max((e.stress[1] - target[1]).abs())
+                / size
+        })
+        .collect()
+}
+
+/// The triangles none of whose nodes a support or boundary group holds (away from the rails).
+pub fn away_from_rails(found: &Model) -> Vec<bool> {
+    let mut rail = vec![false; found.nodes.len()];
+    found.supports.iter().for_each(|s| rail[s.node] = true);
+    found
+        .groups
+        .iter()
+        .flat_map(|g| g.nodes.iter())
+        .for_each(|&v| rail[v] = true);
+    found
+        .triangles
+        .iter()
+        .map(|t| t.iter().all(|&v| !rail[v]))
+        .collect()
+}
+
+/// Settings of [`compensate_elements`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ElementSettings {
+    /// Erections at most.
+    pub iterations: usize,
+    /// Largest element error accepted over the `counted` elements.
+    pub tolerance: f64,
+    /// The triangles the error is taken over (all are corrected); e.g. [`away_from_rails`].
+    pub counted: Vec<bool>,
+}
+
+/// One erection of the element-wise iteration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ElementIteration {
+    /// Area-weighted mean error over the counted triangles.
+    pub mean_error: f64,
+    /// Largest error over the counted triangles, and that triangle.
+    pub max_error: (f64, usize),
+    /// Every triangle's error ([`element_errors`]).
+    pub element_errors: Vec<f64>,
+    /// Triangles with plastic strain after erection.
+    pub yielded: usize,
+    /// Each strip's overall compensation `[c_x, c_y]` (its cut lengths against the flat strip).
+    pub compensation: Vec<[f64; 2]>,
+}
+
+/// The outcome of [`compensate_elements`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct ElementCompensation {
+    /// Every erection.
+    pub history: Vec<ElementIteration>,
+    /// The cut of the last erection.
+    pub cut: Vec<CutStrip>,
+    /// Counted triangles still above the tolerance whose error did not halve in the last step.
+    pub stalled: Vec<usize>,
+    /// Those of `stalled` that touch a node friction holds on a support (sticking, or sliding
+    /// against friction): their stress is set by friction, not by their cut.
+    pub held_by_friction: Vec<usize>,
+}
+
+fn record(
+    found: &Model,
+    settings: &ElementSettings,
+    erected: &Erected,
+    cut: &[CutStrip],
+) -> ElementIteration {
+    let errors = element_errors(found, &erected.elements);
+    let (mut sum, mut area, mut max) = (0.0, 0.0, (0.0, 0));
+    for (t, tri) in found.triangles.iter().enumerate() {
+        if !settings.counted[t] {
+            continue;
+        }
+        let p = tri.map(|v| Vector3::from(found.nodes[v]));
+        let a = 0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm();
+        sum += a * errors[t];
+        area += a;
+        if errors[t] > max.0 {
+            max = (errors[t], t);
+        }
+    }
+    let plastic = |e: &ElementStress| e.plastic.is_some_and(|p| p.equivalent_plastic_strain > 0.0);
+    ElementIteration {
+        mean_error: sum / area.max(f64::MIN_POSITIVE),
+        max_error: max,
+        yielded: erected.elements.iter().filter(|e| plastic(e)).count(),
+        element_errors: errors,
+        compensation: cut.iter().map(|c| c.compensation).collect(),
+    }
+}
+
+/// Cuts the `strips` of the `found` model with the `start` compensation, then erects with
+/// `erect`, corrects every triangle's target metric ([`metric_correction`]) and flattens the
+/// strips again ([`refit_strips`]), until the largest counted error is within the tolerance or
+/// the erections are spent; reports the triangles that stalled and those held by friction.
+pub fn compensate_elements(
+    found: &Model,
+    strips: Vec<Vec<usize>>,
+    start: Compensation,
+    settings: &ElementSettings,
+    erect: &mut ErectContacts<'_>,
+) -> Result<ElementCompensation, String> {
+    if settings.counted.len() != found.triangles.len() {
+        return Err(format!(
+            "element compensation: {} counted flags for {} triangles",
+            settings.counted.len(),
+            found.triangles.len()
+        ));
+    }
+    let mut cut = cut_pattern(found, strips, start)?;
+    let uncut: Vec<[f64; 2]> = cut
+        .iter()
+        .map(|c| [0, 1].map(|a| c.size[a] * (1.0 + c.compensation[a])))
+        .collect();
+    let mut metrics = cut_metrics(found, &cut)?;
+    let (mut history, mut sticking) = (Vec::new(), Vec::new());
+    for iteration in 0..settings.iterations {
+        if iteration > 0 {
+            refit_strips(found, &mut cut, &metrics, &uncut)?;
+        }
+        let reference = reference_geometry(found, &cut)?;
+        let erected = erect(erection_model(found, reference.clone()))?;
+        history.push(record(found, settings, &erected, &cut));
+        sticking = erected.frictional;
+        if history.last().unwrap().max_error.0 <= settings.tolerance {
+            break;
+        }
+        for (t, m) in metrics.iter_mut().enumerate() {
+            if let Some(dm) = metric_correction(found, &reference, t, &erected.elements[t]) {
+                *m += dm;
+            }
+        }
+    }
+    let (stalled, held_by_friction) = diagnose(found, settings, &history, &sticking);
+    Ok(ElementCompensation {
+        history,
+        cut,
+        stalled,
+        held_by_friction,
+    })
+}
+
+/// The counted triangles above the tolerance whose error did not halve in the last step, and
+/// those of them with a node that friction holds (`sticking`: [`Erected::frictional`]).
+fn diagnose(
+    found: &Model,
+    settings: &ElementSettings,
+    history: &[ElementIteration],
+    sticking: &[bool],
+) -> (Vec<usize>, Vec<usize>) {
+    let [.., before, last] = history else {
+        return (vec![], vec![]);
+    };
+    let stalled: Vec<usize> = (0..found.triangles.len())
+        .filter(|&t| settings.counted[t])
+        .filter(|&t| {
+            let e = last.element_errors[t];
+            e > settings.tolerance && e > 0.5 * before.element_errors[t]
+        })
+        .collect();
+    let held = stalled
+        .iter()
+        .copied()
+        .filter(|&t| found.triangles[t].iter().any(|&v| sticking[v]))
+        .collect();
+    (stalled, held)
+}
