@@ -975,3 +975,55 @@ fn element_wise_fixed_point_over_a_drum_with_friction_stalls_and_names_the_eleme
         .collect();
     assert!(!straight.is_empty() && straight.iter().all(|t| !held.contains(t)));
 }
+
+/// `examples/drum.json`: the film over the drum with μ = 0.3 (its own found shape).
+fn drum_example() -> Model {
+    let mut model = film_over_drum(0.3);
+    model.description = "A film over a drum (r = 0.5 m, a curved support, μ = 0.3), wrapped ±60° \
+        with 0.5 m tangents to two rails, 1 m wide between symmetry planes, 2 MPa isotropic: its \
+        own found shape. `membrane-contact pattern drum.json --erect 4 --by-element` shows where \
+        friction keeps the erected film from its prestress (issue 46)."
+        .into();
+    model
+}
+
+#[test]
+fn by_element_erections_through_the_cli_name_the_triangles_friction_holds() {
+    common::assert_example_file("drum.json", &drum_example());
+    let path = format!("{}/examples/drum.json", env!("CARGO_MANIFEST_DIR"));
+    let report = std::env::temp_dir().join(format!("drum-report-{}.json", std::process::id()));
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+            .args(["pattern", &path, "--erect", "3"])
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--by-element", "--report", report.to_str().unwrap()]);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(out.status.success(), "{stdout}");
+    assert!(stdout.contains("held by friction on a support"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    std::fs::remove_file(&report).ok();
+    // The same erections as the library's (drum_element_iterations with μ = 0.3).
+    let library = drum_element_iterations(0.3, (3, 0.01), Compensation::Prestress, &[]);
+    assert_eq!(json["erections"].as_array().unwrap().len(), 3);
+    let first = json["erections"][0]["max_error"].as_f64().unwrap();
+    assert!(
+        (first - library.history[0].max_error.0).abs() < 1e-9,
+        "{first}"
+    );
+    let held: Vec<usize> = serde_json::from_value(json["held_by_friction"].clone()).unwrap();
+    assert_eq!(held, library.held_by_friction);
+    // --by-element without erections is refused.
+    let refused = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["pattern", &path, "--by-element"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(refused.stderr).unwrap();
+    assert!(
+        !refused.status.success() && stderr.contains("--erect"),
+        "{stderr}"
+    );
+}

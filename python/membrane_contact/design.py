@@ -5,7 +5,8 @@ finding and patterning").
 * :func:`form_find` — the shape in which the film carries its prestress (updated reference
   strategy, Bletzinger & Ramm 1999), returned as a model (dict);
 * :func:`pattern` — the strips cut along seams, flattened and compensated, with their sizes and
-  distortions, and, with ``erect=N``, the compensation corrected by erections with the analysis.
+  distortions, and, with ``erect=N``, the compensation corrected by erections with the analysis
+  (each strip's, or with ``by_element=True`` each triangle's).
 
 Both take a model as a dict or a file path; a model the program refuses raises
 :class:`DesignError` with the program's message, which names the bad item.
@@ -67,11 +68,17 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
 def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (),
             seam_nodes: Sequence[Sequence[int]] = (), compensation: str | float | Sequence[float] = "prestress",
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
-            erect_tolerance: float = 1.0, erect_increments: int = 10) -> dict[str, Any]:
+            erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
     ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
     ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
     ``max_error`` and each strip's ``compensation``; empty without ``erect``).
+
+    ``by_element=True`` (with ``erect``) corrects every triangle's reference lengths instead of
+    each strip's two compensations (``pattern --by-element``): the errors are then taken away from
+    the rails, each erection also has ``worst_triangle`` and ``yielded``, and the report has
+    ``stalled`` (triangles above the tolerance whose error did not halve) and ``held_by_friction``
+    (those of them that friction holds on a support: their stress does not follow their cut).
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
@@ -88,6 +95,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             args += ["--seam-plane", ",".join(repr(float(v)) for v in p)]
         for line in seam_nodes:
             args += ["--seam-nodes", ",".join(str(int(v)) for v in line)]
+        if by_element:
+            args.append("--by-element")
         if svg is not None:
             args += ["--svg", str(svg)]
         if erection_model is not None:

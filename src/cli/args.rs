@@ -113,7 +113,14 @@ pub enum Command {
         /// at most N erections (0: none); the compensation given is the first.
         #[arg(long, value_name = "N", default_value_t = 0)]
         erect: usize,
-        /// Stop the erections when the area-mean prestress error is below this (percent).
+        /// With --erect: correct every triangle's reference lengths (its cut metric) by the
+        /// prestress it missed, not each strip's two compensations; the tolerance is then the
+        /// largest error of the triangles away from the rails, and the triangles friction holds
+        /// on a support (whose stress does not follow their cut) are named.
+        #[arg(long)]
+        by_element: bool,
+        /// Stop the erections when the area-mean prestress error is below this (percent; with
+        /// --by-element: the largest error away from the rails).
         #[arg(long, value_name = "PERCENT", default_value_t = 1.0)]
         erect_tolerance: f64,
         /// Increments of each erection.

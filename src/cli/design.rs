@@ -9,6 +9,9 @@ use membrane_contact::mech::formfinding::force_density::force_density_shape;
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
+use membrane_contact::mech::patterning::element_compensation::{
+    ElementSettings, away_from_rails, compensate_elements, erect_with_contacts,
+};
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::outline::{OutlineLabel, dxf, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
@@ -87,6 +90,8 @@ pub struct PatternArgs<'a> {
     pub erection_model: Option<&'a PathBuf>,
     /// Erections at most, the mean error to stop at, increments per erection.
     pub erect: (usize, f64, usize),
+    /// Correct each triangle's reference metric, not each strip's compensation.
+    pub by_element: bool,
     /// Where to write the report as JSON.
     pub report: Option<&'a PathBuf>,
 }
@@ -194,6 +199,60 @@ fn compensate_with_erections(
     Ok((Compensation::PerStrip(last.compensation.clone()), report))
 }
 
+/// The element-wise erections ([`compensate_elements`]), one line each on stdout, then the
+/// triangles that stalled and those friction holds; the last erection's cut and the report.
+fn compensate_by_elements(
+    model: &Model,
+    strips: Vec<Vec<usize>>,
+    start: Compensation,
+    (iterations, tolerance, increments): (usize, f64, usize),
+) -> Result<(Vec<CutStrip>, serde_json::Value), String> {
+    let settings = ElementSettings {
+        iterations,
+        tolerance,
+        counted: away_from_rails(model),
+    };
+    let mut erect = |m: Model| erect_with_contacts(m, increments);
+    let outcome = compensate_elements(model, strips, start, &settings, &mut erect)?;
+    for (k, h) in outcome.history.iter().enumerate() {
+        println!(
+            "erection {k}: prestress error away from the rails mean {:.3} %, max {:.3} % (triangle {}), {} triangles yielded",
+            100.0 * h.mean_error,
+            100.0 * h.max_error.0,
+            h.max_error.1,
+            h.yielded
+        );
+    }
+    if !outcome.stalled.is_empty() {
+        println!(
+            "not reached: {} triangles above {:.3} % whose error did not halve; {} of them held by friction on a support: {:?}",
+            outcome.stalled.len(),
+            100.0 * tolerance,
+            outcome.held_by_friction.len(),
+            outcome.held_by_friction
+        );
+    }
+    let erections: Vec<serde_json::Value> = outcome
+        .history
+        .iter()
+        .map(|h| {
+            serde_json::json!({
+                "mean_error": h.mean_error,
+                "max_error": h.max_error.0,
+                "worst_triangle": h.max_error.1,
+                "yielded": h.yielded,
+                "compensation": h.compensation,
+            })
+        })
+        .collect();
+    let report = serde_json::json!({
+        "erections": erections,
+        "stalled": outcome.stalled,
+        "held_by_friction": outcome.held_by_friction,
+    });
+    Ok((outcome.cut, report))
+}
+
 /// A cut strip as JSON: its triangles, size (m), compensation and distortion (strains).
 fn strip_json(c: &CutStrip) -> serde_json::Value {
     serde_json::json!({
@@ -206,21 +265,29 @@ fn strip_json(c: &CutStrip) -> serde_json::Value {
 
 /// `membrane-contact pattern FILE`: one line per strip on stdout, the outlines as SVG.
 pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
+    if a.by_element && a.erect.0 == 0 {
+        return Err("--by-element corrects by erections: give --erect N (N ≥ 1)".into());
+    }
     let model = read_model(a.file)?;
     let started = Instant::now();
     let strips = strips(&model, &a)?;
     let mut compensation = compensation(a.compensation)?;
-    let mut erections = Vec::new();
-    if a.erect.0 > 0 {
-        (compensation, erections) =
-            compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
-    }
-    let cut = cut_pattern(&model, strips, compensation)?;
+    let mut report = serde_json::json!({ "erections": [] });
+    let cut = if a.erect.0 > 0 && a.by_element {
+        let (cut, r) = compensate_by_elements(&model, strips, compensation, a.erect)?;
+        report = r;
+        cut
+    } else {
+        if a.erect.0 > 0 {
+            let erections;
+            (compensation, erections) =
+                compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
+            report["erections"] = erections.into();
+        }
+        cut_pattern(&model, strips, compensation)?
+    };
     if let Some(file) = a.report {
-        let report = serde_json::json!({
-            "strips": cut.iter().map(strip_json).collect::<Vec<_>>(),
-            "erections": erections,
-        });
+        report["strips"] = cut.iter().map(strip_json).collect::<Vec<_>>().into();
         write_text(Some(file), &(report.to_string() + "\n"))?;
     }
     for (k, c) in cut.iter().enumerate() {

@@ -1018,6 +1018,7 @@ fn main() -> ExitCode {
             dxf,
             erection_model,
             erect,
+            by_element,
             erect_tolerance,
             erect_increments,
             report,
@@ -1030,6 +1031,7 @@ fn main() -> ExitCode {
             dxf: dxf.as_ref(),
             erection_model: erection_model.as_ref(),
             erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
+            by_element: *by_element,
             report: report.as_ref(),
         }),
         Command::ExportSpecimen {
