@@ -84,6 +84,17 @@ pub enum Command {
         /// Most reference updates.
         #[arg(long, value_name = "N", default_value_t = 5000)]
         max_steps: usize,
+        /// Find the shape against the model's curved supports (tubes, arches; frictionless):
+        /// the updated reference strategy with the homotopy λ > 0, each step solved by the
+        /// analysis (docs/mechanics.md "Form finding and patterning").
+        #[arg(long)]
+        on_supports: bool,
+        /// With --on-supports: the share λ of the film's elasticity kept in each step.
+        #[arg(long, value_name = "LAMBDA", default_value_t = 0.01)]
+        homotopy: f64,
+        /// With --on-supports: the largest |σ − σ*|/|σ*| of a step's equilibrium accepted.
+        #[arg(long, value_name = "TOL", default_value_t = 1e-3)]
+        stress_tolerance: f64,
     },
     /// Cuts a (form found) model's film into strips along seams, flattens each with the least
     /// distortion, compensates it and prints each strip's size and distortion

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use membrane_contact::mech::Model;
+use membrane_contact::mech::formfinding::contact::{ContactSettings, find_shape_with_contact};
 use membrane_contact::mech::formfinding::force_density::force_density_shape;
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
@@ -26,6 +27,8 @@ pub struct FormFindArgs<'a> {
     pub prestress: Option<[f64; 3]>,
     pub force_density_start: bool,
     pub settings: UpdateSettings,
+    /// Against the curved supports (frictionless), with these settings.
+    pub on_supports: Option<ContactSettings>,
 }
 
 /// Reads a model file.
@@ -50,9 +53,9 @@ pub fn write_text(out: Option<&PathBuf>, text: &str) -> Result<(), String> {
 pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
     let model = read_model(a.file)?;
     let prestress = a.prestress.unwrap_or(model.material.prestress);
-    if !model.gaps.is_empty() || !model.curved_supports.is_empty() {
+    if !model.gaps.is_empty() || (a.on_supports.is_none() && !model.curved_supports.is_empty()) {
         eprintln!(
-            "warning: form finding does not take gaps or curved supports into account: their film nodes are free"
+            "warning: form finding does not take gaps (or, without --on-supports, curved supports) into account: their film nodes are free"
         );
     }
     let started = Instant::now();
@@ -61,6 +64,25 @@ pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
     } else {
         model.nodes.clone()
     };
+    if let Some(settings) = a.on_supports {
+        if !(settings.homotopy > 0.0 && settings.homotopy.is_finite()) {
+            return Err(format!(
+                "--homotopy {}: must be positive",
+                settings.homotopy
+            ));
+        }
+        let found = find_shape_with_contact(&model, start, prestress, settings)
+            .map_err(|e| e.to_string())?;
+        eprintln!(
+            "form found on the supports: {} reference updates, stress within {:.2e} of the target, {} nodes touching, {:.2?}",
+            found.moves.len(),
+            found.deviations.last().copied().unwrap_or(0.0),
+            found.touching.len(),
+            started.elapsed()
+        );
+        let result = form_found_model(&model, found.nodes, prestress);
+        return write_text(a.out, &(result.to_json() + "\n"));
+    }
     let found = find_shape(&model, start, prestress, a.settings).map_err(|e| e.to_string())?;
     let moved = found
         .nodes

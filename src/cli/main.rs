@@ -999,11 +999,22 @@ fn main() -> ExitCode {
             force_density_start,
             tolerance,
             max_steps,
+            on_supports,
+            homotopy,
+            stress_tolerance,
         } => design::form_find(design::FormFindArgs {
             file,
             out: out.as_ref(),
             prestress: *prestress,
             force_density_start: *force_density_start,
+            on_supports: on_supports.then_some(
+                membrane_contact::mech::formfinding::contact::ContactSettings {
+                    tolerance: *stress_tolerance,
+                    max_steps: *max_steps,
+                    homotopy: *homotopy,
+                    increments: 1,
+                },
+            ),
             settings: membrane_contact::mech::formfinding::update_reference::UpdateSettings {
                 tolerance: *tolerance,
                 max_steps: *max_steps,

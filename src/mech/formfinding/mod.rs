@@ -4,14 +4,16 @@
 //! | file | what |
 //! |---|---|
 //! | [`force_density`] | a first shape by the force density method (Schek 1974, eq. 8) |
+//! | [`contact`] | the updated reference strategy with `λ > 0` against curved supports (each step by the analysis, `μ = 0`) |
 //! | [`update_reference`] | the updated reference strategy (Bletzinger & Ramm 1999) with `λ = 0` |
 //! | `sparse` | the sparse Cholesky solve both use |
 //!
 //! What is held: every DOF a support fixes, the normal DOF of a symmetry plane, the prescribed
 //! components of a boundary group (at the positions the model gives them), and every node that
-//! no triangle or cable touches. Gaps and curved supports are not taken into account: their
-//! film nodes are free (frictionless contact during form finding is left; `docs/mechanics.md`).
+//! no triangle or cable touches. Gaps are not taken into account; curved supports are, by
+//! [`contact`] (frictionless unilateral constraints).
 
+pub mod contact;
 pub mod force_density;
 mod sparse;
 pub mod update_reference;
