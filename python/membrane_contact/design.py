@@ -46,10 +46,13 @@ def _model_file(model: dict | str | Path, folder: str) -> str:
 
 
 def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None, tolerance: float | None = None,
-              max_steps: int | None = None, force_density_start: bool = False) -> dict:
+              max_steps: int | None = None, force_density_start: bool = False, on_supports: bool = False,
+              stress_tolerance: float | None = None) -> dict:
     """The found model: the geometry in which the film carries ``prestress`` (MPa, ``(sx, sy)`` or
     ``(sx, sy, txy)`` in each element's frame; default the model's) with its boundary held, and
-    that prestress as its material's (``membrane-contact form-find``)."""
+    that prestress as its material's (``membrane-contact form-find``). ``on_supports=True``: against
+    the model's curved supports, frictionless (``--on-supports``; ``stress_tolerance`` the largest
+    ``|σ − σ*|/|σ*|`` of a step accepted, default 1e-3); start from a geometry near them."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "found.json"
         args = ["form-find", _model_file(model, tmp), "--out", str(out)]
@@ -61,6 +64,10 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
             args += ["--max-steps", str(int(max_steps))]
         if force_density_start:
             args.append("--force-density-start")
+        if on_supports:
+            args.append("--on-supports")
+        if stress_tolerance is not None:
+            args += ["--stress-tolerance", repr(float(stress_tolerance))]
         _run(args)
         return json.loads(out.read_text())
 

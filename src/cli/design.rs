@@ -258,10 +258,14 @@ fn compensate_by_elements(
         .history
         .iter()
         .map(|h| {
+            let outside = (0..h.element_errors.len())
+                .filter(|&t| settings.counted[t] && h.element_errors[t] > tolerance)
+                .count();
             serde_json::json!({
                 "mean_error": h.mean_error,
                 "max_error": h.max_error.0,
                 "worst_triangle": h.max_error.1,
+                "outside_tolerance": outside,
                 "yielded": h.yielded,
                 "compensation": h.compensation,
             })

@@ -71,3 +71,29 @@ def test_by_element_erections_over_the_drum_with_friction_name_what_friction_hol
     errors = [e["max_error"] for e in report["erections"]]
     assert errors[0] == pytest.approx(1.0) and len(errors) == 2 and errors[1] < 0.005, errors
     assert report["stalled"] == [] and report["held_by_friction"] == []
+
+
+def _vault_bay():
+    import importlib.util
+    path = Path(__file__).resolve().parents[2] / "examples" / "vault_bay.py"
+    spec = importlib.util.spec_from_file_location("vault_bay", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_vault_bay_erects_to_its_prestress_without_friction_and_names_what_friction_holds_with_it(capsys):
+    """The issue's vault bay (``examples/vault_bay.py``): found against its arches and ridge,
+    cut in eight strips. Frictionless, the prestress compensation erects within 0.5 % of 1.5 MPa
+    away from the rails (0.29 %); with μ = 0.3 it misses by 13 %, the per-element correction
+    does not bring it within 5 %, and every triangle left outside is held by friction; none
+    yields (ETFE's data-sheet hardening, first yield 21 MPa)."""
+    bay = _vault_bay()
+    _, (uniform, _) = bay.main(mu=0.0)
+    assert uniform["erections"][0]["max_error"] < 5e-3, uniform["erections"][0]
+    _, (uniform, element) = bay.main()
+    assert uniform["erections"][0]["max_error"] > 0.1
+    last = element["erections"][-1]
+    assert last["max_error"] > 0.05 and last["outside_tolerance"] > 0 and last["yielded"] == 0
+    assert element["held_by_friction"] and set(element["held_by_friction"]) == set(element["stalled"])
+    assert "held by friction" in capsys.readouterr().out
