@@ -49,8 +49,8 @@ use membrane_contact::mech::model::{BoundaryGroup, Model};
 use membrane_contact::mech::patterning::Strip;
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementCompensation, ElementSettings, away_from_rails, compensate_elements,
-    erect_with_contacts, refit_strips,
+    ElementCompensation, ElementSettings, away_from_rails, compensate_elements, erect_along,
+    erect_with_contacts, rail_start_offsets, refit_strips,
 };
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
@@ -1112,4 +1112,30 @@ fn form_finding_against_a_frictionless_drum_puts_a_lifted_film_back_on_its_profi
         .map(|(p, q)| (Vector3::from(*p) - Vector3::from(*q)).norm())
         .fold(0.0, f64::max);
     assert!(apart < 1e-12, "{apart}");
+}
+
+#[test]
+fn the_rail_path_starts_each_rail_up_and_in_across_it_and_refuses_a_node_without_a_group() {
+    // The drum's rails run along y at x = ±0.683 m: each starts 0.10 m up and 0.03 m towards
+    // x = 0, whatever its node's y.
+    let model = film_over_drum(0.3);
+    let offsets = rail_start_offsets(&model, 0.10, 0.03);
+    assert_eq!(offsets.len(), 10);
+    for (v, o) in &offsets {
+        let inward = -model.nodes[*v][0].signum() * 0.03;
+        assert!(
+            (o[0] - inward).abs() < 1e-12 && o[1].abs() < 1e-12 && (o[2] - 0.10).abs() < 1e-12,
+            "{v}: {o:?}"
+        );
+    }
+    // Erected along the path, the drum film comes to the same rails (its groups' targets).
+    let cut = cut_pattern(&model, whole(&model), Compensation::Prestress).unwrap();
+    let erection = erection_model(&model, reference_geometry(&model, &cut).unwrap());
+    let erected = erect_along(erection.clone(), 10, &offsets).unwrap();
+    assert_eq!(erected.elements.len(), model.triangles.len());
+    // Node 52 (mid-film) is held by nothing, so it has no group to start from.
+    let Err(error) = erect_along(erection, 10, &[(52, [0.0, 0.0, 0.1])]) else {
+        panic!("a path for a node without a group was accepted");
+    };
+    assert!(error.contains("node 52"), "{error}");
 }

@@ -75,7 +75,8 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
 def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (),
             seam_nodes: Sequence[Sequence[int]] = (), compensation: str | float | Sequence[float] = "prestress",
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
-            erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False) -> dict[str, Any]:
+            erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
+            rail_path: Sequence[float] | None = None) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
     ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
     ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
@@ -86,6 +87,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     the rails, each erection also has ``worst_triangle`` and ``yielded``, and the report has
     ``stalled`` (triangles above the tolerance whose error did not halve) and ``held_by_friction``
     (those of them that friction holds on a support: their stress does not follow their cut).
+    ``rail_path=(up, in)`` (m): the erections start with the rails that far above and inward of
+    their places and pull them down and out (``--rail-path``).
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
@@ -104,6 +107,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             args += ["--seam-nodes", ",".join(str(int(v)) for v in line)]
         if by_element:
             args.append("--by-element")
+        if rail_path is not None:
+            args += ["--rail-path", ",".join(repr(float(v)) for v in rail_path)]
         if svg is not None:
             args += ["--svg", str(svg)]
         if erection_model is not None:

@@ -134,6 +134,12 @@ pub enum Command {
         /// --by-element: the largest error away from the rails).
         #[arg(long, value_name = "PERCENT", default_value_t = 1.0)]
         erect_tolerance: f64,
+        /// The erection path of a roof: the rails (the model's boundary groups) start UP m above
+        /// and IN m inward (horizontally, towards the film) of their places, the film laid on
+        /// its supports, and are pulled down and out to them; without it the cut is laid at
+        /// its fitted reference and the rails drawn straight to their places.
+        #[arg(long, value_name = "UP,IN", value_parser = parse_pair, allow_negative_numbers = true)]
+        rail_path: Option<[f64; 2]>,
         /// Increments of each erection.
         #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         erect_increments: u32,
@@ -333,6 +339,17 @@ fn parse_plane(s: &str) -> Result<[f64; 6], String> {
         .collect::<Result<_, _>>()?;
     v.try_into()
         .map_err(|_| "six numbers: PX,PY,PZ,NX,NY,NZ".to_string())
+}
+
+fn parse_pair(s: &str) -> Result<[f64; 2], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [a, b] if a.is_finite() && b.is_finite() => Ok([a, b]),
+        _ => Err("two finite numbers: UP,IN".to_string()),
+    }
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {

@@ -11,9 +11,9 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementSettings, away_from_rails, compensate_elements, erect_with_contacts,
+    ElementSettings, away_from_rails, compensate_elements, erect_along, rail_start_offsets,
 };
-use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
+use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::outline::{OutlineLabel, dxf, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::seams::{
@@ -114,6 +114,8 @@ pub struct PatternArgs<'a> {
     pub erect: (usize, f64, usize),
     /// Correct each triangle's reference metric, not each strip's compensation.
     pub by_element: bool,
+    /// The rails' start offsets `[up, in]` (m) of the erection path.
+    pub rail_path: Option<[f64; 2]>,
     /// Where to write the report as JSON.
     pub report: Option<&'a PathBuf>,
 }
@@ -185,10 +187,10 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
 fn compensate_with_erections(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    start: Compensation,
+    (start, path): (Compensation, &[(usize, [f64; 3])]),
     (iterations, tolerance, increments): (usize, f64, usize),
 ) -> Result<(Compensation, Vec<serde_json::Value>), String> {
-    let mut erect = |m: Model| erect_by_analysis(m, increments);
+    let mut erect = |m: Model| erect_along(m, increments, path).map(|e| e.elements);
     let history =
         compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
     for (k, h) in history.iter().enumerate() {
@@ -222,11 +224,11 @@ fn compensate_with_erections(
 }
 
 /// The element-wise erections ([`compensate_elements`]), one line each on stdout, then the
-/// triangles that stalled and those friction holds; the last erection's cut and the report.
+/// triangles that stalled and those friction holds; the best erection's cut and the report.
 fn compensate_by_elements(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    start: Compensation,
+    (start, path): (Compensation, &[(usize, [f64; 3])]),
     (iterations, tolerance, increments): (usize, f64, usize),
 ) -> Result<(Vec<CutStrip>, serde_json::Value), String> {
     let settings = ElementSettings {
@@ -234,7 +236,7 @@ fn compensate_by_elements(
         tolerance,
         counted: away_from_rails(model),
     };
-    let mut erect = |m: Model| erect_with_contacts(m, increments);
+    let mut erect = |m: Model| erect_along(m, increments, path);
     let outcome = compensate_elements(model, strips, start, &settings, &mut erect)?;
     for (k, h) in outcome.history.iter().enumerate() {
         println!(
@@ -299,15 +301,19 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let strips = strips(&model, &a)?;
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
+    let path = a
+        .rail_path
+        .map(|[up, inward]| rail_start_offsets(&model, up, inward))
+        .unwrap_or_default();
     let cut = if a.erect.0 > 0 && a.by_element {
-        let (cut, r) = compensate_by_elements(&model, strips, compensation, a.erect)?;
+        let (cut, r) = compensate_by_elements(&model, strips, (compensation, &path), a.erect)?;
         report = r;
         cut
     } else {
         if a.erect.0 > 0 {
             let erections;
             (compensation, erections) =
-                compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
+                compensate_with_erections(&model, strips.clone(), (compensation, &path), a.erect)?;
             report["erections"] = erections.into();
         }
         cut_pattern(&model, strips, compensation)?

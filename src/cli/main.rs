@@ -1030,6 +1030,7 @@ fn main() -> ExitCode {
             erection_model,
             erect,
             by_element,
+            rail_path,
             erect_tolerance,
             erect_increments,
             report,
@@ -1043,6 +1044,7 @@ fn main() -> ExitCode {
             erection_model: erection_model.as_ref(),
             erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
             by_element: *by_element,
+            rail_path: *rail_path,
             report: report.as_ref(),
         }),
         Command::ExportSpecimen {

@@ -52,9 +52,64 @@ pub type ErectContacts<'a> = dyn FnMut(Model) -> Result<Erected, String> + 'a;
 /// Erects `model` by the project's analysis (every group to its target in `increments`) and
 /// reports which nodes friction holds on a curved support or gap at the end.
 pub fn erect_with_contacts(model: Model, increments: usize) -> Result<Erected, String> {
+    erect_along(model, increments, &[])
+}
+
+/// The rails' start offsets of the erection path: each node of the `found` model's
+/// boundary groups starts `up` (m, +z) above and `inward` (m, horizontally from its group's
+/// centroid towards the film's: across a straight rail) from its place, and is pulled down and
+/// out to it.
+pub fn rail_start_offsets(found: &Model, up: f64, inward: f64) -> Vec<(usize, [f64; 3])> {
+    let centroid = |nodes: &mut dyn Iterator<Item = usize>| {
+        let (mut c, mut n) = ([0.0; 2], 0.0);
+        for v in nodes {
+            c = [c[0] + found.nodes[v][0], c[1] + found.nodes[v][1]];
+            n += 1.0;
+        }
+        c.map(|c| c / f64::max(n, 1.0))
+    };
+    let film = centroid(&mut (0..found.nodes.len()));
+    let mut offsets = Vec::new();
+    for g in &found.groups {
+        let rail = centroid(&mut g.nodes.iter().copied());
+        let (dx, dy) = (film[0] - rail[0], film[1] - rail[1]);
+        let d = dx.hypot(dy).max(f64::MIN_POSITIVE);
+        offsets.extend(
+            g.nodes
+                .iter()
+                .map(|&v| (v, [inward * dx / d, inward * dy / d, up])),
+        );
+    }
+    offsets
+}
+
+/// Erects `model` (an [`super::reference::erection_model`], one group `node<k>` per held node)
+/// in two stages: first each node `k` of `start` to its target plus its offset (the rails lifted
+/// and drawn in: the film laid on the supports slack), then every group to its target (the rails
+/// pulled down and out), `increments` each; with no offsets, one stage.
+pub fn erect_along(
+    model: Model,
+    increments: usize,
+    start: &[(usize, [f64; 3])],
+) -> Result<Erected, String> {
     let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
+    let mut first = targets.clone();
+    for &(v, offset) in start {
+        let name = format!("node{v}");
+        let Some(g) = model.groups.iter().position(|g| g.name == name) else {
+            return Err(format!(
+                "erection path: node {v} has no group {name} in the erection model"
+            ));
+        };
+        (0..3).for_each(|c| first[g][c] += offset[c]);
+    }
     let mut analysis = Analysis::new(model, SolverSettings::default())
         .map_err(|e| format!("erection model: {e}"))?;
+    if !start.is_empty() {
+        analysis
+            .step_to(&first, increments)
+            .map_err(|e| format!("erection, rails to their start: {e}"))?;
+    }
     analysis
         .step_to(&targets, increments)
         .map_err(|e| format!("erection: {e}"))?;
@@ -229,7 +284,7 @@ pub struct ElementIteration {
 pub struct ElementCompensation {
     /// Every erection.
     pub history: Vec<ElementIteration>,
-    /// The cut of the last erection.
+    /// The cut of the erection with the smallest largest error.
     pub cut: Vec<CutStrip>,
     /// Counted triangles still above the tolerance whose error did not halve in the last step.
     pub stalled: Vec<usize>,
@@ -270,8 +325,9 @@ fn record(
 
 /// Cuts the `strips` of the `found` model with the `start` compensation, then erects with
 /// `erect`, corrects every triangle's target metric ([`metric_correction`]) and flattens the
-/// strips again ([`refit_strips`]), until the largest counted error is within the tolerance or
-/// the erections are spent; reports the triangles that stalled and those held by friction.
+/// strips again ([`refit_strips`]), until the largest counted error is within the tolerance, the
+/// erections are spent, or the largest error grows (the corrections do not converge); returns
+/// the best cut and reports the triangles that stalled and those held by friction.
 pub fn compensate_elements(
     found: &Model,
     strips: Vec<Vec<usize>>,
@@ -293,15 +349,24 @@ pub fn compensate_elements(
         .collect();
     let mut metrics = cut_metrics(found, &cut)?;
     let (mut history, mut sticking) = (Vec::new(), Vec::new());
+    let mut best: Option<(f64, Vec<CutStrip>)> = None;
     for iteration in 0..settings.iterations {
         if iteration > 0 {
             refit_strips(found, &mut cut, &metrics, &uncut)?;
         }
         let reference = reference_geometry(found, &cut)?;
         let erected = erect(erection_model(found, reference.clone()))?;
-        history.push(record(found, settings, &erected, &cut));
+        let now = record(found, settings, &erected, &cut);
+        let worst = now.max_error.0;
+        history.push(now);
         sticking = erected.frictional;
-        if history.last().unwrap().max_error.0 <= settings.tolerance {
+        // The largest error grew: the corrections do not converge (friction moves the film
+        // where they push it); stop and keep the best cut.
+        if best.as_ref().is_some_and(|b| worst > b.0) {
+            break;
+        }
+        best = Some((worst, cut.clone()));
+        if worst <= settings.tolerance {
             break;
         }
         for (t, m) in metrics.iter_mut().enumerate() {
@@ -313,7 +378,7 @@ pub fn compensate_elements(
     let (stalled, held_by_friction) = diagnose(found, settings, &history, &sticking);
     Ok(ElementCompensation {
         history,
-        cut,
+        cut: best.map_or(cut, |b| b.1),
         stalled,
         held_by_friction,
     })
