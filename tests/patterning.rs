@@ -49,8 +49,8 @@ use membrane_contact::mech::model::{BoundaryGroup, Model};
 use membrane_contact::mech::patterning::Strip;
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementCompensation, ElementSettings, away_from_rails, compensate_elements, erect_along,
-    erect_with_contacts, rail_start_offsets, refit_strips,
+    ElementCompensation, ElementSettings, Erected, away_from_rails, compensate_elements,
+    erect_along, erect_with_contacts, rail_start_offsets, refit_strips,
 };
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
@@ -1138,4 +1138,43 @@ fn the_rail_path_starts_each_rail_up_and_in_across_it_and_refuses_a_node_without
         panic!("a path for a node without a group was accepted");
     };
     assert!(error.contains("node 52"), "{error}");
+}
+
+#[test]
+fn element_wise_iteration_stops_when_the_largest_error_grows_and_keeps_the_best_cut() {
+    // A stand-in erection whose stress falls further below the target at each erection (as the
+    // friction-held vault did on one path): the iteration stops at the second erection, whose
+    // largest error grew, and returns the first erection's cut.
+    let model = flat_film();
+    let calls = std::cell::Cell::new(0);
+    let mut erect = |m: Model| {
+        calls.set(calls.get() + 1);
+        let mut elements = erect_with_contacts(m, 2)?.elements;
+        let scale = 1.0 - 0.1 * calls.get() as f64;
+        elements
+            .iter_mut()
+            .for_each(|e| e.stress = e.stress.map(|s| s * scale));
+        Ok(Erected {
+            frictional: vec![false; model.nodes.len()],
+            elements,
+        })
+    };
+    let settings = ElementSettings {
+        iterations: 5,
+        tolerance: 1e-6,
+        counted: away_from_rails(&model),
+    };
+    let start = Compensation::Prestress;
+    let outcome =
+        compensate_elements(&model, halves(&model), start.clone(), &settings, &mut erect).unwrap();
+    let h = &outcome.history;
+    assert_eq!(
+        h.len(),
+        2,
+        "{:?}",
+        h.iter().map(|h| h.max_error).collect::<Vec<_>>()
+    );
+    assert!(h[1].max_error.0 > h[0].max_error.0);
+    let first = cut_pattern(&model, halves(&model), start).unwrap();
+    assert_eq!(outcome.cut, first);
 }

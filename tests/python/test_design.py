@@ -97,8 +97,8 @@ def test_vault_bay_erects_to_its_prestress_without_friction_and_names_what_frict
     assert last["max_error"] > 0.05 and last["outside_tolerance"] > 0 and last["yielded"] == 0
     assert element["held_by_friction"] and set(element["held_by_friction"]) == set(element["stalled"])
     assert "held by friction" in capsys.readouterr().out
-    # The path (rails pulled down 0.10 m and out 0.03 m): the first correction makes the
-    # largest error grow, and the iteration stops there.
-    errors = [e["max_error"] for e in element_path["erections"]]
-    assert len(errors) == 2 and errors[1] > errors[0] > 0.05, errors
-    assert element_path["held_by_friction"]
+    # The path (rails pulled down 0.10 m and out 0.03 m): no better.
+    assert uniform_path["erections"][0]["max_error"] > 0.1
+    last = element_path["erections"][-1]
+    assert last["max_error"] > 0.05 and last["outside_tolerance"] > 0 and last["yielded"] == 0
+    assert element_path["held_by_friction"] and set(element_path["held_by_friction"]) == set(element_path["stalled"])
