@@ -21,7 +21,8 @@
 //! it first touched, a sliding one carries `μN` whatever the cut), so the step is repeated; an
 //! element whose error does not halve in the last step and that touches a node friction holds
 //! on a support at the end (sticking, or sliding against friction) is reported as held by
-//! friction.
+//! friction. The iteration stops when the largest error grows (the corrections do not converge)
+//! and keeps the best cut.
 
 use nalgebra::{Matrix2, Matrix3x2, SymmetricEigen, Vector3};
 
