@@ -33,20 +33,35 @@ pub use fmi_glue::scalar::short;
 
 /// Value references, in the order of `modelDescription.xml`.
 pub mod vr {
+    /// Input: the cushion's gauge pressure (Pa).
     pub const PRESSURE: u32 = 0;
+    /// Parameter: the fan's shut-off pressure `p₀` (Pa).
     pub const FAN_PRESSURE: u32 = 1;
+    /// Parameter: the fan's free delivery `Q_max` (m³/s).
     pub const FAN_FLOW_MAX: u32 = 2;
+    /// Parameter: the leakage orifice's area `A` (m²).
     pub const LEAK_AREA: u32 = 3;
+    /// Parameter: the orifice's discharge coefficient `C_d`.
     pub const LEAK_COEFFICIENT: u32 = 4;
+    /// Parameter: the air's density `ρ` (kg/m³).
     pub const AIR_DENSITY: u32 = 5;
+    /// Parameter: the switch's contact closes at or below it (Pa).
     pub const SWITCH_ON: u32 = 6;
+    /// Parameter: the switch's contact opens at or above it (Pa).
     pub const SWITCH_OFF: u32 = 7;
+    /// Parameter: the fan follows the contact this long after it changed (s).
     pub const SWITCH_DELAY: u32 = 8;
+    /// Output: net mass flow into the cushion, the step's average (kg/s).
     pub const MASS_FLOW: u32 = 9;
+    /// Output: 1 while the fan runs at the end of the step.
     pub const FAN_ON: u32 = 10;
+    /// Output: the fraction of the last step the fan ran.
     pub const DUTY: u32 = 11;
+    /// Output: the fraction of the time since the start the fan ran.
     pub const DUTY_TOTAL: u32 = 12;
+    /// Output: the fan's delivery, the step's average (m³/s).
     pub const FAN_FLOW: u32 = 13;
+    /// Output: the leak out of the cushion, the step's average (m³/s).
     pub const LEAK_FLOW: u32 = 14;
     /// Number of variables.
     pub const COUNT: usize = 15;
