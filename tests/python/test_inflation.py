@@ -146,14 +146,14 @@ def test_a_restored_pair_continues_bit_for_bit_and_the_units_bytes_too(fmus, run
     with closing(cushion_system(*fmus)) as system:
         run_events(system, start, H)
         film_state, unit_state = system.film.save(), system.structure.save()
-        unit_bytes = system.structure.serialize(unit_state)
+        film_bytes, unit_bytes = system.film.serialize(film_state), system.structure.serialize(unit_state)
         first = run_events(system, 12.0, H)
         assert np.count_nonzero(np.diff(first["fanOn"])) >= 1, "the fan toggles in the replayed steps"
         system.film.restore(film_state)
         system.structure.restore(unit_state)
         again = run_events(couple(system.film, system.structure), 12.0, H)
-        # the unit's bytes read back by a fresh instance: it continues as the saved one
-        system.film.restore(film_state)
+        # both states' bytes read back (the unit's by a fresh instance): they continue as saved
+        system.film.restore(system.film.deserialize(film_bytes, start))
         with Film(fmus[1], name="fresh", logging=False, quiet=True) as fresh:
             fresh.initialize()
             fresh.restore(fresh.deserialize(unit_bytes, start))
