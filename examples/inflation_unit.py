@@ -63,12 +63,12 @@ def plot(run, path):
     fig.savefig(path, dpi=100)
 
 
-def main():
+def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--out", default="inflation_unit.png", help="the plot (PNG)")
     p.add_argument("--csv", default=None, help="CSV of the records per step")
     p.add_argument("--step", type=float, default=1.0, help="communication step (s)")
-    a = p.parse_args()
+    a = p.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         film_fmu, unit_fmu = pack_cushion_fmu(tmp, root=ROOT), pack_unit_fmu(tmp, root=ROOT)
         with closing(cushion_system(film_fmu, unit_fmu)) as system:
