@@ -544,6 +544,7 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
             gravity: stage.gravity,
             chambers: vec![],
             heating: vec![],
+            air: vec![],
         };
         for k in 1..=stage.steps {
             let f = k as f64 / stage.steps as f64;

@@ -493,6 +493,7 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
         gravity: [0.0; 3],
         chambers: vec![],
         heating: vec![],
+        air: vec![],
     };
     analysis
         .set_limits(SolverSettings {

@@ -1028,6 +1028,7 @@ fn run_staged_from(
             gravity: [gravity[0], gravity[1], gravity[2]],
             chambers: vec![],
             heating: vec![],
+            air: vec![],
         };
         let steps = stage["steps"].as_u64().unwrap() as usize;
         for k in 1..=steps {

@@ -70,16 +70,23 @@ def jack_library(root=None) -> Path:
     the wheel's copy; else the repository around the current directory's."""
     if root is None and _installed_jack() is not None:
         return _installed_jack()[0]
+    return cargo_library(JACK_IDENTIFIER, "hydraulic-jack-fmu", "the jack", root)
+
+
+def cargo_library(identifier: str, package: str, what: str, root=None) -> Path:
+    """The repository's (``root``, ``$MEMBRANE_CONTACT_ROOT``, or the checkout this package
+    lives in) release library ``lib<identifier>.so`` of the cargo package ``package``, built
+    when missing (``what`` names the FMU in the messages)."""
     root = Path(root) if root is not None else repository_root()
     if root is None:
-        raise RuntimeError("the jack FMU is built from the repository (fmu/jack) or installed with the "
+        raise RuntimeError(f"{what} FMU is built from the repository (fmu/) or installed with the "
                            "membrane-contact wheel: neither found")
-    lib = root / "target" / "release" / f"lib{JACK_IDENTIFIER}.so"
+    lib = root / "target" / "release" / f"lib{identifier}.so"
     if not lib.is_file():
-        r = subprocess.run(["cargo", "build", "--release", "-p", "hydraulic-jack-fmu"], cwd=root,
+        r = subprocess.run(["cargo", "build", "--release", "-p", package], cwd=root,
                            capture_output=True, text=True)
         if r.returncode != 0 or not lib.is_file():
-            raise RuntimeError(f"cargo build of the jack failed: {r.stderr.strip()[-2000:]}")
+            raise RuntimeError(f"cargo build of {what} failed: {r.stderr.strip()[-2000:]}")
     return lib
 
 
@@ -171,13 +178,26 @@ def system_structure(group: str = "frame", film_parameters: dict | None = None,
                       {**FILM_PARAMETERS, **(film_parameters or {})})
     jack = _component("jack", "resources/jack.fmu", [("force", "input"), ("dz", "output")],
                       {**JACK_PARAMETERS, **(jack_parameters or {})})
-    connections = (f'<ssd:Connection startElement="jack" startConnector="dz" endElement="film" endConnector="{group}.dz"/>'
-                   f'<ssd:Connection startElement="film" startConnector="{group}.Rz" endElement="jack" endConnector="force"/>')
+    connections = connection("jack", "dz", "film", f"{group}.dz") + connection("film", f"{group}.Rz", "jack", "force")
+    return ssd_text("ErectionSystem", "erection", f"film carried by a hydraulic jack through the group {group}",
+                    film + jack, connections, start, stop, step)
+
+
+def connection(start: str, start_connector: str, end: str, end_connector: str) -> str:
+    """One ``ssd:Connection`` element."""
+    return (f'<ssd:Connection startElement="{start}" startConnector={quoteattr(start_connector)} '
+            f'endElement="{end}" endConnector={quoteattr(end_connector)}/>')
+
+
+def ssd_text(name: str, system: str, description: str, elements: str, connections: str, start: float,
+             stop: float, step: float) -> str:
+    """The text of a ``SystemStructure.ssd``: the system ``system`` of ``elements`` (components)
+    and ``connections``, the default experiment and libcosim's fixed-step annotation."""
     return (f'<?xml version="1.0" encoding="UTF-8"?>\n'
             f'<ssd:SystemStructureDescription xmlns:ssd="{SSD}" xmlns:ssc="{SSC}" xmlns:ssv="{SSV}" '
-            f'xmlns:osp="{OSP}" version="1.0" name="ErectionSystem" generationTool="membrane_contact.ssp">'
-            f'<ssd:System name="erection" description="film carried by a hydraulic jack through the group {group}">'
-            f'<ssd:Elements>{film}{jack}</ssd:Elements><ssd:Connections>{connections}</ssd:Connections></ssd:System>'
+            f'xmlns:osp="{OSP}" version="1.0" name="{name}" generationTool="membrane_contact.ssp">'
+            f'<ssd:System name="{system}" description={quoteattr(description)}>'
+            f'<ssd:Elements>{elements}</ssd:Elements><ssd:Connections>{connections}</ssd:Connections></ssd:System>'
             f'<ssd:DefaultExperiment startTime="{start!r}" stopTime="{stop!r}"><ssd:Annotations>'
             f'<ssc:Annotation type="com.opensimulationplatform"><osp:Algorithm>'
             f'<osp:FixedStepAlgorithm baseStepSize="{step!r}"/></osp:Algorithm></ssc:Annotation>'

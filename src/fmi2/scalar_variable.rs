@@ -225,6 +225,8 @@ pub enum Binding {
     ChamberSealed(usize),
     /// Input: a chamber's air temperature rise above its reference (K).
     ChamberHeating(usize),
+    /// Input: air mass flow into a sealed chamber (kg/s), integrated over the step.
+    ChamberMassFlow(usize),
     /// A chamber's air temperature (K).
     ChamberTemperature(usize),
     /// A chamber's air mass (kg).

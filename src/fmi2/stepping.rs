@@ -92,6 +92,15 @@ impl Instance {
             .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
         // Gravity is a parameter: the built model holds it, and the first step ramps it in.
         loads.gravity = built.analysis.model().loads.gravity;
+        // Air fed into sealed chambers (`<chamber>.massFlow`, issue 43): its running total.
+        let (table, values) = (&self.description.variables, &self.values);
+        match super::variables::supplied_air(&built.analysis, table, values, &sealed, h) {
+            Ok(air) => loads.air = air,
+            Err(e) => {
+                self.phase = Phase::StepFailed;
+                return Err(Failure::discard(e));
+            }
+        }
         // μ and the chambers' valves change the state before the step; a refused step goes back.
         let before = change_state_for_step(&mut built.analysis, mu, &sealed)?;
         match checked_step(built, &targets, &angles, &loads, &self.logger) {

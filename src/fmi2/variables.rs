@@ -72,7 +72,7 @@ pub enum Kind {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 5]); 13] = [
+pub const UNITS: [(&str, [i32; 5]); 14] = [
     ("m", [0, 1, 0, 0, 0]),
     ("m2", [0, 2, 0, 0, 0]),
     ("m3", [0, 3, 0, 0, 0]),
@@ -86,6 +86,7 @@ pub const UNITS: [(&str, [i32; 5]); 13] = [
     ("K", [0, 0, 0, 1, 0]),
     ("kg", [1, 0, 0, 0, 0]),
     ("1", [0, 0, 0, 0, 0]),
+    ("kg/s", [1, 0, -1, 0, 0]),
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
@@ -193,7 +194,66 @@ fn chamber_inputs(table: &mut TableBuilder, model: &Model) {
             ),
             Binding::ChamberHeating(k),
         );
+        table.input(
+            &format!("{}.massFlow", c.name),
+            0.0,
+            "kg/s",
+            &format!(
+                "air mass flow into chamber '{}' while its air is enclosed (negative: leakage \
+                 out), integrated over each step: the step adds massFlow times its size, ramped \
+                 in with the step's other loads (ignored while a supply holds the pressure)",
+                c.name
+            ),
+            Binding::ChamberMassFlow(k),
+        );
     }
+}
+
+/// The supplied-air levels ([`LoadLevels::air`]) a step of size `h` ends at: the converged
+/// state's plus each sealed chamber's `<chamber>.massFlow` (in `values`, by `table`) times `h`
+/// (`sealed`: the valves as the step will have them). Err names a chamber whose air would be
+/// gone (a mass that is not positive: more let out than it holds) or a level that is not finite.
+pub fn supplied_air(
+    analysis: &crate::mech::Analysis,
+    table: &[Variable],
+    values: &[Value],
+    sealed: &[bool],
+    h: f64,
+) -> Result<Vec<f64>, String> {
+    let (model, state) = (analysis.model(), analysis.state());
+    let mut air: Vec<f64> = (0..model.chambers.len())
+        .map(|k| state.loads.air.get(k).copied().unwrap_or(0.0))
+        .collect();
+    for (v, x) in table.iter().zip(values) {
+        let (Binding::ChamberMassFlow(k), &Value::Real(flow)) = (v.binding, x) else {
+            continue;
+        };
+        if !sealed.get(k).copied().unwrap_or(false) || flow == 0.0 {
+            continue;
+        }
+        let (spec, gas) = (&model.chambers[k], &state.chambers[k]);
+        let law = crate::mech::elements::chamber::GasLaw {
+            kappa: spec.kappa,
+            atmosphere: spec.atmosphere,
+            temperature: spec.temperature,
+        };
+        let mass = law.mass(gas.pressure, gas.volume, gas.temperature);
+        let added = flow * h;
+        if !(mass + added > 0.0 && (air[k] + added).is_finite()) {
+            return Err(format!(
+                "{} = {} kg/s over the step of {} s would leave {} kg of air in chamber '{}' \
+                 (it holds {} kg): the mass must stay positive; the state before the step is kept",
+                v.name,
+                message_real(flow),
+                message_real(h),
+                message_real(mass + added),
+                spec.name,
+                message_real(mass)
+            ));
+        }
+        air[k] += added;
+    }
+    Ok(air)
 }
 
 /// Each chamber's outputs: the air's pressure, volume, temperature and mass.

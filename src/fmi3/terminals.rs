@@ -7,7 +7,7 @@
 //! * a group's, `terminalKind` [`KIND`]: its displacement inputs `dx`, `dy`, `dz` and reaction
 //!   outputs `Rx`, `Ry`, `Rz` (those of them the group has);
 //! * a chamber's, `terminalKind` [`PNEUMATIC_KIND`]: its inputs `supplyPressure`, `sealed`,
-//!   `heating` and outputs `pressure`, `volume`, `temperature`, `mass`.
+//!   `heating`, `massFlow` and outputs `pressure`, `volume`, `temperature`, `mass`.
 
 use std::fmt::Write;
 
@@ -23,10 +23,11 @@ pub const PNEUMATIC_KIND: &str = "membrane-contact.pneumatic";
 const MEMBERS: [&str; 6] = ["dx", "dy", "dz", "Rx", "Ry", "Rz"];
 
 /// The members of a chamber's terminal, in order.
-const CHAMBER_MEMBERS: [&str; 7] = [
+const CHAMBER_MEMBERS: [&str; 8] = [
     "supplyPressure",
     "sealed",
     "heating",
+    "massFlow",
     "pressure",
     "volume",
     "temperature",
@@ -42,7 +43,7 @@ pub fn terminals_and_icons(d: &Description) -> Option<String> {
         (&g.name, KIND, "boundary group", what, &MEMBERS[..])
     });
     let chambers = d.model.chambers.iter().map(|c| {
-        let what = "its supply, valve and heating inputs and its air's outputs";
+        let what = "its supply, valve, heating and air-flow inputs and its air's outputs";
         (
             &c.name,
             PNEUMATIC_KIND,

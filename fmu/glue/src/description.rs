@@ -50,6 +50,9 @@ pub struct Description {
     pub description: &'static str,
     pub generation_tool: &'static str,
     pub can_get_and_set_fmu_state: bool,
+    /// `canSerializeFMUstate` (the model implements `ScalarModel::to_numbers`); written only
+    /// where true.
+    pub can_serialize_fmu_state: bool,
     pub provides_directional_derivative: bool,
     /// Unit name and the attributes of its `<BaseUnit>` (`kg="1" m="1" s="-2"`).
     pub units: &'static [(&'static str, &'static str)],
@@ -108,6 +111,7 @@ impl Description {
         let flags = [
             ("canHandleVariableCommunicationStepSize", true),
             ("canGetAndSetFMUstate", self.can_get_and_set_fmu_state),
+            ("canSerializeFMUstate", self.can_serialize_fmu_state),
             ("canNotUseMemoryManagementFunctions", true),
             (
                 "providesDirectionalDerivative",
@@ -170,9 +174,14 @@ impl Description {
         );
         let _ = writeln!(
             x,
-            "  <CoSimulation modelIdentifier=\"{}\" canHandleVariableCommunicationStepSize=\"true\"\n    canGetAndSetFMUState=\"{}\" providesDirectionalDerivatives=\"{d}\" providesAdjointDerivatives=\"{d}\" hasEventMode=\"false\"/>",
+            "  <CoSimulation modelIdentifier=\"{}\" canHandleVariableCommunicationStepSize=\"true\"\n    canGetAndSetFMUState=\"{}\"{} providesDirectionalDerivatives=\"{d}\" providesAdjointDerivatives=\"{d}\" hasEventMode=\"false\"/>",
             self.model_identifier,
             self.can_get_and_set_fmu_state,
+            if self.can_serialize_fmu_state {
+                " canSerializeFMUState=\"true\""
+            } else {
+                ""
+            },
             d = self.provides_directional_derivative
         );
         self.units_and_categories(&mut x);
@@ -203,6 +212,29 @@ impl Description {
         }
         x.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
         x
+    }
+
+    /// Whether `dir/modelDescription.xml` and `dir/modelDescription3.xml` (a model FMU's
+    /// committed descriptions, the files its packer ships) are [`Self::fmi2_xml`] and
+    /// [`Self::fmi3_xml`] to the byte; with `write`, writes them so. Err names the file that
+    /// differs and the command that regenerates it (`regenerate`).
+    pub fn committed(&self, dir: &str, write: bool, regenerate: &str) -> Result<(), String> {
+        for (file, generated) in [
+            ("modelDescription.xml", self.fmi2_xml()),
+            ("modelDescription3.xml", self.fmi3_xml()),
+        ] {
+            let path = format!("{dir}/{file}");
+            if write {
+                std::fs::write(&path, generated).map_err(|e| format!("{path}: {e}"))?;
+            } else if std::fs::read_to_string(&path).map_err(|e| format!("{path}: {e}"))?
+                != generated
+            {
+                return Err(format!(
+                    "{path} is not the generated text: regenerate it: {regenerate}"
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// `<UnitDefinitions>`, `<LogCategories>`, `<DefaultExperiment>`.
@@ -262,6 +294,36 @@ impl Description {
         }
         a
     }
+}
+
+/// A model FMU's two tests of its committed descriptions ([`Description::committed`], files in
+/// the package's folder): that they are the texts generated from `$description`, and, ignored,
+/// one that writes them (`cargo test --release -p $package --test model_description --
+/// --ignored`). Invoked in the package's `tests/model_description.rs`.
+#[macro_export]
+macro_rules! committed_description_tests {
+    ($description:expr, $package:literal) => {
+        /// How to regenerate the files.
+        const REGENERATE: &str = concat!(
+            "cargo test --release -p ",
+            $package,
+            " --test model_description -- --ignored"
+        );
+
+        #[test]
+        fn the_committed_descriptions_are_the_generated_ones() {
+            let dir = env!("CARGO_MANIFEST_DIR");
+            $description.committed(dir, false, REGENERATE).unwrap();
+        }
+
+        /// Writes the files from the table (run after changing it).
+        #[test]
+        #[ignore]
+        fn write_the_committed_descriptions() {
+            let dir = env!("CARGO_MANIFEST_DIR");
+            $description.committed(dir, true, REGENERATE).unwrap();
+        }
+    };
 }
 
 fn causality(c: Causality) -> &'static str {

@@ -35,7 +35,62 @@ pub trait ScalarModel: Clone + 'static {
     /// `d unknown / d known` at the present state; `None` if `unknown` is not an output or
     /// `known` not an input.
     fn derivative(&self, unknown: u32, known: u32) -> Option<f64>;
+    /// The whole state as numbers, for serialized FMU states; `None` (the default): the model
+    /// does not serialize (its description says `canSerializeFMUstate` only where it does).
+    fn to_numbers(&self) -> Option<Vec<f64>> {
+        None
+    }
+    /// The model from [`Self::to_numbers`]' numbers, or why they are not a state of it.
+    fn from_numbers(_numbers: &[f64]) -> Result<Self, String> {
+        Err("serialized FMU states are not supported".into())
+    }
 }
+
+/// The [`ScalarModel`] items every model whose state is a `values` array by value reference
+/// and a `time` field shares: `description` (the static `$description`), `new` (`Default`),
+/// `get`, `set`, `check` (the function `$check`), `time`, `set_time`. Invoked inside the model's
+/// `impl ScalarModel`, beside its own `initialize`, `step` and `derivative`.
+#[macro_export]
+macro_rules! scalar_values {
+    ($description:expr, $check:path) => {
+        fn description() -> &'static $crate::description::Description {
+            &$description
+        }
+
+        fn new() -> Self {
+            <Self as ::core::default::Default>::default()
+        }
+
+        fn get(&self, vr: u32) -> f64 {
+            self.values[vr as usize]
+        }
+
+        fn check(vr: u32, value: f64) -> ::core::result::Result<(), String> {
+            $check(vr, value)
+        }
+
+        fn set(&mut self, vr: u32, value: f64) {
+            self.values[vr as usize] = value;
+        }
+
+        fn time(&self) -> f64 {
+            self.time
+        }
+
+        fn set_time(&mut self, t: f64) {
+            self.time = t;
+        }
+    };
+}
+
+/// The phases a serialized state may hold, by their byte.
+const SAVED_PHASES: [Phase; 5] = [
+    Phase::Instantiated,
+    Phase::Initialization,
+    Phase::StepComplete,
+    Phase::StepFailed,
+    Phase::Terminated,
+];
 
 /// An instance of a [`ScalarModel`].
 pub struct Scalar<M: ScalarModel> {
@@ -243,6 +298,50 @@ impl<M: ScalarModel> Core for Scalar<M> {
             .remove(&handle)
             .map(drop)
             .ok_or_else(|| Failure::error("not an FMU state of this instance"))
+    }
+
+    /// The token, the phase's byte, then [`ScalarModel::to_numbers`] (little-endian).
+    fn serialize_fmu_state(&mut self, handle: usize) -> Outcome<Vec<u8>> {
+        let (model, phase) = (self.states.get(&handle))
+            .ok_or_else(|| Failure::error("not an FMU state of this instance"))?
+            .as_ref();
+        let numbers = (model.to_numbers())
+            .ok_or_else(|| Failure::error("serialized FMU states are not supported"))?;
+        let mut bytes = M::description().token.as_bytes().to_vec();
+        let k = SAVED_PHASES.iter().position(|p| p == phase).unwrap_or(0);
+        bytes.push(k as u8);
+        bytes.extend(numbers.iter().flat_map(|x| x.to_le_bytes()));
+        Ok(bytes)
+    }
+
+    /// Bytes of [`Core::serialize_fmu_state`] of this model (its token first) into `handle`.
+    fn deserialize_fmu_state(&mut self, bytes: &[u8], handle: usize) -> Outcome<usize> {
+        let token = M::description().token.as_bytes();
+        let body = (bytes.strip_prefix(token))
+            .ok_or_else(|| Failure::error("the bytes are not a serialized state of this FMU"))?;
+        let (&k, numbers) = (body.split_first())
+            .filter(|(_, rest)| rest.len() % 8 == 0)
+            .ok_or_else(|| Failure::error("the serialized state is cut short"))?;
+        let phase = *(SAVED_PHASES.get(k as usize)).ok_or_else(|| {
+            Failure::error(format!("the serialized state's phase {k} is unknown"))
+        })?;
+        let numbers: Vec<f64> = (numbers.chunks_exact(8))
+            .map(|c| f64::from_le_bytes(c.try_into().expect("chunks of 8")))
+            .collect();
+        let model = M::from_numbers(&numbers).map_err(Failure::error)?;
+        let saved = Box::new((model, phase));
+        match self.states.get_mut(&handle) {
+            Some(s) => {
+                *s = saved;
+                Ok(handle)
+            }
+            None if handle == 0 => {
+                let key = std::ptr::from_ref::<(M, Phase)>(&saved).addr();
+                self.states.insert(key, saved);
+                Ok(key)
+            }
+            None => Err(Failure::error("not an FMU state of this instance")),
+        }
     }
 
     fn directional_derivative(

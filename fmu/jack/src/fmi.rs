@@ -4,39 +4,12 @@
 //! from here; the phases, the checks of value references, the
 //! refused step that keeps the last state, the FMU states and the log are the glue's.
 
-use fmi_glue::description::Description;
 use fmi_glue::scalar::{Scalar, ScalarModel};
 
 use crate::{DESCRIPTION, Jack, check_value};
 
 impl ScalarModel for Jack {
-    fn description() -> &'static Description {
-        &DESCRIPTION
-    }
-
-    fn new() -> Self {
-        Jack::default()
-    }
-
-    fn get(&self, vr: u32) -> f64 {
-        self.values[vr as usize]
-    }
-
-    fn check(vr: u32, value: f64) -> Result<(), String> {
-        check_value(vr, value)
-    }
-
-    fn set(&mut self, vr: u32, value: f64) {
-        self.values[vr as usize] = value;
-    }
-
-    fn time(&self) -> f64 {
-        self.time
-    }
-
-    fn set_time(&mut self, t: f64) {
-        self.time = t;
-    }
+    fmi_glue::scalar_values!(DESCRIPTION, check_value);
 
     fn initialize(&mut self) -> Result<(), String> {
         Jack::initialize(self)

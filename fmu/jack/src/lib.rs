@@ -67,6 +67,7 @@ pub static DESCRIPTION: Description = Description {
     description: "Hydraulic jack (or winch) that carries a frame: a pump lowers the piston at a constant rate, a relief valve limits the pull, a cylinder of finite stiffness links piston and frame. Quasi-static, backward Euler over each communication step.",
     generation_tool: "membrane-contact fmu/jack",
     can_get_and_set_fmu_state: true,
+    can_serialize_fmu_state: false,
     provides_directional_derivative: true,
     units: &[
         ("m", "m=\"1\""),

@@ -531,3 +531,80 @@ fn the_loads_the_first_step_applies_are_named_at_the_end_of_initialization() {
     assert!(snow.len() == 1 && !snow[0].contains("suction"), "{snow:?}");
     assert!(warned(&[("suction.pressure", 0.0), ("snow.pressure", 0.0)]).is_empty());
 }
+
+/// Issue 43 item 4: `<chamber>.massFlow` feeds a sealed chamber. `examples/cushion_air.json`
+/// inflated from its supply to 300 Pa and sealed, then fed at a constant flow for three steps:
+/// the air's mass is the sealed mass plus Σ ṁ h (to rounding), its pressure the gas law's at
+/// the new volume, and the cushion swells. A leak that would let out more air than the chamber
+/// holds is refused (fmi2Discard) naming the input, the last converged state kept; a flow
+/// while the supply holds the pressure changes nothing.
+#[test]
+fn a_sealed_chamber_fed_by_mass_flow_holds_the_integrated_mass_at_the_gas_laws_pressure() {
+    let model =
+        crate::mech::Model::from_json(include_str!("../../../examples/cushion_air.json")).unwrap();
+    let (u, log) = (
+        Unpacked::new("mass flow", Source::Model(model)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[("air.supplyPressure", 0.0)], &[]);
+    // A flow while supplied is ignored: the supply holds the pressure.
+    assert_eq!(fmu.set_real("air.massFlow", 1.0), 0);
+    for (k, p) in [150.0, 300.0].into_iter().enumerate() {
+        assert_eq!(fmu.set_real("air.supplyPressure", p), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+    }
+    assert_eq!(fmu.real("air.pressure"), 300.0);
+    assert_eq!(fmu.set_boolean("air.sealed", true), 0);
+    assert_eq!(fmu.set_real("air.massFlow", 0.0), 0);
+    assert_eq!(fmu.step(2.0, 1.0), 0, "{:?}", log.take());
+    let (m0, v0) = (fmu.real("air.mass"), fmu.real("air.volume"));
+    let (flow, h) = (2e-4, 0.5);
+    let (r, t, pa) = (287.05, 293.15, 101_325.0);
+    let mut time = 3.0;
+    for n in 1..=3 {
+        assert_eq!(fmu.set_real("air.massFlow", flow), 0);
+        assert_eq!(fmu.step(time, h), 0, "{:?}", log.take());
+        time += h;
+        let (m, v, p) = (
+            fmu.real("air.mass"),
+            fmu.real("air.volume"),
+            fmu.real("air.pressure"),
+        );
+        let want = m0 + n as f64 * flow * h;
+        assert!(
+            (m - want).abs() <= 1e-12 * want,
+            "step {n}: {m} kg, want {want}"
+        );
+        let gas_law = want * r * t / v - pa;
+        assert!(
+            (p - gas_law).abs() <= 1e-6,
+            "step {n}: {p} Pa, gas law {gas_law}"
+        );
+        assert!(v > v0 && p > 300.0, "step {n}: {v} m³, {p} Pa");
+    }
+    // A leak of more than the air: refused, nothing changed.
+    let before = (
+        fmu.real("air.mass"),
+        fmu.real("air.volume"),
+        fmu.real("crownTop.uz"),
+    );
+    assert_eq!(fmu.set_real("air.massFlow", -1.0), 0);
+    log.take();
+    assert_eq!(fmu.step(time, h), 2);
+    assert!(
+        log.contains(Status::Discard, "air.massFlow = -1 kg/s")
+            && log.contains(Status::Discard, "the mass must stay positive"),
+        "{:?}",
+        log.take()
+    );
+    let after = (
+        fmu.real("air.mass"),
+        fmu.real("air.volume"),
+        fmu.real("crownTop.uz"),
+    );
+    assert_eq!(after, before);
+    // A leak it can take: the air and its pressure fall again.
+    assert_eq!(fmu.set_real("air.massFlow", -flow), 0);
+    assert_eq!(fmu.step(time, h), 0, "{:?}", log.take());
+    assert!((fmu.real("air.mass") - (before.0 - flow * h)).abs() <= 1e-12 * before.0);
+}

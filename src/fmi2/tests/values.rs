@@ -210,6 +210,7 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
         gravity: [0.0, 0.0, -9.81],
         chambers: vec![],
         heating: vec![],
+        air: vec![],
     };
     analysis
         .step_to_with_loads(&[[0.0; 3]], &levels, 2)
@@ -315,6 +316,7 @@ fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
         gravity: model.loads.gravity,
         chambers: vec![],
         heating: vec![],
+        air: vec![],
     };
     analysis
         .step_to_with_loads(&[[0.0; 3]], &levels, 2)

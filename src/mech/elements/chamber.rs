@@ -88,6 +88,16 @@ impl GasLaw {
         -self.kappa * c * (t / self.temperature) / v.powf(self.kappa + 1.0)
     }
 
+    /// The constant of gas `c` with `mass` kg of air added (negative: let out) in volume `v`:
+    /// `C + Δm R T₀ V^{κ−1}`, so that the air's mass [`Self::mass`] in `v` grows by exactly
+    /// `Δm` whatever its temperature (for `κ = 1`, in every volume: `C = m R T₀`).
+    pub fn with_air(&self, c: f64, mass: f64, v: f64) -> f64 {
+        if mass == 0.0 {
+            return c;
+        }
+        c + mass * AIR_GAS_CONSTANT * self.temperature * v.powf(self.kappa - 1.0)
+    }
+
     /// The mass of air (kg) at gauge pressure `p` in volume `v` at temperature `t` (ideal gas).
     pub fn mass(&self, p: f64, v: f64, t: f64) -> f64 {
         (p + self.atmosphere) * v / (AIR_GAS_CONSTANT * t)

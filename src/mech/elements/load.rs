@@ -51,6 +51,20 @@ pub struct LoadLevels {
     /// Temperature rise of each chamber's air above its reference temperature (K), model order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub heating: Vec<f64>,
+    /// Air mass supplied into each chamber since the analysis started (kg), model order: a
+    /// running total that a step ramps like the other levels (`<chamber>.massFlow` times the
+    /// step). Only a sealed chamber's air takes it in; empty reads as zeros (states written
+    /// before it was kept).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub air: Vec<f64>,
+}
+
+/// `a[k] + (b[k] − a[k]) · fraction` over the longer of `a` and `b`, a missing entry read as 0.
+fn lerp_padded(a: &[f64], b: &[f64], fraction: f64) -> Vec<f64> {
+    let at = |v: &[f64], k: usize| v.get(k).copied().unwrap_or(0.0);
+    (0..a.len().max(b.len()))
+        .map(|k| at(a, k) + (at(b, k) - at(a, k)) * fraction)
+        .collect()
 }
 
 impl LoadLevels {
@@ -62,6 +76,7 @@ impl LoadLevels {
             gravity: [0.0; 3],
             chambers: vec![0.0; model.chambers.len()],
             heating: vec![0.0; model.chambers.len()],
+            air: vec![0.0; model.chambers.len()],
         }
     }
 
@@ -73,6 +88,7 @@ impl LoadLevels {
             gravity: model.loads.gravity,
             chambers: model.chambers.iter().map(|c| c.pressure).collect(),
             heating: model.chambers.iter().map(|c| c.heating).collect(),
+            air: vec![0.0; model.chambers.len()],
         }
     }
 
@@ -105,6 +121,7 @@ impl LoadLevels {
                 .zip(&target.heating)
                 .map(|(&a, &b)| lerp(a, b))
                 .collect(),
+            air: lerp_padded(&self.air, &target.air, fraction),
         }
     }
 
@@ -116,6 +133,7 @@ impl LoadLevels {
             gravity: self.gravity.map(|g| g * factor),
             chambers: self.chambers.iter().map(|p| p * factor).collect(),
             heating: self.heating.iter().map(|t| t * factor).collect(),
+            air: self.air.iter().map(|m| m * factor).collect(),
         }
     }
 
@@ -127,6 +145,7 @@ impl LoadLevels {
             .chain(&self.gravity)
             .chain(&self.chambers)
             .chain(&self.heating)
+            .chain(&self.air)
             .copied()
     }
 
@@ -141,6 +160,7 @@ impl LoadLevels {
             && self.force.len() == model.loads.forces.len()
             && self.chambers.len() == model.chambers.len()
             && self.heating.len() == model.chambers.len()
+            && (self.air.is_empty() || self.air.len() == model.chambers.len())
     }
 }
 

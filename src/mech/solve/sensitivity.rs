@@ -234,6 +234,7 @@ impl Analysis {
                 gravity: end.loads.gravity,
                 chambers: end.loads.chambers.clone(),
                 heating: end.loads.heating.clone(),
+                air: end.loads.air.clone(),
             };
             (motion, levels, s * seed.friction)
         };
@@ -273,6 +274,7 @@ impl Analysis {
                 gravity: [0.0; 3],
                 chambers: vec![0.0; end.loads.chambers.len()],
                 heating: vec![0.0; end.loads.heating.len()],
+                air: vec![0.0; end.loads.air.len()],
             };
             self.parts
                 .loads

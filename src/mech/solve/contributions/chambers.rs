@@ -30,6 +30,11 @@ pub struct ChamberState {
     /// The air's temperature (K) at convergence (0 in a state written before it was kept).
     #[serde(default)]
     pub temperature: f64,
+    /// The supplied-air level ([`crate::mech::LoadLevels::air`], kg) that [`Self::constant`]
+    /// already holds: air supplied beyond it is added to the gas at the next evaluation (0 in
+    /// a state written before it was kept).
+    #[serde(default)]
+    pub supplied: f64,
 }
 
 /// One chamber's result.
@@ -110,6 +115,7 @@ impl Chambers {
                     pressure: if c.sealed { c.pressure } else { 0.0 },
                     volume,
                     temperature: c.temperature,
+                    supplied: 0.0,
                 }
             })
             .collect()
@@ -179,15 +185,23 @@ impl Contribution for Chambers {
             let v = volumes[k];
             let law = &self.laws[k];
             let t = law.temperature + at.levels.heating.get(k).copied().unwrap_or(0.0);
+            let supplied = at.levels.air.get(k).copied().unwrap_or(0.0);
+            let constant = if gas.sealed {
+                law.with_air(gas.constant, supplied - gas.supplied, gas.volume)
+            } else {
+                gas.constant
+            };
             let p = if gas.sealed {
-                law.pressure(gas.constant, v, t)
+                law.pressure(constant, v, t)
             } else {
                 at.levels.chambers.get(k).copied().unwrap_or(0.0)
             };
             self.last.push(ChamberState {
+                constant,
                 pressure: p,
                 volume: v,
                 temperature: t,
+                supplied,
                 ..gas
             });
             // `g` over the free equations, for the rank-one term: only where a matrix is asked.
@@ -210,7 +224,7 @@ impl Contribution for Chambers {
                 }
             }
             if let Some(grad) = gradient {
-                let a = -law.slope(gas.constant, v, t);
+                let a = -law.slope(constant, v, t);
                 self.low_rank.push((a, grad));
             }
         }
