@@ -112,13 +112,11 @@ impl Instance {
                 self.refresh_outputs(Some(&report))?;
                 self.event(|| {
                     format!(
-                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, {} enlarged \
-                         (larger than 1/solver.incrementsPerStep because every smaller one failed), residual {:.3e} N{}",
+                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N{}",
                         self.time,
                         report.iterations.len(),
                         report.total_iterations(),
                         report.cutbacks,
-                        report.enlarged,
                         report.residual,
                         report.attempts()
                     )
