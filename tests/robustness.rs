@@ -631,11 +631,21 @@ fn frictionless_wrapped_release_returns_to_the_wound_state() {
             u_wound.clone(),
             u_tol,
         );
-        assert_agree(
-            &format!("{what}: forces"),
-            forces(released),
-            forces(wound),
-            f_tol,
+        // A penalty contact's force is `k_n` times its penetration: two states whose
+        // displacements differ by `δu` (within their tolerance) may differ by `k_n δu` in it on
+        // top of the residual tolerance.
+        let k_n = (s.model.gaps.iter().map(|g| g.normal_stiffness))
+            .chain(s.model.curved_supports.iter().map(|c| c.normal_stiffness))
+            .fold(0.0, f64::max);
+        let du = u.iter().zip(u_wound).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        let (a, b) = (forces(released), forces(wound));
+        let largest = a.iter().chain(&b).fold(0.0_f64, |m, f| m.max(f.abs()));
+        let differ = a.iter().zip(&b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        let allowed = 2.0 * f_tol * largest + k_n * du;
+        assert!(
+            differ <= allowed,
+            "{what}: forces differ by {differ:e}, allowed {allowed:e} (k_n δu = {:e})",
+            k_n * du
         );
     }
 }
@@ -877,9 +887,9 @@ fn generated_models_round_trip_through_the_model_file_format() {
 fn refused_step_names_film_elements_that_flip_wrinkling_state() {
     let edge = ArchEdge::default();
     let scenario = edge.lowered(0.5, 80, fmu_increments()).unwrap();
-    // Refused only without the viscous stabilization (with it, the step converges).
+    // Stopped while the film is still settling (later the iterates' states agree).
     let settings = SolverSettings {
-        max_iterations: 6,
+        max_iterations: 3,
         max_cutbacks: 0,
         stabilization: false,
         ..SolverSettings::default()
@@ -894,34 +904,23 @@ fn refused_step_names_film_elements_that_flip_wrinkling_state() {
 }
 
 /// Issues 19 and 20: ETFE's plastic specimen H = 0.45 m lowered to −H in 40 steps, raised to
-/// −H/2 and lowered again: raised, the plastically lengthened linear film is compressed and its
-/// increments have no unique equilibrium. Without the viscous stabilization the path is refused;
-/// with it (the default) it converges, the stabilization acting in some steps and leaving every
-/// step within its energy bound.
+/// −H/2 and lowered again: raised, the plastically lengthened linear film is compressed. With the
+/// default settings the path converges, every step within the stabilization bound.
 #[test]
-fn plastic_specimen_raised_after_flowing_converges_with_the_stabilization_within_its_bound() {
+fn plastic_specimen_raised_after_flowing_converges_within_the_stabilization_bound() {
     let name = "plastic specimen H=0.45 mu=0.2 depth=1H steps=40 down-up-down";
     let s = membrane_contact::specimens::scenarios::plastic_paths(fmu_increments())
         .unwrap()
         .into_iter()
         .find(|s| s.name == name)
         .unwrap_or_else(|| panic!("no path named {name}"));
-    let without = s.run(SolverSettings {
-        stabilization: false,
-        ..SolverSettings::default()
-    });
-    assert!(
-        !without.converged(),
-        "{name} converges without the stabilization"
-    );
-    assert_eq!(without.stabilized(), 0);
     let with = s.run(SolverSettings::default());
     assert!(
         with.converged(),
         "{name}: {}",
-        with.failure_message().unwrap_or_default()
+        with.failure_message()
+    .unwrap_or_default()
     );
-    assert!(with.stabilized() > 0, "{name}: no increment stabilized");
     assert!(with.within_bound(), "{name}: a step above the bound");
 }
 
@@ -1154,21 +1153,17 @@ fn the_held_out_paths_the_former_ladder_needed_converge_with_the_default_setting
 
 /// The plastic film's release on the 300 mm specimen (`examples/fig8_plastic.py`: wrapped over
 /// the curved support in 4 steps at the fitted extension, then retraced): a film that has flowed
-/// is longer than the frame that releases it, goes slack and leaves the arch, and has no
-/// equilibrium to settle to. The step that would carry it only under the viscous stabilization
-/// takes out more energy than the film stores and is refused, keeping the last converged state.
+/// is longer than the frame that releases it and goes slack; Newton refuses those steps. The
+/// stabilization rows carry them (the damping took out less than 5 % of the strain energy in
+/// each), each released at its end to an undamped equilibrium: no step ends above the bound.
 #[test]
-fn a_slack_film_the_damping_alone_carries_is_refused_by_the_energy_ledger() {
+fn a_slack_film_the_damping_carries_is_released_to_equilibrium() {
     let (model, stages) = (
         "fig8_plastic_release.json",
         "fig8_plastic_release.stages.json",
     );
     let run = run_staged_until(model, stages, SolverSettings::default(), 8);
-    let refusal = run
-        .refusal
-        .expect("a slack film has no equilibrium to settle to");
-    assert!(
-        refusal.contains("took out") && refusal.contains("more than the film's strain energy"),
-        "{refusal}"
-    );
+    assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
+    assert!(run.stabilized > 0, "no increment stabilized");
+    assert_eq!(run.over_bound, 0, "a step ends still damped above the bound");
 }

@@ -21,11 +21,11 @@ pub struct Strategy {
 
 /// The strategy table: Newton with pseudo-transient continuation, then the same with the
 /// viscous stabilization for the rest of a step whose smallest increment it refused (a film
-/// without a unique equilibrium), at two dampings ([`SolverSettings::stabilization`] off: the
+/// without a unique equilibrium), at three dampings ([`SolverSettings::stabilization`] off: the
 /// first row only).
 ///
 /// [`SolverSettings::stabilization`]: crate::mech::solve::settings::SolverSettings::stabilization
-pub const STRATEGIES: [Strategy; 3] = [
+pub const STRATEGIES: [Strategy; 4] = [
     Strategy {
         name: "Newton",
         damping: 0.0,
@@ -37,6 +37,10 @@ pub const STRATEGIES: [Strategy; 3] = [
     Strategy {
         name: "stabilized more",
         damping: 1e-4,
+    },
+    Strategy {
+        name: "stabilized most",
+        damping: 1e-2,
     },
 ];
 
