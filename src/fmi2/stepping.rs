@@ -115,12 +115,11 @@ impl Instance {
                 self.refresh_outputs(Some(&report))?;
                 self.event(|| {
                     format!(
-                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs{}, residual {:.3e} N{}",
+                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N{}",
                         self.time,
                         report.iterations.len(),
                         report.total_iterations(),
                         report.cutbacks,
-                        enlarged_note(report.enlarged),
                         report.residual,
                         report.attempts()
                     )

@@ -329,23 +329,6 @@ impl GapLaw {
         }
     }
 
-    /// [`GapLaw::evaluate`] for a gap landing again within the increment after a lift-off
-    /// release (the sliding-direction law, `Analysis::step_to_motion`): its y history follows
-    /// the node as it does while the gap is open, so it holds nothing across (`t_y = 0`) and
-    /// commits `s_py = d_y`, holding from where the increment ends.
-    pub fn evaluate_landing(&self, d: Vector3<f64>, plastic_slip: Vector2<f64>) -> GapResponse {
-        self.evaluate(d, Vector2::new(plastic_slip.x, d.y))
-    }
-
-    /// The iteration matrix `matrix` (either kind) of a gap landing ([`GapLaw::evaluate_landing`]):
-    /// `t_y ≡ 0`, so its row and column y are zero (for the sliding-direction law they hold `k_s`
-    /// on the diagonal alone in every status).
-    pub fn landing_matrix(mut matrix: Matrix3<f64>) -> Matrix3<f64> {
-        matrix.row_mut(1).fill(0.0);
-        matrix.column_mut(1).fill(0.0);
-        matrix
-    }
-
     /// Checks that `status` with the slip history `plastic_slip` is what [`GapLaw::evaluate`]
     /// commits at `d` from some history before it (a converged state read back): open or stick
     /// exactly as the law evaluates them; slip closed, with the trial force on or beyond (2.13)
@@ -482,44 +465,6 @@ mod tests {
                     "{friction_law} {name}"
                 );
                 assert_tangent_matches_finite_difference(&law, d, HISTORY);
-            }
-        }
-    }
-
-    /// A sliding-direction gap landing after a lift-off release holds nothing across in every
-    /// status, commits `s_py = d_y` (so the committed state passes the law's own check), and its
-    /// consistent and Ju–Rowlands matrices are the derivative of its force (the latter where
-    /// the status is stick; in slip it is the paper's matrix, checked as such above).
-    #[test]
-    fn landing_gap_holds_nothing_across_and_its_tangent_matches_finite_differences() {
-        let law = law_of(FrictionLaw::SlidingDirection);
-        let step = 1e-10;
-        for (name, d, _) in STATES {
-            let d = Vector3::from(d);
-            let r = law.evaluate_landing(d, HISTORY);
-            assert_eq!(r.force.y, 0.0, "{name}");
-            assert_eq!(r.plastic_slip.y, d.y, "{name}");
-            assert_eq!(
-                law.check_committed(r.status, d, r.plastic_slip, 1e-6),
-                Ok(()),
-                "{name}"
-            );
-            let k = GapLaw::landing_matrix(law.consistent_tangent(&r));
-            for j in 0..3 {
-                let (mut dp, mut dm) = (d, d);
-                dp[j] += step;
-                dm[j] -= step;
-                let force = |d| law.evaluate_landing(d, HISTORY).force;
-                let column = (force(dp) - force(dm)) / (2.0 * step);
-                let err = (column - k.column(j)).amax();
-                assert!(
-                    err < 1e-6 * law.normal_stiffness,
-                    "{name}, column {j}: {err:e}"
-                );
-            }
-            if r.status == GapStatus::Stick {
-                let jr = GapLaw::landing_matrix(law.ju_rowlands_matrix(r.status, r.direction));
-                assert_eq!(jr, k, "{name}");
             }
         }
     }

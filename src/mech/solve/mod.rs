@@ -8,10 +8,9 @@
 //! | [`linear`] | sparse LDLᵀ / Woodbury / GMRES / LU with a reused symbolic analysis |
 //! | [`analysis`] | [`Analysis`]: setup, state, steps and their input checks |
 //! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
-//! | `increments` | the increment controller: cut-back, enlargement, predictor |
-//! | `newton` | Newton–Raphson for one increment |
-//! | `smoothing` | the smoothing homotopy of a refused increment with curved contacts |
-//! | `line_search` | backtracking line search with a watchdog |
+//! | `increments` | the increment controller (Ramm's rule, cut-back), the strategy table, the predictor |
+//! | `newton` | one increment: semismooth Newton on the laws' equations |
+//! | `continuation` | its globalization: pseudo-transient continuation (SER) |
 //! | [`settings`] | [`SolverSettings`] |
 //! | [`state`] | [`AnalysisState`], the converged state an FMU state serializes |
 //! | [`report`] | [`StepReport`], [`IncrementFailure`] and its advice, [`StepError`], [`SetupError`] |
@@ -23,19 +22,19 @@ mod continuation;
 pub mod contributions;
 mod increments;
 mod inputs;
-mod line_search;
 pub mod linear;
 mod newton;
 pub mod report;
 mod sensitivity;
 pub mod settings;
-mod smoothing;
 pub mod state;
 
 pub use analysis::Analysis;
 pub use newton::max_abs;
+pub use increments::{STRATEGIES, Strategy};
 pub use report::{
-    IncrementFailure, IterationRecord, SettingNames, SetupError, StepError, StepReport,
+    Attempt, DISSIPATION_BOUND, IncrementFailure, IterationRecord, STABILIZATION_BOUND,
+    SettingNames, SetupError, StepError, StepReport,
 };
 pub use sensitivity::{Response, Seed};
 pub use settings::{DEFAULT_INCREMENTS_PER_STEP, MAX_THREADS, SolverSettings};

@@ -52,7 +52,6 @@
 //! |---|---|
 //! | `mod.rs` | the contact law: [`SurfaceContact`], [`SurfaceContacts`], histories, responses |
 //! | [`surface`] | the supports' geometry: centrelines, frames, closest-point projection |
-//! | [`smoothing`] | the law with its corners rounded: the smoothing homotopy's problems |
 //! | `tests` | tangent against central differences, caps, corners, slip |
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
@@ -62,7 +61,6 @@ use crate::mech::elements::gap::{FrictionLaw, GapStatus};
 use crate::mech::elements::triangle::ElementMatrix;
 use crate::mech::model::Model;
 use crate::mech::solve::assembly::{System, node_vector};
-pub mod smoothing;
 pub mod surface;
 
 use surface::*;
@@ -94,12 +92,6 @@ pub struct ContactHistory {
     pub status: GapStatus,
     /// Friction coefficient.
     pub friction: f64,
-    /// Lifted off at the start of the increment and landing again within it (the
-    /// sliding-direction law's lift-off release, `Analysis::step_to_motion`): it holds nothing
-    /// across until the increment converges, and then holds from where it ended. Never set in a
-    /// converged state.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub lands: bool,
 }
 
 /// Force on the film, tangent and status of a contact at one iterate.
@@ -111,8 +103,6 @@ pub struct ContactResponse {
     pub tangent: Matrix3<f64>,
     /// The status whose law gave this response (imposed in an active-set iteration).
     pub status: GapStatus,
-    /// The law's own status at this iterate (equal to `status` unless one was imposed).
-    pub natural: GapStatus,
     /// `λN ≥ 0` (N; negative only where a closed status was imposed on an open gap).
     pub normal_force: f64,
     /// Friction force components `[f1, f2]` along `ξ1`, `ξ2` (N).
@@ -293,38 +283,12 @@ impl SurfaceContact {
 
     /// The contact's response at node position `x` from the converged `history`.
     pub fn respond(&self, x: &Vector3<f64>, history: &ContactHistory) -> ContactResponse {
-        self.respond_as(x, history, None)
-    }
-
-    /// The tube's radius (m).
-    pub fn tube_radius(&self) -> f64 {
-        self.tube_radius
-    }
-
-    /// The friction law.
-    pub fn law(&self) -> FrictionLaw {
-        self.law
-    }
-
-    /// The response with the status `frozen` imposed when given (an active-set iteration:
-    /// closed means the penalty force `−k_n g` even where the gap has opened, open means no
-    /// force even where it penetrates, stick or slip picks that branch of the friction law);
-    /// [`ContactResponse::natural`] is the law's own status at `x` either way.
-    pub fn respond_as(
-        &self,
-        x: &Vector3<f64>,
-        history: &ContactHistory,
-        frozen: Option<GapStatus>,
-    ) -> ContactResponse {
         let p = self.project(x, history.angle);
         let anchor = Vector2::from(history.anchor);
         let lambda = -self.kn * p.gap;
         let limit = history.friction * lambda;
-        let mut trial = -(p.xi - anchor) * self.ks;
-        if history.lands {
-            trial.y = 0.0;
-        }
-        let natural = if p.gap >= 0.0 {
+        let trial = -(p.xi - anchor) * self.ks;
+        let status = if p.gap >= 0.0 {
             GapStatus::Open
         } else if match self.law {
             FrictionLaw::Isotropic => trial.norm() <= limit,
@@ -338,7 +302,6 @@ impl SurfaceContact {
             residual: Vector3::zeros(),
             tangent: Matrix3::zeros(),
             status: GapStatus::Open,
-            natural,
             normal_force: 0.0,
             friction: Vector2::zeros(),
             xi: p.xi,
@@ -346,7 +309,7 @@ impl SurfaceContact {
             next_anchor: p.xi,
             angle: p.parameter,
         };
-        let used = frozen.unwrap_or(natural);
+        let used = status;
         if used == GapStatus::Open {
             return open;
         }
@@ -372,9 +335,6 @@ impl SurfaceContact {
             }
             FrictionLaw::SlidingDirection => {
                 let mut dfd = -Matrix2::identity() * self.ks;
-                if history.lands {
-                    dfd[(1, 1)] = 0.0;
-                }
                 if used == GapStatus::Stick {
                     (GapStatus::Stick, trial, dfd, Vector2::zeros())
                 } else {
@@ -403,7 +363,6 @@ impl SurfaceContact {
             residual: -force,
             tangent: k,
             status,
-            natural,
             normal_force: lambda,
             friction: f,
             xi: p.xi,
@@ -412,6 +371,17 @@ impl SurfaceContact {
             angle: p.parameter,
         }
     }
+
+    /// The tube's radius (m).
+    pub fn tube_radius(&self) -> f64 {
+        self.tube_radius
+    }
+
+    /// The friction law.
+    pub fn law(&self) -> FrictionLaw {
+        self.law
+    }
+
 
     /// Checks a converged `history` read back, at node position `x`, against this contact's own
     /// law ([`SurfaceContact::respond`], either friction law): open where the gap is not
@@ -471,7 +441,6 @@ impl SurfaceContact {
                 GapStatus::Open
             },
             friction: mu,
-            lands: false,
         }
     }
 }
@@ -594,19 +563,14 @@ impl SurfaceContacts {
             .collect()
     }
 
-    /// Adds the contacts' residuals and tangents at `u` (from `histories`; with the statuses
-    /// `frozen` imposed when given, [`SurfaceContact::respond_as`]; under the law smoothed over
-    /// the width `smoothing` where it is positive, [`SurfaceContact::respond_smoothed`]) to `residual` and
+    /// Adds the contacts' residuals and tangents at `u` (from `histories`) to `residual` and
     /// the Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
     /// once it has grown).
-    #[allow(clippy::too_many_arguments)] // the evaluation's inputs and outputs, each needed
     pub fn add_to(
         &self,
         system: &System,
         u: &[f64],
         histories: &[ContactHistory],
-        frozen: Option<&[GapStatus]>,
-        smoothing: f64,
         residual: &mut [f64],
         mut values: Option<&mut [f64]>,
         responses: &mut Vec<ContactResponse>,
@@ -616,15 +580,7 @@ impl SurfaceContacts {
             self.contacts
                 .iter()
                 .zip(histories)
-                .enumerate()
-                .map(|(k, (c, h))| {
-                    let x = self.position(c, u);
-                    if smoothing > 0.0 {
-                        c.respond_smoothed(&x, h, smoothing)
-                    } else {
-                        c.respond_as(&x, h, frozen.map(|f| f[k]))
-                    }
-                }),
+                .map(|(c, h)| c.respond(&self.position(c, u), h)),
         );
         for ((c, r), &(triangle, local)) in
             self.contacts.iter().zip(responses.iter()).zip(&self.slots)
@@ -662,8 +618,7 @@ impl SurfaceContacts {
                 } else {
                     h.origin
                 },
-                lands: false,
-                ..*h
+                    ..*h
             })
             .collect()
     }
