@@ -637,10 +637,16 @@ fn frictionless_wrapped_release_returns_to_the_wound_state() {
         let k_n = (s.model.gaps.iter().map(|g| g.normal_stiffness))
             .chain(s.model.curved_supports.iter().map(|c| c.normal_stiffness))
             .fold(0.0, f64::max);
-        let du = u.iter().zip(u_wound).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
+        let du = u
+            .iter()
+            .zip(u_wound)
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
         let (a, b) = (forces(released), forces(wound));
         let largest = a.iter().chain(&b).fold(0.0_f64, |m, f| m.max(f.abs()));
-        let differ = a.iter().zip(&b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        let differ = a
+            .iter()
+            .zip(&b)
+            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
         let allowed = 2.0 * f_tol * largest + k_n * du;
         assert!(
             differ <= allowed,
@@ -918,8 +924,7 @@ fn plastic_specimen_raised_after_flowing_converges_within_the_stabilization_boun
     assert!(
         with.converged(),
         "{name}: {}",
-        with.failure_message()
-    .unwrap_or_default()
+        with.failure_message().unwrap_or_default()
     );
     assert!(with.within_bound(), "{name}: a step above the bound");
 }
@@ -1165,5 +1170,8 @@ fn a_slack_film_the_damping_carries_is_released_to_equilibrium() {
     let run = run_staged_until(model, stages, SolverSettings::default(), 8);
     assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
     assert!(run.stabilized > 0, "no increment stabilized");
-    assert_eq!(run.over_bound, 0, "a step ends still damped above the bound");
+    assert_eq!(
+        run.over_bound, 0,
+        "a step ends still damped above the bound"
+    );
 }

@@ -263,15 +263,3 @@ fn unavailable_status(kind: i32, function: &str) -> Failure {
         "{function}: {name} ({kind}) is not available from this synchronous FMU"
     ))
 }
-
-/// The step log's note on enlarged increments: "" on the ordinary step that had none.
-fn enlarged_note(enlarged: usize) -> String {
-    if enlarged == 0 {
-        String::new()
-    } else {
-        format!(
-            ", {enlarged} enlarged (larger than 1/solver.incrementsPerStep because every smaller \
-             one failed)"
-        )
-    }
-}

@@ -686,11 +686,7 @@ fn every_parameter_and_input_of_the_circular_membrane_reaches_the_solver() {
         "circular",
         Source::Model(example("circular_membrane.json")),
         &[("solver.incrementsPerStep", Value::Integer(2))],
-        &[
-            NOTHING_SLIDES,
-            NEVER_WRINKLES,
-            NO_CONTACT_MATRIX,
-        ],
+        &[NOTHING_SLIDES, NEVER_WRINKLES, NO_CONTACT_MATRIX],
     );
 }
 
@@ -718,11 +714,7 @@ fn every_parameter_and_input_of_a_yielding_circular_membrane_reaches_the_solver(
         "plastic",
         Source::Model(model),
         &[("solver.incrementsPerStep", Value::Integer(2))],
-        &[
-            NOTHING_SLIDES,
-            NEVER_WRINKLES,
-            NO_CONTACT_MATRIX,
-        ],
+        &[NOTHING_SLIDES, NEVER_WRINKLES, NO_CONTACT_MATRIX],
     );
 }
 

@@ -120,14 +120,24 @@ impl Analysis {
         let mut report = StepReport::default();
         let largest = 1.0 / increments as f64;
         let smallest = largest / 2f64.powi(self.settings.max_cutbacks as i32);
-        let rows = if self.settings.stabilization { STRATEGIES.len() } else { 1 };
+        let rows = if self.settings.stabilization {
+            STRATEGIES.len()
+        } else {
+            1
+        };
         let (mut done, mut size, mut row) = (0.0_f64, largest, 0);
         // The share of the step of the last converged increment.
         let mut last_size = largest;
         self.parts.stabilization.start_step();
         while done < 1.0 {
-            let next = if done + size > 1.0 - 1e-12 { 1.0 } else { done + size };
-            self.parts.stabilization.set(STRATEGIES[row].damping, next - done);
+            let next = if done + size > 1.0 - 1e-12 {
+                1.0
+            } else {
+                done + size
+            };
+            self.parts
+                .stabilization
+                .set(STRATEGIES[row].damping, next - done);
             let attempt = self.solve_increment(&current, &path.motion(next), &path.levels(next));
             report.attempts.push(Attempt {
                 strategy: row,
@@ -144,9 +154,12 @@ impl Analysis {
                     done = next;
                     // The Ju–Rowlands matrix converges linearly by design: its iterations do
                     // not measure the increment's nonlinearity.
-                    let n = match self.settings.iteration_matrix {
-                        IterationMatrix::Consistent => history.len().saturating_sub(1).max(1),
-                        IterationMatrix::JuRowlands => Self::TARGET_ITERATIONS,
+                    let linear = self.settings.iteration_matrix == IterationMatrix::JuRowlands
+                        && (!self.parts.curved.is_empty() || !self.state.status.is_empty());
+                    let n = if linear {
+                        Self::TARGET_ITERATIONS
+                    } else {
+                        history.len().saturating_sub(1).max(1)
                     } as f64;
                     let ratio = (Self::TARGET_ITERATIONS as f64 / n).sqrt();
                     size = (size * ratio.clamp(1.0 / Self::GROWTH, Self::GROWTH)).min(largest);
@@ -304,7 +317,6 @@ impl Analysis {
         }
         u
     }
-
 }
 
 #[cfg(test)]

@@ -30,8 +30,8 @@ pub mod settings;
 pub mod state;
 
 pub use analysis::Analysis;
-pub use newton::max_abs;
 pub use increments::{STRATEGIES, Strategy};
+pub use newton::max_abs;
 pub use report::{
     Attempt, DISSIPATION_BOUND, IncrementFailure, IterationRecord, STABILIZATION_BOUND,
     SettingNames, SetupError, StepError, StepReport,

@@ -34,7 +34,11 @@ impl Progress {
     /// Notes `record`; true when it improved on the best residual or correction by
     /// [`Analysis::PROGRESS`].
     fn note(&mut self, record: IterationRecord) -> bool {
-        if record.iteration > 0 && self.closest.is_none_or(|c| record.distance() < c.distance()) {
+        if record.iteration > 0
+            && self
+                .closest
+                .is_none_or(|c| record.distance() < c.distance())
+        {
             self.closest = Some(record);
         }
         let better = record.residual < Analysis::PROGRESS * self.best
@@ -155,11 +159,21 @@ impl Analysis {
                     continue;
                 }
             };
-            let reference = merits.iter().copied().fold(0.0, f64::max);
+            let reference = [
+                merits.iter().copied().fold(0.0, f64::max),
+                merits[merits.len() - 1],
+            ];
             previous_u.clone_from(&u);
             let tolerance = record.residual_tolerance;
             let statuses = progress.statuses.last().cloned().unwrap_or_default();
-            match self.step_along(&mut u, levels, iteration + 1, reference, tolerance, &statuses) {
+            match self.step_along(
+                &mut u,
+                levels,
+                iteration + 1,
+                reference,
+                tolerance,
+                &statuses,
+            ) {
                 Some((step, merit)) => {
                     // SER after a full step; a shortened one keeps `c`.
                     if step == 1.0 {
@@ -244,12 +258,14 @@ impl Analysis {
 
     /// Moves `u` along the correction in `work.rhs` by the first `α` of 1, then of a
     /// backtracking by quadratic interpolation of `φ(α) = ‖R(u + αΔ)‖₂²` (within `[α/10, α/2]`,
-    /// [`Self::TRIALS`] in all), that meets the nonmonotone Armijo test
-    /// `φ(α) ≤ (1 − 2·10⁻⁴ α) φ_ref` against the largest of the last [`Self::MEMORY`] merits,
-    /// `reference` = `√φ_ref` (Grippo, Lampariello & Lucidi 1986; Dennis & Schnabel §6.3.2), or
-    /// that ends with `‖R‖∞` within `tolerance`; a full step that leaves the contact `statuses`
-    /// of the iterate as they were is kept unless it raises `‖R‖₂` [`Continuation::GROW`]-fold.
-    /// Where no trial meets it, the best trial that lowered `‖R‖₂` below `reference` at all.
+    /// [`Self::TRIALS`] in all), that meets the Armijo test `φ(α) ≤ (1 − 2·10⁻⁴ α) φ_ref`, or
+    /// that ends with `‖R‖∞` within `tolerance`. `reference` = `[√φ_max, √φ(0)]`: on the smooth
+    /// piece of the iterate (every contact's status as in `statuses`) `φ_ref` is the largest of
+    /// the last [`Self::MEMORY`] merits, the nonmonotone test (Grippo, Lampariello & Lucidi
+    /// 1986), and a full step is kept unless it raises `‖R‖₂` [`Continuation::GROW`]-fold;
+    /// across a kink (a status changed) it is the iterate's own `φ(0)`, the monotone test, so
+    /// that a contact cannot cycle between two statuses (open ↔ pressed) on the memory's
+    /// allowance. Where no trial meets it, the best trial below `φ(0)`.
     /// Some((α, ‖R‖₂)) with the workspace holding the residual at the new `u` (and its matrix
     /// where α = 1); None with `u` back where it was.
     fn step_along(
@@ -257,7 +273,7 @@ impl Analysis {
         u: &mut [f64],
         levels: &LoadLevels,
         next_iteration: usize,
-        reference: f64,
+        [reference, current]: [f64; 2],
         tolerance: f64,
         statuses: &[GapStatus],
     ) -> Option<(f64, f64)> {
@@ -269,9 +285,11 @@ impl Analysis {
             }
         };
         let delta = std::mem::take(&mut self.work.rhs);
-        let phi0 = reference * reference;
+        let before = self.parts.gaps();
+        let (phi_max, phi0) = (reference * reference, current * current);
         let (mut alpha, mut applied) = (1.0_f64, 0.0);
-        let (mut accepted, mut best) = (None, (0.0, reference));
+        let (mut accepted, mut best) = (None, (0.0, current));
+        let mut at_event = false;
         for trial in 0..Self::TRIALS {
             apply(u, &self.system.dofs, &delta, alpha - applied);
             applied = alpha;
@@ -282,12 +300,18 @@ impl Analysis {
             // A full step that leaves every contact's status as it was stays on the same smooth
             // piece of `R`, where Newton's model holds: kept unless it raises the residual
             // [`Continuation::GROW`]-fold (the flat film's first pressure step).
-            let same_piece = trial == 0
-                && merit <= Continuation::GROW * reference
-                && self.parts.statuses() == *statuses;
+            let same = self.parts.statuses() == *statuses;
+            // The event trial ends on the next piece's edge, where the merit's slope changes:
+            // kept on the same allowance, so that the next iteration's tangent carries the
+            // contact's new status.
+            let same_piece = (trial == 0 && same || trial == 1 && at_event)
+                && merit <= Continuation::GROW * reference;
+            let phi_ref = if same { phi_max } else { phi0 };
             // A step to within the residual tolerance needs no decrease (at roundoff the merit
             // cannot fall).
-            if phi <= (1.0 - 2e-4 * alpha) * phi0 || same_piece || self.free_norm_inf() <= tolerance
+            if phi <= (1.0 - 2e-4 * alpha) * phi_ref
+                || same_piece
+                || self.free_norm_inf() <= tolerance
             {
                 accepted = Some((alpha, merit));
                 break;
@@ -295,13 +319,19 @@ impl Analysis {
             if merit < best.1 {
                 best = (alpha, merit);
             }
+            let event = if trial == 0 && !same {
+                first_event(&before, &self.parts.gaps())
+            } else {
+                None
+            };
             let curvature = (phi - phi0 + 2.0 * phi0 * alpha) / (alpha * alpha);
             let next = if curvature.is_finite() && curvature > 0.0 {
                 phi0 / curvature
             } else {
                 0.5 * alpha
             };
-            alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
+            at_event = event.is_some();
+            alpha = event.unwrap_or_else(|| next.clamp(0.1 * alpha, 0.5 * alpha));
         }
         if accepted.is_none() {
             // No trial met the test: the best one that lowered the merit at all (across a kink
@@ -370,6 +400,24 @@ impl Analysis {
     }
 }
 
+/// The event trial of the line search: where the full correction moved a contact across its
+/// surface (a gap from `before` to `after` changed sign), the step just past the first such
+/// crossing along the line, `1.01 α_k` with `α_k = g₀/(g₀ − g₁)` the smallest (a linear estimate
+/// of the crossing): the end of the smooth piece on which Newton's model holds, and the first
+/// iterate on the next piece, whose tangent then carries the contact's new status (an open
+/// contact has no stiffness, so its correction pushes the node deep into the support; a pressed
+/// one is pulled far off). None where no gap changed sign before the full step.
+fn first_event(before: &[f64], after: &[f64]) -> Option<f64> {
+    before
+        .iter()
+        .zip(after)
+        .filter(|(g0, g1)| (**g0 > 0.0) != (**g1 > 0.0))
+        .map(|(g0, g1)| g0 / (g0 - g1))
+        .filter(|a| a.is_finite())
+        .fold(None, |m: Option<f64>, a| Some(m.map_or(a, |m| m.min(a))))
+        .map(|a| (1.01 * a).min(0.5))
+}
+
 /// `max |v|`, NaN when any value is NaN (`f64::max` alone would skip a NaN and report the
 /// rest: a NaN residual would then measure 0 and pass a convergence test).
 pub fn max_abs<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
@@ -435,5 +483,3 @@ mod tests {
         assert_eq!(p.closest.unwrap().iteration, 2);
     }
 }
-
-

@@ -116,12 +116,10 @@ impl StepReport {
     /// release reached the undamped equilibrium warns instead ([`Self::dissipation_warning`]).
     pub fn dissipation_refusal(&self) -> Option<IncrementFailure> {
         let damped = self.stabilization_energy > 0.0;
-        (damped && self.dissipation_ratio() > 1.0).then_some(
-            IncrementFailure::Dissipated {
-                dissipated: self.stabilization_dissipated,
-                strain_energy: self.strain_energy,
-            },
-        )
+        (damped && self.dissipation_ratio() > 1.0).then_some(IncrementFailure::Dissipated {
+            dissipated: self.stabilization_dissipated,
+            strain_energy: self.strain_energy,
+        })
     }
 
     /// Total Newton iterations (converged increments only).

@@ -287,7 +287,6 @@ impl RunOutcome {
         self.converged() && self.steps.iter().all(|s| !s.over_bound)
     }
 
-
     /// Most Newton iterations of one converged increment.
     pub fn max_increment_iterations(&self) -> usize {
         self.steps

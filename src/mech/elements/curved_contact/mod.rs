@@ -38,7 +38,9 @@
 //! Normal: gap `g = d − r`, contact force `λN = k_n ⟨−g⟩` along `n` (the paper's penalty).
 //! Friction (penalty `k_s`, history `ξ̄` of the last converged state): trial
 //! `f = −k_s (ξ − ξ̄)`; `isotropic`: Coulomb cone `|f| ≤ μλN`, returned to it along `f`;
-//! `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays elastic.
+//! `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays elastic up to
+//! the cross hold `|f2| ≤ κλN` (`FrictionLaw::CROSS_HOLD`; the gap module's "cross hold at
+//! lift-off": the hold goes to zero with the normal force).
 //! Force on the film `F = λN n + Σ fα ∇ξα`; consistent tangent of `−F`:
 //! `k_n n⊗n − λN ∂n/∂x − Σ (∂fα/∂ξβ) ∇ξα⊗∇ξβ − Σ (∂fα/∂λN) ∇ξα⊗∇λN − Σ fα ∇²ξα`
 //! (`∇λN = −k_n n`), checked against central differences in every status and region
@@ -105,6 +107,8 @@ pub struct ContactResponse {
     pub status: GapStatus,
     /// `λN ≥ 0` (N; negative only where a closed status was imposed on an open gap).
     pub normal_force: f64,
+    /// The signed gap to the surface (m; negative: pressed in).
+    pub gap: f64,
     /// Friction force components `[f1, f2]` along `ξ1`, `ξ2` (N).
     pub friction: Vector2<f64>,
     /// `ξ` at this iterate, and the anchor to commit if it converges.
@@ -288,11 +292,12 @@ impl SurfaceContact {
         let lambda = -self.kn * p.gap;
         let limit = history.friction * lambda;
         let trial = -(p.xi - anchor) * self.ks;
+        let cross = FrictionLaw::cross_limit(lambda, history.friction);
         let status = if p.gap >= 0.0 {
             GapStatus::Open
         } else if match self.law {
             FrictionLaw::Isotropic => trial.norm() <= limit,
-            FrictionLaw::SlidingDirection => trial.x.abs() <= limit,
+            FrictionLaw::SlidingDirection => trial.x.abs() <= limit && trial.y.abs() <= cross,
         } {
             GapStatus::Stick
         } else {
@@ -303,6 +308,7 @@ impl SurfaceContact {
             tangent: Matrix3::zeros(),
             status: GapStatus::Open,
             normal_force: 0.0,
+            gap: p.gap,
             friction: Vector2::zeros(),
             xi: p.xi,
             // An open contact forgets its anchor: it sticks where it touches down next.
@@ -334,19 +340,23 @@ impl SurfaceContact {
                 }
             }
             FrictionLaw::SlidingDirection => {
+                // Each direction elastic inside its bound (μN along, κN across the support)
+                // and on it beyond: `f = ±bound`, `∂f/∂λN = ±ratio`.
                 let mut dfd = -Matrix2::identity() * self.ks;
-                if used == GapStatus::Stick {
-                    (GapStatus::Stick, trial, dfd, Vector2::zeros())
-                } else {
-                    let s = trial.x.signum();
-                    dfd[(0, 0)] = 0.0;
-                    (
-                        GapStatus::Slip,
-                        Vector2::new(s * limit, trial.y),
-                        dfd,
-                        Vector2::new(s * history.friction, 0.0),
-                    )
+                let mut dfl = Vector2::zeros();
+                let mut f = trial;
+                let kappa = FrictionLaw::CROSS_HOLD.max(history.friction);
+                for (i, (bound, ratio)) in [(limit, history.friction), (cross, kappa)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    if trial[i].abs() > bound {
+                        f[i] = trial[i].signum() * bound;
+                        dfd[(i, i)] = 0.0;
+                        dfl[i] = trial[i].signum() * ratio;
+                    }
                 }
+                (used, f, dfd, dfl)
             }
         };
         let force = n * lambda + p.grad[0] * f.x + p.grad[1] * f.y;
@@ -364,6 +374,7 @@ impl SurfaceContact {
             tangent: k,
             status,
             normal_force: lambda,
+            gap: p.gap,
             friction: f,
             xi: p.xi,
             // f = −k_s (ξ − ξ̄_new): the anchor the committed friction force implies.
@@ -382,12 +393,12 @@ impl SurfaceContact {
         self.law
     }
 
-
     /// Checks a converged `history` read back, at node position `x`, against this contact's own
     /// law ([`SurfaceContact::respond`], either friction law): open where the gap is not
     /// negative; in contact (stick or slip) where it is not positive, with an anchor that the
     /// law's return map leaves where it is (stick inside the limit, slip on it), and for slip
-    /// the trial force on or beyond the limit (`|f|` isotropic, `|f1|` sliding-direction). The
+    /// the trial force on or beyond the limit (`|f|` isotropic; `|f1|` or the cross hold `|f2|`,
+    /// sliding-direction). The
     /// gap to `length_tolerance` (m), forces to `force_tolerance` (N). Err: what differs.
     pub fn check_committed(
         &self,
@@ -401,16 +412,18 @@ impl SurfaceContact {
         let anchor = Vector2::from(history.anchor);
         let moved = (r.next_anchor - anchor).norm() * self.ks;
         let trial = -(r.xi - anchor) * self.ks;
-        let measure = match self.law {
-            FrictionLaw::Isotropic => trial.norm(),
-            FrictionLaw::SlidingDirection => trial.x.abs(),
-        };
         let limit = history.friction * r.normal_force;
+        // How far the trial force is beyond its bound (≥ 0 on it).
+        let measure = match self.law {
+            FrictionLaw::Isotropic => trial.norm() - limit,
+            FrictionLaw::SlidingDirection => (trial.x.abs() - limit)
+                .max(trial.y.abs() - FrictionLaw::cross_limit(r.normal_force, history.friction)),
+        };
         let in_contact = gap <= length_tolerance && moved <= force_tolerance;
         let consistent = match history.status {
             GapStatus::Open => gap >= -length_tolerance,
             GapStatus::Stick => in_contact,
-            GapStatus::Slip => in_contact && measure >= limit - force_tolerance,
+            GapStatus::Slip => in_contact && measure >= -force_tolerance,
         };
         if consistent {
             return Ok(());
@@ -618,7 +631,7 @@ impl SurfaceContacts {
                 } else {
                     h.origin
                 },
-                    ..*h
+                ..*h
             })
             .collect()
     }

@@ -127,33 +127,58 @@ fn tangent_matches_finite_differences_in_every_status() {
                 let dir = Vector3::new(rand(), rand(), rand()).normalize();
                 let y = centre_at(&c.shape, u) + dir * (s.tube_radius * (0.5 + rand().abs()));
                 let py = c.project(&y, u);
-                let depth = 1e-4 * (rand() + 0.3);
+                // Every fourth case pressed lightly and dragged far across: the
+                // sliding-direction law's cross hold let go (|f2| = κλN).
+                let across = case % 4 == 1;
+                let depth = if across {
+                    2e-5 * (1.0 + rand().abs())
+                } else {
+                    1e-4 * (rand() + 0.3)
+                };
                 let x = y - py.normal * (py.gap + depth);
                 let p0 = c.project(&x, py.parameter);
                 // Anchors near ξ (stick) or far (slip), either side.
                 let offset = if case % 3 == 0 { 1e-6 } else { 5e-3 } * rand().signum();
                 {
                     let history = ContactHistory {
-                        anchor: [p0.xi.x + offset, p0.xi.y - 0.5 * offset],
+                        anchor: [
+                            p0.xi.x + offset,
+                            p0.xi.y - if across { 4.0 } else { 0.5 } * offset,
+                        ],
                         angle: p0.parameter,
                         origin: 0.0,
                         status: GapStatus::Stick,
                         friction: 0.3,
                     };
                     let r = c.respond(&x, &history);
-                    // Skip points within reach of a change of status or region.
+                    // The smooth piece of the law: the status, and which components are on
+                    // their bounds (μλN along, κλN across).
+                    let piece = |r: &ContactResponse| {
+                        let on = |f: f64, b: f64| f.abs() >= b * (1.0 - 1e-12) && b > 0.0;
+                        let mu = history.friction;
+                        (
+                            r.status,
+                            on(r.friction.x, mu * r.normal_force),
+                            on(r.friction.y, FrictionLaw::cross_limit(r.normal_force, mu)),
+                        )
+                    };
+                    // Skip points within reach of a change of piece or region.
                     let h = 1e-7;
                     let unchanged = (0..3).all(|k| {
                         [-1.0, 1.0].iter().all(|sgn| {
                             let y = x + Vector3::ith(k, 20.0 * h * sgn);
-                            c.respond(&y, &history).status == r.status
+                            piece(&c.respond(&y, &history)) == piece(&r)
                                 && c.project(&y, history.angle).region == p0.region
                         })
                     });
                     if !unchanged {
                         continue;
                     }
-                    seen.insert((law, kind, p0.region, r.status as u8));
+                    let cross = FrictionLaw::cross_limit(r.normal_force, history.friction);
+                    let let_go = law == FrictionLaw::SlidingDirection
+                        && r.friction.y.abs() >= cross * (1.0 - 1e-12)
+                        && r.status == GapStatus::Slip;
+                    seen.insert((law, kind, p0.region, r.status as u8 + 10 * u8::from(let_go)));
                     let mut fd = Matrix3::zeros();
                     for k in 0..3 {
                         let e = Vector3::ith(k, h);
@@ -188,10 +213,17 @@ fn tangent_matches_finite_differences_in_every_status() {
                 seen.contains(&(law, kind, Region::Tube, GapStatus::Open as u8)),
                 "{law:?} {kind} open never tested"
             );
+            if law == FrictionLaw::SlidingDirection {
+                assert!(
+                    seen.contains(&(law, kind, Region::Tube, 10 + GapStatus::Slip as u8)),
+                    "{law:?} {kind}: the cross hold let go never tested"
+                );
+            }
             for region in regions {
                 for status in [GapStatus::Stick, GapStatus::Slip] {
+                    let hold = |c: u8| seen.contains(&(law, kind, region, c));
                     assert!(
-                        seen.contains(&(law, kind, region, status as u8)),
+                        hold(status as u8) || hold(10 + status as u8),
                         "{law:?} {kind} {region:?} {status:?} never tested"
                     );
                 }

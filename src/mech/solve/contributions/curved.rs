@@ -89,6 +89,10 @@ impl Contribution for CurvedContacts {
         out.extend(self.responses.iter().map(|r| r.status));
     }
 
+    fn gaps(&self, out: &mut Vec<f64>) {
+        out.extend(self.responses.iter().map(|r| r.gap));
+    }
+
     fn results(
         &self,
         at: &Evaluation<'_>,

@@ -141,10 +141,14 @@ impl Contribution for Gaps {
         out.extend(self.responses.iter().map(|r| r.status));
     }
 
+    fn gaps(&self, out: &mut Vec<f64>) {
+        let gap = |(r, l): (&GapResponse, &GapLaw)| l.initial_gap + r.relative.z;
+        out.extend(self.responses.iter().zip(&self.laws).map(gap));
+    }
+
     fn status_names(&self, out: &mut Vec<String>) {
         out.extend(self.names.iter().cloned());
     }
-
 
     /// The status is the one found when the increment converged.
     fn results(

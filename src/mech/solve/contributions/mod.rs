@@ -83,6 +83,11 @@ pub trait Contribution {
     /// curved-support contact), in the order of [`Contribution::status_names`].
     fn statuses(&self, _out: &mut Vec<GapStatus>) {}
 
+    /// Appends the signed gap of each contact at the last evaluation (m; negative: pressed
+    /// in), in the order of [`Contribution::statuses`]: where along a Newton correction a
+    /// contact opens or closes (the line search's event trial, `newton.rs`).
+    fn gaps(&self, _out: &mut Vec<f64>) {}
+
     /// Appends the names of the items [`Contribution::statuses`] lists, in its order.
     fn status_names(&self, _out: &mut Vec<String>) {}
 
@@ -183,6 +188,15 @@ impl Contributions {
     }
 
     /// The names of the items of [`Self::statuses`], in its order.
+    /// The signed gaps at the last evaluation, in the order of [`Self::statuses`].
+    pub fn gaps(&self) -> Vec<f64> {
+        let mut out = Vec::new();
+        for c in self.all() {
+            c.gaps(&mut out);
+        }
+        out
+    }
+
     pub fn status_names(&self) -> Vec<String> {
         let mut out = Vec::new();
         for c in self.all() {

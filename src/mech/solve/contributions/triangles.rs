@@ -47,7 +47,6 @@ impl Triangles {
             .filter(|&e| stress_state(system, &self.start, e, u).principal[1] < 0.0)
             .collect()
     }
-
 }
 
 impl Contribution for Triangles {
