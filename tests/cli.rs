@@ -997,3 +997,34 @@ fn tiny_and_huge_values_print_with_their_magnitude() {
     assert!(err.len() < 300, "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 47 item 8 ("ten minutes of silence"): `--log-increments` writes a line per increment
+/// to standard error off a terminal too (this test's stderr is a pipe), even with `--quiet`: as
+/// many lines as the Newton summary counts increments, each with the step, the share of it
+/// reached, how it was solved and its residual; without the option there are none.
+#[test]
+fn log_increments_writes_a_line_per_increment_off_a_terminal() {
+    let (ok, out, err) = specimen(&["--log-increments"]);
+    assert!(ok, "{err}");
+    let lines: Vec<&str> = err.lines().filter(|l| l.contains(": increment ")).collect();
+    let summary = out
+        .lines()
+        .find(|l| l.starts_with("Newton:"))
+        .unwrap_or_else(|| panic!("{out}"));
+    let increments: usize = summary
+        .split(", ")
+        .find_map(|p| p.strip_suffix(" increments"))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{summary}"));
+    assert_eq!(lines.len(), increments, "{err}");
+    assert!(lines[0].starts_with("step 1/2 ("), "{}", lines[0]);
+    assert!(
+        lines[0].contains("increment 0.0000 → 0.1000 of the step: Newton in "),
+        "{}",
+        lines[0]
+    );
+    assert!(lines.last().unwrap().starts_with("step 2/2 ("));
+    assert!(lines.iter().all(|l| l.contains("residual ")));
+    let (ok, _, quiet) = specimen(&[]);
+    assert!(ok && !quiet.contains(": increment "), "{quiet}");
+}

@@ -207,6 +207,11 @@ pub struct RunArgs {
     /// No progress line on the terminal.
     #[arg(long)]
     pub quiet: bool,
+    /// A line on standard error as each increment ends, on a terminal or not (a log file, a
+    /// batch job): the step, the share of it reached, how the increment was solved or why it
+    /// was refused, its iterations and residual, the cut-backs so far.
+    #[arg(long)]
+    pub log_increments: bool,
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {

@@ -11,6 +11,7 @@ use membrane_contact::mech::elements::triangle::state_counts;
 use membrane_contact::mech::model::ElementSelection;
 use membrane_contact::mech::results::summary::mpa;
 use membrane_contact::mech::results::vtk;
+use membrane_contact::mech::solve::IncrementObserver;
 use membrane_contact::mech::{
     Analysis, FrictionLaw, LoadLevels, Model, Results, SettingNames, SolverSettings,
 };
@@ -209,6 +210,17 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         !o.quiet && std::io::stderr().is_terminal(),
         path.steps.len(),
     );
+    // The step the increment log's lines belong to (set before each step).
+    let logged_step = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    if o.log_increments {
+        let (step, steps) = (logged_step.clone(), path.steps.len());
+        let started = std::time::Instant::now();
+        analysis.observe_increments(IncrementObserver::new(move |note| {
+            let k = step.load(std::sync::atomic::Ordering::Relaxed);
+            let t = started.elapsed().as_secs_f64();
+            eprintln!("step {k}/{steps} ({t:.1} s): {note}");
+        }));
+    }
     let (mut iterations, mut cutbacks, mut increments) = (Vec::new(), 0, 0);
     // Increments solved with the viscous stabilization on, and the step of the largest
     // ratio of its work to the strain energy.
@@ -216,6 +228,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     let count = path.steps.len();
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
+        logged_step.store(step, std::sync::atomic::Ordering::Relaxed);
         if let Some(mu) = inputs.mu {
             analysis.set_friction(mu)?;
         }

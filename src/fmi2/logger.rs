@@ -15,9 +15,10 @@
 use std::ffi::CString;
 
 use super::types::{Fmi2CallbackLogger, Fmi2ComponentEnvironment, Status};
+use crate::mech::solve::{IncrementNote, IncrementObserver};
 
 /// The declared log categories: name and description (`<LogCategories>`).
-pub const CATEGORIES: [(&str, &str); 6] = [
+pub const CATEGORIES: [(&str, &str); 7] = [
     (
         "logEvents",
         "initialization, steps and their Newton statistics, state save/restore",
@@ -35,11 +36,18 @@ pub const CATEGORIES: [(&str, &str); 6] = [
         "logStatusFatal",
         "internal errors (fmi2Fatal): the instance must be freed",
     ),
+    (
+        "logIncrements",
+        "each increment of a step as it ends: share of the step, how it was solved or why it was \
+         refused, iterations, residual, cut-backs (a line per increment: not enabled by \
+         loggingOn = true, only by name or logAll)",
+    ),
     ("logAll", "all of the above"),
 ];
 
 const EVENTS: usize = 0;
-const ALL: usize = 5;
+const INCREMENTS: usize = 5;
+const ALL: usize = 6;
 
 /// The category a message of this status goes to.
 fn category_of(status: Status) -> usize {
@@ -74,6 +82,7 @@ impl Logger {
         for status in [Status::Discard, Status::Error, Status::Fatal] {
             enabled[category_of(status)] = true;
         }
+        enabled[INCREMENTS] = false;
         Self {
             callback,
             environment,
@@ -122,12 +131,36 @@ impl Logger {
         self.callback.is_some() && self.enabled[category_of(status)]
     }
 
+    /// Whether `logIncrements` messages would be passed on.
+    pub fn increments_enabled(&self) -> bool {
+        self.callback.is_some() && self.enabled[INCREMENTS]
+    }
+
+    /// Sends an increment's line ([`Self::increments_enabled`]) to the importer, status OK.
+    pub fn log_increment(&self, message: &str) {
+        self.send(INCREMENTS, Status::Ok, message);
+    }
+
+    /// The solver's observer of increments for the next step: a `logIncrements` line per
+    /// increment where the category is enabled, else none.
+    pub fn increment_observer(&self) -> IncrementObserver {
+        if !self.increments_enabled() {
+            return IncrementObserver::default();
+        }
+        let logger = SteppingLogger(self.clone());
+        IncrementObserver::new(move |note| logger.say(note))
+    }
+
     /// Sends `message` with `status` to the importer if its category is enabled.
     pub fn log(&self, status: Status, message: &str) {
+        self.send(category_of(status), status, message);
+    }
+
+    /// Sends `message` in `category` with `status` if the category is enabled.
+    fn send(&self, category: usize, status: Status, message: &str) {
         let Some(callback) = self.callback else {
             return;
         };
-        let category = category_of(status);
         if !self.enabled[category] {
             return;
         }
@@ -150,6 +183,26 @@ impl Logger {
     }
 }
 
+/// A copy of an instance's logger held by the solver's increment observer.
+struct SteppingLogger(Logger);
+
+impl SteppingLogger {
+    /// Logs `note` in `logIncrements`.
+    fn say(&self, note: &IncrementNote) {
+        self.0.log_increment(&note.to_string());
+    }
+}
+
+// SAFETY: the observer holding it is called only from `Analysis::step_to_motion`, which the
+// instance runs inside its own fmi2DoStep, on the thread the importer called it from; it is
+// replaced before each step. So the callback and environment pointers are used exactly as the
+// instance's own logger uses them, inside an FMI call, never concurrently with it (FMI 2.0
+// §2.1.5: an instance is called by one thread at a time).
+unsafe impl Send for SteppingLogger {}
+// SAFETY: as for `Send`: no two threads call the observer at once (it is only called inside
+// the instance's fmi2DoStep), so shared references never race.
+unsafe impl Sync for SteppingLogger {}
+
 /// A C string of `text`; an interior NUL (which C would read as the end) becomes U+FFFD.
 fn c_string(text: &str) -> CString {
     CString::new(text.replace('\0', "\u{FFFD}")).expect("no NUL left")
@@ -162,7 +215,9 @@ mod tests {
     #[test]
     fn default_categories_follow_logging_on() {
         let on = Logger::new(None, std::ptr::null_mut(), "a", true);
-        assert!(on.enabled.iter().all(|&e| e));
+        // Every category but the increments' (a line per increment: only by name).
+        let named = |i: usize| i == INCREMENTS;
+        assert!(on.enabled.iter().enumerate().all(|(i, &e)| e != named(i)));
         let off = Logger::new(None, std::ptr::null_mut(), "a", false);
         assert!(!off.enabled[category_of(Status::Ok)]);
         assert!(

@@ -223,6 +223,7 @@ fn checked_step(
 ) -> Result<StepReport, StepError> {
     let analysis = &mut built.analysis;
     let before = analysis.state().clone();
+    analysis.observe_increments(logger.increment_observer());
     let report = analysis.step_to_motion(targets, angles, loads, built.increments)?;
     let results = analysis.results();
     match check_results(analysis.model(), &results, Some(report.residual)) {

@@ -245,3 +245,41 @@ fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
     assert!((fmu.real("G.frictionX") + 20.0).abs() < 1e-9);
     assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
 }
+
+/// Issue 47 item 8: the `logIncrements` category carries a line per increment of a step (as
+/// many as the step's log counts), status OK; `loggingOn = true` alone does not enable
+/// it (a line per increment), naming it does.
+#[test]
+fn log_increments_carries_a_line_per_increment_when_named() {
+    let (u, log) = (Unpacked::specimen("increment log"), Log::default());
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    assert_eq!(fmu.set_real("frame.dz", -0.001), 0);
+    assert_eq!(fmu.step(0.0, 0.05), 0);
+    let of = |said: &[(i32, String, String)]| {
+        said.iter()
+            .filter(|(s, c, _)| *s == 0 && c == "logIncrements")
+            .map(|(_, _, m)| m.clone())
+            .collect::<Vec<_>>()
+    };
+    assert!(of(&log.take()).is_empty());
+    let named = [c"logIncrements".as_ptr()];
+    // SAFETY: see the module doc; `named` holds one NUL-terminated literal.
+    assert_eq!(
+        unsafe { fmi2_set_debug_logging(fmu.c, 1, 1, named.as_ptr()) },
+        0
+    );
+    assert_eq!(fmu.set_real("frame.dz", -0.002), 0);
+    assert_eq!(fmu.step(0.05, 0.05), 0);
+    let said = log.take();
+    let lines = of(&said);
+    let summary = said
+        .iter()
+        .find_map(|(_, _, m)| m.strip_prefix("step to t = 0.1: "))
+        .unwrap_or_else(|| panic!("{said:?}"));
+    let increments: usize = summary.split(' ').next().unwrap().parse().unwrap();
+    assert_eq!(lines.len(), increments, "{lines:?}");
+    assert!(
+        lines[0].starts_with("increment 0.0000 → ") && lines[0].contains("of the step: Newton in "),
+        "{lines:?}"
+    );
+}

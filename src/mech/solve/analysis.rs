@@ -19,6 +19,7 @@ use crate::mech::solve::assembly::{System, node_vector};
 use crate::mech::solve::continuation::pseudo_mass;
 use crate::mech::solve::contributions::{Contributions, Evaluation};
 use crate::mech::solve::linear::{LinearSolver, SolveProfile, UnsymmetricMethod};
+use crate::mech::solve::progress::IncrementObserver;
 use crate::mech::solve::report::{SetupError, StepError, StepReport};
 use crate::mech::solve::sensitivity::HeldTangent;
 use crate::mech::solve::settings::SolverSettings;
@@ -47,6 +48,8 @@ pub struct Analysis {
     pub(super) length_scale: f64,
     /// `1e-6·E·t·L` (N): the force scale of an unloaded film.
     pub(super) force_floor: f64,
+    /// Who is told of each increment as it ends ([`Analysis::observe_increments`]).
+    pub(super) observer: IncrementObserver,
 }
 
 /// Buffers reused by every iteration.
@@ -121,7 +124,14 @@ impl Analysis {
             held_tangent: None,
             length_scale,
             force_floor,
+            observer: IncrementObserver::default(),
         })
+    }
+
+    /// Tells `observer` of every increment of the following steps as it ends (converged or
+    /// refused); [`IncrementObserver::default`] tells no one.
+    pub fn observe_increments(&mut self, observer: IncrementObserver) {
+        self.observer = observer;
     }
 
     /// Solves so far: `[LU, LDLᵀ of a symmetric consistent tangent, LDLᵀ or GMRES redone by

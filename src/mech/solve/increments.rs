@@ -4,7 +4,8 @@ use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
-use crate::mech::solve::report::{Attempt, StepError, StepReport};
+use crate::mech::solve::progress::IncrementNote;
+use crate::mech::solve::report::{Attempt, IncrementFailure, StepError, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
 /// One row of the strategy table: how the increments of a step are solved once the rows before
@@ -139,6 +140,9 @@ impl Analysis {
                 .stabilization
                 .set(STRATEGIES[row].damping, next - done);
             let attempt = self.solve_increment(&current, &path.motion(next), &path.levels(next));
+            let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
+            let how = STRATEGIES[row].name;
+            self.note_increment(done, next, how, outcome, report.cutbacks);
             report.attempts.push(Attempt {
                 strategy: row,
                 from: done,
@@ -223,6 +227,9 @@ impl Analysis {
                 .stabilization
                 .set(if damped { damping } else { 0.0 }, last);
             let attempt = self.solve_increment(current, &motion, &levels);
+            let how = if damped { "release, damped" } else { "release" };
+            let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
+            self.note_increment(1.0, 1.0, how, outcome, report.cutbacks);
             report.attempts.push(Attempt {
                 strategy: usize::from(damped),
                 from: 1.0,
@@ -250,6 +257,27 @@ impl Analysis {
                 return;
             }
         }
+    }
+
+    /// Tells the observer (`progress.rs`) how the increment from `from` to `to` of the step
+    /// ended: converged by `how`, or refused.
+    fn note_increment(
+        &self,
+        from: f64,
+        to: f64,
+        how: &'static str,
+        outcome: Result<&[f64], &IncrementFailure>,
+        cutbacks: usize,
+    ) {
+        self.observer.note(|| IncrementNote {
+            from,
+            to,
+            attempt: how,
+            iterations: outcome.map_or(0, |h| h.len().saturating_sub(1)),
+            residual: outcome.map_or(f64::NAN, |h| h.last().copied().unwrap_or(0.0)),
+            refused: outcome.err().map(IncrementFailure::phrase),
+            cutbacks,
+        });
     }
 
     /// Most damped increments [`Self::release_stabilization`] adds at a step's end.

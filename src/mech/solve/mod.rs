@@ -11,6 +11,7 @@
 //! | `increments` | the increment controller (Ramm's rule, cut-back), the strategy table, the predictor |
 //! | `newton` | one increment: semismooth Newton on the laws' equations |
 //! | `continuation` | its globalization: pseudo-transient continuation (SER) |
+//! | [`progress`] | [`IncrementNote`]: each increment as it ends, for a front end's log |
 //! | [`settings`] | [`SolverSettings`] |
 //! | [`state`] | [`AnalysisState`], the converged state an FMU state serializes |
 //! | [`report`] | [`StepReport`], [`IncrementFailure`] and its advice, [`StepError`], [`SetupError`] |
@@ -24,6 +25,7 @@ mod increments;
 mod inputs;
 pub mod linear;
 mod newton;
+pub mod progress;
 pub mod report;
 mod sensitivity;
 pub mod settings;
@@ -32,6 +34,7 @@ pub mod state;
 pub use analysis::Analysis;
 pub use increments::{STRATEGIES, Strategy};
 pub use newton::max_abs;
+pub use progress::{IncrementNote, IncrementObserver};
 pub use report::{
     Attempt, DISSIPATION_BOUND, IncrementFailure, IterationRecord, STABILIZATION_BOUND,
     SettingNames, SetupError, StepError, StepReport,

@@ -285,6 +285,19 @@ pub enum IncrementFailure {
     },
 }
 
+impl IncrementFailure {
+    /// One phrase for a progress line (the [`fmt::Display`] text has the figures).
+    pub fn phrase(&self) -> &'static str {
+        match self {
+            Self::MaxIterations { .. } => "iteration limit",
+            Self::Stalled { .. } => "no progress",
+            Self::Diverged { .. } => "diverged",
+            Self::Singular { .. } => "singular matrix",
+            Self::Dissipated { .. } => "the damping took out more than the film stores",
+        }
+    }
+}
+
 /// `names` as a short list: the first few, then how many more.
 fn name_list(names: &[String]) -> String {
     const SHOWN: usize = 6;
