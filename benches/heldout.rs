@@ -536,6 +536,12 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
             return o;
         }
     };
+    if std::env::var_os("HELDOUT_LOG_INCREMENTS").is_some() {
+        let name = path.name.clone();
+        analysis.observe_increments(membrane_contact::mech::solve::IncrementObserver::new(
+            move |note| eprintln!("{name}: {note}"),
+        ));
+    }
     'stages: for stage in &path.stages {
         let s = analysis.state().clone();
         let target_loads = LoadLevels {
