@@ -57,11 +57,13 @@ def export(height_mm, contact, eps, steps, work, plastic=False):
 class Specimen:
     """One packed FMU per specimen and contact model; any eps is a table for it."""
 
-    def __init__(self, height_mm, contact, steps, work, plastic=False):
+    def __init__(self, height_mm, contact, steps, work, plastic=False, mu=MU):
         from membrane_contact import build_fmu
 
         self.height_mm, self.contact, self.steps, self.work = height_mm, contact, steps, work
-        self.plastic = plastic
+        self.plastic, self.mu = plastic, mu
+        # Every output's value at the end of the last run of slips() (stress, statuses, ...).
+        self.final = {}
         model, _ = export(height_mm, contact, PROBES[-1], steps, work, plastic)
         model["name"] = (f"ParallelArchWrapped{height_mm}{'Curved' if contact != 'gaps' else 'Gaps'}"
                          + ("Plastic" if plastic else ""))
@@ -75,7 +77,7 @@ class Specimen:
 
         _, table = export(self.height_mm, self.contact, eps, self.steps, self.work, self.plastic)
         with Film(self.fmu, logging=False) as film:
-            film.initialize(inputs={"mu": MU})
+            film.initialize(inputs={"mu": self.mu})
             try:
                 film.run(table, outputs=[])
                 reached = eps
@@ -92,6 +94,7 @@ class Specimen:
                     node = self.model["curved_supports"][0]["nodes"][int(g[1:]) - 1]
                     name = f"arch.node{node}"
                 result[p] = (film[f"{name}.slip"] * 1e3, archfmu.STATUS[int(film[f"{name}.status"])])
+            self.final = film.values()
             return result, reached
 
 

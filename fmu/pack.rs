@@ -5,6 +5,7 @@
 //! fmu-pack path/to/model.json    → target/fmu/<model name>.fmu
 //! fmu-pack model.json --out DIR  → DIR/<model name>.fmu
 //! fmu-pack model.json -o FILE    → FILE (any name ending in .fmu)
+//! fmu-pack --platforms linux64,win64,aarch64-linux   → one FMU with three binaries
 //! ```
 //!
 //! The archive holds
@@ -14,6 +15,12 @@
 //!   `target/release/libmembrane_contact.so` and `target/release/deps/…`: `cargo run --bin
 //!   fmu-pack` refreshes only the latter; an `fmu-pack` installed from the Python wheel in
 //!   `PREFIX/bin` ships `PREFIX/lib/membrane-contact/libmembrane_contact.so`);
+//! * with `--platforms`, the cross-built libraries as well, each in its platform folder (see
+//!   [`PLATFORMS`]): `binaries/win64/<modelIdentifier>.dll` from cargo's
+//!   `target/x86_64-pc-windows-gnu/release/membrane_contact.dll`,
+//!   `binaries/aarch64-linux/<modelIdentifier>.so` from `target/aarch64-unknown-linux-gnu/…`, and
+//!   so on (`tests/platforms.sh` builds them). The modelDescription and its GUID are the same for
+//!   every set of platforms;
 //! * `resources/parallel_arch.json` or `resources/model.json`, from which `fmi2Instantiate`
 //!   rebuilds the model, the variable table and the GUID;
 //! * `documentation/index.html`.
@@ -45,7 +52,8 @@ use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
 const USAGE: &str = "\
-usage: fmu-pack [MODEL.json] [--out DIR | -o FILE] [--force] [--library PATH]
+usage: fmu-pack [MODEL.json] [--out DIR | -o FILE] [--force] [--platforms LIST]
+                [--library [PLATFORM=]PATH]...
 
 Packs an FMI 2.0 Co-Simulation FMU. Without MODEL.json it packs the paper's parallel-arch
 specimen (ParallelArch.fmu); with it, an FMU of that model, named after the model's `name`.
@@ -57,19 +65,89 @@ options:
                    the FMU file to write, any name ending in .fmu (instead of --out)
   --force          let a user model replace the built-in specimen FMU (target/fmu/ParallelArch.fmu,
                    or any file holding the specimen): refused without it
-  --library PATH   the shared library to ship (default: the newest libmembrane_contact.so
-                   next to this program, in target/release or target/release/deps; for an
-                   fmu-pack installed with pip, PREFIX/lib/membrane-contact/)
+  --platforms LIST the binaries to ship, comma-separated FMI platform folders (default
+                   linux64): linux64 (x86_64 Linux), win64 (x86_64 Windows), aarch64-linux
+                   (Linux on ARM: FMI 2.0 has no name for it; FMI 3.0's and fmpy's tuple),
+                   darwin64 (x86_64 macOS), aarch64-darwin (macOS on ARM). A platform other
+                   than linux64 takes cargo's cross build of its target beside this program
+                   (target/<target triple>/release/), e.g. `cargo build --release --lib
+                   --target x86_64-pc-windows-gnu` for win64
+  --library [PLATFORM=]PATH
+                   the shared library to ship for PLATFORM (default linux64), instead of the
+                   one found: for linux64 the newest libmembrane_contact.so next to this
+                   program, in target/release or target/release/deps (for an fmu-pack installed
+                   with pip, PREFIX/lib/membrane-contact/); repeatable
   -h, --help       this text";
 
 const LIBRARY: &str = "libmembrane_contact.so";
+
+/// A platform an FMU can carry a binary for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Platform {
+    /// The folder under `binaries/` (FMI 2.0 §2.5 names linux64, win64 and darwin64; for ARM
+    /// FMI 3.0's `<arch>-<os>`, which fmpy 0.3.32 reports as `fmpy.platform_tuple`).
+    folder: &'static str,
+    /// Rust's target triple, whose cross build is in `target/<triple>/release/`.
+    triple: &'static str,
+    /// The library's file name as cargo writes it.
+    cargo_file: &'static str,
+    /// The extension of `<modelIdentifier>.<ext>` in the FMU.
+    extension: &'static str,
+}
+
+/// Every platform `--platforms` knows, the host's (linux64) first.
+const PLATFORMS: [Platform; 5] = [
+    Platform {
+        folder: "linux64",
+        triple: "x86_64-unknown-linux-gnu",
+        cargo_file: LIBRARY,
+        extension: "so",
+    },
+    Platform {
+        folder: "win64",
+        triple: "x86_64-pc-windows-gnu",
+        cargo_file: "membrane_contact.dll",
+        extension: "dll",
+    },
+    Platform {
+        folder: "aarch64-linux",
+        triple: "aarch64-unknown-linux-gnu",
+        cargo_file: LIBRARY,
+        extension: "so",
+    },
+    Platform {
+        folder: "darwin64",
+        triple: "x86_64-apple-darwin",
+        cargo_file: "libmembrane_contact.dylib",
+        extension: "dylib",
+    },
+    Platform {
+        folder: "aarch64-darwin",
+        triple: "aarch64-apple-darwin",
+        cargo_file: "libmembrane_contact.dylib",
+        extension: "dylib",
+    },
+];
+
+fn platform(folder: &str) -> Result<Platform, String> {
+    PLATFORMS
+        .into_iter()
+        .find(|p| p.folder == folder)
+        .ok_or_else(|| {
+            let known: Vec<&str> = PLATFORMS.iter().map(|p| p.folder).collect();
+            format!("unknown platform '{folder}' (known: {})", known.join(", "))
+        })
+}
 
 struct Options {
     model: Option<PathBuf>,
     out: Option<PathBuf>,
     file: Option<PathBuf>,
     force: bool,
-    library: Option<PathBuf>,
+    /// The platforms to ship, in the order given (default: linux64).
+    platforms: Vec<Platform>,
+    /// Libraries given with `--library`, by platform.
+    libraries: Vec<(Platform, PathBuf)>,
 }
 
 fn parse(args: &[String]) -> Result<Options, String> {
@@ -78,7 +156,8 @@ fn parse(args: &[String]) -> Result<Options, String> {
         out: None,
         file: None,
         force: false,
-        library: None,
+        platforms: vec![PLATFORMS[0]],
+        libraries: Vec::new(),
     };
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -92,7 +171,32 @@ fn parse(args: &[String]) -> Result<Options, String> {
             "--out" => o.out = Some(value("--out")?),
             "-o" | "--output" => o.file = Some(value(a)?),
             "--force" => o.force = true,
-            "--library" => o.library = Some(value("--library")?),
+            "--platforms" => {
+                let list = value("--platforms")?;
+                let list = list.to_string_lossy();
+                o.platforms.clear();
+                for folder in list.split(',').map(str::trim).filter(|f| !f.is_empty()) {
+                    let p = platform(folder)?;
+                    if !o.platforms.contains(&p) {
+                        o.platforms.push(p);
+                    }
+                }
+                if o.platforms.is_empty() {
+                    return Err("--platforms needs at least one platform".into());
+                }
+            }
+            "--library" => {
+                let given = value("--library")?;
+                let text = given.to_string_lossy();
+                let (p, path) = match text.split_once('=') {
+                    Some((folder, path)) if PLATFORMS.iter().any(|p| p.folder == folder) => {
+                        (platform(folder)?, PathBuf::from(path))
+                    }
+                    _ => (PLATFORMS[0], given.clone()),
+                };
+                o.libraries.retain(|(q, _)| *q != p);
+                o.libraries.push((p, path));
+            }
             s if s.starts_with('-') => return Err(format!("unknown option {s}")),
             s if o.model.is_none() => o.model = Some(PathBuf::from(s)),
             s => {
@@ -104,6 +208,12 @@ fn parse(args: &[String]) -> Result<Options, String> {
     }
     if o.out.is_some() && o.file.is_some() {
         return Err("give either --out DIR or -o FILE, not both".into());
+    }
+    if let Some((p, _)) = o.libraries.iter().find(|(p, _)| !o.platforms.contains(p)) {
+        return Err(format!(
+            "--library for {}, which --platforms does not name",
+            p.folder
+        ));
     }
     if let Some(file) = &o.file
         && file.extension().is_none_or(|e| e != "fmu")
@@ -176,6 +286,28 @@ fn find_library(dir: &Path) -> Result<PathBuf, String> {
         })
 }
 
+/// The cross-built library of `platform` beside this program (`dir`, cargo's `target/release`):
+/// `target/<triple>/release/<cargo file>`.
+fn find_cross_library(dir: &Path, platform: Platform) -> Result<PathBuf, String> {
+    let path = dir
+        .join("..")
+        .join(platform.triple)
+        .join("release")
+        .join(platform.cargo_file);
+    if path.is_file() {
+        Ok(path)
+    } else {
+        Err(format!(
+            "no {} for {}: run `cargo build --release --lib --target {}` first (tests/platforms.sh \
+             does), or pass --library {}=PATH",
+            path.display(),
+            platform.folder,
+            platform.triple,
+            platform.folder
+        ))
+    }
+}
+
 /// The default output directory: `target/fmu` when this program runs from cargo's target
 /// directory (`target/release`, whose parent cargo marks with `CACHEDIR.TAG`), else the current
 /// directory (an installed `fmu-pack`, whose own directory is no place for FMUs).
@@ -187,7 +319,13 @@ fn cargo_target_fmu_dir(dir: &Path) -> Option<PathBuf> {
         .map(|target| target.join("fmu"))
 }
 
-fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> Result<(), String> {
+/// Writes the FMU: `libraries` holds each platform's library, in the order they are stored.
+fn write_fmu(
+    path: &Path,
+    d: &Description,
+    source: &Source,
+    libraries: &[(Platform, Vec<u8>)],
+) -> Result<(), String> {
     let io = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let tmp = path.with_extension("fmu.partial");
     let file = std::fs::File::create(&tmp).map_err(|e| io(&e))?;
@@ -198,24 +336,32 @@ fn write_fmu(path: &Path, d: &Description, source: &Source, library: &[u8]) -> R
     let binary = text.unix_permissions(0o755);
     let (resource_name, resource_text) = source.resource_file();
     let documentation = documentation_html(d);
-    let entries: [(String, &[u8], SimpleFileOptions); 4] = [
-        ("modelDescription.xml".into(), d.xml.as_bytes(), text),
+    let binaries = libraries.iter().map(|(p, bytes)| {
         (
-            format!("binaries/linux64/{}.so", d.model_identifier),
-            library,
+            format!(
+                "binaries/{}/{}.{}",
+                p.folder, d.model_identifier, p.extension
+            ),
+            bytes.as_slice(),
             binary,
-        ),
-        (
-            format!("resources/{resource_name}"),
-            resource_text.as_bytes(),
-            text,
-        ),
-        (
-            "documentation/index.html".into(),
-            documentation.as_bytes(),
-            text,
-        ),
-    ];
+        )
+    });
+    let entries: Vec<(String, &[u8], SimpleFileOptions)> =
+        std::iter::once(("modelDescription.xml".into(), d.xml.as_bytes(), text))
+            .chain(binaries)
+            .chain([
+                (
+                    format!("resources/{resource_name}"),
+                    resource_text.as_bytes(),
+                    text,
+                ),
+                (
+                    "documentation/index.html".into(),
+                    documentation.as_bytes(),
+                    text,
+                ),
+            ])
+            .collect();
     for (name, bytes, options) in entries {
         zip.start_file(name.as_str(), options).map_err(|e| io(&e))?;
         zip.write_all(bytes).map_err(|e| io(&e))?;
@@ -277,12 +423,27 @@ fn run(o: &Options) -> Result<(), String> {
         }
     }
     let dir = program_dir()?;
-    let library_path = match &o.library {
-        Some(p) => p.clone(),
-        None => find_library(&dir)?,
-    };
-    let library =
-        std::fs::read(&library_path).map_err(|e| format!("{}: {e}", library_path.display()))?;
+    let mut libraries = Vec::new();
+    let mut shipped = Vec::new();
+    for &p in &o.platforms {
+        let given = o
+            .libraries
+            .iter()
+            .find(|(q, _)| *q == p)
+            .map(|(_, l)| l.clone());
+        let library_path = match given {
+            Some(l) => l,
+            None if p == PLATFORMS[0] => find_library(&dir)?,
+            None => find_cross_library(&dir, p)?,
+        };
+        let bytes =
+            std::fs::read(&library_path).map_err(|e| format!("{}: {e}", library_path.display()))?;
+        shipped.push(match o.platforms.len() {
+            1 => library_path.display().to_string(),
+            _ => format!("{} {}", p.folder, library_path.display()),
+        });
+        libraries.push((p, bytes));
+    }
     let cargo_fmu = cargo_target_fmu_dir(&dir);
     let path = match (&o.file, &o.out) {
         (Some(file), _) => file.clone(),
@@ -303,7 +464,7 @@ fn run(o: &Options) -> Result<(), String> {
         let specimen = cargo_fmu.map(|d| d.join(format!("{MODEL_NAME}.fmu")));
         refuse_to_replace_the_specimen(&path, specimen.as_deref(), &model.name)?;
     }
-    write_fmu(&path, &description, &source, &library)?;
+    write_fmu(&path, &description, &source, &libraries)?;
     let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
     println!(
         "{}: {} variables, GUID {}, {:.1} MB (library {})",
@@ -311,7 +472,7 @@ fn run(o: &Options) -> Result<(), String> {
         description.variables.len(),
         description.guid,
         size as f64 / 1e6,
-        library_path.display()
+        shipped.join("; ")
     );
     Ok(())
 }
@@ -328,5 +489,54 @@ fn main() -> ExitCode {
             eprintln!("fmu-pack: {message}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options(args: &[&str]) -> Result<Options, String> {
+        parse(&args.iter().map(|a| a.to_string()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn platforms_default_to_linux64_and_keep_their_order() {
+        let folders = |o: Options| o.platforms.iter().map(|p| p.folder).collect::<Vec<_>>();
+        assert_eq!(folders(options(&[]).unwrap()), ["linux64"]);
+        assert_eq!(
+            folders(options(&["--platforms", "win64, aarch64-linux,win64"]).unwrap()),
+            ["win64", "aarch64-linux"]
+        );
+        let e = options(&["--platforms", "win32"]).err().unwrap();
+        assert!(
+            e.contains("unknown platform 'win32'") && e.contains("darwin64"),
+            "{e}"
+        );
+        assert!(options(&["--platforms", ","]).is_err());
+    }
+
+    #[test]
+    fn a_library_names_its_platform() {
+        let o = options(&[
+            "--platforms",
+            "linux64,win64",
+            "--library",
+            "win64=x.dll",
+            "--library",
+            "a.so",
+        ])
+        .unwrap();
+        let given: Vec<_> = o
+            .libraries
+            .iter()
+            .map(|(p, l)| (p.folder, l.to_str().unwrap()))
+            .collect();
+        assert_eq!(given, [("win64", "x.dll"), ("linux64", "a.so")]);
+        let e = options(&["--library", "win64=x.dll"]).err().unwrap();
+        assert!(e.contains("--platforms does not name"), "{e}");
+        // a path holding '=' whose head is no platform is linux64's
+        let o = options(&["--library", "dir=1/lib.so"]).unwrap();
+        assert_eq!(o.libraries[0].1, PathBuf::from("dir=1/lib.so"));
     }
 }

@@ -7,6 +7,8 @@
 use std::io::Read;
 use std::process::{Command, Stdio};
 
+mod common;
+
 #[test]
 fn closed_pipe_ends_the_program_quietly() {
     let mut child = Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
@@ -629,6 +631,88 @@ fn check_prints_the_warnings_and_the_orientation_of_each_pressure_set() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// TEST GOAL (issue 47 item 8): a prestressed film with free edges starts out of equilibrium
+/// (the vault roof: 302 of 728 elements wrinkled, a 100 s first stage) and `check` said
+/// nothing. `examples/crossing_supports.json` is such a film: 1.5 MPa both ways, rails on its
+/// 3 m edges only, so that its two 4 m edges (nodes 0–32 and 792–824) are free. `check` warns
+/// naming both chains and what holds them; with an edge cable along each it is silent again.
+#[test]
+fn check_warns_that_a_prestressed_film_with_free_edges_starts_out_of_equilibrium() {
+    let example = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/crossing_supports.json"
+    );
+    let (ok, _, err) = cli(&["check", example]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains(
+            "warning: the film's prestress pulls across 64 free edge segments in 2 chains (nodes \
+             0 to 32 (32 segments); nodes 792 to 824 (32 segments)) that no support, symmetry \
+             plane, group, gap, curved support or edge cable holds"
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("hold each edge with an edge cable (cables), a group or supports"),
+        "{err}"
+    );
+    let mut model =
+        membrane_contact::mech::Model::from_json(&std::fs::read_to_string(example).unwrap())
+            .unwrap();
+    for (name, first) in [("cableS", 0), ("cableN", 792)] {
+        model.cables.push(membrane_contact::mech::model::CableSpec {
+            name: name.into(),
+            nodes: (first..=first + 32).collect(),
+            area: 1e-5,
+            youngs_modulus: 1.6e11,
+            prestress_force: 0.0,
+        });
+    }
+    let file = std::env::temp_dir().join(format!(
+        "membrane-contact-cabled-{}.json",
+        std::process::id()
+    ));
+    std::fs::write(&file, model.to_json()).unwrap();
+    let (ok, _, err) = cli(&["check", file.to_str().unwrap()]);
+    let _ = std::fs::remove_file(&file);
+    assert!(ok && err.is_empty(), "{err}");
+}
+
+/// TEST GOAL (issue 47 item 8): contacts far outside the model's scale are said after each
+/// step, as the FMU says them, naming the contacts (the vault roof's rails "converged" with
+/// 1.14 MN on its end caps, unflagged). `examples/driven_gap.json` with a pipe (tube radius
+/// 20 mm, `k_n` = 1e6 N/m) 1 mm under node 1, the film driven 5 then 10 mm down in two steps:
+/// both steps warn of both contacts' penetration and of the pipe's force, with the step's
+/// number, and the end of the run does not say the last step's again.
+#[test]
+fn contacts_pressed_far_into_their_supports_are_said_after_each_step() {
+    let mut model = common::driven_gap_over_a_pipe();
+    model.groups[0].target = [0.0, 0.0, -0.01];
+    let file = std::env::temp_dir().join(format!(
+        "membrane-contact-pressed-{}.json",
+        std::process::id()
+    ));
+    std::fs::write(&file, model.to_json()).unwrap();
+    let (ok, _, err) = cli(&["model", file.to_str().unwrap(), "--steps", "2", "--quiet"]);
+    let _ = std::fs::remove_file(&file);
+    assert!(ok, "{err}");
+    for step in [1, 2] {
+        let said = format!(
+            "warning: step {step}: contact penetration far beyond what a rigid support allows at \
+             2 contacts: pipe.node1 {0}e-3 m, gap 'G' {0}e-3 m",
+            ["4.000", "9.000"][step - 1]
+        );
+        assert!(err.contains(&said), "{said}\n{err}");
+        let said = format!(
+            "warning: step {step}: contact force far beyond the film's scale at 1 contact: \
+             pipe.node1 {}e3 N",
+            ["4.000", "9.000"][step - 1]
+        );
+        assert!(err.contains(&said), "{said}\n{err}");
+    }
+    assert_eq!(err.matches("contact force").count(), 2, "{err}");
+}
+
 /// TEST GOAL (issue 17, defect 4): a model without a free DOF runs from the command line (it
 /// was refused with "the model has no free DOF"): `examples/driven_gap.json` driven along
 /// `examples/driven_gap_path.csv` sticks at `k_s·dx`, slips at `μN` = 30 N and sticks again on
@@ -1027,4 +1111,34 @@ fn log_increments_writes_a_line_per_increment_off_a_terminal() {
     assert!(lines.iter().all(|l| l.contains("residual ")));
     let (ok, _, quiet) = specimen(&[]);
     assert!(ok && !quiet.contains(": increment "), "{quiet}");
+}
+
+/// Issue 47 item 8: the summary prints the contacts' force on the film; on the unloaded
+/// specimen it balances the total reaction, and no share of a load is claimed.
+#[test]
+fn the_summary_prints_the_contact_force_on_the_film() {
+    let (ok, out, err) = specimen(&[]);
+    assert!(ok, "{err}");
+    let vector = |prefix: &str| -> Vec<f64> {
+        let line = out
+            .lines()
+            .find(|l| l.starts_with(prefix))
+            .unwrap_or_else(|| panic!("{out}"));
+        let inside = &line[line.find(": (").unwrap() + 3..line.find(") N").unwrap()];
+        inside.split(", ").map(|v| v.parse().unwrap()).collect()
+    };
+    let (c, t) = (
+        vector("contact forces on the film"),
+        vector("total reaction"),
+    );
+    for k in 0..3 {
+        assert!(
+            (c[k] + t[k]).abs() < 2e-3 + 1e-4 * c[k].abs(),
+            "{c:?} vs {t:?}"
+        );
+    }
+    assert!(
+        out.contains("balancing the reactions (no load on the film)"),
+        "{out}"
+    );
 }

@@ -319,6 +319,7 @@ fn hinged_panel() -> Model {
         0.1,
     );
     m.loads.pressures.push(PressureSet {
+        kind: Default::default(),
         name: "snow".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: -100.0,

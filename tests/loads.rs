@@ -13,7 +13,7 @@ use membrane_contact::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATIO
 use membrane_contact::mech::elements::triangle::{ElementVector, Material};
 use membrane_contact::mech::model::{
     AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, ForceSet, LoadSpec, Model,
-    OutputPoint, OutputSpec, PressureSet, Side, Support, Towards,
+    OutputPoint, OutputSpec, PressureKind, PressureSet, Side, Support, Towards,
 };
 use membrane_contact::mech::solve::assembly::{Dof, System};
 use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings, StepError};
@@ -74,6 +74,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
 
 fn pressure_everywhere(name: &str, p: f64) -> PressureSet {
     PressureSet {
+        kind: Default::default(),
         name: name.into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: p,
@@ -171,12 +172,14 @@ fn assembled_tangent_with_pressure_matches_central_differences_of_the_assembled_
     model.loads.pressures = vec![
         pressure_everywhere("all", 700.0),
         PressureSet {
+            kind: Default::default(),
             name: "part".into(),
             elements: ElementSelection::List(vec![0, 3, 4]),
             pressure: -300.0,
             towards: None,
         },
         PressureSet {
+            kind: Default::default(),
             name: "oriented".into(),
             elements: ElementSelection::List(vec![1, 2, 4, 5]),
             pressure: 450.0,
@@ -630,6 +633,7 @@ fn oriented_pressure_deflects_a_disc_the_same_whatever_the_triangles_winding() {
     let with = |model: &Model, towards: Option<Towards>| {
         let mut model = model.clone();
         model.loads.pressures = vec![PressureSet {
+            kind: Default::default(),
             towards,
             ..pressure_everywhere("top", 300.0)
         }];
@@ -668,6 +672,7 @@ fn flipped_triangles_in_a_pressure_set_without_towards_are_warned_naming_how_man
     let flipped = half_flipped(&base);
     let count = base.triangles.len();
     let set = |towards| PressureSet {
+        kind: Default::default(),
         towards,
         ..pressure_everywhere("top", 300.0)
     };
@@ -779,6 +784,7 @@ fn load_sets_are_validated_naming_the_bad_item() {
         (
             Box::new(|m| {
                 m.loads.pressures = vec![PressureSet {
+                    kind: Default::default(),
                     name: "top".into(),
                     elements: ElementSelection::List(vec![0, 5]),
                     pressure: 1.0,
@@ -790,6 +796,7 @@ fn load_sets_are_validated_naming_the_bad_item() {
         (
             Box::new(|m| {
                 m.loads.pressures = vec![PressureSet {
+                    kind: Default::default(),
                     name: "top".into(),
                     elements: ElementSelection::List(vec![]),
                     pressure: 1.0,
@@ -1051,4 +1058,107 @@ fn a_pressure_step_from_a_flat_film_converges_in_one_increment_without_a_crawl()
             report.total_iterations()
         );
     }
+}
+
+/// A load per plan area (pressure set `"kind": "plan"`, snow) on a flat patch tilted by `θ`
+/// about x totals `s · A cos θ` straight down (the plan area's share, EN 1991-1-3), whatever the
+/// triangles' node order; along `towards` when given; carries no stiffness (the residual does
+/// not depend on `u`); and balances the reactions of a clamped film at equilibrium. A follower
+/// pressure of the same value on the same film totals `s · A` along the normal instead.
+#[test]
+fn a_load_per_plan_area_totals_its_value_times_the_projected_area_along_its_direction() {
+    let (s, theta) = (800.0, 0.5_f64);
+    let mut model = patch(4, 3, 2.0, 1.5);
+    for p in &mut model.nodes {
+        let (y, z) = (p[1], p[2]);
+        (p[1], p[2]) = (
+            y * theta.cos() - z * theta.sin(),
+            y * theta.sin() + z * theta.cos(),
+        );
+    }
+    for t in model.triangles.iter_mut().step_by(3) {
+        t.swap(1, 2); // node order does not matter
+    }
+    let mut snow = pressure_everywhere("snow", s);
+    snow.kind = PressureKind::Plan;
+    model.loads.pressures = vec![snow.clone()];
+    let total = |model: &Model, u: &[f64]| -> Vector3<f64> {
+        let system = System::new(model, false).unwrap();
+        let loads = Loads::new(model, &system);
+        let mut r = vec![0.0; u.len()];
+        loads.add_to(&system, &LoadLevels::of_model(model), u, &mut r, None);
+        (0..model.nodes.len())
+            .map(|v| -Vector3::new(r[3 * v], r[3 * v + 1], r[3 * v + 2]))
+            .sum()
+    };
+    let area = 2.0 * 1.5;
+    let still = vec![0.0; model.dof_count()];
+    let down = Vector3::new(0.0, 0.0, -s * area * theta.cos());
+    assert!((total(&model, &still) - down).norm() < 1e-10 * down.norm());
+    let mut rng = Random(5);
+    let moved: Vec<f64> = still.iter().map(|_| 0.05 * rng.next()).collect();
+    assert_eq!(total(&model, &moved), total(&model, &still), "a dead load");
+    // Its tangent is zero: every DOF's residual is the same at any displacement (the central
+    // difference of the force is 0 in every component), and it adds nothing to the matrix.
+    let system = System::new(&model, false).unwrap();
+    let loads = Loads::new(&model, &system);
+    let levels = LoadLevels::of_model(&model);
+    let residual_at = |u: &[f64]| {
+        let mut r = vec![0.0; u.len()];
+        let mut values = vec![0.0; system.nonzeros()];
+        loads.add_to(&system, &levels, u, &mut r, Some(&mut values));
+        assert!(values.iter().all(|&v| v == 0.0), "plan load stiffness");
+        r
+    };
+    assert_eq!(residual_at(&moved), residual_at(&still));
+    // Along towards: the area projected on the plane normal to it.
+    let mut along_y = model.clone();
+    along_y.loads.pressures[0].towards = Some(Towards::Side(Side::PlusY));
+    let sideways = Vector3::new(0.0, s * area * theta.sin(), 0.0);
+    assert!((total(&along_y, &still) - sideways).norm() < 1e-10 * sideways.norm());
+    // The follower pressure of the same value: s A along the normal.
+    let mut follower = model.clone();
+    follower.loads.pressures[0].kind = PressureKind::Follower;
+    follower.loads.pressures[0].towards = Some(Towards::Side(Side::MinusZ));
+    let normal = total(&follower, &still);
+    assert!(
+        (normal.norm() - s * area).abs() < 1e-9 * s * area,
+        "{normal}"
+    );
+    // A clamped film at equilibrium: the rim's reactions carry it.
+    let rim: Vec<usize> = (0..model.nodes.len())
+        .filter(|&v| v % 5 == 0 || v % 5 == 4)
+        .collect();
+    clamp(&mut model, rim);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let target = LoadLevels::of_model(&model);
+    analysis.step_to_with_loads(&[], &target, 4).unwrap();
+    let system = analysis.system().clone();
+    let r = residual(
+        &system,
+        analysis.loads(),
+        &target,
+        &analysis.state().displacement,
+        None,
+    );
+    let mut reaction = Vector3::zeros();
+    for (i, d) in system.dofs.iter().enumerate() {
+        if *d == Dof::Fixed {
+            reaction[i % 3] += r[i];
+        }
+    }
+    assert!(
+        (reaction + down).norm() < 1e-6 * down.norm(),
+        "{reaction} vs {down}"
+    );
+    // Read and written by its kind; a follower set writes none.
+    let json = serde_json::to_value(&snow).unwrap();
+    assert_eq!(json["kind"], "plan");
+    assert!(
+        serde_json::to_value(pressure_everywhere("p", 1.0))
+            .unwrap()
+            .get("kind")
+            .is_none()
+    );
+    assert_eq!(serde_json::from_value::<PressureSet>(json).unwrap(), snow);
 }

@@ -2047,6 +2047,7 @@ fn parallel_assembly_is_bit_identical_to_serial_for_every_thread_count() {
     model.material.density = 1750.0;
     model.loads.gravity = [0.0, 0.0, -9.81];
     model.loads.pressures.push(PressureSet {
+        kind: Default::default(),
         name: "wind".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: 300.0,

@@ -153,6 +153,17 @@ MUTATIONS = [
         fmu=True,
     ),
     Mutation(
+        "stab-energy",
+        "the reported stabilization_energy of a step set to 0 (issue 47 item 11: no test read "
+        "it from a real run)",
+        "src/mech/solve/increments.rs",
+        [(
+            "        report.stabilization_energy = std::mem::take(&mut self.work.stabilization);",
+            "        report.stabilization_energy = std::mem::take(&mut self.work.stabilization) * 0.0;",
+        )],
+        first=["--test surfaces"],
+    ),
+    Mutation(
         "study-gaps",
         "a study resume that skips the missing cases below the largest stored case id",
         "python/membrane_contact/study.py",

@@ -13,6 +13,8 @@ use membrane_contact::mech::{Analysis, LoadLevels, Material, Model, SolverSettin
 use membrane_contact::specimens::ParallelArch;
 use membrane_contact::specimens::scenarios::CircularMembrane;
 
+mod common;
+
 /// A 4-ring disc of radius 1 m, the specimen's ETFE film prestressed to 1 MPa, 100 Pa.
 fn disc(pressure: f64) -> CircularMembrane {
     CircularMembrane {
@@ -165,6 +167,49 @@ fn the_specimen_gives_no_model_warning() {
         let model = ParallelArch::with_height(h).model().unwrap();
         assert_eq!(model_warnings(&model), Vec::<String>::new());
     }
+}
+
+/// TEST GOAL (issue 47 item 8): the vault roof's rails were driven into the curved supports'
+/// end caps and "converged" with contact forces of 1.14 MN on a film whose forces are kN,
+/// unflagged. `examples/driven_gap.json` (a triangle of 0.224 m, every node driven by group
+/// `Drive`; gap `G` under node 0, 1 mm away, `k_n` = 1e5 N/m) with a cylinder `pipe` (tube
+/// radius 20 mm, `k_n` = 1e6 N/m) 1 mm under node 1, driven down: 1 mm into both is nothing to
+/// warn of; 9 mm is beyond 1 % of the film's size (2.24 mm, the gap) and 10 % of the tube
+/// radius (2 mm, the pipe), and the pipe's 9 kN is beyond the film's scale E·t·L·5 % = 2.8 kN
+/// (the gap's 0.9 kN is not). Each warning names its contacts, worst first.
+#[test]
+fn contacts_pressed_far_into_their_supports_warn_naming_them() {
+    let model = common::driven_gap_over_a_pipe();
+    let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+    let mut pressed = |dz: f64| {
+        a.step_to(&[[0.0, 0.0, dz]], 1).unwrap();
+        let results = a.results();
+        let w = result_warnings(a.model(), &results);
+        (results, w)
+    };
+    let (results, w) = pressed(-0.002);
+    assert!((results.gaps[0].normal_force - 100.0).abs() < 1e-6);
+    assert!((results.surface_contacts[0].gap + 0.001).abs() < 1e-9);
+    assert_eq!(w, Vec::<String>::new());
+    let (results, w) = pressed(-0.010);
+    assert!((results.surface_contacts[0].normal_force - 9e3).abs() < 1e-3);
+    assert_eq!(w.len(), 2, "{w:#?}");
+    assert_eq!(
+        w[0],
+        "contact penetration far beyond what a rigid support allows at 2 contacts: pipe.node1 \
+         9.000e-3 m, gap 'G' 9.000e-3 m (limits: 1 % of the film's size 2.236e-1 m for a gap, 10 % \
+         of the tube radius for a curved support); the penalty holds the node only by being \
+         pressed in: check the prescribed displacements, the support's position and its \
+         normal_stiffness"
+    );
+    assert!(
+        w[1].starts_with(
+            "contact force far beyond the film's scale at 1 contact: pipe.node1 9.000e3 N \
+             (E·t·L·5 % = 2.795e3 N, what the whole film carries across its size L = 2.236e-1 m \
+             at 5 % strain)"
+        ),
+        "{w:#?}"
+    );
 }
 
 #[test]

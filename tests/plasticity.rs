@@ -159,30 +159,75 @@ fn strip_to_30_percent_log_strain_and_back_follows_the_hardening_table() {
     assert!(a.results().reactions[0][0].abs() < 1e-6 * SY * W * T0);
 }
 
+/// The strip yields all along at each of these strains, so that every step also warns that the
+/// whole film yielded (issue 47 item 8); the rupture warning comes only past the rupture strain.
 #[test]
 fn strip_past_the_rupture_strain_is_reported_in_the_warnings() {
     use membrane_contact::mech::elements::plasticity::ETFE_RUPTURE_PLASTIC_STRAIN;
     use membrane_contact::mech::results::warnings::result_warnings;
     let mut a = Analysis::new(strip(2), Default::default()).unwrap();
-    let mut warned = vec![];
+    let mut ruptured = vec![];
     for eps in [1.0, 1.4, 1.7] {
         a.step_to(&[[L * (f64::exp(eps) - 1.0), 0.0, 0.0]], 20)
             .unwrap();
         let r = a.results();
         let ep = r.elements[0].plastic.unwrap().equivalent_plastic_strain;
         let w = result_warnings(a.model(), &r);
-        assert_eq!(
-            !w.is_empty(),
-            ep > ETFE_RUPTURE_PLASTIC_STRAIN,
+        assert!(
+            w[0].starts_with("the film has yielded over 100 % of its area (4 of 4 triangles"),
             "ε̄p {ep}: {w:?}"
         );
-        warned.extend(w);
+        let rupture: Vec<_> = w.into_iter().filter(|w| w.contains("rupture")).collect();
+        assert_eq!(
+            !rupture.is_empty(),
+            ep > ETFE_RUPTURE_PLASTIC_STRAIN,
+            "ε̄p {ep}: {rupture:?}"
+        );
+        ruptured.extend(rupture);
     }
-    assert_eq!(warned.len(), 1);
+    assert_eq!(ruptured.len(), 1);
     assert!(
-        warned[0].contains("past ETFE's rupture strain 1.455"),
-        "{warned:?}"
+        ruptured[0].contains("past ETFE's rupture strain 1.455"),
+        "{ruptured:?}"
     );
+}
+
+/// TEST GOAL (issue 47 item 8): a plastic film that yielded all over said nothing (the vault
+/// roof: every element, ε̄p up to 6.8 %); only rupture warned. Yield over more than half the
+/// film's area warns with the largest equivalent plastic strain; half of it or less does not.
+/// The strip (8 triangles of one area) is pulled 5 % past yield, then the plastic strain of
+/// some triangles is set back to zero.
+#[test]
+fn a_film_yielded_over_more_than_half_its_area_warns_with_its_largest_plastic_strain() {
+    use membrane_contact::mech::results::warnings::result_warnings;
+    let mut a = Analysis::new(strip(4), Default::default()).unwrap();
+    a.step_to(&[[L * (f64::exp(0.05) - 1.0), 0.0, 0.0]], 5)
+        .unwrap();
+    let yielded = a.results();
+    let ep = yielded.elements[0]
+        .plastic
+        .unwrap()
+        .equivalent_plastic_strain;
+    assert!(ep > 0.02, "{ep}");
+    let with_elastic = |count: usize| {
+        let mut r = yielded.clone();
+        for e in &mut r.elements[..count] {
+            e.plastic.as_mut().unwrap().equivalent_plastic_strain = 0.0;
+        }
+        result_warnings(a.model(), &r)
+    };
+    let w = with_elastic(0);
+    assert_eq!(w.len(), 1, "{w:?}");
+    let expected = format!(
+        "the film has yielded over 100 % of its area (8 of 8 triangles; more than 50 % warns), \
+         equivalent plastic strain up to {:.2} % in triangle ",
+        100.0 * ep
+    );
+    assert!(w[0].starts_with(&expected), "{w:?}");
+    assert!(w[0].contains("its prestress is lost for good"), "{w:?}");
+    assert!(with_elastic(3)[0].contains("yielded over 62 % of its area (5 of 8"));
+    assert_eq!(with_elastic(4), Vec::<String>::new());
+    assert_eq!(with_elastic(8), Vec::<String>::new());
 }
 
 #[test]
@@ -341,6 +386,7 @@ fn erection_then_service_unloads_elastically_and_keeps_the_slip_history() {
     };
     let mut model = spec.model().unwrap();
     model.loads.pressures.push(PressureSet {
+        kind: Default::default(),
         name: "snow".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: -500.0,
@@ -541,4 +587,56 @@ fn plastic_film_on_threads_is_bit_identical_to_serial() {
             assert!(bits(a) == bits(b), "{threads} threads: {what} differs");
         }
     }
+}
+
+/// TEST GOAL (issue 47 item 8): the default ETFE curve had to be copied into the model file as
+/// numbers. `"hardening": "etfe-23C"` names it: the model gets exactly
+/// `etfe_datasheet_hardening()`, is written back by name and reads back equal; it runs like the
+/// table; an unknown name is refused naming the known ones.
+#[test]
+fn the_default_etfe_curve_is_accepted_by_name_and_an_unknown_name_is_refused() {
+    use membrane_contact::mech::elements::plasticity::etfe_datasheet_hardening;
+    let mut table = strip(2);
+    table.material.plasticity = Some(Plasticity {
+        hardening: etfe_datasheet_hardening(),
+    });
+    let text = table.to_json();
+    let rows = serde_json::to_string(&etfe_datasheet_hardening().rows()).unwrap();
+    let compact = text.split_whitespace().collect::<String>();
+    assert!(
+        compact.contains(&format!("\"hardening\":{rows}")),
+        "{compact}"
+    );
+    let named_text = compact.replace(&rows, "\"etfe-23C\"");
+    let named = Model::from_json(&named_text).unwrap();
+    let hardening = named.material.plasticity.unwrap().hardening;
+    assert_eq!(hardening.rows(), etfe_datasheet_hardening().rows());
+    assert_eq!(hardening.name(), Some("etfe-23C"));
+    let written = named.to_json();
+    assert!(written.contains("\"hardening\": \"etfe-23C\""), "{written}");
+    assert_eq!(Model::from_json(&written).unwrap(), named);
+    // It runs as the table does, bit for bit.
+    let pulled = |m: Model| {
+        let mut a = Analysis::new(m, Default::default()).unwrap();
+        a.step_to(&[[0.05 * L, 0.0, 0.0]], 2).unwrap();
+        assert!(
+            a.results().elements[0]
+                .plastic
+                .unwrap()
+                .equivalent_plastic_strain
+                > 0.0
+        );
+        a.results()
+    };
+    assert_eq!(pulled(named).elements, pulled(table).elements);
+    let err = Model::from_json(&compact.replace(&rows, "\"etfe-20C\""))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(
+            "hardening: unknown curve \"etfe-20C\"; the known names are \"etfe-23C\": ETFE's \
+             data-sheet curve at 23 °C"
+        ),
+        "{err}"
+    );
 }

@@ -493,3 +493,34 @@ fn a_gap_driven_along_a_path_sticks_slips_and_sticks_again_on_the_way_back() {
         }
     }
 }
+
+/// Issue 47 item 8: the contact force vector. On the 300 mm specimen lowered onto its arch
+/// (gaps, then curved supports) no load acts on the film, so the contacts' force on it balances
+/// the reactions at its held nodes: `contact_force + total_reaction = 0` (fails with a gap's
+/// local force not rotated back, or with the film's force on the support instead of the
+/// support's on the film), the arch pushing the film up; and the film's support
+/// (`film_support_force`), which balances its loads, is ~0.
+#[test]
+fn the_contacts_force_on_the_film_balances_the_reactions_of_an_unloaded_film() {
+    use membrane_contact::specimens::parallel_arch::SpecimenContact;
+    for contact in [SpecimenContact::Gaps, SpecimenContact::CurvedSupport] {
+        let spec = ParallelArch {
+            contact,
+            ..ParallelArch::default()
+        };
+        let model = spec.model().unwrap();
+        let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+        for k in 1..=8 {
+            let targets = spec.boundary_targets(&model, k as f64 / 20.0);
+            analysis.step_to(&targets, 10).unwrap();
+        }
+        let results = analysis.results();
+        let c = results.contact_force(&model);
+        let t = nalgebra::Vector3::from(results.total_reaction);
+        assert!(c.z > 0.1 * c.norm(), "{contact:?}: {c}");
+        // Within the equilibrium tolerance: 1e-5 of the largest nodal force, summed over the
+        // film's nodes.
+        assert!((c + t).norm() < 1e-4 * c.norm(), "{contact:?}: {c} vs {t}");
+        assert!(results.film_support_force(&model).norm() < 1e-4 * c.norm());
+    }
+}

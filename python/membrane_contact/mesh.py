@@ -86,7 +86,7 @@ CONTACT_KEYS = {"normal_stiffness", "tangential_stiffness", "friction", "frictio
 # role → (required keys, optional keys)
 ROLES: dict[str, tuple[set[str], set[str]]] = {
     "element_set": (set(), {"name"}),
-    "pressure": ({"pressure"}, {"name", "towards"}),
+    "pressure": ({"pressure"}, {"name", "towards", "kind"}),
     "force": ({"force"}, {"name"}),
     "support": (set(), {"fixed", "set"}),
     "boundary": (set(), {"name", "target", "components"}),
@@ -464,6 +464,31 @@ class _Importer:
             _fail(f"{self.where(name, role)}: has no line elements (it holds {self.describe_group(g)})")
         return segments
 
+    def leave_prescribed_nodes_out_of_planes(self, symmetry: list, plane_of: dict, prescribed: list) -> None:
+        """A node that a boundary group prescribes along a symmetry plane's normal (a rail's end
+        point on the plane) leaves the plane: the group's motion governs it. Where the group's
+        target along the normal is 0 the two are the same constraint (a note says so); else the
+        group moves the node off the plane, which the warning says. One MeshImportWarning per
+        plane and group."""
+        left: dict[tuple[int, str], list[int]] = {}
+        for group, nodes, comps, target in prescribed:
+            for v in nodes:
+                for a in comps:
+                    if (v, a) in plane_of:
+                        left.setdefault((plane_of[(v, a)], group), []).append(v)
+        for (k, group), nodes in left.items():
+            plane = symmetry[k]
+            out = set(nodes)
+            plane["nodes"] = [v for v in plane["nodes"] if v not in out]
+            a = plane["normal"]
+            target = next(t for g, _, _, t in prescribed if g == group)[AXES.index(a)]
+            shown = ", ".join(str(v) for v in sorted(out)[:6]) + (" …" if len(out) > 6 else "")
+            verdict = ("the same constraint: the group holds them at 0 along it" if target == 0.0 else
+                       f"the group moves them by {target:g} m along {a}, off the plane, and its motion is kept")
+            warnings.warn(f"symmetry plane '{plane['name']}' (normal {a}): {len(out)} nodes left out ({shown}), "
+                          f"prescribed along {a} by boundary group '{group}': {verdict}",
+                          MeshImportWarning, stacklevel=3)
+
     def curved_support(self, name: str, entry: dict) -> dict:
         """The ``curved_supports`` item of a ``curved_support`` role: the centreline fitted to the
         group's line chain (a note reports the fit), and its film nodes."""
@@ -529,7 +554,8 @@ class _Importer:
         pressures, forces, points, element_sets = [], [], [], []
         in_boundary: dict[int, str] = {}
         fixed_by: dict[tuple[int, str], str] = {}
-        prescribed: list[tuple[str, list[int], list[str]]] = []
+        plane_of: dict[tuple[int, str], int] = {}  # (node, normal) → its symmetry plane
+        prescribed: list[tuple[str, list[int], list[str], list[float]]] = []
         arch_entries, tube_entries = [], []
         for name, entry in self.entries:
             role = entry["role"]
@@ -544,7 +570,7 @@ class _Importer:
                 pressures.append({"name": _identifier(label("name"), where),
                                   "elements": self.group_triangles(name, role),
                                   "pressure": _number(entry["pressure"], f"{where}: pressure"),
-                                  **_towards(entry, where)})
+                                  **_towards(entry, where), **_pressure_kind(entry, where)})
             elif role == "force":
                 forces.append({"name": _identifier(label("name"), where), "nodes": self.nodes_of(name, role),
                                "force": _vector(entry["force"], f"{where}: force")})
@@ -573,6 +599,7 @@ class _Importer:
                 symmetry.append({"name": label("name"), "normal": normal, "nodes": nodes})
                 for v in nodes:
                     fixed_by.setdefault((v, normal), f"symmetry group '{name}'")
+                    plane_of.setdefault((v, normal), len(symmetry) - 1)
             elif role == "boundary":
                 group_name = _identifier(label("name"), where)
                 target = _vector(entry.get("target", [0.0, 0.0, 0.0]), f"{where}: target")
@@ -588,7 +615,7 @@ class _Importer:
                 if comps is not None:
                     g["components"] = comps
                 groups.append(g)
-                prescribed.append((name, nodes, comps or list(AXES)))
+                prescribed.append((name, nodes, comps or list(AXES), target))
             elif role == "output_point":
                 nodes = self.nodes_of(name, role)
                 if len(nodes) != 1:
@@ -632,12 +659,15 @@ class _Importer:
             arch_entries.append((name, entry, pool))
 
         # ---------------------------------------------------------------- conflicts
-        for group, nodes, comps in prescribed:
+        for group, nodes, comps, target in prescribed:
             for v in nodes:
                 for a in comps:
+                    if (v, a) in plane_of:
+                        continue  # resolved below: the group's motion governs the node
                     if (v, a) in fixed_by:
                         _fail(f"{self.node_label(v)} is prescribed in {a} by boundary group '{group}' and also "
                               f"fixed in {a} by {fixed_by[(v, a)]}: remove it from one of them")
+        self.leave_prescribed_nodes_out_of_planes(symmetry, plane_of, prescribed)
 
         # ---------------------------------------------------------------- gaps over arches
         counters: dict[str, int] = {}
@@ -743,6 +773,15 @@ def _towards(entry: dict, where: str) -> dict:
 
 
 SIDES = ("+x", "-x", "+y", "-y", "+z", "-z")
+
+
+def _pressure_kind(entry: dict, where: str) -> dict:
+    """A pressure entry's ``kind``: ``"follower"`` (the default, left out) or ``"plan"`` (a load
+    per plan area, snow)."""
+    kind = entry.get("kind", "follower")
+    if kind not in ("follower", "plan"):
+        _fail(f"{where}: kind '{kind}' is not 'follower' or 'plan'")
+    return {} if kind == "follower" else {"kind": kind}
 #: The solver's command line, run by :func:`solver_check` (default: the one installed with this
 #: package from the wheel, else the checkout's ``target/release/membrane-contact``, else
 #: ``membrane-contact`` on the PATH: the order in which ``build_fmu`` finds ``fmu-pack``).

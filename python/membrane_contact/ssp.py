@@ -83,11 +83,24 @@ def jack_library(root=None) -> Path:
     return lib
 
 
-def pack_jack_fmu(out=None, library=None, root=None) -> Path:
+#: Platforms the jack FMU can carry besides linux64 (``fmu-pack --platforms`` names the same
+#: folders): folder under ``binaries/`` → (cargo's target triple, the library's file name as cargo
+#: writes it, its extension in the FMU). tests/platforms.sh cross-builds them.
+CROSS_PLATFORMS = {
+    "win64": ("x86_64-pc-windows-gnu", f"{JACK_IDENTIFIER}.dll", "dll"),
+    "aarch64-linux": ("aarch64-unknown-linux-gnu", f"lib{JACK_IDENTIFIER}.so", "so"),
+    "darwin64": ("x86_64-apple-darwin", f"lib{JACK_IDENTIFIER}.dylib", "dylib"),
+    "aarch64-darwin": ("aarch64-apple-darwin", f"lib{JACK_IDENTIFIER}.dylib", "dylib"),
+}
+
+
+def pack_jack_fmu(out=None, library=None, root=None, platforms=()) -> Path:
     """Packs ``HydraulicJack.fmu`` (``out``: a file name ending in ``.fmu`` or a directory;
     default the repository's ``target/fmu``, installed the current directory) from ``library``
     (default :func:`jack_library`) and the model description (the repository's
-    ``fmu/jack/modelDescription.xml``, or installed from the wheel, its copy). Returns its path."""
+    ``fmu/jack/modelDescription.xml``, or installed from the wheel, its copy). Returns its path.
+    ``platforms``: further binaries (folders of :data:`CROSS_PLATFORMS`), each the repository's
+    cross build ``target/<triple>/release/<file>``."""
     installed = _installed_jack() if root is None else None
     if installed is not None:
         description = installed[1]
@@ -107,6 +120,15 @@ def pack_jack_fmu(out=None, library=None, root=None) -> Path:
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
         z.write(description, "modelDescription.xml")
         z.write(library, f"binaries/linux64/{JACK_IDENTIFIER}.so")
+        for folder in (f for f in platforms if f != "linux64"):
+            if folder not in CROSS_PLATFORMS:
+                raise ValueError(f"unknown platform {folder!r} (known: linux64, {', '.join(CROSS_PLATFORMS)})")
+            triple, name, extension = CROSS_PLATFORMS[folder]
+            cross = (root or repository_root() or Path.cwd()) / "target" / triple / "release" / name
+            if not cross.is_file():
+                raise RuntimeError(f"no {cross}: run `cargo build --release --lib -p hydraulic-jack-fmu "
+                                   f"--target {triple}` first (tests/platforms.sh does)")
+            z.write(cross, f"binaries/{folder}/{JACK_IDENTIFIER}.{extension}")
     return out
 
 

@@ -17,6 +17,7 @@ use membrane_contact::mech::{
 };
 use membrane_contact::specimens::ParallelArch;
 use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, etfe_plastic, table1};
+use nalgebra::Vector3;
 
 mod args;
 mod path;
@@ -226,6 +227,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     // ratio of its work to the strain energy.
     let (mut stabilized, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
     let count = path.steps.len();
+    // The contact warnings of the last step (said with its number, not again at the end).
+    let mut last_contacts = vec![];
     for (k, (inputs, &time)) in path.steps.iter().zip(&path.times).enumerate() {
         let step = k + 1;
         logged_step.store(step, std::sync::atomic::Ordering::Relaxed);
@@ -292,6 +295,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             csv.write_step(step, time, analysis.model(), results)?;
             outputs.step(step, time, inputs, &report, &analysis, results)?;
         }
+        last_contacts = contact_step_warnings(&mut analysis, results.as_ref());
+        for w in &last_contacts {
+            eprintln!("warning: step {step}: {w}");
+        }
         progress.step(step);
     }
     progress.finish();
@@ -303,7 +310,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
     for w in membrane_contact::mech::results::warnings::result_warnings(analysis.model(), &results)
     {
-        eprintln!("warning: {w}");
+        if !last_contacts.contains(&w) {
+            eprintln!("warning: {w}");
+        }
     }
     let total: usize = iterations.iter().sum();
     out!(
@@ -486,6 +495,25 @@ struct VtkWritten {
 
 /// Writes the last state of `steps` (`(fraction, step)` pairs) as the film and gaps `.vtu` files
 /// in `dir` and rewrites both `.pvd` collections.
+/// The contact warnings of the state a step reached
+/// ([`membrane_contact::mech::results::contact_warnings`]), said after each step as the FMU
+/// says them: from `results` when the step gathered them, else gathered here; none without
+/// gaps or curved supports.
+fn contact_step_warnings(analysis: &mut Analysis, results: Option<&Results>) -> Vec<String> {
+    use membrane_contact::mech::results::contact_warnings::contact_warnings;
+    let model = analysis.model();
+    if model.gaps.is_empty() && model.curved_supports.is_empty() {
+        return vec![];
+    }
+    match results {
+        Some(r) => contact_warnings(analysis.model(), r),
+        None => {
+            let r = analysis.results();
+            contact_warnings(analysis.model(), &r)
+        }
+    }
+}
+
 fn write_vtk(
     dir: &std::path::Path,
     analysis: &Analysis,
@@ -669,6 +697,28 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
         t[1],
         t[2]
     );
+    if !model.gaps.is_empty() || !results.surface_contacts.is_empty() {
+        let (c, all) = (
+            results.contact_force(model),
+            results.film_support_force(model),
+        );
+        // The film's supports balance its loads: where those are ~0 the contacts only balance
+        // the reactions, and no share is defined.
+        let share = if all.norm() > 1e-3 * c.norm().max(Vector3::from(t).norm()) {
+            format!(
+                "carrying {:.1} % of the film's loads (along their resultant)",
+                100.0 * c.dot(&all) / all.norm_squared()
+            )
+        } else {
+            "balancing the reactions (no load on the film)".into()
+        };
+        out!(
+            "contact forces on the film (gaps, curved supports): ({:.3}, {:.3}, {:.3}) N, {share}",
+            c.x,
+            c.y,
+            c.z
+        );
+    }
     let (lo, hi) = results.von_mises_range();
     out!(
         "equivalent (von Mises) stress: {} … {} MPa",

@@ -4,6 +4,8 @@
 
 use super::instance::{Instance, start_values};
 use super::phase::{Failure, Outcome, Phase};
+use super::scalar_variable::{Binding, Causality, Value};
+use super::types::Status;
 use crate::mech::results::warnings::model_warnings;
 
 impl Instance {
@@ -49,6 +51,9 @@ impl Instance {
                 self.time
             )
         });
+        if let Some(loads) = self.starting_loads() {
+            self.logger.log(Status::Warning, &loads);
+        }
         let written = self.write_results();
         let doubts = self
             .analysis
@@ -64,6 +69,40 @@ impl Instance {
             Err(Failure::warning(message))
         };
         self.warn_about_assumptions(written)
+    }
+
+    /// The load inputs that the first fmi2DoStep applies at once, as they stand at the end of
+    /// initialization (a pressure or force set's input starts at the model file's value), as a
+    /// message naming each and its value; None where every one is 0.
+    fn starting_loads(&self) -> Option<String> {
+        let model = &self.analysis.as_ref()?.analysis.model().loads;
+        let mut said = Vec::new();
+        for (v, x) in self.description.variables.iter().zip(&self.values) {
+            let (Value::Real(x), true) = (x, v.causality == Causality::Input) else {
+                continue;
+            };
+            let from_file = match v.binding {
+                Binding::Pressure(set) => model.pressures[set].pressure,
+                Binding::NodalForce { set, axis } => model.forces[set].force[axis],
+                _ => continue,
+            };
+            if *x != 0.0 {
+                let origin = if *x == from_file {
+                    " (the model file's value)"
+                } else {
+                    ""
+                };
+                said.push(format!("{} = {x} {}{origin}", v.name, v.unit.unwrap_or("")));
+            }
+        }
+        (!said.is_empty()).then(|| {
+            format!(
+                "load inputs start at nonzero values, so the first fmi2DoStep applies these \
+                 loads at once (from zero to the inputs' values then) unless the master changes \
+                 them first: {}; set an input to 0 to apply its load in a later step",
+                said.join(", ")
+            )
+        })
     }
 
     pub fn terminate(&mut self) -> Outcome {

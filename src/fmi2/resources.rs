@@ -11,10 +11,9 @@
 //! `file://localhost/abs/path`, OMSimulator's `file:////abs/path` with no encoding at all, a
 //! trailing slash, a case-insensitive scheme. Percent-decoding acts only on valid `%XX`; when the
 //! decoded path does not exist but the raw one does (an unencoded path holding `%`), the raw one
-//! is used.
+//! is used. On Windows the path of `file:///C:/dir/resources` is `C:/dir/resources` (RFC 8089,
+//! appendix E.2: a drive letter after the leading slash).
 
-use std::ffi::OsString;
-use std::os::unix::ffi::OsStringExt;
 use std::path::{Path, PathBuf};
 
 use crate::mech::Model;
@@ -100,10 +99,20 @@ impl Source {
 
 /// The `file:///…` URI of a local absolute path, percent-encoded as fmpy sends it (RFC 3986:
 /// everything but unreserved characters and `/`). For in-process hosts such as benchmarks.
+/// A Windows path `C:\dir` becomes `file:///C:/dir`.
 pub fn file_uri(path: &Path) -> String {
     let mut uri = String::from("file://");
-    for &b in path.as_os_str().as_encoded_bytes() {
-        if b.is_ascii_alphanumeric() || b"-._~/".contains(&b) {
+    let bytes = path.as_os_str().as_encoded_bytes();
+    let windows = cfg!(windows);
+    if windows && bytes.get(1) == Some(&b':') {
+        uri.push('/');
+    }
+    for (i, &b) in bytes.iter().enumerate() {
+        if windows && b == b'\\' {
+            uri.push('/');
+        } else if windows && i == 1 && b == b':' {
+            uri.push(':');
+        } else if b.is_ascii_alphanumeric() || b"-._~/".contains(&b) {
             uri.push(b as char);
         } else {
             uri.push_str(&format!("%{b:02X}"));
@@ -159,12 +168,34 @@ fn uri_paths(uri: &str) -> Result<(PathBuf, PathBuf), String> {
         while bytes.len() > 1 && bytes.last() == Some(&b'/') {
             bytes.pop();
         }
-        PathBuf::from(OsString::from_vec(bytes))
+        local_path(bytes)
     };
     Ok((
         normalize(path.as_bytes()),
         normalize(&percent_decode(path.as_bytes())),
     ))
+}
+
+/// The local path of a URI's decoded path bytes (`/abs/path`). Unix takes the bytes as they are;
+/// Windows reads them as UTF-8 and drops the slash before a drive letter (`/C:/x` → `C:/x`).
+#[cfg(unix)]
+fn local_path(bytes: Vec<u8>) -> PathBuf {
+    use std::os::unix::ffi::OsStringExt;
+    PathBuf::from(std::ffi::OsString::from_vec(bytes))
+}
+
+#[cfg(not(unix))]
+fn local_path(bytes: Vec<u8>) -> PathBuf {
+    PathBuf::from(without_slash_before_drive(&String::from_utf8_lossy(&bytes)))
+}
+
+/// `/C:/dir` → `C:/dir` (a URI path's drive letter, RFC 8089 appendix E.2); anything else as is.
+#[cfg_attr(unix, allow(dead_code))] // used on Windows, tested everywhere
+fn without_slash_before_drive(path: &str) -> &str {
+    match path.as_bytes() {
+        [b'/', drive, b':', ..] if drive.is_ascii_alphabetic() => &path[1..],
+        _ => path,
+    }
 }
 
 /// Decodes valid `%XX` sequences; anything else is kept as it is.
@@ -193,6 +224,17 @@ mod tests {
 
     fn decoded(uri: &str) -> String {
         uri_paths(uri).unwrap().1.to_string_lossy().into_owned()
+    }
+
+    #[test]
+    fn windows_drive_letters() {
+        assert_eq!(
+            without_slash_before_drive("/C:/dir/resources"),
+            "C:/dir/resources"
+        );
+        assert_eq!(without_slash_before_drive("/z:"), "z:");
+        assert_eq!(without_slash_before_drive("/tmp/C:/x"), "/tmp/C:/x");
+        assert_eq!(without_slash_before_drive("/1:/x"), "/1:/x");
     }
 
     #[test]

@@ -53,6 +53,7 @@
 //!
 //! The elasto-plastic film's outputs come last, so that an elastic model's table is unchanged.
 
+use crate::mech::model::PressureKind;
 use crate::mech::{LoadLevels, Model, SolverSettings};
 
 /// The types of one variable (defined in `scalar_variable.rs`), also under this module's path.
@@ -258,14 +259,23 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             &format!("{}.pressure", p.name),
             p.pressure,
             "Pa",
-            &format!(
-                "follower pressure on pressure set '{}' (positive {}), reached at the end of a step",
-                p.name,
-                match p.towards {
-                    None => "along the triangles' normals".to_string(),
-                    Some(t) => format!("pushes towards {:?}", t.vector()),
-                }
-            ),
+            &match p.kind {
+                PressureKind::Follower => format!(
+                    "follower pressure on pressure set '{}' (positive {}), reached at the end of a \
+                     step",
+                    p.name,
+                    match p.towards {
+                        None => "along the triangles' normals".to_string(),
+                        Some(t) => format!("pushes towards {:?}", t.vector()),
+                    }
+                ),
+                PressureKind::Plan => format!(
+                    "load per plan area on pressure set '{}' (positive along {:?}), reached at the \
+                     end of a step",
+                    p.name,
+                    crate::mech::elements::load::plan_direction(p).as_slice()
+                ),
+            },
             Binding::Pressure(set),
         );
     }

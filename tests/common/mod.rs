@@ -53,3 +53,27 @@ pub fn assert_example_file(file: &str, model: &Model) {
     let text = std::fs::read_to_string(&path).unwrap();
     assert_eq!(&Model::from_json(&text).unwrap(), model, "{path}");
 }
+
+/// `examples/driven_gap.json` (a triangle of 0.224 m, every node driven by group `Drive`; gap
+/// `G` 1 mm above its support point under node 0, `k_n` = 1e5 N/m) with a cylinder `pipe`
+/// (tube radius 20 mm, `k_n` = 1e6 N/m, axis along Y) whose top is 1 mm under node 1.
+pub fn driven_gap_over_a_pipe() -> Model {
+    use membrane_contact::mech::elements::curved_contact::{Centreline, CurvedSupport};
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/driven_gap.json");
+    let mut model = Model::from_json(&std::fs::read_to_string(example).unwrap()).unwrap();
+    model.curved_supports.push(CurvedSupport {
+        name: "pipe".into(),
+        centreline: Centreline::Line {
+            point: [0.2, 0.0, -0.021],
+            axis: [0.0, 1.0, 0.0],
+        },
+        tube_radius: 0.02,
+        nodes: vec![1],
+        normal_stiffness: 1e6,
+        tangential_stiffness: 1e5,
+        friction: 0.3,
+        friction_law: Default::default(),
+    });
+    model.validate().unwrap();
+    model
+}

@@ -681,3 +681,41 @@ def test_a_wrong_membrane_contact_cli_skips_the_solvers_check_with_a_warning_say
                        env={**package_env(), "MEMBRANE_CONTACT_CLI": str(tmp_path)}, capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
     assert "note: the solver's check is skipped" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_a_pressure_group_of_kind_plan_becomes_a_load_per_plan_area(small_mesh):
+    """Issue 47 item 8: the roof's snow as a load per plan area (``"kind": "plan"``) passes
+    through the importer; a follower set writes no kind; an unknown kind is refused naming it."""
+    from membrane_contact.mesh import MeshImportError
+
+    m = small_mapping(LINEAR, film={"role": "pressure", "name": "snow", "pressure": 960.0, "kind": "plan"},
+                      left={"role": "support"}, top={"role": "support"}, bottom={"role": "support"})
+    model = import_mesh(small_mesh, m)
+    assert model["loads"]["pressures"] == [{"name": "snow", "elements": "all", "pressure": 960.0, "kind": "plan"}]
+    m["physical_groups"]["film"]["kind"] = "follower"
+    assert "kind" not in import_mesh(small_mesh, m)["loads"]["pressures"][0]
+    m["physical_groups"]["film"]["kind"] = "snow"
+    with pytest.raises(MeshImportError, match="kind 'snow' is not 'follower' or 'plan'"):
+        import_mesh(small_mesh, m)
+
+
+def test_a_rails_end_points_on_a_symmetry_plane_leave_the_plane_with_a_note(small_mesh):
+    """Issue 47 item 8: the vault roof's symmetry planes took in the end points of curves a rail
+    already holds, and the user wrote 14 lines to take them out. A node a boundary group
+    prescribes along a plane's normal now leaves the plane: where the group holds it at 0 along
+    the normal that is the same constraint (said so), else the group moves it off the plane (said
+    so); the model runs. A support that fixes what a group prescribes is still refused."""
+    from membrane_contact.mesh import MeshImportError, MeshImportWarning
+
+    for target, verdict in ((0.0, "the same constraint"), (0.01, "moves them by 0.01 m along x, off the plane")):
+        m = small_mapping(LINEAR, left={"role": "symmetry", "normal": "x"}, bottom={"role": "support"},
+                          top={"role": "boundary", "name": "rail", "target": [target, 0.0, -0.01]})
+        with pytest.warns(MeshImportWarning, match=verdict) as caught:
+            model = import_mesh(small_mesh, m)
+        (note,) = [str(w.message) for w in caught if "symmetry plane 'left'" in str(w.message)]
+        assert "symmetry plane 'left' (normal x): 1 nodes left out (20)" in note, note
+        (plane,) = model["symmetry"]
+        assert 20 not in plane["nodes"] and plane["nodes"] == [0, 5, 10, 15], plane
+    m = small_mapping(LINEAR, left={"role": "support"}, top={"role": "boundary", "name": "rail"})
+    with pytest.raises(MeshImportError, match="also fixed in x by support group 'left'"):
+        import_mesh(small_mesh, m)

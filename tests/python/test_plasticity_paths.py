@@ -49,7 +49,7 @@ import numpy as np
 import pytest
 from axisymmetric_membrane import Film, Hardening
 from conftest import pack_model
-from fmu_helpers import OK, Slave
+from fmu_helpers import OK, WARNING, Slave
 
 E, NU, T0, S = 1.0e9, 0.43, 250e-6, 0.05
 G = E / (2 * (1 + NU))
@@ -289,8 +289,14 @@ def run(slave, path):
         ux, uy = S * (l1 - 1), S * (l2 - 1)
         slave.set({"right.dx": ux, "top.dy": uy, "corner.dx": ux, "corner.dy": uy})
         status = slave.step(k * STEP, STEP)
-        assert status == OK, f"{path.name} step {k}: status {status}: {slave.messages[-3:]}"
-        outputs.append(slave.outputs())
+        out = slave.outputs()
+        # The sheet yields all at once: from then on every step warns that the whole film
+        # yielded (issue 47 item 8), and nothing else.
+        expected = WARNING if out["film.yieldedElements"] > 0 else OK
+        assert status == expected, f"{path.name} step {k}: status {status}: {slave.messages[-3:]}"
+        warned = [m for status, _, m in slave.messages if status == WARNING]
+        assert expected == OK or "the film has yielded over 100 % of its area" in warned[-1], warned[-1:]
+        outputs.append(out)
     return outputs
 
 

@@ -138,6 +138,7 @@ fn every_input_specimen(law: FrictionLaw) -> Model {
         target_angle: 0.0,
     });
     model.loads.pressures.push(PressureSet {
+        kind: Default::default(),
         name: "cover".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: 0.0,

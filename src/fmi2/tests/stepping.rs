@@ -283,3 +283,45 @@ fn log_increments_carries_a_line_per_increment_when_named() {
         "{lines:?}"
     );
 }
+
+/// Issue 47 item 8: a load input starts at the model file's value, so the first step applies
+/// snow and suction together unless the master zeroes one. The end of initialization says so in
+/// the warning log, naming each nonzero load input and its value (marked as the file's); an
+/// input set to 0 during initialization is not named, and with every one at 0 nothing is said.
+#[test]
+fn the_loads_the_first_step_applies_are_named_at_the_end_of_initialization() {
+    use crate::mech::model::format::{AllElements, ElementSelection, PressureSet};
+    let mut model = crate::specimens::ParallelArch::default().model().unwrap();
+    for (name, pressure) in [("snow", 960.0), ("suction", -600.0)] {
+        model.loads.pressures.push(PressureSet {
+            kind: Default::default(),
+            name: name.into(),
+            elements: ElementSelection::All(AllElements::All),
+            pressure,
+            towards: None,
+        });
+    }
+    let u = Unpacked::new("start loads", Source::Model(model));
+    let warned = |reals: &[(&str, f64)]| {
+        let log = Log::default();
+        let _fmu = Fmu::initialized(&u, &log, reals, &[]);
+        log.take()
+            .into_iter()
+            .filter(|(s, _, m)| {
+                *s == Status::Warning.raw() && m.contains("first fmi2DoStep applies these loads")
+            })
+            .map(|(_, _, m)| m)
+            .collect::<Vec<_>>()
+    };
+    let both = warned(&[]);
+    assert_eq!(both.len(), 1, "{both:?}");
+    for named in [
+        "snow.pressure = 960 Pa (the model file's value)",
+        "suction.pressure = -600 Pa (the model file's value)",
+    ] {
+        assert!(both[0].contains(named), "{both:?}");
+    }
+    let snow = warned(&[("suction.pressure", 0.0)]);
+    assert!(snow.len() == 1 && !snow[0].contains("suction"), "{snow:?}");
+    assert!(warned(&[("suction.pressure", 0.0), ("snow.pressure", 0.0)]).is_empty());
+}

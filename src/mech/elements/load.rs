@@ -16,6 +16,11 @@
 //! * Self-weight: `ρ t A0 g / 3` on each node of each triangle (reference area: the film's mass
 //!   does not change); no stiffness.
 //! * Nodal forces: the set's force on each of its nodes (dead load); no stiffness.
+//! * A load per plan area (a pressure set of kind `"plan"`, snow): `p · A_d / 3` along the unit
+//!   direction `d` (`towards`, default `−z`) on each node of each triangle, `A_d = ½ |n0 · d|`
+//!   the triangle's initial area projected on the plane normal to `d` (`n0` its initial
+//!   node-order normal vector): a dead load, no stiffness. A flat roof at slope `θ` carries
+//!   `p A cos θ`, the plan area's share, whatever its node order.
 //!
 //! A pressure set's sense: without `towards`, `p > 0` pushes along each triangle's node-order
 //! normal; with it, each triangle's pressure is signed once, from its initial normal, so that it
@@ -27,7 +32,7 @@ use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 
 use crate::mech::elements::triangle::{ElementMatrix, ElementVector};
-use crate::mech::model::{Model, PressureSet};
+use crate::mech::model::{Model, PressureKind, PressureSet};
 use crate::mech::solve::assembly::{System, node_dofs, node_vector};
 
 /// The magnitudes of the model's loads at one instant (what a step ramps).
@@ -153,11 +158,69 @@ pub struct NodalForces {
     sets: Vec<Vec<usize>>,
 }
 
+/// Loads per plan area: for each pressure set, the nodal forces of a unit value (N/Pa; empty
+/// for a follower set).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanLoads {
+    sets: Vec<Vec<(usize, Vector3<f64>)>>,
+}
+
+impl PlanLoads {
+    /// The unit nodal forces of each pressure set of `model` of kind `"plan"`.
+    fn new(model: &Model) -> Self {
+        let sets = model
+            .loads
+            .pressures
+            .iter()
+            .map(|set| {
+                if set.kind != PressureKind::Plan {
+                    return Vec::new();
+                }
+                let d = plan_direction(set);
+                let mut forces = Vec::new();
+                for e in model.selected_triangles(&set.elements) {
+                    let share = 0.5 * initial_normal(model, e).dot(&d).abs() / 3.0;
+                    forces.extend(model.triangles[e].map(|v| (v, d * share)));
+                }
+                forces
+            })
+            .collect();
+        Self { sets }
+    }
+}
+
+/// The unit direction of a load per plan area: `towards`, else down (`−z`).
+pub fn plan_direction(set: &PressureSet) -> Vector3<f64> {
+    set.towards
+        .map_or(-Vector3::z(), |t| Vector3::from(t.vector()).normalize())
+}
+
+impl ExternalLoad for PlanLoads {
+    fn add_to(
+        &self,
+        _system: &System,
+        levels: &LoadLevels,
+        _u: &[f64],
+        residual: &mut [f64],
+        _values: Option<&mut [f64]>,
+    ) {
+        for (set, &p) in self.sets.iter().zip(&levels.pressure) {
+            for &(v, f) in set {
+                for c in 0..3 {
+                    residual[3 * v + c] -= p * f[c];
+                }
+            }
+        }
+    }
+}
+
 /// Every external load of a model.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Loads {
     /// Follower pressure.
     pub pressure: FollowerPressure,
+    /// Loads per plan area.
+    pub plan: PlanLoads,
     /// Self-weight.
     pub self_weight: SelfWeight,
     /// Nodal forces.
@@ -171,7 +234,10 @@ impl Loads {
             .loads
             .pressures
             .iter()
-            .map(|p| pressure_signs(model, p))
+            .map(|p| match p.kind {
+                PressureKind::Follower => pressure_signs(model, p),
+                PressureKind::Plan => Vec::new(),
+            })
             .collect();
         let reference = model.nodes.iter().map(|&p| Vector3::from(p)).collect();
         let m = &model.material;
@@ -185,6 +251,7 @@ impl Loads {
         }
         Self {
             pressure: FollowerPressure { sets, reference },
+            plan: PlanLoads::new(model),
             self_weight: SelfWeight {
                 weightless: nodal_mass.iter().all(|&m| m == 0.0),
                 nodal_mass,
@@ -211,6 +278,8 @@ impl ExternalLoad for Loads {
         mut values: Option<&mut [f64]>,
     ) {
         self.pressure
+            .add_to(system, levels, u, residual, values.as_deref_mut());
+        self.plan
             .add_to(system, levels, u, residual, values.as_deref_mut());
         self.self_weight
             .add_to(system, levels, u, residual, values.as_deref_mut());
@@ -278,6 +347,9 @@ pub fn check_towards(model: &Model, set: &PressureSet) -> Result<(), String> {
             "towards {:?} must be a finite, non-zero direction",
             towards.vector()
         ));
+    }
+    if set.kind == PressureKind::Plan {
+        return Ok(()); // the load's direction: a triangle edge-on to it carries nothing
     }
     for e in model.selected_triangles(&set.elements) {
         let n = initial_normal(model, e);
@@ -380,7 +452,12 @@ pub fn orientation(model: &Model, set: &PressureSet) -> Orientation {
 /// than their neighbours, naming how many.
 pub fn orientation_warnings(model: &Model) -> Vec<String> {
     let mut warnings = vec![];
-    for set in &model.loads.pressures {
+    for set in model
+        .loads
+        .pressures
+        .iter()
+        .filter(|s| s.kind == PressureKind::Follower)
+    {
         let o = orientation(model, set);
         if o.against_neighbours == 0 {
             continue;
@@ -408,6 +485,9 @@ pub fn orientation_report(model: &Model) -> Vec<String> {
         .pressures
         .iter()
         .map(|set| {
+            if set.kind == PressureKind::Plan {
+                return plan_report(model, set);
+            }
             let o = orientation(model, set);
             let m = o.mean_direction;
             let sense = match set.towards {
@@ -425,6 +505,27 @@ pub fn orientation_report(model: &Model) -> Vec<String> {
             )
         })
         .collect()
+}
+
+/// The `check` line of a load per plan area: its direction, its plan area and the force a
+/// value of 1 kPa puts on the film.
+fn plan_report(model: &Model, set: &PressureSet) -> String {
+    let d = plan_direction(set);
+    let triangles = model.selected_triangles(&set.elements);
+    let area: f64 = triangles
+        .iter()
+        .map(|&e| 0.5 * initial_normal(model, e).dot(&d).abs())
+        .sum();
+    format!(
+        "pressure set '{}': {} triangles, a load per plan area along [{:.3}, {:.3}, {:.3}]; plan \
+         area {area:.4} m² (1 kPa: {:.4e} N)",
+        set.name,
+        triangles.len(),
+        d.x,
+        d.y,
+        d.z,
+        1e3 * area
+    )
 }
 
 /// `[v]×`, the matrix of `w ↦ v × w`.

@@ -211,7 +211,27 @@ pub enum AllElements {
     All,
 }
 
-/// A follower pressure on a named set of triangles (normal to the deformed film).
+/// How a pressure set's value acts ([`PressureSet::kind`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PressureKind {
+    /// Follower pressure: normal to the deformed film, per unit of its area.
+    #[default]
+    Follower,
+    /// A dead load per unit of plan area: along `towards` (default `-z`, down), per unit of the
+    /// triangles' initial area projected on the plane normal to it (snow: EN 1991-1-3 gives
+    /// `s` per plan area); no stiffness.
+    Plan,
+}
+
+impl PressureKind {
+    fn is_follower(&self) -> bool {
+        *self == Self::Follower
+    }
+}
+
+/// A pressure on a named set of triangles: a follower pressure (normal to the deformed film)
+/// or a load per plan area ([`PressureKind`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PressureSet {
@@ -227,6 +247,10 @@ pub struct PressureSet {
     /// direction, whatever its node order (`None`: the node order decides).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub towards: Option<Towards>,
+    /// `"follower"` (default) or `"plan"`: a load per plan area along `towards` (default
+    /// down, `-z`), positive along it.
+    #[serde(default, skip_serializing_if = "PressureKind::is_follower")]
+    pub kind: PressureKind,
 }
 
 /// The world direction a pressure set pushes the film to (`"towards"`): a vector or a signed

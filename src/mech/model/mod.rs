@@ -5,10 +5,12 @@
 //! | file | what |
 //! |---|---|
 //! | [`format`](mod@format) | the model file's items (serde types), [`ModelError`], [`bounding_diagonal`] |
+//! | [`free_edges`] | boundary edges a prestress pulls across that nothing holds (a warning) |
 //! | `validate` | `Model::validate`: every item checked, the first problem named |
 //! | [`restraint`] | rigid-body modes no restraint holds (singular models), found at validation |
 
 pub mod format;
+pub mod free_edges;
 pub mod restraint;
 mod validate;
 

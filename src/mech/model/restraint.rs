@@ -310,7 +310,7 @@ fn initial_stiffness(
 }
 
 /// Which axes of each node a support, symmetry plane or group holds.
-fn held_axes(model: &Model) -> Vec<[bool; 3]> {
+pub(crate) fn held_axes(model: &Model) -> Vec<[bool; 3]> {
     let mut held = vec![[false; 3]; model.nodes.len()];
     for s in &model.supports {
         s.fixed.iter().for_each(|a| held[s.node][a.index()] = true);

@@ -5,7 +5,9 @@ use crate::mech::elements::cable::CableResult;
 use crate::mech::elements::curved_contact::SurfaceContactResult;
 use crate::mech::elements::gap::GapStatus;
 use crate::mech::elements::triangle::ElementStress;
+use crate::mech::model::Model;
 use crate::mech::results::summary::FieldSummary;
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 /// Converged results of one gap.
@@ -91,6 +93,38 @@ impl Results {
                 min_thickness: -nan_max(-s.min_thickness, -p.thickness),
             },
         ))
+    }
+
+    /// The force of every contact on the film, summed in global axes (N): each gap's
+    /// `Rᵀ(−t_x, −t_y, N)` (eq. 2.8, the gap's force on node A with the paper's sign reversed)
+    /// and each curved-support contact's force.
+    pub fn contact_force(&self, model: &Model) -> Vector3<f64> {
+        let gaps = model.gaps.iter().zip(&self.gaps).map(|(g, r)| {
+            let local = Vector3::new(-r.friction[0], -r.friction[1], r.normal_force);
+            g.frame.rotation().transpose() * local
+        });
+        let curved = self.surface_contacts.iter().map(|c| Vector3::from(c.force));
+        gaps.chain(curved).sum()
+    }
+
+    /// The force of everything that holds the film, summed (N): the reactions at its own
+    /// constrained nodes (supports, symmetry planes, groups) and [`Self::contact_force`]; the
+    /// contacts' share of it is what they carry of the film's load.
+    pub fn film_support_force(&self, model: &Model) -> Vector3<f64> {
+        let mut on_film = vec![false; model.nodes.len()];
+        for t in &model.triangles {
+            for &v in t {
+                on_film[v] = true;
+            }
+        }
+        let held: Vector3<f64> = self
+            .node_reactions
+            .iter()
+            .zip(&on_film)
+            .filter(|(_, on)| **on)
+            .map(|(r, _)| Vector3::from(*r))
+            .sum();
+        held + self.contact_force(model)
     }
 
     /// Range `(min, max)` of the element von Mises stress (Pa).

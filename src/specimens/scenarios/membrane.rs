@@ -93,6 +93,7 @@ impl CircularMembrane {
             }],
             loads: LoadSpec {
                 pressures: vec![PressureSet {
+                    kind: Default::default(),
                     name: "top".into(),
                     elements: ElementSelection::All(AllElements::All),
                     pressure: self.pressure,

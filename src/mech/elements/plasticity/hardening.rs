@@ -13,12 +13,25 @@ pub const MAX_HARDENING_ROWS: usize = 32;
 /// A piecewise-linear isotropic hardening curve: rows of (equivalent plastic strain, flow stress in
 /// Pa). The first row is initial yield at zero plastic strain; past the last row the last slope
 /// continues (a single row is perfect plasticity).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "Vec<[f64; 2]>", into = "Vec<[f64; 2]>")]
+///
+/// In a model file it is the table of rows or the name of a known curve
+/// ([`NAMED_HARDENING`], e.g. `"etfe-23C"`); a curve read by name is written back by name.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(into = "serde_json::Value")]
 pub struct Hardening {
     table: [[f64; 2]; MAX_HARDENING_ROWS],
     len: usize,
+    /// The name it was given by ([`NAMED_HARDENING`]); none for a table.
+    name: Option<&'static str>,
 }
+
+/// The hardening curves a model file may name instead of giving the table: name, what it is,
+/// the curve.
+pub const NAMED_HARDENING: [(&str, &str, fn() -> Hardening); 1] = [(
+    "etfe-23C",
+    "ETFE's data-sheet curve at 23 °C, etfe_datasheet_hardening: [[0, 21e6], [1.4547, 275e6]]",
+    etfe_datasheet_hardening,
+)];
 
 /// Why a hardening table is refused; `row` is the 0-based index in the table.
 #[derive(Clone, Debug, PartialEq)]
@@ -122,7 +135,71 @@ impl From<Hardening> for Vec<[f64; 2]> {
     }
 }
 
+impl TryFrom<serde_json::Value> for Hardening {
+    type Error = String;
+    /// A table of rows, or the name of a known curve (the error names the known ones).
+    fn try_from(value: serde_json::Value) -> Result<Self, String> {
+        if let serde_json::Value::String(name) = &value {
+            return Self::named(name);
+        }
+        let rows: Vec<[f64; 2]> = serde_json::from_value(value).map_err(|e| {
+            format!(
+                "hardening: {e}; give a table [[ε̄p, σ in Pa], …] or a name ({})",
+                known_names()
+            )
+        })?;
+        Self::new(rows).map_err(|e| e.to_string())
+    }
+}
+
+impl<'de> Deserialize<'de> for Hardening {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let value = serde_json::Value::deserialize(d)?;
+        Self::try_from(value).map_err(serde::de::Error::custom)
+    }
+}
+
+impl From<Hardening> for serde_json::Value {
+    fn from(h: Hardening) -> Self {
+        match h.name {
+            Some(name) => serde_json::Value::from(name),
+            None => serde_json::json!(h.rows()),
+        }
+    }
+}
+
+/// The names of [`NAMED_HARDENING`] with what each is, for messages.
+fn known_names() -> String {
+    NAMED_HARDENING
+        .iter()
+        .map(|(name, what, _)| format!("\"{name}\": {what}"))
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 impl Hardening {
+    /// The known curve called `name` ([`NAMED_HARDENING`]); the error names the known ones.
+    pub fn named(name: &str) -> Result<Self, String> {
+        let (known, _, curve) = NAMED_HARDENING
+            .iter()
+            .find(|(known, _, _)| *known == name)
+            .ok_or_else(|| {
+                format!(
+                    "hardening: unknown curve \"{name}\"; the known names are {}",
+                    known_names()
+                )
+            })?;
+        Ok(Self {
+            name: Some(known),
+            ..curve()
+        })
+    }
+
+    /// The name the curve was given by, if it was read by name.
+    pub fn name(&self) -> Option<&'static str> {
+        self.name
+    }
+
     /// Validates and builds the table (errors name the bad row).
     pub fn new(rows: Vec<[f64; 2]>) -> Result<Self, HardeningError> {
         let first = rows.first().ok_or(HardeningError::Empty)?;
@@ -160,6 +237,7 @@ impl Hardening {
         Ok(Self {
             table,
             len: rows.len(),
+            name: None,
         })
     }
 
@@ -195,9 +273,11 @@ impl Hardening {
         (rows[i], slope)
     }
 
-    /// The same curve with every flow stress multiplied by `factor` (> 0).
+    /// The same curve with every flow stress multiplied by `factor` (> 0); no longer the named
+    /// curve.
     pub fn scaled(&self, factor: f64) -> Self {
         let mut scaled = *self;
+        scaled.name = None;
         scaled.table.iter_mut().for_each(|r| r[1] *= factor);
         scaled
     }
