@@ -572,7 +572,10 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
                     o.increments += report.iterations.len();
                     o.cutbacks += report.cutbacks;
                     o.stabilized += report.stabilized;
-                    o.over_bound += usize::from(report.stabilization_warning().is_some());
+                    o.over_bound += usize::from(
+                        report.stabilization_warning().is_some()
+                            || report.dissipation_ratio() > 1.0,
+                    );
                     o.max_increment = o
                         .max_increment
                         .max(report.iterations.iter().copied().max().unwrap_or(0));

@@ -52,6 +52,76 @@ impl Progress {
     }
 }
 
+/// The hold of contacts that cycle between stick and slip (a generalized Newton iteration can
+/// alternate between the two pieces of a kinked law whose solution lies near the kink): their
+/// status is imposed, stick first, and Newton's iteration on the held laws converges on one
+/// smooth piece; its answer is then judged on the true laws, and where it fails there, held in
+/// slip instead (the active-set view of semismooth Newton: Hintermüller, Ito & Kunisch 2002).
+/// Once both have failed the increment goes on without a hold. Convergence is always judged on
+/// the true laws.
+#[derive(Debug, Default)]
+struct Hold {
+    /// 0: none tried; 1: stick held; 2: slip held; 3: both tried.
+    stage: u8,
+    /// The statuses imposed now (empty: none).
+    held: Vec<Option<GapStatus>>,
+    /// The statuses of the hold the current iterate is judged without.
+    judged: Vec<Option<GapStatus>>,
+}
+
+impl Hold {
+    /// The statuses to impose from now on (Some(empty): none) given whether the current
+    /// iterate `met` the tolerances and the statuses of the iterates so far; None: unchanged.
+    fn next(&mut self, met: bool, statuses: &[Vec<GapStatus>]) -> Option<Vec<Option<GapStatus>>> {
+        if !self.held.is_empty() {
+            // Converged on the held laws: judged on the true ones next.
+            return met.then(|| {
+                self.judged = std::mem::take(&mut self.held);
+                Vec::new()
+            });
+        }
+        if !self.judged.is_empty() {
+            let judged = std::mem::take(&mut self.judged);
+            if met || self.stage != 1 {
+                self.stage = 3;
+                return None;
+            }
+            self.stage = 2;
+            self.held = judged.iter().map(|h| h.map(|_| GapStatus::Slip)).collect();
+            return Some(self.held.clone());
+        }
+        if self.stage != 0 {
+            return None;
+        }
+        let held = cycling(statuses)?;
+        self.stage = 1;
+        self.held.clone_from(&held);
+        Some(held)
+    }
+}
+
+/// Stick for each contact whose status changed between stick and slip at least
+/// [`Analysis::CYCLE`] times over the last [`Analysis::CYCLE`]` + 3` iterates, None for the
+/// others; None where no contact did.
+fn cycling(statuses: &[Vec<GapStatus>]) -> Option<Vec<Option<GapStatus>>> {
+    let recent = &statuses[statuses.len().saturating_sub(Analysis::CYCLE + 3)..];
+    let last = recent.last()?;
+    let closed = |s: GapStatus| s != GapStatus::Open;
+    let held: Vec<Option<GapStatus>> = (0..last.len())
+        .map(|k| {
+            let changes = recent
+                .windows(2)
+                .filter(|w| {
+                    let (a, b) = (w[0].get(k).copied(), w[1].get(k).copied());
+                    matches!((a, b), (Some(a), Some(b)) if a != b && closed(a) && closed(b))
+                })
+                .count();
+            (changes >= Analysis::CYCLE).then_some(GapStatus::Stick)
+        })
+        .collect();
+    held.iter().any(Option::is_some).then_some(held)
+}
+
 impl Analysis {
     /// Newton's iteration for one increment from the converged `start` to the group motion
     /// `motion` and the load levels `levels`: the full correction of
@@ -90,6 +160,7 @@ impl Analysis {
         };
         // `‖R‖₂` of the last accepted iterates (the nonmonotone line search's reference).
         let mut merits: Vec<f64> = Vec::new();
+        let mut hold = Hold::default();
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
             if !assembled {
@@ -114,11 +185,11 @@ impl Analysis {
                 correction,
                 correction_tolerance: s.displacement_tolerance * displacement_scale,
             };
-            if (iteration > 0 || self.system.free_count == 0)
+            let met = (iteration > 0 || self.system.free_count == 0)
                 && record.correction <= record.correction_tolerance
                 && residual <= record.residual_tolerance
-                && artificial <= record.residual_tolerance
-            {
+                && artificial <= record.residual_tolerance;
+            if met && hold.held.is_empty() {
                 return self.commit_increment(start, motion, levels, u, residuals, iteration);
             }
             let improved = progress.note(record);
@@ -131,6 +202,16 @@ impl Analysis {
                     flipping: self.flipping_elements(&previous_u, &u),
                     compressed: self.compressed_elements(&u),
                 });
+            }
+            if let Some(held) = hold.next(met, &progress.statuses) {
+                // The laws changed: the same iterate evaluated again, Newton's iteration afresh.
+                self.parts.hold(&held);
+                (assembled, correction) = (false, f64::INFINITY);
+                merits.clear();
+                ptc.c = 0.0;
+                (progress.best, progress.best_correction) = (f64::INFINITY, f64::INFINITY);
+                progress.best_at = iteration;
+                continue;
             }
             if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
@@ -351,6 +432,8 @@ impl Analysis {
     pub(crate) const PROGRESS: f64 = 0.9;
     /// Iterations without progress before an increment is declared stalled and cut back.
     pub(crate) const STALL_PATIENCE: usize = 12;
+    /// Changes between stick and slip that make a contact's status a cycle ([`Hold`]).
+    pub(crate) const CYCLE: usize = 3;
     /// Merits the nonmonotone line search compares against.
     pub(crate) const MEMORY: usize = 4;
     /// Trial steps of the line search before the pseudo-time step is shortened instead.
@@ -454,6 +537,56 @@ mod tests {
         assert!(max_abs_difference(&[1.0, 2.0], &[1.0, f64::NAN]).is_nan());
         assert_eq!(max_abs_difference(&[1.0, -2.0], &[0.5, 1.0]), 3.0);
         assert_eq!(max_abs(&[]), 0.0);
+    }
+
+    /// A contact whose status alternates between stick and slip three times is held in stick;
+    /// once the held iteration meets the tolerances the hold is released to judge it on the true
+    /// laws; failing there it is held in slip, and after a second failure nothing is held
+    /// again. Changes to or from open, and fewer than three changes, are no cycle.
+    #[test]
+    fn a_contact_cycling_between_stick_and_slip_is_held_then_judged_on_the_true_laws() {
+        use GapStatus::{Open, Slip, Stick};
+        let iterates = |seq: &[[GapStatus; 2]]| -> Vec<Vec<GapStatus>> {
+            seq.iter().map(|s| s.to_vec()).collect()
+        };
+        let open = iterates(&[[Open, Stick], [Stick, Stick], [Open, Stick], [Stick, Stick]]);
+        assert_eq!(cycling(&open), None);
+        assert_eq!(
+            cycling(&iterates(&[[Stick, Stick], [Slip, Stick], [Stick, Stick]])),
+            None
+        );
+        let cycle = iterates(&[[Stick, Open], [Slip, Stick], [Stick, Open], [Slip, Stick]]);
+        assert_eq!(cycling(&cycle), Some(vec![Some(Stick), None]));
+        let mut hold = Hold::default();
+        assert_eq!(hold.next(false, &cycle[..2]), None, "no cycle yet");
+        assert_eq!(hold.next(false, &cycle), Some(vec![Some(Stick), None]));
+        assert_eq!(hold.next(false, &cycle), None, "held: iterating");
+        assert_eq!(
+            hold.next(true, &cycle),
+            Some(vec![]),
+            "converged held: released"
+        );
+        assert_eq!(
+            hold.next(false, &cycle),
+            Some(vec![Some(Slip), None]),
+            "failed: slip"
+        );
+        assert_eq!(hold.next(true, &cycle), Some(vec![]));
+        assert_eq!(
+            hold.next(false, &cycle),
+            None,
+            "failed twice: no more holds"
+        );
+        assert_eq!(hold.next(false, &cycle), None);
+        let mut hold = Hold::default();
+        hold.next(false, &cycle);
+        hold.next(true, &cycle);
+        assert_eq!(
+            hold.next(true, &cycle),
+            None,
+            "the stick hold met the true laws"
+        );
+        assert_eq!(hold.stage, 3);
     }
 
     /// Progress is a residual or a correction 10 % below its best; the closest iterate is the

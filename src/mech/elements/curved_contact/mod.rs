@@ -287,6 +287,18 @@ impl SurfaceContact {
 
     /// The contact's response at node position `x` from the converged `history`.
     pub fn respond(&self, x: &Vector3<f64>, history: &ContactHistory) -> ContactResponse {
+        self.respond_held(x, history, None)
+    }
+
+    /// [`Self::respond`] with the friction status `held` imposed where the contact is closed
+    /// (stick: the elastic law; slip: on the bound along the slip direction; None: the law's
+    /// own): the Newton loop's hold of a contact cycling between stick and slip (`newton.rs`).
+    pub fn respond_held(
+        &self,
+        x: &Vector3<f64>,
+        history: &ContactHistory,
+        held: Option<GapStatus>,
+    ) -> ContactResponse {
         let p = self.project(x, history.angle);
         let anchor = Vector2::from(history.anchor);
         let lambda = -self.kn * p.gap;
@@ -315,10 +327,10 @@ impl SurfaceContact {
             next_anchor: p.xi,
             angle: p.parameter,
         };
-        let used = status;
-        if used == GapStatus::Open {
+        if status == GapStatus::Open {
             return open;
         }
+        let used = held.unwrap_or(status);
         let n = p.normal;
         // f, ∂f/∂ξ and ∂f/∂λN per law and status.
         let (status, f, df_dxi, df_dlambda) = match self.law {
@@ -350,7 +362,12 @@ impl SurfaceContact {
                     .into_iter()
                     .enumerate()
                 {
-                    if trial[i].abs() > bound {
+                    let on_bound = match held {
+                        Some(GapStatus::Stick) => false,
+                        Some(GapStatus::Slip) if i == 0 => true,
+                        _ => trial[i].abs() > bound,
+                    };
+                    if on_bound {
                         f[i] = trial[i].signum() * bound;
                         dfd[(i, i)] = 0.0;
                         dfl[i] = trial[i].signum() * ratio;
@@ -576,14 +593,15 @@ impl SurfaceContacts {
             .collect()
     }
 
-    /// Adds the contacts' residuals and tangents at `u` (from `histories`) to `residual` and
-    /// the Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
+    /// Adds the contacts' residuals and tangents at `u` (from `histories`, with the statuses
+    /// `held` imposed: [`SurfaceContact::respond_held`]; empty: none) to `residual` and the
+    /// Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
     /// once it has grown).
     pub fn add_to(
         &self,
         system: &System,
         u: &[f64],
-        histories: &[ContactHistory],
+        (histories, held): (&[ContactHistory], &[Option<GapStatus>]),
         residual: &mut [f64],
         mut values: Option<&mut [f64]>,
         responses: &mut Vec<ContactResponse>,
@@ -593,7 +611,10 @@ impl SurfaceContacts {
             self.contacts
                 .iter()
                 .zip(histories)
-                .map(|(c, h)| c.respond(&self.position(c, u), h)),
+                .enumerate()
+                .map(|(k, (c, h))| {
+                    c.respond_held(&self.position(c, u), h, held.get(k).copied().flatten())
+                }),
         );
         for ((c, r), &(triangle, local)) in
             self.contacts.iter().zip(responses.iter()).zip(&self.slots)

@@ -232,6 +232,86 @@ fn tangent_matches_finite_differences_in_every_status() {
     }
 }
 
+/// The laws held in a status by the Newton loop's hold of a contact cycling between stick and
+/// slip (`respond_held`): the tangent matches central differences of the residual for both
+/// friction laws, held in stick where the law slips and in slip where it sticks; the response
+/// reports the held status; nothing held is the law itself, and an open contact stays open.
+#[test]
+fn held_laws_tangent_matches_finite_differences_in_both_held_statuses() {
+    let mut seed = 11u64;
+    let mut rand = || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    };
+    let mut checked = std::collections::HashSet::new();
+    for law in FrictionLaw::ALL {
+        let s = support(ring(None), law);
+        let c = SurfaceContact::new(&s, 0);
+        let [lo, hi] = sampled_range(&c.shape);
+        for case in 0..200 {
+            let u = lo + (hi - lo) * 0.5 * (rand() + 1.0);
+            let dir = Vector3::new(rand(), rand(), rand()).normalize();
+            let y = centre_at(&c.shape, u) + dir * (s.tube_radius * (0.5 + rand().abs()));
+            let py = c.project(&y, u);
+            let x = y - py.normal * (py.gap + 1e-4 * (1.0 + rand().abs()));
+            let p0 = c.project(&x, py.parameter);
+            if p0.region != Region::Tube {
+                continue;
+            }
+            let offset = if case % 2 == 0 { 1e-6 } else { 5e-3 } * rand().signum();
+            let history = ContactHistory {
+                anchor: [p0.xi.x + offset, p0.xi.y - 0.5 * offset],
+                angle: p0.parameter,
+                origin: 0.0,
+                status: GapStatus::Stick,
+                friction: 0.3,
+            };
+            let natural = c.respond(&x, &history);
+            let unheld = c.respond_held(&x, &history, None);
+            assert_eq!(natural.residual, unheld.residual);
+            assert_eq!(natural.tangent, unheld.tangent);
+            if natural.status == GapStatus::Open {
+                continue;
+            }
+            for held in [GapStatus::Stick, GapStatus::Slip] {
+                let r = c.respond_held(&x, &history, Some(held));
+                assert_eq!(r.status, held, "{law:?}");
+                // Within reach of the slip direction's own kink (the trial force's zero) only
+                // by a step well below the anchor's distance.
+                let h = (1e-3 * (p0.xi - Vector2::from(history.anchor)).norm()).min(1e-7);
+                let mut fd = Matrix3::zeros();
+                for k in 0..3 {
+                    let e = Vector3::ith(k, h);
+                    let plus = c.respond_held(&(x + e), &history, Some(held)).residual;
+                    let minus = c.respond_held(&(x - e), &history, Some(held)).residual;
+                    fd.set_column(k, &((plus - minus) / (2.0 * h)));
+                }
+                let scale = r.tangent.norm().max(s.normal_stiffness * 1e-3);
+                let error = (fd - r.tangent).norm() / scale;
+                assert!(
+                    error < 1e-5,
+                    "{law:?} held {held:?} (law: {:?}): relative error {error:e}",
+                    natural.status
+                );
+                checked.insert((law, held as u8, natural.status as u8));
+            }
+        }
+    }
+    for law in FrictionLaw::ALL {
+        for (held, other) in [
+            (GapStatus::Stick, GapStatus::Slip),
+            (GapStatus::Slip, GapStatus::Stick),
+        ] {
+            assert!(
+                checked.contains(&(law, held as u8, other as u8)),
+                "{law:?} held {held:?} where the law gives {other:?} never tested"
+            );
+        }
+    }
+}
+
 #[test]
 fn a_node_outside_the_tube_is_open_and_carries_nothing() {
     let s = support(ring(None), FrictionLaw::Isotropic);

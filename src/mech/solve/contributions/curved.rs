@@ -21,6 +21,8 @@ pub struct CurvedContacts {
     responses: Vec<ContactResponse>,
     /// Each contact's name in messages: `<support>.<k>` (k-th node of the support).
     pub names: Vec<String>,
+    /// Statuses imposed until the next restore ([`Contribution::hold`]; empty: none).
+    held: Vec<Option<GapStatus>>,
 }
 
 impl CurvedContacts {
@@ -31,6 +33,7 @@ impl CurvedContacts {
             start: contacts.initial_histories(model),
             contacts,
             responses: Vec::new(),
+            held: Vec::new(),
             names: model
                 .curved_supports
                 .iter()
@@ -55,6 +58,11 @@ impl CurvedContacts {
 impl Contribution for CurvedContacts {
     fn restore(&mut self, start: &AnalysisState) {
         self.start.clone_from(&start.contacts);
+        self.held.clear();
+    }
+
+    fn hold(&mut self, held: &[Option<GapStatus>]) {
+        self.held = held.to_vec();
     }
 
     fn status_names(&self, out: &mut Vec<String>) {
@@ -65,7 +73,7 @@ impl Contribution for CurvedContacts {
         self.contacts.add_to(
             at.system,
             at.u,
-            &self.start,
+            (&self.start, &self.held),
             residual,
             values,
             &mut self.responses,

@@ -88,6 +88,11 @@ pub trait Contribution {
     /// contact opens or closes (the line search's event trial, `newton.rs`).
     fn gaps(&self, _out: &mut Vec<f64>) {}
 
+    /// Imposes the friction statuses `held` on its contacts, in the order of
+    /// [`Contribution::statuses`] (None: the law's own), until the next restore: the Newton
+    /// loop's hold of contacts cycling between stick and slip (`newton.rs`).
+    fn hold(&mut self, _held: &[Option<GapStatus>]) {}
+
     /// Appends the names of the items [`Contribution::statuses`] lists, in its order.
     fn status_names(&self, _out: &mut Vec<String>) {}
 
@@ -187,7 +192,19 @@ impl Contributions {
         out
     }
 
-    /// The names of the items of [`Self::statuses`], in its order.
+    /// Imposes the statuses `held` (in the order of [`Self::statuses`]) on each contribution's
+    /// contacts until the next restore ([`Contribution::hold`]).
+    pub fn hold(&mut self, held: &[Option<GapStatus>]) {
+        let mut from = 0;
+        for c in self.all_mut() {
+            let mut own = Vec::new();
+            c.statuses(&mut own);
+            let to = (from + own.len()).min(held.len());
+            c.hold(&held[from.min(to)..to]);
+            from += own.len();
+        }
+    }
+
     /// The signed gaps at the last evaluation, in the order of [`Self::statuses`].
     pub fn gaps(&self) -> Vec<f64> {
         let mut out = Vec::new();
@@ -197,6 +214,7 @@ impl Contributions {
         out
     }
 
+    /// The names of the items of [`Self::statuses`], in its order.
     pub fn status_names(&self) -> Vec<String> {
         let mut out = Vec::new();
         for c in self.all() {
