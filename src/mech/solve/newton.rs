@@ -256,9 +256,14 @@ impl Analysis {
                 &statuses,
             ) {
                 Some((step, merit)) => {
-                    // SER after a full step; a shortened one keeps `c`.
-                    if step == 1.0 {
-                        ptc.accept(merits[merits.len() - 1], merit);
+                    // SER after a full step; a shortened one keeps `c`. A step back to the merit
+                    // of two iterates ago is a two-cycle (between pieces of `R` the contact
+                    // statuses do not name): a shorter pseudo-time step next.
+                    let n = merits.len();
+                    if n >= 2 && (merit - merits[n - 2]).abs() <= 1e-9 * merit {
+                        ptc.reject();
+                    } else if step == 1.0 {
+                        ptc.accept(merits[n - 1], merit);
                     }
                     assembled = step == 1.0;
                     correction *= step;
