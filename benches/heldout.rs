@@ -548,6 +548,8 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
             pressure: stage.pressure.clone(),
             force: stage.force.clone().unwrap_or_else(|| s.loads.force.clone()),
             gravity: stage.gravity,
+            chambers: vec![],
+            heating: vec![],
         };
         for k in 1..=stage.steps {
             let f = k as f64 / stage.steps as f64;

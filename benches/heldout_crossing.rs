@@ -827,6 +827,8 @@ fn run(path: &Path, increments: usize) -> Outcome {
             pressure: stage.pressure.clone(),
             force: s.loads.force.clone(),
             gravity: stage.gravity,
+            chambers: vec![],
+            heating: vec![],
         };
         for k in 1..=stage.steps {
             let f = k as f64 / stage.steps as f64;

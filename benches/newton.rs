@@ -11,15 +11,28 @@
 //! factorization of the same pattern's lower triangle (the Ju–Rowlands matrix at the final
 //! state, same AMD ordering, same cost) and the memory: ours (pattern, values, symmetric part,
 //! Woodbury block, Krylov basis, vectors) against the LDLᵀ factor.
+//!
+//! Issue 42: `-- --sheet 83,259,579 --threads 1,2 --ordering amd,nd` runs, on the side-by-side
+//! sheet of `n × n` nodes (`3 (n − 2)²` free DOF), each ordering in a fresh process: the
+//! symbolic analysis, nnz(L), then one Newton iteration (assembly of the consistent tangent, the
+//! LDLᵀ of its symmetric part and the solve) at each thread count, alternating, twice, best of
+//! each, the answers compared bit for bit, and the peak RSS. `-- --sheet-solve 259 --threads
+//! 1,2` times the whole solve (centre pushed 50 mm in 5 steps of one increment), alternating,
+//! with the default ordering. Each prints one table. `-- --iteration R --ordering amd|nd` runs
+//! the specimen's iteration row under either ordering (the default: automatic).
 
 use std::time::{Duration, Instant};
 
 use membrane_contact::mech::elements::gap::GapLaw;
 use membrane_contact::mech::solve::assembly::System;
-use membrane_contact::mech::solve::linear::{LinearSolver, UnsymmetricMethod};
+use membrane_contact::mech::solve::linear::{FillOrdering, LinearSolver, UnsymmetricMethod};
 use membrane_contact::mech::{Analysis, SolverSettings};
 use membrane_contact::specimens::ParallelArch;
 use nalgebra::Vector2;
+
+#[path = "common/sheet.rs"]
+mod common;
+use common::sheet;
 
 /// Peak resident set size (bytes) from /proc (0 where unavailable).
 fn peak_rss() -> usize {
@@ -61,7 +74,7 @@ fn parse_method(name: &str) -> UnsymmetricMethod {
 /// 10 mm behind), without running the analysis there: assembly of the consistent tangent plus
 /// our solve (`LinearSolver` with the symmetric part), twice, against the bare LDLᵀ of the same
 /// pattern's lower triangle, twice; best of each.
-fn iteration(r: usize) {
+fn iteration(r: usize, ordering: FillOrdering) {
     let spec = ParallelArch {
         refinement: r,
         ..ParallelArch::with_height(0.3)
@@ -80,7 +93,7 @@ fn iteration(r: usize) {
     let mut run = |lower_only: bool| -> (Duration, Duration, [usize; 4], usize, usize, usize) {
         let system = System::new(&model, lower_only).unwrap();
         free = system.free_count;
-        let mut linear = LinearSolver::new(&system, true).unwrap();
+        let mut linear = LinearSolver::with_ordering(&system, true, ordering).unwrap();
         let mut internal = vec![0.0; model.dof_count()];
         let mut values = vec![0.0; system.nonzeros()];
         let p = system.pattern();
@@ -129,7 +142,8 @@ fn iteration(r: usize) {
     let (ours_time, ours_factor, counts, columns, ours, factor) = run(false);
     let (_, bare, _, _, _, _) = run(true);
     println!(
-        "| {r} | {} | {:?} | {columns} | {:.0} ms | {:.0} ms | {:.0} ms | **{:.2}** | {:.0} MiB | {:.0} MiB | {:.2} | {:.0} MiB |",
+        "| {r} | {ordering:?} | {:.1} M | {} | {:?} | {columns} | {:.0} ms | {:.0} ms | {:.0} ms | **{:.2}** | {:.0} MiB | {:.0} MiB | {:.2} | {:.0} MiB |",
+        factor as f64 / 8e6,
         free,
         counts,
         ms(ours_time),
@@ -252,6 +266,209 @@ fn case(r: usize, steps: usize, method: &str) {
     );
 }
 
+fn parse_ordering(name: &str) -> FillOrdering {
+    match name {
+        "amd" => FillOrdering::Amd,
+        "nd" => FillOrdering::NestedDissection,
+        _ => FillOrdering::Auto,
+    }
+}
+
+fn list(text: &str) -> Vec<usize> {
+    text.split(',').map(|v| v.parse().unwrap()).collect()
+}
+
+/// One Newton iteration on the sheet of `n × n` nodes under `ordering`, at each thread count
+/// of `threads`, alternating, twice: one table row per thread count.
+fn sheet_iteration(n: usize, ordering: &str, threads: &[usize]) {
+    let model = sheet(n);
+    let mut system = System::new(&model, false).unwrap();
+    let started = Instant::now();
+    let mut linear = LinearSolver::with_ordering(&system, true, parse_ordering(ordering)).unwrap();
+    let symbolic = started.elapsed();
+    let mut u = vec![0.0; model.dof_count()];
+    for (i, p) in model.nodes.iter().enumerate() {
+        let s = (std::f64::consts::PI * p[0]).sin() * (std::f64::consts::PI * p[1]).sin();
+        u[3 * i + 2] = 0.05 * s;
+    }
+    let mut internal = vec![0.0; model.dof_count()];
+    let mut values = vec![0.0; system.nonzeros()];
+    let (mut best, mut factor) = (
+        vec![Duration::MAX; threads.len()],
+        vec![Duration::MAX; threads.len()],
+    );
+    let mut answers: Vec<Vec<f64>> = vec![vec![]; threads.len()];
+    for round in 0..2 {
+        for k in 0..threads.len() {
+            // Alternate the order of the thread counts between rounds.
+            let k = if round % 2 == 0 {
+                k
+            } else {
+                threads.len() - 1 - k
+            };
+            system.set_threads(threads[k]);
+            linear.set_threads(threads[k]);
+            let started = Instant::now();
+            system.assemble(&u, &mut internal, Some(&mut values), |_, _| {
+                unreachable!("no gaps")
+            });
+            let mut rhs = vec![1.0; system.free_count];
+            let before = linear.profile().ldlt;
+            linear
+                .factorize_and_solve(system.matrix(&values), &mut rhs)
+                .unwrap();
+            best[k] = best[k].min(started.elapsed());
+            factor[k] = factor[k].min(linear.profile().ldlt - before);
+            answers[k] = rhs;
+        }
+    }
+    let same = same_bits(&answers);
+    for (k, &t) in threads.iter().enumerate() {
+        println!(
+            "| {n} × {n} | {} | {ordering} | {:.2} s | {:.1} M | {:.0} MiB | {t} | {:.0} ms | {:.0} ms | {:.2} | {} | {:.0} MiB | {:.2} |",
+            system.free_count,
+            symbolic.as_secs_f64(),
+            linear.factor_len() as f64 / 1e6,
+            mib(8 * linear.factor_len()),
+            ms(best[k]),
+            ms(factor[k]),
+            ms(best[k]) / ms(best[0]),
+            if same { "yes" } else { "NO" },
+            mib(peak_rss()),
+            load(),
+        );
+    }
+}
+
+/// Whether every answer has the first's bits.
+fn same_bits(answers: &[Vec<f64>]) -> bool {
+    answers.iter().all(|a| {
+        a.iter()
+            .zip(&answers[0])
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    })
+}
+
+/// The one-minute load average.
+fn load() -> f64 {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|t| t.split_whitespace().next().and_then(|v| v.parse().ok()))
+        .unwrap_or(f64::NAN)
+}
+
+/// The whole sheet solve (centre pushed 50 mm in 5 steps of one increment) at each thread
+/// count, alternating, twice: one row per thread count, best of two.
+fn sheet_solve(n: usize, threads: &[usize]) {
+    let model = sheet(n);
+    let mut best = vec![Duration::MAX; threads.len()];
+    let mut answers: Vec<Vec<f64>> = vec![vec![]; threads.len()];
+    let mut iterations = 0;
+    for round in 0..2 {
+        for k in 0..threads.len() {
+            let k = if round % 2 == 0 {
+                k
+            } else {
+                threads.len() - 1 - k
+            };
+            let settings = SolverSettings {
+                threads: threads[k],
+                ..SolverSettings::default()
+            };
+            let started = Instant::now();
+            let mut analysis = Analysis::new(model.clone(), settings).unwrap();
+            iterations = 0;
+            for step in 1..=5 {
+                let report = analysis
+                    .step_to(&[[0.0, 0.0, 0.01 * step as f64]], 1)
+                    .unwrap();
+                iterations += report.total_iterations();
+            }
+            best[k] = best[k].min(started.elapsed());
+            answers[k] = analysis.state().displacement.clone();
+        }
+    }
+    let same = same_bits(&answers);
+    for (k, &t) in threads.iter().enumerate() {
+        println!(
+            "| {n} × {n} | {} | {t} | {iterations} | {:.1} s | {:.2} | {} | {:.0} MiB | {:.2} |",
+            3 * (n - 2) * (n - 2),
+            best[k].as_secs_f64(),
+            ms(best[k]) / ms(best[0]),
+            if same { "yes" } else { "NO" },
+            mib(peak_rss()),
+            load(),
+        );
+    }
+}
+
+/// Runs this bench again with `args`, printing its table rows (or the failure).
+fn child(args: &[String]) {
+    let exe = std::env::current_exe().unwrap();
+    let out = std::process::Command::new(&exe)
+        .args(args)
+        .output()
+        .unwrap();
+    print!("{}", String::from_utf8_lossy(&out.stdout));
+    if !out.status.success() {
+        let err = String::from_utf8_lossy(&out.stderr);
+        println!(
+            "| {} | failed: {} |",
+            args.join(" "),
+            err.lines().last().unwrap_or("")
+        );
+    }
+}
+
+/// `--sheet`, `--sheet-solve` and their one-case children; false when none is given.
+fn sheet_tables(option: &dyn Fn(&str) -> Option<String>) -> bool {
+    let threads = option("--threads").unwrap_or_else(|| "1,2".into());
+    if let Some(case) = option("--sheet-one") {
+        let (n, ordering) = case.split_once(',').unwrap();
+        sheet_iteration(n.parse().unwrap(), ordering, &list(&threads));
+    } else if let Some(n) = option("--sheet-solve-one") {
+        sheet_solve(n.parse().unwrap(), &list(&threads));
+    } else if let Some(sizes) = option("--sheet") {
+        println!(
+            "## one Newton iteration on the sheet, by ordering and threads (best of two, alternating)\n"
+        );
+        println!(
+            "| sheet | free DOF | ordering | symbolic | nnz(L) | factor | threads | iteration | LDLᵀ | ratio | same bits | peak RSS | load |"
+        );
+        println!("|{}", "---|".repeat(13));
+        for n in list(&sizes) {
+            for ordering in option("--ordering")
+                .unwrap_or_else(|| "amd,nd".into())
+                .split(',')
+            {
+                child(&[
+                    "--sheet-one".into(),
+                    format!("{n},{ordering}"),
+                    "--threads".into(),
+                    threads.clone(),
+                ]);
+            }
+        }
+    } else if let Some(sizes) = option("--sheet-solve") {
+        println!("## the whole sheet solve, 5 steps of one increment (best of two, alternating)\n");
+        println!(
+            "| sheet | free DOF | threads | iterations | solve | ratio | same bits | peak RSS | load |"
+        );
+        println!("|{}", "---|".repeat(9));
+        for n in list(&sizes) {
+            child(&[
+                "--sheet-solve-one".into(),
+                n.to_string(),
+                "--threads".into(),
+                threads.clone(),
+            ]);
+        }
+    } else {
+        return false;
+    }
+    true
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let option = |name: &str| {
@@ -260,8 +477,12 @@ fn main() {
             .and_then(|i| args.get(i + 1))
             .cloned()
     };
+    if sheet_tables(&option) {
+        return;
+    }
     if let Some(r) = option("--iteration") {
-        iteration(r.parse().unwrap());
+        let ordering = parse_ordering(&option("--ordering").unwrap_or_default());
+        iteration(r.parse().unwrap(), ordering);
         return;
     }
     if let Some(r) = option("--lu-symbolic") {

@@ -79,6 +79,7 @@ fn strip(cables: bool, n0: f64) -> Model {
             vec![]
         },
         curved_supports: vec![],
+        chambers: vec![],
     }
 }
 

@@ -631,6 +631,25 @@ fn check_prints_the_warnings_and_the_orientation_of_each_pressure_set() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// TEST GOAL (issue 43): `check` says what each chamber encloses; `model` prints its pressure
+/// and volume after the run (`examples/cushion_air.json`: 0.196035 m³ at 300 Pa).
+#[test]
+fn check_and_model_report_each_chamber() {
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion_air.json");
+    let (ok, out, err) = cli(&["check", example]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("chamber 'air': 768 triangles, closed by its own triangles, 0.000000 m³ in the reference geometry, air held by a supply at 300 Pa"),
+        "{out}"
+    );
+    let (ok, out, err) = cli(&["model", example, "--steps", "5"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("chamber air: pressure 300.000 Pa, volume 0.196035 m³ (held by its supply)"),
+        "{out}"
+    );
+}
+
 /// TEST GOAL (issue 47 item 8): a prestressed film with free edges starts out of equilibrium
 /// (the vault roof: 302 of 728 elements wrinkled, a 100 s first stage) and `check` said
 /// nothing. `examples/crossing_supports.json` is such a film: 1.5 MPa both ways, rails on its

@@ -9,7 +9,6 @@ use membrane_contact::mech::elements::load::{
     ExternalLoad, LoadLevels, Loads, orientation, pressure_force, pressure_signs,
     pressure_stiffness,
 };
-use membrane_contact::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
 use membrane_contact::mech::elements::triangle::{ElementVector, Material};
 use membrane_contact::mech::model::{
     AllElements, Axis, BoundaryGroup, ElementSelection, ElementSet, ForceSet, LoadSpec, Model,
@@ -21,7 +20,7 @@ use membrane_contact::specimens::scenarios::CircularMembrane;
 use nalgebra::{DMatrix, Vector3};
 
 mod common;
-use common::{assert_example_file, flat_grid};
+use common::{assert_example_file, film, flat_grid, hencky};
 
 /// A small deterministic generator (xorshift64*) for random configurations.
 struct Random(u64);
@@ -34,21 +33,6 @@ impl Random {
         self.0 ^= self.0 >> 27;
         let bits = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11;
         2.0 * (bits as f64 / (1u64 << 53) as f64) - 1.0
-    }
-}
-
-fn film(prestress: f64) -> Material {
-    Material {
-        youngs_modulus: 1.0e9,
-        poisson_ratio: 0.3,
-        thickness: 2.0e-4,
-        prestress: [prestress, prestress, 0.0],
-        density: 0.0,
-        wrinkling: Wrinkling::None,
-        wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
-        yield_stress: None,
-        plasticity: None,
-        temperature: 23.0,
     }
 }
 
@@ -69,6 +53,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         outputs: Default::default(),
         cables: vec![],
         curved_supports: vec![],
+        chambers: vec![],
     }
 }
 
@@ -384,64 +369,9 @@ fn nodal_forces_act_on_each_node_of_the_set_and_group_reactions_balance_them() {
     assert_eq!(analysis.state().loads, levels);
 }
 
-/// The Föppl–Hencky clamped circular membrane under uniform pressure `q`, with an isotropic
-/// prestress `σ_pre`: radial stress `σ_r = S s(ρ)`, `S = (E q² a²/t²)^{1/3}`, `ρ = r/a`.
-///
-/// Equilibrium `σ_θ = d(r σ_r)/dr`, `σ_r t w' = −q r/2`, and compatibility of
-/// `ε_r = u' + w'²/2`, `ε_θ = u/r` give `s'' + 3 s'/ρ = −1/(8 s²)` (ν drops out); the clamped
-/// edge `u(a) = 0` gives `(1 − ν) s(1) + s'(1) = (1 − ν) σ_pre/S`. Shooting on `s(0)` (series
-/// start `s ≈ s0 − ρ²/(64 s0²)`, RK4) returns `(s0, c_w)` with the centre deflection
-/// `w0 = a (qa/Et)^{1/3} c_w`, `c_w = ∫₀¹ ρ/(2s) dρ`. Without prestress and ν = 0.3 it gives
-/// `4 s0 = 1.7244` (Hencky's `b0`) and `c_w = 0.6534`.
-fn hencky(nu: f64, prestress_ratio: f64) -> (f64, f64) {
-    let shoot = |s0: f64| {
-        let r0 = 1e-6;
-        let mut y = [
-            s0 - r0 * r0 / (64.0 * s0 * s0),
-            -r0 / (32.0 * s0 * s0),
-            r0 * r0 / (4.0 * s0),
-        ];
-        let f = |r: f64, y: [f64; 3]| {
-            [
-                y[1],
-                -1.0 / (8.0 * y[0] * y[0]) - 3.0 * y[1] / r,
-                r / (2.0 * y[0]),
-            ]
-        };
-        let n = 2000;
-        let h = (1.0 - r0) / n as f64;
-        let mut r = r0;
-        for _ in 0..n {
-            let add = |y: [f64; 3], k: [f64; 3], s: f64| std::array::from_fn(|i| y[i] + s * k[i]);
-            let k1 = f(r, y);
-            let k2 = f(r + h / 2.0, add(y, k1, h / 2.0));
-            let k3 = f(r + h / 2.0, add(y, k2, h / 2.0));
-            let k4 = f(r + h, add(y, k3, h));
-            y = std::array::from_fn(|i| {
-                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
-            r += h;
-        }
-        ((1.0 - nu) * (y[0] - prestress_ratio) + y[1], y[2])
-    };
-    // The edge condition rises with s0: bisect on a bracket.
-    let (mut lo, mut hi) = (prestress_ratio.max(0.05), prestress_ratio.max(0.0) + 5.0);
-    assert!(shoot(lo).0 < 0.0 && shoot(hi).0 > 0.0);
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if shoot(mid).0 < 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let s0 = 0.5 * (lo + hi);
-    (s0, shoot(s0).1)
-}
-
 #[test]
 fn hencky_ode_reproduces_the_published_coefficients() {
-    let (s0, cw) = hencky(0.3, 0.0);
+    let (s0, cw, _) = hencky(0.3, 0.0);
     assert!((4.0 * s0 - 1.7244).abs() < 2e-4, "b0 = {}", 4.0 * s0);
     assert!((cw - 0.6534).abs() < 2e-4, "w0 coefficient {cw}");
 }
@@ -498,7 +428,7 @@ fn hencky_clamped_circular_membrane_matches_the_closed_form_within_one_percent()
     let m = film(100.0);
     let (e, t, nu) = (m.youngs_modulus, m.thickness, m.poisson_ratio);
     let stress_scale = (e * q * q * a * a / (t * t)).cbrt();
-    let (s0, cw) = hencky(nu, 100.0 / stress_scale);
+    let (s0, cw, _) = hencky(nu, 100.0 / stress_scale);
     // A flat film is stiffened only by the deflection, `q ∝ w³`: a load growing tenfold per step
     // lets Newton start near each answer (w grows 2.15× per step).
     let path: Vec<f64> = (0..=6).map(|k| 10f64.powi(k - 6)).collect();
@@ -525,7 +455,7 @@ fn prestressed_circular_membrane_matches_the_foppl_hencky_solution_and_its_linea
     let model = disc(a, 24, m);
     for (q, limit_tolerance) in [(1.0, 0.002), (20.0, f64::INFINITY)] {
         let stress_scale = (e * q * q * a * a / (t * t)).cbrt();
-        let (_, cw) = hencky(nu, sigma_pre / stress_scale);
+        let (_, cw, _) = hencky(nu, sigma_pre / stress_scale);
         let w_ref = a * (q * a / (e * t)).cbrt() * cw;
         // Small load: the prestress carries it, w0 = q a²/(4 N0) (linear membrane, N0 = σ0 t).
         let w_linear = q * a * a / (4.0 * sigma_pre * t);
@@ -553,6 +483,8 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
         pressure: vec![10.0],
         force: vec![],
         gravity: [0.0; 3],
+        chambers: vec![],
+        heating: vec![],
     };
     analysis
         .set_limits(SolverSettings {

@@ -10,6 +10,8 @@
 //!   0 --- 1 --- 2
 //! ```
 
+mod common;
+use common::{dense, worst_fd_mismatch};
 use membrane_contact::mech::elements::gap::{
     FrictionLaw, GapFrame, GapLaw, GapResponse, GapStatus, IterationMatrix,
 };
@@ -61,6 +63,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         outputs: Default::default(),
         cables: vec![],
         curved_supports: vec![],
+        chambers: vec![],
         name: "Patch".into(),
         description: String::new(),
         nodes,
@@ -100,19 +103,6 @@ fn pressed_node_model(g0: f64, mu: f64) -> Model {
         hinge: None,
     });
     m
-}
-
-fn dense(system: &System, values: &[f64]) -> DMatrix<f64> {
-    let m = system.matrix(values);
-    let n = system.free_count;
-    let mut d = DMatrix::zeros(n, n);
-    let (cp, ri, v) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
-    for j in 0..n {
-        for k in cp[j]..cp[j + 1] {
-            d[(ri[k], j)] += v[k];
-        }
-    }
-    d
 }
 
 fn free_residual(system: &System, internal: &[f64]) -> Vec<f64> {
@@ -190,19 +180,9 @@ fn assembled_tangent_matches_finite_difference_in_every_gap_status_of_both_laws(
             assert_eq!(responses[3].force.x, -limit(&responses[3]), "x sliding");
         }
         let (_, k) = assemble(&system, &laws, &history, &u, None);
-        let h = 1e-9;
-        let mut worst: f64 = 0.0;
-        for (i, d) in system.dofs.iter().enumerate() {
-            let Dof::Free(j) = d else { continue };
-            let (mut up, mut um) = (u.clone(), u.clone());
-            up[i] += h;
-            um[i] -= h;
-            let rp = free_residual(&system, &assemble(&system, &laws, &history, &up, None).0);
-            let rm = free_residual(&system, &assemble(&system, &laws, &history, &um, None).0);
-            for row in 0..system.free_count {
-                worst = worst.max(((rp[row] - rm[row]) / (2.0 * h) - k[(row, *j)]).abs());
-            }
-        }
+        let worst = worst_fd_mismatch(&system, &u, 1e-9, &k, |v| {
+            free_residual(&system, &assemble(&system, &laws, &history, v, None).0)
+        });
         assert!(
             worst < 1e-5 * k.amax(),
             "{law}: worst FD mismatch {worst:e} (scale {:e})",

@@ -69,6 +69,7 @@ fn strip(nx: usize) -> Model {
         outputs: Default::default(),
         cables: vec![],
         curved_supports: vec![],
+        chambers: vec![],
         name: "Strip".into(),
         description: String::new(),
         nodes,

@@ -1011,6 +1011,8 @@ fn run_staged_from(
                 triples(&stage["force"])
             },
             gravity: [gravity[0], gravity[1], gravity[2]],
+            chambers: vec![],
+            heating: vec![],
         };
         let steps = stage["steps"].as_u64().unwrap() as usize;
         for k in 1..=steps {

@@ -80,6 +80,7 @@ fn strip() -> Model {
         outputs: Default::default(),
         cables: vec![],
         curved_supports: vec![],
+        chambers: vec![],
     }
 }
 

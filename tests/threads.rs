@@ -1,7 +1,8 @@
 //! No thread of the FMU outlives the FMI call that started it (issue 17, defect 3; docs/fmu.md,
 //! `solver.threads`).
 //!
-//! TEST GOAL: with `solver.threads = 2` every assembly runs a worker thread; after each
+//! TEST GOAL: with `solver.threads = 2` every assembly runs a worker thread and every LDLᵀ
+//! factorization a scoped rayon pool of two threads (issue 42 item 1); after each
 //! `fmi2DoStep` and each `fmi2FreeInstance` the process has exactly the tasks it had before
 //! (`/proc/self/task`, which lists a thread until the kernel has removed it, also after its
 //! code ended): 200 steps over 10 instances. Before the fix a worker was still listed after
@@ -30,7 +31,7 @@ fn vr(inst: &Instance, name: &str) -> u32 {
 
 #[cfg(target_os = "linux")]
 #[test]
-fn no_assembly_thread_outlives_do_step_or_free_instance() {
+fn no_assembly_or_factorization_thread_outlives_do_step_or_free_instance() {
     const INSTANCES: usize = 10;
     const STEPS: usize = 20;
     let baseline = tasks();

@@ -63,5 +63,6 @@ pub fn sheet(n: usize) -> Model {
         outputs: Default::default(),
         cables: vec![],
         curved_supports: vec![],
+        chambers: vec![],
     }
 }

@@ -178,8 +178,9 @@ pub struct RunArgs {
     /// (the answer then carries no damping force; docs/mechanics.md "The nonlinear method")
     #[arg(long)]
     pub no_stabilization: bool,
-    /// Threads of the element assembly (0 = automatic: one below 100 000 triangles, else up to
-    /// two; results are identical for every count).
+    /// Threads of the element assembly and the LDLᵀ factorization (0 = automatic: the idle
+    /// cores, one below 100 000 triangles and 2^24 factor values; results are identical for
+    /// every count).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub threads: usize,
     /// Write the gap results of every step as CSV.

@@ -119,6 +119,7 @@ fn load_path(
                 .collect(),
             loads: loads.scaled(f),
             mu: None,
+            sealed: model.chambers.iter().map(|c| c.sealed).collect(),
         })
         .collect();
     Ok(StagedPath { times, steps: rows })
@@ -690,6 +691,19 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             r.slack_segments
         );
     }
+    for c in &results.chambers {
+        out!(
+            "chamber {}: pressure {:.3} Pa, volume {:.6} m³ ({})",
+            c.name,
+            c.pressure,
+            c.volume,
+            if c.sealed {
+                "enclosed air"
+            } else {
+                "held by its supply"
+            }
+        );
+    }
     let t = results.total_reaction;
     out!(
         "total reaction (supports, symmetry planes, groups): ({:.3}, {:.3}, {:.3}) N",
@@ -884,7 +898,7 @@ fn import(
 }
 
 /// `membrane-contact check FILE`: validates the model, prints its warnings on stderr (as a run
-/// does) and how each pressure set faces on stdout.
+/// does), how each pressure set faces and what each chamber encloses on stdout.
 fn check(file: &std::path::Path) -> Result<(), String> {
     let name = file.display();
     let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
@@ -894,6 +908,9 @@ fn check(file: &std::path::Path) -> Result<(), String> {
     }
     out!("{}", size_line(&model, ": valid,"));
     for line in membrane_contact::mech::elements::load::orientation_report(&model) {
+        out!("{line}");
+    }
+    for line in membrane_contact::mech::elements::chamber::chamber_report(&model) {
         out!("{line}");
     }
     Ok(())

@@ -147,14 +147,14 @@ fn fill<'a>(template: &str, value: impl Fn(&str) -> Option<&'a str>) -> Result<S
 fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
     w.create_element("UnitDefinitions")
         .write_inner_content(|w| {
-            for (name, [kg, m, s, rad]) in UNITS {
+            for (name, [kg, m, s, k, rad]) in UNITS {
                 if !table.iter().any(|v| v.unit == Some(name)) {
                     continue;
                 }
                 w.create_element("Unit")
                     .with_attribute(("name", name))
                     .write_inner_content(|w| {
-                        let exponents = [("kg", kg), ("m", m), ("s", s), ("rad", rad)];
+                        let exponents = [("kg", kg), ("m", m), ("s", s), ("K", k), ("rad", rad)];
                         let exps: Vec<(&str, String)> = exponents
                             .iter()
                             .filter(|(_, e)| *e != 0)

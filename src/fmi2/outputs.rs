@@ -150,6 +150,10 @@ pub(super) fn state_result(binding: &Binding, results: &Results) -> Option<f64> 
         Binding::SurfaceFrictionForce(c) => results.surface_contacts[c].friction_force,
         Binding::PointDisplacement { point, axis } => results.points[point][axis],
         Binding::SetSummary { set, quantity } => quantity.of(&results.sets[set]),
+        Binding::ChamberPressure(k) => results.chambers[k].pressure,
+        Binding::ChamberVolume(k) => results.chambers[k].volume,
+        Binding::ChamberTemperature(k) => results.chambers[k].temperature,
+        Binding::ChamberMass(k) => results.chambers[k].mass,
         _ => return None,
     })
 }
@@ -174,5 +178,9 @@ pub(super) fn is_state_result(binding: &Binding) -> bool {
             | Binding::SurfaceFrictionForce(_)
             | Binding::PointDisplacement { .. }
             | Binding::SetSummary { .. }
+            | Binding::ChamberPressure(_)
+            | Binding::ChamberVolume(_)
+            | Binding::ChamberTemperature(_)
+            | Binding::ChamberMass(_)
     )
 }

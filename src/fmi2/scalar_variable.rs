@@ -213,6 +213,20 @@ pub enum Binding {
     SurfaceSlip(usize),
     SurfaceNormalForce(usize),
     SurfaceFrictionForce(usize),
+    /// Input: the supply's gauge pressure of a chamber (ignored once its air is enclosed).
+    ChamberSupply(usize),
+    /// Input: whether a chamber's air is enclosed (its valve closed).
+    ChamberSealed(usize),
+    /// Input: a chamber's air temperature rise above its reference (K).
+    ChamberHeating(usize),
+    /// A chamber's air temperature (K).
+    ChamberTemperature(usize),
+    /// A chamber's air mass (kg).
+    ChamberMass(usize),
+    /// Gauge pressure of a chamber's air.
+    ChamberPressure(usize),
+    /// Volume of a chamber.
+    ChamberVolume(usize),
     SurfaceStatus(usize),
     /// Displacement of an output point along axis 0, 1, 2.
     PointDisplacement {

@@ -178,10 +178,30 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             loads.force.len(),
             model.loads.forces.len(),
         ),
+        (
+            "chamber supply levels",
+            loads.chambers.len(),
+            model.chambers.len(),
+        ),
+        (
+            "chamber heating levels",
+            loads.heating.len(),
+            model.chambers.len(),
+        ),
+        ("chambers' air", state.chambers.len(), model.chambers.len()),
     ];
     for (what, have, want) in load_sizes {
         if have != want {
             return Err(format!("the state has {have} {what}, the model {want}"));
+        }
+    }
+    for (c, spec) in state.chambers.iter().zip(&model.chambers) {
+        let numbers = [c.constant, c.pressure, c.volume];
+        if !numbers.iter().all(|v| v.is_finite()) || (c.sealed && !(c.constant > 0.0)) {
+            return Err(format!(
+                "the state's air of chamber '{}' is not finite or not positive",
+                spec.name
+            ));
         }
     }
     if let Some(v) = loads.values().find(|v| !v.is_finite()) {

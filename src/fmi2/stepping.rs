@@ -18,7 +18,9 @@ use super::scalar_variable::message_real;
 use super::types::{FMI2_DO_STEP_STATUS, FMI2_LAST_SUCCESSFUL_TIME, FMI2_TERMINATED, Status};
 use super::variables::{StepInputs, step_inputs};
 use crate::mech::solve::IncrementFailure;
-use crate::mech::{LoadLevels, SettingNames, StepError, StepReport, check_results};
+use crate::mech::{
+    Analysis, AnalysisState, LoadLevels, SettingNames, StepError, StepReport, check_results,
+};
 
 /// The FMU parameters that a refused step's advice names.
 const SETTING_NAMES: SettingNames = SettingNames {
@@ -77,6 +79,7 @@ impl Instance {
             angles,
             mut loads,
             mu,
+            sealed,
         } = step_inputs(
             &self.description.model,
             &self.description.variables,
@@ -89,21 +92,8 @@ impl Instance {
             .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
         // Gravity is a parameter: the built model holds it, and the first step ramps it in.
         loads.gravity = built.analysis.model().loads.gravity;
-        // μ changes the state's friction (gaps and curved-support contacts) before the step; a
-        // refused step must not keep it.
-        let state = built.analysis.state();
-        let changes = |mu: f64| {
-            let contacts = state.contacts.iter().map(|c| &c.friction);
-            state.friction.iter().chain(contacts).any(|&f| f != mu)
-        };
-        let before = match mu {
-            Some(mu) if changes(mu) => {
-                let before = built.analysis.state().clone();
-                built.analysis.set_friction(mu).map_err(Failure::error)?;
-                Some(before)
-            }
-            _ => None,
-        };
+        // μ and the chambers' valves change the state before the step; a refused step goes back.
+        let before = change_state_for_step(&mut built.analysis, mu, &sealed)?;
         match checked_step(built, &targets, &angles, &loads, &self.logger) {
             Ok(report) => {
                 if let Some(b) = self.analysis.as_mut() {
@@ -208,6 +198,38 @@ impl Instance {
     pub fn get_string_status(&self, kind: i32) -> Outcome {
         Err(unavailable_status(kind, "fmi2GetStringStatus"))
     }
+}
+
+/// Applies the inputs that change the converged state before a step: `mu` (the friction of every
+/// gap and curved-support contact) and the chambers' valves `sealed`. Returns the state before
+/// where anything changed (a refused step goes back to it); Err, with that state restored, where
+/// a valve cannot close.
+fn change_state_for_step(
+    analysis: &mut Analysis,
+    mu: Option<f64>,
+    sealed: &[bool],
+) -> Result<Option<AnalysisState>, Failure> {
+    let state = analysis.state();
+    let contacts = state.contacts.iter().map(|c| &c.friction);
+    let friction = mu.filter(|&mu| state.friction.iter().chain(contacts).any(|&f| f != mu));
+    let valves = state
+        .chambers
+        .iter()
+        .zip(sealed)
+        .any(|(c, &s)| c.sealed != s);
+    if friction.is_none() && !valves {
+        return Ok(None);
+    }
+    let before = state.clone();
+    if let Some(mu) = friction {
+        analysis.set_friction(mu).map_err(Failure::error)?;
+    }
+    // A chamber's valve closes (or opens) as the step starts.
+    if valves && let Err(e) = analysis.set_chambers_sealed(sealed) {
+        analysis.set_state(before).map_err(Failure::error)?;
+        return Err(Failure::error(e));
+    }
+    Ok(Some(before))
 }
 
 /// `Analysis::step_to_motion`, then a check that every output of the new state is finite; a state

@@ -30,7 +30,7 @@
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
 //! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.stabilization` | | parameter | | Newton settings |
-//! | `solver.threads` | Integer | parameter | | threads of the element assembly (0: automatic); results identical for every count |
+//! | `solver.threads` | Integer | parameter | | threads of the element assembly and the factorization (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
 //! | `<gap>.slip/.slipY/.normalForce/.frictionForce` | Real | output | m, N | gap results |
@@ -72,17 +72,20 @@ pub enum Kind {
 }
 
 /// Units used by the table, with their SI base-unit exponents `(kg, m, s)`.
-pub const UNITS: [(&str, [i32; 4]); 10] = [
-    ("m", [0, 1, 0, 0]),
-    ("m2", [0, 2, 0, 0]),
-    ("m/s2", [0, 1, -2, 0]),
-    ("kg/m3", [1, -3, 0, 0]),
-    ("N", [1, 1, -2, 0]),
-    ("N.m", [1, 2, -2, 0]),
-    ("Pa", [1, -1, -2, 0]),
-    ("N/m", [1, 0, -2, 0]),
-    ("rad", [0, 0, 0, 1]),
-    ("1", [0, 0, 0, 0]),
+pub const UNITS: [(&str, [i32; 5]); 13] = [
+    ("m", [0, 1, 0, 0, 0]),
+    ("m2", [0, 2, 0, 0, 0]),
+    ("m3", [0, 3, 0, 0, 0]),
+    ("m/s2", [0, 1, -2, 0, 0]),
+    ("kg/m3", [1, -3, 0, 0, 0]),
+    ("N", [1, 1, -2, 0, 0]),
+    ("N.m", [1, 2, -2, 0, 0]),
+    ("Pa", [1, -1, -2, 0, 0]),
+    ("N/m", [1, 0, -2, 0, 0]),
+    ("rad", [0, 0, 0, 0, 1]),
+    ("K", [0, 0, 0, 1, 0]),
+    ("kg", [1, 0, 0, 0, 0]),
+    ("1", [0, 0, 0, 0, 0]),
 ];
 
 /// Top-level names the table uses; gap and group names must differ from them.
@@ -152,6 +155,77 @@ pub fn check_names(model: &Model) -> Result<(), String> {
     Ok(())
 }
 
+/// Each chamber's inputs: the supply's pressure, the valve, the heating.
+fn chamber_inputs(table: &mut TableBuilder, model: &Model) {
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.input(
+            &format!("{}.supplyPressure", c.name),
+            c.pressure,
+            "Pa",
+            &format!(
+                "gauge pressure the supply holds in chamber '{}', reached at the end of a step \
+                 (ignored while its air is enclosed)",
+                c.name
+            ),
+            Binding::ChamberSupply(k),
+        );
+        table.push(
+            &format!("{}.sealed", c.name),
+            VarType::Boolean,
+            Causality::Input,
+            Some(Value::Boolean(c.sealed)),
+            None,
+            &format!(
+                "true: the air of chamber '{}' is enclosed at its pressure and volume when the next \
+                 step starts and follows Boyle's law; false: a supply holds supplyPressure",
+                c.name
+            ),
+            Binding::ChamberSealed(k),
+        );
+        table.input(
+            &format!("{}.heating", c.name),
+            c.heating,
+            "K",
+            &format!(
+                "temperature rise of the air in chamber '{}' above its reference {} K (the sun), \
+                 reached at the end of a step",
+                c.name, c.temperature
+            ),
+            Binding::ChamberHeating(k),
+        );
+    }
+}
+
+/// Each chamber's outputs: the air's pressure, volume, temperature and mass.
+fn chamber_outputs(table: &mut TableBuilder, model: &Model) {
+    for (k, c) in model.chambers.iter().enumerate() {
+        table.output(
+            &format!("{}.pressure", c.name),
+            "Pa",
+            &format!("gauge pressure of the air in chamber '{}'", c.name),
+            Binding::ChamberPressure(k),
+        );
+        table.output(
+            &format!("{}.volume", c.name),
+            "m3",
+            &format!("volume of chamber '{}'", c.name),
+            Binding::ChamberVolume(k),
+        );
+        table.output(
+            &format!("{}.temperature", c.name),
+            "K",
+            &format!("temperature of the air in chamber '{}'", c.name),
+            Binding::ChamberTemperature(k),
+        );
+        table.output(
+            &format!("{}.mass", c.name),
+            "kg",
+            &format!("mass of the air in chamber '{}' (ideal gas)", c.name),
+            Binding::ChamberMass(k),
+        );
+    }
+}
+
 /// What the inputs ask of the next step: where the groups go (translations and hinge angles),
 /// the load levels, and `μ` (only once it has been set).
 #[derive(Clone, Debug, PartialEq)]
@@ -161,6 +235,8 @@ pub struct StepInputs {
     /// Pressures and nodal forces from the inputs; gravity from the model (a parameter).
     pub loads: LoadLevels,
     pub mu: Option<f64>,
+    /// Whether each chamber's air is to be enclosed from this step on.
+    pub sealed: Vec<bool>,
 }
 
 /// Reads the step's targets from the input values of `table` (`values[i]` belongs to
@@ -178,6 +254,7 @@ pub fn step_inputs(
         angles: vec![0.0; model.groups.len()],
         loads: LoadLevels::zero(model),
         mu: None,
+        sealed: model.chambers.iter().map(|c| c.sealed).collect(),
     };
     inputs.loads.gravity = model.loads.gravity;
     for (v, x) in table.iter().zip(values) {
@@ -187,6 +264,9 @@ pub fn step_inputs(
             }
             (Binding::GroupAngle(group), &Value::Real(x)) => inputs.angles[group] = x,
             (Binding::Pressure(set), &Value::Real(x)) => inputs.loads.pressure[set] = x,
+            (Binding::ChamberSupply(k), &Value::Real(x)) => inputs.loads.chambers[k] = x,
+            (Binding::ChamberSealed(k), &Value::Boolean(b)) => inputs.sealed[k] = b,
+            (Binding::ChamberHeating(k), &Value::Real(x)) => inputs.loads.heating[k] = x,
             (Binding::NodalForce { set, axis }, &Value::Real(x)) => {
                 inputs.loads.force[set][axis] = x
             }
@@ -279,6 +359,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::Pressure(set),
         );
     }
+    chamber_inputs(&mut table, model);
     for (set, f) in model.loads.forces.iter().enumerate() {
         for (axis, a) in ["Fx", "Fy", "Fz"].iter().enumerate() {
             table.input(
@@ -475,8 +556,9 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "threads",
             Value::Integer(saturating_i32(solver.threads)),
             None,
-            "threads of the element assembly, ended before each call returns (0: automatic, one on meshes \
-             below 100 000 triangles, else up to two); the results are identical for every count",
+            "threads of the element assembly and the LDLT factorization, ended before each call returns \
+             (0: automatic, the idle cores, one on meshes below 100 000 triangles and factors below \
+             2^24 values); the results are identical for every count",
             Binding::Threads,
         ),
     ];
@@ -657,6 +739,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::CableForce(cable),
         );
     }
+    chamber_outputs(&mut table, model);
     for (point, p) in model.outputs.points.iter().enumerate() {
         for (axis, a) in ["ux", "uy", "uz"].iter().enumerate() {
             table.output(

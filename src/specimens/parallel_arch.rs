@@ -406,6 +406,7 @@ impl ParallelArch {
             outputs: Default::default(),
             cables: vec![],
             curved_supports,
+            chambers: vec![],
             name: MODEL_NAME.into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

@@ -2,7 +2,11 @@
 #![allow(dead_code)]
 
 use membrane_contact::mech::Model;
+use membrane_contact::mech::elements::material::{DEFAULT_WRINKLING_REGULARISATION, Wrinkling};
+use membrane_contact::mech::elements::triangle::Material;
+use membrane_contact::mech::solve::assembly::{Dof, System};
 use membrane_contact::specimens::ParallelArch;
+use nalgebra::DMatrix;
 
 /// A model of just a film (the specimen's ETFE, no supports, groups, gaps or loads).
 pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) -> Model {
@@ -20,6 +24,7 @@ pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) 
         outputs: Default::default(),
         cables: vec![],
         curved_supports: vec![],
+        chambers: vec![],
     }
 }
 
@@ -76,4 +81,115 @@ pub fn driven_gap_over_a_pipe() -> Model {
     });
     model.validate().unwrap();
     model
+}
+
+/// The Föppl–Hencky clamped circular membrane under uniform pressure `q`, with an isotropic
+/// prestress `σ_pre`: radial stress `σ_r = S s(ρ)`, `S = (E q² a²/t²)^{1/3}`, `ρ = r/a`.
+///
+/// Equilibrium `σ_θ = d(r σ_r)/dr`, `σ_r t w' = −q r/2`, and compatibility of
+/// `ε_r = u' + w'²/2`, `ε_θ = u/r` give `s'' + 3 s'/ρ = −1/(8 s²)` (ν drops out); the clamped
+/// edge `u(a) = 0` gives `(1 − ν) s(1) + s'(1) = (1 − ν) σ_pre/S`. Shooting on `s(0)` (series
+/// start `s ≈ s0 − ρ²/(64 s0²)`, RK4) returns `(s0, c_w)` with the centre deflection
+/// `w0 = a (qa/Et)^{1/3} c_w`, `c_w = ∫₀¹ ρ/(2s) dρ`, and the volume under the membrane
+/// `V = 2π a³ (qa/Et)^{1/3} c_v`, `c_v = ∫₀¹ ρ³/(4s) dρ` (`∫ w ρ dρ` by parts). Without prestress
+/// and ν = 0.3 it gives `4 s0 = 1.7244` (Hencky's `b0`) and `c_w = 0.6534`.
+pub fn hencky(nu: f64, prestress_ratio: f64) -> (f64, f64, f64) {
+    let shoot = |s0: f64| {
+        let r0 = 1e-6;
+        let mut y = [
+            s0 - r0 * r0 / (64.0 * s0 * s0),
+            -r0 / (32.0 * s0 * s0),
+            r0 * r0 / (4.0 * s0),
+            0.0,
+        ];
+        let f = |r: f64, y: [f64; 4]| {
+            [
+                y[1],
+                -1.0 / (8.0 * y[0] * y[0]) - 3.0 * y[1] / r,
+                r / (2.0 * y[0]),
+                r * r * r / (4.0 * y[0]),
+            ]
+        };
+        let n = 2000;
+        let h = (1.0 - r0) / n as f64;
+        let mut r = r0;
+        for _ in 0..n {
+            let add = |y: [f64; 4], k: [f64; 4], s: f64| std::array::from_fn(|i| y[i] + s * k[i]);
+            let k1 = f(r, y);
+            let k2 = f(r + h / 2.0, add(y, k1, h / 2.0));
+            let k3 = f(r + h / 2.0, add(y, k2, h / 2.0));
+            let k4 = f(r + h, add(y, k3, h));
+            y = std::array::from_fn(|i| {
+                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+            r += h;
+        }
+        ((1.0 - nu) * (y[0] - prestress_ratio) + y[1], (y[2], y[3]))
+    };
+    // The edge condition rises with s0: bisect on a bracket.
+    let (mut lo, mut hi) = (prestress_ratio.max(0.05), prestress_ratio.max(0.0) + 5.0);
+    assert!(shoot(lo).0 < 0.0 && shoot(hi).0 > 0.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if shoot(mid).0 < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let s0 = 0.5 * (lo + hi);
+    let (cw, cv) = shoot(s0).1;
+    (s0, cw, cv)
+}
+
+pub fn film(prestress: f64) -> Material {
+    Material {
+        youngs_modulus: 1.0e9,
+        poisson_ratio: 0.3,
+        thickness: 2.0e-4,
+        prestress: [prestress, prestress, 0.0],
+        density: 0.0,
+        wrinkling: Wrinkling::None,
+        wrinkling_regularisation: DEFAULT_WRINKLING_REGULARISATION,
+        yield_stress: None,
+        plasticity: None,
+        temperature: 23.0,
+    }
+}
+
+/// The free–free matrix of the system value array `values`, dense.
+pub fn dense(system: &System, values: &[f64]) -> DMatrix<f64> {
+    let m = system.matrix(values);
+    let n = system.free_count;
+    let mut d = DMatrix::zeros(n, n);
+    let (cp, ri, v) = (m.symbolic().col_ptr(), m.symbolic().row_idx(), m.val());
+    for j in 0..n {
+        for k in cp[j]..cp[j + 1] {
+            d[(ri[k], j)] += v[k];
+        }
+    }
+    d
+}
+
+/// The largest difference between the free–free matrix `k` and central differences (step `h`)
+/// of the free residual `residual(u)` over every free DOF of `system`.
+pub fn worst_fd_mismatch(
+    system: &System,
+    u: &[f64],
+    h: f64,
+    k: &DMatrix<f64>,
+    mut residual: impl FnMut(&[f64]) -> Vec<f64>,
+) -> f64 {
+    let mut worst: f64 = 0.0;
+    for (i, d) in system.dofs.iter().enumerate() {
+        let Dof::Free(j) = d else { continue };
+        let (mut up, mut um) = (u.to_vec(), u.to_vec());
+        up[i] += h;
+        um[i] -= h;
+        let (rp, rm) = (residual(&up), residual(&um));
+        for row in 0..system.free_count {
+            worst = worst.max(((rp[row] - rm[row]) / (2.0 * h) - k[(row, *j)]).abs());
+        }
+    }
+    worst
 }

@@ -246,6 +246,90 @@ fn a_model_without_free_dofs_steps_its_gap_through_stick_and_slip() {
     assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut state) }, 0);
 }
 
+/// Issue 43: a chamber through the FMU. `examples/cushion.json` with its air as a chamber
+/// supplied through `air.supplyPressure`: `air.pressure` is the supply's, `air.volume` grows
+/// with it (the same volume the CLI prints at 300 Pa: 0.196 m³), and an FMU state taken after
+/// the first step repeats the second step bit for bit. `air.sealed` closes the valve (the air
+/// keeps the cushion up with the supply at 0) and opens it again (the cushion collapses).
+#[test]
+fn a_chamber_inflates_seals_and_opens_through_the_fmu_and_its_state_round_trips() {
+    let mut model =
+        crate::mech::Model::from_json(include_str!("../../../examples/cushion.json")).unwrap();
+    model.loads.pressures.clear();
+    model.chambers = vec![crate::mech::model::ChamberSpec {
+        name: "air".into(),
+        elements: crate::mech::model::ElementSelection::All(crate::mech::model::AllElements::All),
+        closed_by_plane: None,
+        pressure: 300.0,
+        sealed: false,
+        kappa: 1.0,
+        atmosphere: 101_325.0,
+        temperature: 293.15,
+        heating: 0.0,
+    }];
+    let (u, log) = (
+        Unpacked::new("chamber", Source::Model(model)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[("air.supplyPressure", 0.0)], &[]);
+    let mut volumes = vec![];
+    let mut saved: Fmi2FmuState = std::ptr::null_mut();
+    for (k, p) in [150.0, 300.0].into_iter().enumerate() {
+        assert_eq!(fmu.set_real("air.supplyPressure", p), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+        assert_eq!(fmu.real("air.pressure"), p);
+        volumes.push(fmu.real("air.volume"));
+        if k == 0 {
+            assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut saved) }, 0);
+        }
+    }
+    assert!(
+        volumes[0] > 0.0 && volumes[1] > 1.2 * volumes[0],
+        "{volumes:?}"
+    );
+    assert!((volumes[1] - 0.196).abs() < 1e-3, "{volumes:?}");
+    assert!(fmu.real("crownTop.uz") > 0.05);
+    // Serialized and read back: the air travels with the state's bytes.
+    let bytes = serialized(&fmu, saved);
+    let mut restored: Fmi2FmuState = std::ptr::null_mut();
+    let size = bytes.len();
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr(), size, &mut restored) },
+        0
+    );
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, restored) }, 0);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut restored) }, 0);
+    assert_eq!(
+        fmu.real("air.volume"),
+        volumes[0],
+        "the state holds the air"
+    );
+    assert_eq!(fmu.set_real("air.supplyPressure", 300.0), 0);
+    assert_eq!(fmu.step(1.0, 1.0), 0, "{:?}", log.take());
+    assert_eq!(fmu.real("air.volume"), volumes[1]);
+    assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut saved) }, 0);
+    // The valve closes: the supply's pressure no longer acts, the enclosed air keeps the
+    // cushion up at the same pressure and volume (Boyle, nothing else changed).
+    assert_eq!(fmu.set_boolean("air.sealed", true), 0);
+    assert_eq!(fmu.set_real("air.supplyPressure", 0.0), 0);
+    assert_eq!(fmu.step(2.0, 1.0), 0, "{:?}", log.take());
+    assert!(
+        (fmu.real("air.pressure") - 300.0).abs() < 1e-6,
+        "{}",
+        fmu.real("air.pressure")
+    );
+    assert!((fmu.real("air.volume") / volumes[1] - 1.0).abs() < 1e-9);
+    // Opened again to a supply at 0 Pa: the cushion collapses to its prestressed flat state.
+    assert_eq!(fmu.set_boolean("air.sealed", false), 0);
+    assert_eq!(fmu.step(3.0, 1.0), 0, "{:?}", log.take());
+    assert_eq!(fmu.real("air.pressure"), 0.0);
+    assert!(
+        fmu.real("air.volume").abs() < 1e-6 * volumes[1],
+        "{}",
+        fmu.real("air.volume")
+    );
+}
+
 /// Issue 47 item 8: the `logIncrements` category carries a line per increment of a step (as
 /// many as the step's log counts), status OK; `loggingOn = true` alone does not enable
 /// it (a line per increment), naming it does.

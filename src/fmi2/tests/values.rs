@@ -212,6 +212,8 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
         pressure: vec![50.0],
         force: vec![[0.0, 0.0, -2.0]],
         gravity: [0.0, 0.0, -9.81],
+        chambers: vec![],
+        heating: vec![],
     };
     analysis
         .step_to_with_loads(&[[0.0; 3]], &levels, 2)
@@ -315,6 +317,8 @@ fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
         pressure: vec![80.0],
         force: vec![],
         gravity: model.loads.gravity,
+        chambers: vec![],
+        heating: vec![],
     };
     analysis
         .step_to_with_loads(&[[0.0; 3]], &levels, 2)

@@ -45,6 +45,12 @@ pub struct LoadLevels {
     pub force: Vec<[f64; 3]>,
     /// Gravity acceleration (m/s²) acting on the film's mass.
     pub gravity: [f64; 3],
+    /// Supply pressure of each chamber (Pa), model order (a sealed chamber's is its gas's).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chambers: Vec<f64>,
+    /// Temperature rise of each chamber's air above its reference temperature (K), model order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub heating: Vec<f64>,
 }
 
 impl LoadLevels {
@@ -54,6 +60,8 @@ impl LoadLevels {
             pressure: vec![0.0; model.loads.pressures.len()],
             force: vec![[0.0; 3]; model.loads.forces.len()],
             gravity: [0.0; 3],
+            chambers: vec![0.0; model.chambers.len()],
+            heating: vec![0.0; model.chambers.len()],
         }
     }
 
@@ -63,6 +71,8 @@ impl LoadLevels {
             pressure: model.loads.pressures.iter().map(|p| p.pressure).collect(),
             force: model.loads.forces.iter().map(|f| f.force).collect(),
             gravity: model.loads.gravity,
+            chambers: model.chambers.iter().map(|c| c.pressure).collect(),
+            heating: model.chambers.iter().map(|c| c.heating).collect(),
         }
     }
 
@@ -83,6 +93,18 @@ impl LoadLevels {
                 .map(|(a, b)| std::array::from_fn(|c| lerp(a[c], b[c])))
                 .collect(),
             gravity: std::array::from_fn(|c| lerp(self.gravity[c], target.gravity[c])),
+            chambers: self
+                .chambers
+                .iter()
+                .zip(&target.chambers)
+                .map(|(&a, &b)| lerp(a, b))
+                .collect(),
+            heating: self
+                .heating
+                .iter()
+                .zip(&target.heating)
+                .map(|(&a, &b)| lerp(a, b))
+                .collect(),
         }
     }
 
@@ -92,6 +114,8 @@ impl LoadLevels {
             pressure: self.pressure.iter().map(|p| p * factor).collect(),
             force: self.force.iter().map(|f| f.map(|v| v * factor)).collect(),
             gravity: self.gravity.map(|g| g * factor),
+            chambers: self.chambers.iter().map(|p| p * factor).collect(),
+            heating: self.heating.iter().map(|t| t * factor).collect(),
         }
     }
 
@@ -101,6 +125,8 @@ impl LoadLevels {
             .iter()
             .chain(self.force.iter().flatten())
             .chain(&self.gravity)
+            .chain(&self.chambers)
+            .chain(&self.heating)
             .copied()
     }
 
@@ -109,10 +135,12 @@ impl LoadLevels {
         self.values().all(f64::is_finite)
     }
 
-    /// Whether the sizes match `model`'s pressure and force sets.
+    /// Whether the sizes match `model`'s pressure and force sets and chambers.
     pub fn fits(&self, model: &Model) -> bool {
         self.pressure.len() == model.loads.pressures.len()
             && self.force.len() == model.loads.forces.len()
+            && self.chambers.len() == model.chambers.len()
+            && self.heating.len() == model.chambers.len()
     }
 }
 

@@ -7,6 +7,7 @@
 //! | [`triangle`] | CST membrane triangle, eqs. (2.2)–(2.7) |
 //! | [`material`] | film law, eq. (2.3), and its tension-field (wrinkling) option |
 //! | [`cable`] | tension-only edge cables (2-node truss segments along triangle edges) |
+//! | [`chamber`] | enclosed gas chambers: volume by the divergence theorem, gas law, pneumatic stiffness |
 //! | [`gap`] | friction gap element, eqs. (2.8), (2.9), (2.13) |
 //! | [`curved_contact`] | node-to-surface friction contact on rigid curved supports (and, in `surface`, their geometry) |
 //! | [`load`] | follower pressure, self-weight, nodal forces and their load stiffness |
@@ -14,6 +15,7 @@
 //! | [`temperature`] | ETFE's modulus and flow stress between 0 and 50 °C (`material.temperature`, issue 20) |
 
 pub mod cable;
+pub mod chamber;
 pub mod curved_contact;
 pub mod gap;
 pub mod load;

@@ -479,6 +479,71 @@ pub struct Model {
     /// whose frames follow the contact point ([`crate::mech::elements::curved_contact`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub curved_supports: Vec<CurvedSupport>,
+    /// Closed volumes of gas bounded by film triangles (cushions;
+    /// [`crate::mech::elements::chamber`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chambers: Vec<ChamberSpec>,
+}
+
+/// A closed volume of gas bounded by film triangles (issue 43): held at a gauge pressure by a
+/// supply, or enclosed (`(p + p_a) V^κ = C`, [`crate::mech::elements::chamber::GasLaw`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChamberSpec {
+    /// Name (an identifier).
+    pub name: String,
+    /// The film triangles that bound it (their node order need not agree: they are oriented
+    /// out of the chamber by their shared edges).
+    pub elements: ElementSelection,
+    /// The rigid plane that closes the triangles' rim (the frame's plane), when they do not
+    /// close the volume themselves.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_by_plane: Option<ClosingPlane>,
+    /// Gauge pressure (Pa): the supply's of a standard run, or, `sealed`, the enclosed gas's
+    /// in the reference geometry.
+    pub pressure: f64,
+    /// Whether the gas is enclosed from the start (else a supply holds `pressure` until
+    /// `Analysis::seal_chambers`).
+    #[serde(default)]
+    pub sealed: bool,
+    /// Polytropic exponent κ of the enclosed gas: 1 isothermal (default), 1.4 adiabatic air.
+    #[serde(default = "default_kappa")]
+    pub kappa: f64,
+    /// Atmospheric pressure (Pa), default 101 325.
+    #[serde(default = "default_atmosphere")]
+    pub atmosphere: f64,
+    /// The air's temperature in the reference state (K), default 293.15.
+    #[serde(default = "default_air_temperature")]
+    pub temperature: f64,
+    /// The air's temperature rise in a standard run (K; the sun on a cushion), default 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub heating: f64,
+}
+
+fn default_air_temperature() -> f64 {
+    293.15
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+/// A plane closing a chamber: a point on it and its normal pointing into the chamber.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClosingPlane {
+    /// A point of the plane (m).
+    pub point: [f64; 3],
+    /// Its normal, pointing into the chamber (any length, not zero).
+    pub normal: [f64; 3],
+}
+
+fn default_kappa() -> f64 {
+    1.0
+}
+
+fn default_atmosphere() -> f64 {
+    101_325.0
 }
 
 /// Why a model is rejected. Every variant names the offending item.

@@ -6,6 +6,8 @@
 
 use std::collections::HashSet;
 
+use crate::mech::elements::chamber::ChamberGeometry;
+
 use nalgebra::Vector3;
 
 use super::format::*;
@@ -284,6 +286,7 @@ impl Model {
         self.validate_outputs(&mut names)?;
         self.validate_cables(&mut names)?;
         self.validate_curved_supports(&mut names)?;
+        self.validate_chambers(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -496,6 +499,49 @@ impl Model {
                     )));
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Checks the `chambers` section (names join the namespace): finite pressure, κ in
+    /// [1, 5/3], a positive atmosphere, known triangles, and a boundary that closes and can
+    /// be oriented ([`ChamberGeometry::new`]).
+    fn validate_chambers(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        for c in &self.chambers {
+            check_name(names, "chamber", &c.name)?;
+            let error = |message: String| ModelError::Load {
+                item: format!("chamber '{}'", c.name),
+                message,
+            };
+            if !c.pressure.is_finite() {
+                return Err(error("pressure must be finite".into()));
+            }
+            if !(1.0..=5.0 / 3.0).contains(&c.kappa) {
+                return Err(error(format!(
+                    "kappa = {} must be within [1, 5/3]",
+                    c.kappa
+                )));
+            }
+            if !(c.atmosphere > 0.0 && c.atmosphere.is_finite()) {
+                return Err(error(format!("atmosphere = {} must be > 0", c.atmosphere)));
+            }
+            if !(c.temperature > 0.0 && c.temperature.is_finite()) {
+                return Err(error(format!(
+                    "temperature = {} K must be > 0",
+                    c.temperature
+                )));
+            }
+            if !(c.heating.is_finite() && c.temperature + c.heating > 0.0) {
+                return Err(error(format!(
+                    "heating = {} K must leave the air above 0 K",
+                    c.heating
+                )));
+            }
+            if c.pressure + c.atmosphere <= 0.0 {
+                return Err(error("the absolute pressure must be positive".into()));
+            }
+            self.check_selection(&c.elements).map_err(error)?;
+            ChamberGeometry::new(self, c).map_err(error)?;
         }
         Ok(())
     }

@@ -46,6 +46,9 @@ pub struct Results {
     /// Slip along the support, forces and status of each curved-support contact (model order:
     /// supports, then their nodes).
     pub surface_contacts: Vec<SurfaceContactResult>,
+    /// Pressure and volume of each gas chamber, model order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chambers: Vec<crate::mech::solve::contributions::ChamberResult>,
     /// Total reaction of each named support set (N), global axes, over its fixed components.
     pub support_reactions: Vec<[f64; 3]>,
     /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the

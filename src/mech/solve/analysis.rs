@@ -77,8 +77,9 @@ impl Analysis {
         let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
         let mut system = System::new(&model, lower_only)?;
         system.set_threads(settings.threads);
-        let linear = LinearSolver::new(&system, settings.symmetric_factorization)
+        let mut linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
+        linear.set_threads(settings.threads);
         // Computed once: the continuation and the viscous stabilization both use them.
         let (diagonal, mass) = (diagonal_slots(&system), pseudo_mass(&system));
         let parts = Contributions::new(&model, &system, diagonal.clone(), mass.clone());
@@ -96,6 +97,7 @@ impl Analysis {
                 .collect(),
             last_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
+            chambers: parts.chambers.initial_states(&model),
             plastic: system
                 .material
                 .plastic_film()
@@ -185,6 +187,7 @@ impl Analysis {
             return Err("the iteration matrix is fixed when the analysis is created".into());
         }
         self.system.set_threads(settings.threads);
+        self.linear.set_threads(settings.threads);
         self.settings = settings;
         Ok(())
     }

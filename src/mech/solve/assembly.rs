@@ -30,8 +30,10 @@ const NO_SLOT: u32 = u32::MAX;
 /// second thread lost time on every smaller mesh measured (docs/benchmarks.md, issue 11 item 3).
 pub const PARALLEL_MIN_TRIANGLES: usize = 100_000;
 
-/// Most threads the automatic thread count uses.
-pub const AUTOMATIC_MAX_THREADS: usize = 2;
+/// Triangles per thread of the automatic count from [`PARALLEL_MIN_TRIANGLES`] up (two threads
+/// at 100 000 triangles, eight at 400 000, never more than the available cores): each thread's
+/// share stays far above the cost of starting it and of the triangles two threads compute.
+pub const TRIANGLES_PER_THREAD: usize = 50_000;
 
 /// What a global DOF is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -216,14 +218,11 @@ impl System {
     }
 
     /// Sets the threads of [`System::assemble`]: `requested` when positive, else the automatic
-    /// count (1 below [`PARALLEL_MIN_TRIANGLES`] triangles, else the available cores up to
-    /// [`AUTOMATIC_MAX_THREADS`]).
+    /// count (1 below [`PARALLEL_MIN_TRIANGLES`] triangles, else one per
+    /// [`TRIANGLES_PER_THREAD`] triangles up to the available cores).
     pub fn set_threads(&mut self, requested: usize) {
         self.threads = match requested {
-            0 if self.triangles.len() < PARALLEL_MIN_TRIANGLES => 1,
-            0 => std::thread::available_parallelism()
-                .map_or(1, |n| n.get())
-                .min(AUTOMATIC_MAX_THREADS),
+            0 => automatic_threads(self.triangles.len()),
             n => n,
         };
         self.parts = if self.threads > 1 {
@@ -600,6 +599,35 @@ impl System {
     }
 }
 
+/// The automatic assembly thread count for `triangles` triangles (see [`System::set_threads`]).
+pub fn automatic_threads(triangles: usize) -> usize {
+    if triangles < PARALLEL_MIN_TRIANGLES {
+        return 1;
+    }
+    (triangles / TRIANGLES_PER_THREAD).clamp(1, idle_cores())
+}
+
+/// The available cores less those other processes keep busy: the one-minute load average
+/// beyond this process's own running thread, rounded (Linux; elsewhere the available cores),
+/// at least 1. A second thread on a core that another process holds lost 1.5–1.8× on the
+/// shared 2-core machine (docs/benchmarks.md, issue 42), so the automatic counts take the idle
+/// cores only; a study's workers, one per core, keep them busy and get one thread.
+pub fn idle_cores() -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let load = std::fs::read_to_string("/proc/loadavg").ok().and_then(|t| {
+        t.split_whitespace()
+            .next()
+            .and_then(|v| v.parse::<f64>().ok())
+    });
+    match load {
+        Some(load) => {
+            let busy = (load - 1.0).max(0.0);
+            ((cores as f64 - busy).round() as usize).clamp(1, cores)
+        }
+        None => cores,
+    }
+}
+
 /// The nine global DOFs of a triangle.
 pub fn node_dofs(nodes: &[usize; 3]) -> [usize; 9] {
     std::array::from_fn(|i| 3 * nodes[i / 3] + i % 3)
@@ -645,13 +673,13 @@ pub fn node_vector(u: &[f64], v: usize) -> Vector3<f64> {
 /// `/proc/self/task` after about 40 % of the FMU's calls on the shared 2-core machine
 /// (`tests/threads.rs`). So on Linux a worker reports its task id, and the caller waits, after
 /// the join, until that task is gone (a few microseconds; bounded).
-mod worker {
+pub(crate) mod worker {
     /// Longest wait for the kernel to remove a joined thread's task.
     #[cfg(target_os = "linux")]
     const LONGEST_WAIT: std::time::Duration = std::time::Duration::from_millis(200);
 
     /// The calling thread's task id (`/proc/thread-self` → `<pid>/task/<tid>`), Linux only.
-    pub fn own_task() -> Option<std::ffi::OsString> {
+    pub(crate) fn own_task() -> Option<std::ffi::OsString> {
         #[cfg(target_os = "linux")]
         {
             std::fs::read_link("/proc/thread-self")
@@ -664,7 +692,7 @@ mod worker {
 
     /// Waits until the joined thread's `task` has left `/proc/self/task` (at most
     /// [`LONGEST_WAIT`]: beyond it the thread's code has ended anyway).
-    pub fn wait_until_gone(task: Option<std::ffi::OsString>) {
+    pub(crate) fn wait_until_gone(task: Option<std::ffi::OsString>) {
         #[cfg(target_os = "linux")]
         if let Some(task) = task {
             let path = std::path::Path::new("/proc/self/task").join(task);
@@ -682,5 +710,25 @@ mod worker {
         }
         #[cfg(not(target_os = "linux"))]
         let _ = task;
+    }
+}
+
+#[cfg(test)]
+mod thread_count_tests {
+    use super::*;
+
+    #[test]
+    fn automatic_assembly_threads_are_one_below_the_threshold_and_within_the_cores_above() {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        assert_eq!(automatic_threads(PARALLEL_MIN_TRIANGLES - 1), 1);
+        for triangles in [PARALLEL_MIN_TRIANGLES, 10 * PARALLEL_MIN_TRIANGLES] {
+            let t = automatic_threads(triangles);
+            assert!(
+                (1..=cores).contains(&t),
+                "{triangles} triangles: {t} threads"
+            );
+            assert!(t <= triangles / TRIANGLES_PER_THREAD);
+        }
+        assert!((1..=cores).contains(&idle_cores()));
     }
 }

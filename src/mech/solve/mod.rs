@@ -4,8 +4,9 @@
 //! | file | what |
 //! |---|---|
 //! | [`assembly`] | DOF numbering, sparsity pattern, scatter (eq. 2.11) |
-//! | [`contributions`] | the [`Contribution`](contributions::Contribution) trait: residual, tangent and history of each kind (triangles, gaps, loads, cables, curved contacts) |
+//! | [`contributions`] | the [`Contribution`](contributions::Contribution) trait: residual, tangent and history of each kind (triangles, gaps, loads, cables, curved contacts, chambers) |
 //! | [`linear`] | sparse LDLᵀ / Woodbury / GMRES / LU with a reused symbolic analysis |
+//! | `low_rank` | the chambers' pneumatic stiffness by Sherman–Morrison–Woodbury; sealing the chambers |
 //! | [`analysis`] | [`Analysis`]: setup, state, steps and their input checks |
 //! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
 //! | `increments` | the increment controller (Ramm's rule, cut-back), the strategy table, the predictor |
@@ -24,6 +25,7 @@ pub mod contributions;
 mod increments;
 mod inputs;
 pub mod linear;
+mod low_rank;
 mod newton;
 pub mod progress;
 pub mod report;

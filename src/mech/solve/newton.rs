@@ -461,6 +461,10 @@ impl Analysis {
         self.linear
             .factorize_and_solve(matrix, &mut self.work.rhs)
             .map_err(|e| IncrementFailure::Singular { message: e.0 })?;
+        let mut rhs = std::mem::take(&mut self.work.rhs);
+        let low_rank = self.add_low_rank(&mut rhs);
+        self.work.rhs = rhs;
+        low_rank.map_err(|e| IncrementFailure::Singular { message: e.0 })?;
         Ok(max_abs(&self.work.rhs))
     }
     /// `‖R_free‖∞` of the last assembly.

@@ -146,6 +146,13 @@ impl Analysis {
             );
         }
         let end = self.state.clone();
+        if !end.chambers.is_empty() {
+            return Err(
+                "derivatives are not available for a model with gas chambers: \
+                        the pneumatic stiffness is not in the held tangent"
+                    .into(),
+            );
+        }
         if seed.translation.len() != end.boundary.len()
             || seed.angles.len() != end.angles.len()
             || seed.pressure.len() != end.loads.pressure.len()
@@ -225,6 +232,8 @@ impl Analysis {
                     .map(|(f, d)| std::array::from_fn(|c| f[c] + s * d[c]))
                     .collect(),
                 gravity: end.loads.gravity,
+                chambers: end.loads.chambers.clone(),
+                heating: end.loads.heating.clone(),
             };
             (motion, levels, s * seed.friction)
         };
@@ -262,6 +271,8 @@ impl Analysis {
                 pressure: seed.pressure.clone(),
                 force: seed.force.clone(),
                 gravity: [0.0; 3],
+                chambers: vec![0.0; end.loads.chambers.len()],
+                heating: vec![0.0; end.loads.heating.len()],
             };
             self.parts
                 .loads

@@ -37,9 +37,15 @@ pub struct SolverSettings {
     /// a step whose smallest increment Newton refused; its work is reported and judged against
     /// the strain energy. false: the first row only (the stabilization-free answer).
     pub stabilization: bool,
-    /// Threads of the element assembly (scoped: none outlives a call); 0 = automatic (one
-    /// below [`crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES`] triangles, else up to two). Results
-    /// are bit-identical for every count.
+    /// Threads of the element assembly and of the LDLᵀ factorizations (each scoped: none
+    /// outlives a call); 0 = automatic: the assembly one below
+    /// [`PARALLEL_MIN_TRIANGLES`](crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES)
+    /// triangles, else one per
+    /// [`TRIANGLES_PER_THREAD`](crate::mech::solve::assembly::TRIANGLES_PER_THREAD) up to the
+    /// idle cores ([`idle_cores`](crate::mech::solve::assembly::idle_cores): the available
+    /// ones less the load average of other processes); the factorization one below
+    /// [`PARALLEL_MIN_FACTOR`](crate::mech::solve::linear::PARALLEL_MIN_FACTOR) factor values,
+    /// else the idle cores. Studies set 1 per worker. Results are bit-identical for every count.
     pub threads: usize,
 }
 

@@ -43,6 +43,9 @@ pub struct AnalysisState {
     /// increment converges (empty for the elastic film).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plastic: Vec<PlasticHistory>,
+    /// The gas of each chamber ([`crate::mech::solve::contributions::ChamberState`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub chambers: Vec<crate::mech::solve::contributions::ChamberState>,
 }
 
 impl AnalysisState {

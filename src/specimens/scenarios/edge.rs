@@ -120,6 +120,7 @@ impl ArchEdge {
             outputs: Default::default(),
             cables: vec![],
             curved_supports: vec![],
+            chambers: vec![],
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",

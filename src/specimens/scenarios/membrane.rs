@@ -114,6 +114,7 @@ impl CircularMembrane {
             },
             cables: vec![],
             curved_supports: vec![],
+            chambers: vec![],
         })
     }
 

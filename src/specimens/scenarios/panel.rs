@@ -142,6 +142,7 @@ impl ArchPanel {
             outputs: Default::default(),
             cables: vec![],
             curved_supports: vec![],
+            chambers: vec![],
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",

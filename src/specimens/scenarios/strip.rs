@@ -111,6 +111,7 @@ impl CylinderStrip {
             outputs: Default::default(),
             cables: vec![],
             curved_supports: vec![],
+            chambers: vec![],
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,

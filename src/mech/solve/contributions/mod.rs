@@ -30,12 +30,14 @@
 //! | `curved` | node-to-surface contacts on curved supports |
 //! | `stabilization` | the viscous stabilization of a step whose equilibrium is not unique |
 
+mod chambers;
 mod curved;
 mod gaps;
 mod loads;
 mod stabilization;
 mod triangles;
 
+pub use chambers::{ChamberResult, ChamberState, Chambers};
 pub use curved::CurvedContacts;
 pub use gaps::Gaps;
 pub use stabilization::ViscousStabilization;
@@ -125,6 +127,8 @@ pub struct Contributions {
     pub cables: Cables,
     /// Node-to-surface contacts on curved supports.
     pub curved: CurvedContacts,
+    /// Gas chambers.
+    pub chambers: Chambers,
     /// The viscous stabilization of the current step (off unless a step turns it on).
     pub stabilization: ViscousStabilization,
 }
@@ -139,30 +143,33 @@ impl Contributions {
             loads: Loads::new(model, system),
             cables: Cables::new(model),
             curved: CurvedContacts::new(model),
+            chambers: Chambers::new(model),
             stabilization: ViscousStabilization::new(diagonal, mass),
         }
     }
 
     /// All of them, in assembly order (the order of the floating-point sums).
-    pub fn all_mut(&mut self) -> [&mut dyn Contribution; 6] {
+    pub fn all_mut(&mut self) -> [&mut dyn Contribution; 7] {
         [
             &mut self.triangles,
             &mut self.gaps,
             &mut self.loads,
             &mut self.cables,
             &mut self.curved,
+            &mut self.chambers,
             &mut self.stabilization,
         ]
     }
 
     /// All of them, in assembly order.
-    pub fn all(&self) -> [&dyn Contribution; 6] {
+    pub fn all(&self) -> [&dyn Contribution; 7] {
         [
             &self.triangles,
             &self.gaps,
             &self.loads,
             &self.cables,
             &self.curved,
+            &self.chambers,
             &self.stabilization,
         ]
     }

@@ -7,13 +7,14 @@ use std::time::Instant;
 use crate::mech::solve::linear::Context;
 use crate::mech::solve::linear::accurate;
 use crate::mech::solve::linear::gmres;
+use crate::mech::solve::linear::ordering::{self, FillOrdering};
+use crate::mech::solve::linear::pool;
 use crate::mech::solve::linear::timed;
 use crate::mech::solve::linear::woodbury::woodbury_correction;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
-use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, MatMut, Par, Side};
+use faer::{Conj, MatMut, Par};
 
 /// LDLᵀ of the symmetric part of a full-pattern matrix, stored on the pattern's lower triangle
 /// (what a symmetric matrix's LDLᵀ reads), the slot of each lower entry's transpose, and the
@@ -46,6 +47,8 @@ pub(super) struct SymmetricPart {
     pub(super) scratch: MemBuffer,
     /// How the last factorization's system was solved (what a held solve repeats).
     pub(super) path: Path,
+    /// Threads of the numeric factorization.
+    pub(super) threads: usize,
 }
 
 /// How a system is solved on the symmetric part's LDLᵀ.
@@ -65,6 +68,7 @@ pub(super) const SKEW_ENTRIES: usize = 1 << 14;
 impl SymmetricPart {
     pub(super) fn new(
         pattern: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+        ordering: FillOrdering,
     ) -> Result<Self, String> {
         let (ptr, rows) = (pattern.col_ptr(), pattern.row_idx());
         let n = pattern.ncols();
@@ -95,13 +99,7 @@ impl SymmetricPart {
         let structural =
             transpose.iter().all(|&t| t != u32::MAX) && 2 * lower_count - n == rows.len();
         let lower = SymbolicSparseColMat::new_checked(n, n, lower_ptr, None, lower_rows);
-        let symbolic = factorize_symbolic_cholesky(
-            lower.as_ref(),
-            Side::Lower,
-            Default::default(),
-            Default::default(),
-        )
-        .map_err(|e| format!("{e:?}"))?;
+        let symbolic = ordering::analyse(lower.as_ref(), ordering).map_err(|e| format!("{e:?}"))?;
         Ok(Self::with_analysis(
             Arc::new(lower),
             Arc::new(symbolic),
@@ -134,26 +132,35 @@ impl SymmetricPart {
             block_columns: 0,
             scratch: MemBuffer::new(StackReq::EMPTY),
             path: Path::Direct,
+            threads: 1,
         };
         part.scratch = MemBuffer::new(part.scratch_req());
         part
     }
 
+    /// Sets the threads of the numeric factorization (resolved: at least 1).
+    pub(super) fn set_threads(&mut self, threads: usize) {
+        self.threads = threads;
+        self.scratch = MemBuffer::new(self.scratch_req());
+    }
+
     pub(super) fn scratch_req(&self) -> StackReq {
         StackReq::any_of(&[
             self.symbolic
-                .factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+                .factorize_numeric_ldlt_scratch::<f64>(pool::par(self.threads), Default::default()),
             self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         ])
     }
 
     pub(super) fn fresh_copy(&self) -> Self {
-        Self::with_analysis(
+        let mut copy = Self::with_analysis(
             self.lower.clone(),
             self.symbolic.clone(),
             self.transpose.clone(),
             self.structural,
-        )
+        );
+        copy.set_threads(self.threads);
+        copy
     }
 
     /// One pass over the lower triangle of `a`: the symmetric part, the row sums of `|A|` and
@@ -245,16 +252,13 @@ impl SymmetricPart {
             self.factor = vec![0.0; self.symbolic.len_val()];
         }
         let s = SparseColMatRef::new(self.lower.as_ref().as_ref(), &self.symmetric_values);
-        let stack = MemStack::new(&mut self.scratch);
         let start = Instant::now();
-        let factored = self.symbolic.factorize_numeric_ldlt(
+        let factored = pool::factorize_ldlt(
+            &self.symbolic,
             &mut self.factor,
             s,
-            Side::Lower,
-            LdltRegularization::default(),
-            Par::Seq,
-            stack,
-            Default::default(),
+            self.threads,
+            &mut self.scratch,
         );
         ctx.profile.ldlt += start.elapsed();
         ctx.profile.ldlt_count += 1;

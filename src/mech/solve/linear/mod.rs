@@ -1,7 +1,8 @@
 //! Sparse factorization of the Newton matrix with the symbolic analysis done once per analysis.
 //!
 //! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer` supernodal/simplicial Cholesky structure,
-//!   AMD ordering), which also handles the indefinite matrices of compressed films;
+//!   AMD ordering, nested dissection from 100 k equations: `ordering.rs`), which also handles
+//!   the indefinite matrices of compressed films;
 //! * the consistent tangent `A` (full pattern): one pass over its lower triangle forms the
 //!   symmetric part `S = (A + Aᵀ)/2` through a transpose map built once, the row sums of `|A|`
 //!   and the entries of the skew part `K = (A − Aᵀ)/2` above `1e-12` of the largest entry; then
@@ -38,6 +39,8 @@
 //! | `woodbury` | the Woodbury correction for a skew part on few DOFs |
 //! | `gmres` | GMRES right-preconditioned by that LDLᵀ |
 //! | `lu` | LU with partial pivoting, the checked fallback |
+//! | `ordering` | the fill-reducing ordering of the LDLᵀ analyses: AMD, or nested dissection from 100 k equations |
+//! | `pool` | the LDLᵀ numeric factorization on a scoped thread pool ([`LinearSolver::set_threads`]) |
 //! | `tests` | the solver's tests |
 
 use std::sync::Arc;
@@ -45,18 +48,22 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
 use faer::sparse::linalg::lu::LuRef;
-use faer::{Conj, MatMut, Par, Side};
+use faer::{Conj, MatMut, Par};
 
 use crate::mech::solve::assembly::{Dof, System};
 
 mod gmres;
 mod ldlt;
 mod lu;
+pub mod ordering;
+mod pool;
 mod woodbury;
+
+pub use ordering::FillOrdering;
+pub use pool::PARALLEL_MIN_FACTOR;
 
 use gmres::{Krylov, gmres};
 use ldlt::SymmetricPart;
@@ -185,6 +192,8 @@ pub struct LinearSolver {
     /// The factor the last factorization left, and its identity (0: none).
     held: Held,
     factor_id: u64,
+    /// Threads of the numeric LDLᵀ factorizations (resolved: at least 1).
+    threads: usize,
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -223,6 +232,7 @@ impl Clone for LinearSolver {
             // The copy's factor values are not copied: it holds none.
             held: Held::None,
             factor_id: 0,
+            threads: self.threads,
         }
     }
 }
@@ -232,17 +242,20 @@ impl LinearSolver {
     /// with `symmetric_when_possible`, LDLᵀ of its symmetric part (LU analysed when first
     /// needed), without it LU.
     pub fn new(system: &System, symmetric_when_possible: bool) -> Result<Self, FactorizationError> {
+        Self::with_ordering(system, symmetric_when_possible, FillOrdering::Auto)
+    }
+
+    /// [`Self::new`] with the LDLᵀ analyses under `ordering` (the LU keeps faer's COLAMD).
+    pub fn with_ordering(
+        system: &System,
+        symmetric_when_possible: bool,
+        ordering: FillOrdering,
+    ) -> Result<Self, FactorizationError> {
         let err =
             |e: faer::sparse::FaerError| FactorizationError(format!("symbolic analysis: {e:?}"));
         let started = Instant::now();
         let kind = if system.is_lower_only() {
-            let symbolic = factorize_symbolic_cholesky(
-                system.pattern(),
-                Side::Lower,
-                Default::default(),
-                Default::default(),
-            )
-            .map_err(err)?;
+            let symbolic = ordering::analyse(system.pattern(), ordering).map_err(err)?;
             let factor = vec![0.0; symbolic.len_val()];
             Kind::Ldlt {
                 symbolic: Arc::new(symbolic),
@@ -252,7 +265,7 @@ impl LinearSolver {
             Kind::Full {
                 lu: None,
                 symmetric: Some(Box::new(
-                    SymmetricPart::new(system.pattern())
+                    SymmetricPart::new(system.pattern(), ordering)
                         .map_err(|e| FactorizationError(format!("symbolic analysis: {e}")))?,
                 )),
             }
@@ -281,6 +294,7 @@ impl LinearSolver {
             profile: SolveProfile::default(),
             held: Held::None,
             factor_id: 0,
+            threads: 1,
         };
         solver.scratch = MemBuffer::new(solver.scratch_req());
         solver.profile.symbolic = started.elapsed();
@@ -290,12 +304,39 @@ impl LinearSolver {
     fn scratch_req(&self) -> StackReq {
         match &self.kind {
             Kind::Ldlt { symbolic, .. } => StackReq::any_of(&[
-                symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+                symbolic.factorize_numeric_ldlt_scratch::<f64>(
+                    pool::par(self.threads),
+                    Default::default(),
+                ),
                 symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
             ]),
             // The parts hold their own.
             Kind::Full { .. } => StackReq::EMPTY,
         }
+    }
+
+    /// Sets the threads of the numeric LDLᵀ factorizations: `requested` when positive, else
+    /// automatic (the available cores for factors of [`PARALLEL_MIN_FACTOR`] values or more,
+    /// else 1). Each factorization starts its threads and joins them before it returns.
+    pub fn set_threads(&mut self, requested: usize) {
+        let threads = pool::resolve(requested, self.factor_len());
+        if threads == self.threads {
+            return;
+        }
+        self.threads = threads;
+        self.scratch = MemBuffer::new(self.scratch_req());
+        if let Kind::Full {
+            symmetric: Some(part),
+            ..
+        } = &mut self.kind
+        {
+            part.set_threads(self.threads);
+        }
+    }
+
+    /// Threads of the numeric LDLᵀ factorizations.
+    pub fn threads(&self) -> usize {
+        self.threads
     }
 
     /// Allows (true, the default) or forbids the LDLᵀ and Krylov paths for full patterns.
@@ -552,19 +593,11 @@ impl LinearSolver {
         };
         match &mut self.kind {
             Kind::Ldlt { symbolic, factor } => {
-                let stack = MemStack::new(&mut self.scratch);
                 let start = Instant::now();
-                let ldlt = symbolic
-                    .factorize_numeric_ldlt(
-                        factor,
-                        matrix,
-                        Side::Lower,
-                        LdltRegularization::default(),
-                        Par::Seq,
-                        stack,
-                        Default::default(),
-                    )
+                pool::factorize_ldlt(symbolic, factor, matrix, self.threads, &mut self.scratch)
                     .map_err(|e| FactorizationError(format!("LDLᵀ: {e:?}")))?;
+                let ldlt = LdltRef::new(&**symbolic, factor);
+                let stack = MemStack::new(&mut self.scratch);
                 self.profile.ldlt += start.elapsed();
                 self.profile.ldlt_count += 1;
                 self.held = Held::Ldlt;

@@ -1,0 +1,245 @@
+//! The gas chambers as a contribution (issue 43; [`crate::mech::elements::chamber`]): the
+//! pressure's nodal forces `p ∂V/∂x`, the load stiffness `−p ∂²V/∂u²` into the sparse matrix,
+//! and the pneumatic stiffness `−(dp/dV) g gᵀ` of each sealed chamber kept aside as a rank-one
+//! term, which the Newton correction adds by the Sherman–Morrison–Woodbury identity
+//! (`solve/low_rank.rs`), never as a dense row.
+
+use nalgebra::Vector3;
+use serde::{Deserialize, Serialize};
+
+use super::{Contribution, Evaluation};
+use crate::mech::elements::chamber::{ChamberGeometry, GasLaw, tet_gradient, tet_hessian};
+use crate::mech::model::Model;
+use crate::mech::results::Results;
+use crate::mech::solve::assembly::{Dof, node_dofs};
+use crate::mech::solve::state::AnalysisState;
+
+/// The gas of one chamber in a converged state (serialized with FMU states).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChamberState {
+    /// Whether the gas is enclosed (else a supply holds the load level's pressure).
+    pub sealed: bool,
+    /// `C = (p + p_a) V^κ` of the enclosed gas at the chamber's reference temperature
+    /// (Pa m^{3κ}; 0 while supplied).
+    pub constant: f64,
+    /// Gauge pressure (Pa) at convergence.
+    pub pressure: f64,
+    /// Volume (m³) at convergence.
+    pub volume: f64,
+    /// The air's temperature (K) at convergence (0 in a state written before it was kept).
+    #[serde(default)]
+    pub temperature: f64,
+}
+
+/// One chamber's result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChamberResult {
+    /// The chamber's name.
+    pub name: String,
+    /// Gauge pressure (Pa).
+    pub pressure: f64,
+    /// Enclosed volume (m³).
+    pub volume: f64,
+    /// Whether the gas is enclosed.
+    pub sealed: bool,
+    /// The air's temperature (K).
+    pub temperature: f64,
+    /// The air's mass (kg, ideal gas).
+    pub mass: f64,
+}
+
+/// The chambers of a model with their state at the start of the increment and at the last
+/// evaluation.
+#[derive(Clone, Debug, Default)]
+pub struct Chambers {
+    geometry: Vec<ChamberGeometry>,
+    laws: Vec<GasLaw>,
+    names: Vec<String>,
+    reference: Vec<Vector3<f64>>,
+    /// The gas at the increment's start.
+    start: Vec<ChamberState>,
+    /// Pressure and volume at the last evaluation.
+    last: Vec<ChamberState>,
+    /// `(−dp/dV, g)` of each sealed chamber at the last evaluation with a matrix: `g` over the
+    /// free equations.
+    low_rank: Vec<(f64, Vec<f64>)>,
+}
+
+impl Chambers {
+    /// The chambers of a validated `model`.
+    pub fn new(model: &Model) -> Self {
+        Self {
+            geometry: model
+                .chambers
+                .iter()
+                .map(|c| ChamberGeometry::new(model, c).expect("validated chamber"))
+                .collect(),
+            laws: model
+                .chambers
+                .iter()
+                .map(|c| GasLaw {
+                    kappa: c.kappa,
+                    atmosphere: c.atmosphere,
+                    temperature: c.temperature,
+                })
+                .collect(),
+            names: model.chambers.iter().map(|c| c.name.clone()).collect(),
+            reference: model.nodes.iter().map(|&p| Vector3::from(p)).collect(),
+            ..Self::default()
+        }
+    }
+
+    /// The gas of each chamber in the reference geometry: sealed ones enclosed at their
+    /// `pressure`, the others supplied.
+    pub fn initial_states(&self, model: &Model) -> Vec<ChamberState> {
+        model
+            .chambers
+            .iter()
+            .zip(&self.geometry)
+            .zip(&self.laws)
+            .map(|((c, g), law)| {
+                let volume = g.volume(&self.reference);
+                ChamberState {
+                    sealed: c.sealed,
+                    constant: if c.sealed {
+                        law.constant(c.pressure, volume, c.temperature)
+                    } else {
+                        0.0
+                    },
+                    pressure: if c.sealed { c.pressure } else { 0.0 },
+                    volume,
+                    temperature: c.temperature,
+                }
+            })
+            .collect()
+    }
+
+    /// Chamber `k`'s air `c` enclosed at its converged pressure and volume (the inflation
+    /// unit's valve closes; unchanged if enclosed already); Err where it encloses no volume.
+    pub fn enclosed(&self, k: usize, c: &ChamberState) -> Result<ChamberState, String> {
+        if c.sealed {
+            return Ok(*c);
+        }
+        if !(c.volume > 0.0) {
+            return Err(format!(
+                "chamber '{}' encloses no volume ({:e} m³): it cannot be sealed",
+                self.names[k], c.volume
+            ));
+        }
+        Ok(ChamberState {
+            sealed: true,
+            constant: self.laws[k].constant(c.pressure, c.volume, c.temperature),
+            ..*c
+        })
+    }
+
+    /// Whether the model has a sealed chamber now (a pneumatic stiffness to add).
+    pub fn any_sealed(&self) -> bool {
+        self.start.iter().any(|c| c.sealed)
+    }
+
+    /// The rank-one terms `(a, g)` of the last evaluation with a matrix (`a g gᵀ` to add to it).
+    pub fn low_rank(&self) -> &[(f64, Vec<f64>)] {
+        &self.low_rank
+    }
+
+    /// Each chamber's volume (m³) at the displacements `u`.
+    fn volumes(&self, u: &[f64]) -> Vec<f64> {
+        let x: Vec<Vector3<f64>> = self
+            .reference
+            .iter()
+            .enumerate()
+            .map(|(v, p)| p + Vector3::new(u[3 * v], u[3 * v + 1], u[3 * v + 2]))
+            .collect();
+        self.geometry.iter().map(|g| g.volume(&x)).collect()
+    }
+}
+
+impl Contribution for Chambers {
+    fn restore(&mut self, start: &AnalysisState) {
+        self.start.clone_from(&start.chambers);
+    }
+
+    fn at_converged(&mut self, state: &AnalysisState) {
+        self.start.clone_from(&state.chambers);
+    }
+
+    fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], mut values: Option<&mut [f64]>) {
+        if self.geometry.is_empty() {
+            return;
+        }
+        let volumes = self.volumes(at.u);
+        self.last.clear();
+        self.low_rank.clear();
+        let system = at.system;
+        for (k, g) in self.geometry.iter().enumerate() {
+            // Before any restore (a first evaluation) the air is the reference's, supplied.
+            let gas = self.start.get(k).copied().unwrap_or_default();
+            let v = volumes[k];
+            let law = &self.laws[k];
+            let t = law.temperature + at.levels.heating.get(k).copied().unwrap_or(0.0);
+            let p = if gas.sealed {
+                law.pressure(gas.constant, v, t)
+            } else {
+                at.levels.chambers.get(k).copied().unwrap_or(0.0)
+            };
+            self.last.push(ChamberState {
+                pressure: p,
+                volume: v,
+                temperature: t,
+                ..gas
+            });
+            let mut gradient = gas.sealed.then(|| vec![0.0; system.free_count]);
+            for (e, sign, nodes) in g.oriented() {
+                let x = nodes.map(|n| {
+                    self.reference[n] + Vector3::new(at.u[3 * n], at.u[3 * n + 1], at.u[3 * n + 2])
+                });
+                let ge = tet_gradient(&g.origin, &x) * sign;
+                for (i, d) in node_dofs(&nodes).into_iter().enumerate() {
+                    residual[d] -= p * ge[i];
+                    if let (Some(grad), Dof::Free(eq)) = (gradient.as_mut(), &system.dofs[d]) {
+                        grad[*eq] += ge[i];
+                    }
+                }
+                if let Some(values) = values.as_deref_mut() {
+                    let h = tet_hessian(&g.origin, &x) * (-p * sign);
+                    system.add_element_matrix(e, &h, values);
+                }
+            }
+            if let (Some(grad), true) = (gradient, values.is_some()) {
+                let a = -law.slope(gas.constant, v, t);
+                self.low_rank.push((a, grad));
+            }
+        }
+    }
+
+    fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
+        if !self.geometry.is_empty() {
+            state.chambers.clone_from(&self.last);
+        }
+    }
+
+    fn results(
+        &self,
+        _at: &Evaluation<'_>,
+        state: &AnalysisState,
+        _model: &Model,
+        out: &mut Results,
+    ) {
+        out.chambers = state
+            .chambers
+            .iter()
+            .zip(&self.names)
+            .zip(&self.laws)
+            .map(|((c, name), law)| ChamberResult {
+                name: name.clone(),
+                pressure: c.pressure,
+                volume: c.volume,
+                sealed: c.sealed,
+                temperature: c.temperature,
+                mass: law.mass(c.pressure, c.volume, c.temperature),
+            })
+            .collect();
+    }
+}
