@@ -258,7 +258,9 @@ fn orient(model: &Model, triangles: &[usize]) -> Result<Vec<f64>, String> {
     }
     if let Some(((a, b), _)) = by_edge.iter().find(|(_, ks)| ks.len() > 2) {
         return Err(format!(
-            "edge ({a}, {b}) is shared by more than two of its triangles"
+            "edge ({a}, {b}) is shared by more than two of its triangles (layers welded at a rim \
+             must not share an edge off it: mesh the corner cells so that no triangle has all \
+             three nodes on the rim)"
         ));
     }
     // Whether triangle k traverses a → b in its node order.

@@ -69,6 +69,12 @@ pub fn check_results(
             ));
         }
     }
+    for (r, c) in results.chambers.iter().zip(&model.chambers) {
+        let values = [r.pressure, r.volume, r.temperature, r.mass];
+        if let Some(x) = values.iter().find(|x| !x.is_finite()) {
+            return Err(format!("air of chamber {} = {x}", c.name));
+        }
+    }
     for (r, c) in results.cables.iter().zip(&model.cables) {
         if !r.max_force.is_finite() {
             return Err(format!("axial force of cable {} = {}", c.name, r.max_force));
@@ -140,5 +146,19 @@ mod tests {
         }
         let e = check_results(model, &good, Some(f64::NAN)).unwrap_err();
         assert!(e.contains("residual"), "{e}");
+    }
+
+    /// A chamber's air that is not finite (its volume gone to zero under a sealed gas) is named.
+    #[test]
+    fn a_chambers_non_finite_air_is_named() {
+        let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion_air.json");
+        let model = Model::from_json(&std::fs::read_to_string(example).unwrap()).unwrap();
+        let mut a = Analysis::new(model, Default::default()).unwrap();
+        let good = a.results();
+        check_results(a.model(), &good, None).unwrap();
+        let mut r = good.clone();
+        r.chambers[0].pressure = f64::INFINITY;
+        let e = check_results(a.model(), &r, None).unwrap_err();
+        assert!(e.contains("air of chamber air = inf"), "{e}");
     }
 }

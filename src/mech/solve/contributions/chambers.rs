@@ -190,7 +190,9 @@ impl Contribution for Chambers {
                 temperature: t,
                 ..gas
             });
-            let mut gradient = gas.sealed.then(|| vec![0.0; system.free_count]);
+            // `g` over the free equations, for the rank-one term: only where a matrix is asked.
+            let mut gradient =
+                (gas.sealed && values.is_some()).then(|| vec![0.0; system.free_count]);
             for (e, sign, nodes) in g.oriented() {
                 let x = nodes.map(|n| {
                     self.reference[n] + Vector3::new(at.u[3 * n], at.u[3 * n + 1], at.u[3 * n + 2])
@@ -207,7 +209,7 @@ impl Contribution for Chambers {
                     system.add_element_matrix(e, &h, values);
                 }
             }
-            if let (Some(grad), true) = (gradient, values.is_some()) {
+            if let Some(grad) = gradient {
                 let a = -law.slope(gas.constant, v, t);
                 self.low_rank.push((a, grad));
             }
