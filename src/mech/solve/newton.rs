@@ -122,6 +122,81 @@ fn cycling(statuses: &[Vec<GapStatus>]) -> Option<Vec<Option<GapStatus>>> {
     held.iter().any(Option::is_some).then_some(held)
 }
 
+/// The iteration state of one increment.
+struct Iterates {
+    /// The iterate, and the one before the last correction.
+    u: Vec<f64>,
+    previous_u: Vec<f64>,
+    /// `‖R_free‖∞` of every iterate.
+    residuals: Vec<f64>,
+    /// Whether the workspace holds the residual and the matrix at `u`.
+    assembled: bool,
+    /// `‖ΔU‖∞` of the last correction (infinite before the first).
+    correction: f64,
+    ptc: Continuation,
+    /// The pseudo-time force of the last correction (N).
+    artificial: f64,
+    progress: Progress,
+    /// `‖R‖₂` of the last accepted iterates (the nonmonotone line search's reference).
+    merits: Vec<f64>,
+    hold: Hold,
+}
+
+impl Iterates {
+    /// The state at the predictor `u`; `fixed`: a model without free DOFs (every node
+    /// prescribed or fixed: how single elements are verified), converged at its first assembly.
+    fn new(u: Vec<f64>, fixed: bool) -> Self {
+        Self {
+            previous_u: u.clone(),
+            u,
+            residuals: Vec::new(),
+            assembled: false,
+            correction: if fixed { 0.0 } else { f64::INFINITY },
+            ptc: Continuation::new(),
+            artificial: 0.0,
+            progress: Progress {
+                best: f64::INFINITY,
+                best_correction: f64::INFINITY,
+                best_at: 0,
+                closest: None,
+                statuses: Vec::new(),
+            },
+            merits: Vec::new(),
+            hold: Hold::default(),
+        }
+    }
+
+    /// Newton's iteration afresh from the same iterate at `iteration` (the laws were held or
+    /// released).
+    fn restart(&mut self, iteration: usize) {
+        (self.assembled, self.correction) = (false, f64::INFINITY);
+        self.merits.clear();
+        self.ptc.c = 0.0;
+        (self.progress.best, self.progress.best_correction) = (f64::INFINITY, f64::INFINITY);
+        self.progress.best_at = iteration;
+    }
+
+    /// After the line search moved `u` by the share `step` of the correction to the merit
+    /// `merit`, with the pseudo-time force `force`: SER after a full step (a shortened one keeps
+    /// `c`); a step back to the merit of two iterates ago is a two-cycle (between pieces of `R`
+    /// the contact statuses do not name): a shorter pseudo-time step next.
+    fn stepped(&mut self, step: f64, merit: f64, force: f64) {
+        let n = self.merits.len();
+        if n >= 2 && (merit - self.merits[n - 2]).abs() <= 1e-9 * merit {
+            self.ptc.reject();
+        } else if step == 1.0 {
+            self.ptc.accept(self.merits[n - 1], merit);
+        }
+        self.assembled = step == 1.0;
+        self.correction *= step;
+        self.artificial = force;
+        self.merits.push(merit);
+        if self.merits.len() > Analysis::MEMORY {
+            self.merits.remove(0);
+        }
+    }
+}
+
 impl Analysis {
     /// Newton's iteration for one increment from the converged `start` to the group motion
     /// `motion` and the load levels `levels`: the full correction of
@@ -134,155 +209,147 @@ impl Analysis {
         motion: &GroupMotion,
         levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
-        let mut u = self.predict(start, motion);
+        let u = self.predict(start, motion);
         for c in self.parts.all_mut() {
             c.restore(start);
         }
-        // A model without free DOFs (every node prescribed or fixed: how single elements are
-        // verified) converges at its first assembly.
-        let mut correction = if self.system.free_count == 0 {
-            0.0
-        } else {
-            f64::INFINITY
-        };
-        let mut previous_u = u.clone();
-        let mut residuals = Vec::new();
-        let mut assembled = false;
-        let mut ptc = Continuation::new();
-        // The pseudo-time force of the last correction (N).
-        let mut artificial = 0.0_f64;
-        let mut progress = Progress {
-            best: f64::INFINITY,
-            best_correction: f64::INFINITY,
-            best_at: 0,
-            closest: None,
-            statuses: Vec::new(),
-        };
-        // `‖R‖₂` of the last accepted iterates (the nonmonotone line search's reference).
-        let mut merits: Vec<f64> = Vec::new();
-        let mut hold = Hold::default();
+        let mut it = Iterates::new(u, self.system.free_count == 0);
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
-            if !assembled {
-                self.assemble_at(&u, levels, Some(iteration));
+            if !it.assembled {
+                self.assemble_at(&it.u, levels, Some(iteration));
             }
-            let residual = self.free_norm_inf();
-            if !residual.is_finite() {
-                return Err(IncrementFailure::Diverged { iteration });
-            }
-            residuals.push(residual);
-            if merits.is_empty() {
-                merits.push(self.free_norm2());
-            }
-            progress.statuses.push(self.parts.statuses());
-            let moved = max_abs_difference(&u, &start.displacement);
-            let displacement_scale = moved.max(max_abs(&u)).max(1e-9 * self.length_scale);
-            let force_scale = max_abs(&self.work.internal).max(self.force_floor);
-            let record = IterationRecord {
-                iteration,
-                residual,
-                residual_tolerance: s.residual_tolerance * force_scale,
-                correction,
-                correction_tolerance: s.displacement_tolerance * displacement_scale,
-            };
+            let (record, force_scale) = self.observe(&mut it, start, iteration)?;
             let met = (iteration > 0 || self.system.free_count == 0)
                 && record.correction <= record.correction_tolerance
-                && residual <= record.residual_tolerance
-                && artificial <= record.residual_tolerance;
-            if met && hold.held.is_empty() {
-                return self.commit_increment(start, motion, levels, u, residuals, iteration);
+                && record.residual <= record.residual_tolerance
+                && it.artificial <= record.residual_tolerance;
+            if met && it.hold.held.is_empty() {
+                return self.commit_increment(start, motion, levels, it.u, it.residuals, iteration);
             }
-            let improved = progress.note(record);
+            let improved = it.progress.note(record);
             if iteration == s.max_iterations {
-                return Err(IncrementFailure::MaxIterations {
-                    first_residual: residuals[0],
-                    last: record,
-                    matrix: s.iteration_matrix,
-                    chattering: self.chattering(&progress.statuses),
-                    flipping: self.flipping_elements(&previous_u, &u),
-                    compressed: self.compressed_elements(&u),
-                });
+                return Err(self.failure(&it, record, false));
             }
-            if let Some(held) = hold.next(met, &progress.statuses) {
+            if let Some(held) = it.hold.next(met, &it.progress.statuses) {
                 // The laws changed: the same iterate evaluated again, Newton's iteration afresh.
                 self.parts.hold(&held);
-                (assembled, correction) = (false, f64::INFINITY);
-                merits.clear();
-                ptc.c = 0.0;
-                (progress.best, progress.best_correction) = (f64::INFINITY, f64::INFINITY);
-                progress.best_at = iteration;
+                it.restart(iteration);
                 continue;
             }
-            if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
+            if iteration > 3 && record.residual > 1e6 * it.residuals[0].max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
             }
             // The Ju–Rowlands matrix converges linearly by design: judged by the limit only.
             if !improved
                 && s.iteration_matrix == IterationMatrix::Consistent
-                && iteration >= progress.best_at + Self::STALL_PATIENCE
+                && iteration >= it.progress.best_at + Self::STALL_PATIENCE
             {
-                return Err(IncrementFailure::Stalled {
-                    iteration,
-                    closest: progress.closest.unwrap_or(record),
-                    chattering: self.chattering(&progress.statuses),
-                    flipping: self.flipping_elements(&previous_u, &u),
-                    compressed: self.compressed_elements(&u),
-                });
+                return Err(self.failure(&it, record, true));
             }
-            let c = ptc.c;
-            correction = match self.correction(&mut ptc) {
-                Ok(norm) if norm.is_finite() => norm,
-                Ok(_) => return Err(IncrementFailure::Diverged { iteration }),
-                Err(_) => {
-                    // A singular matrix: a shorter pseudo-time step from the same iterate.
-                    ptc.reject();
-                    assembled = false;
-                    continue;
-                }
-            };
-            let reference = [
-                merits.iter().copied().fold(0.0, f64::max),
-                merits[merits.len() - 1],
-            ];
-            previous_u.clone_from(&u);
-            let tolerance = record.residual_tolerance;
-            let statuses = progress.statuses.last().cloned().unwrap_or_default();
-            match self.step_along(
-                &mut u,
-                levels,
-                iteration + 1,
-                reference,
-                tolerance,
-                &statuses,
-            ) {
-                Some((step, merit)) => {
-                    // SER after a full step; a shortened one keeps `c`. A step back to the merit
-                    // of two iterates ago is a two-cycle (between pieces of `R` the contact
-                    // statuses do not name): a shorter pseudo-time step next.
-                    let n = merits.len();
-                    if n >= 2 && (merit - merits[n - 2]).abs() <= 1e-9 * merit {
-                        ptc.reject();
-                    } else if step == 1.0 {
-                        ptc.accept(merits[n - 1], merit);
-                    }
-                    assembled = step == 1.0;
-                    correction *= step;
-                    let (work, force) =
-                        ptc.work_and_force(c * step, &self.work.rhs, &self.work.pseudo_mass);
-                    self.work.pseudo_time_work += work * step;
-                    artificial = force;
-                    merits.push(merit);
-                    if merits.len() > Self::MEMORY {
-                        merits.remove(0);
-                    }
-                }
-                None => {
-                    ptc.reject();
-                    (assembled, correction) = (false, f64::INFINITY);
-                }
-            }
+            self.advance(&mut it, levels, iteration, record.residual_tolerance)?;
         }
         unreachable!("the loop returns at max_iterations")
+    }
+
+    /// The figures of the assembled iterate `it.u` against the tolerances (and the force scale
+    /// `F_ref`), noted in `it`.
+    fn observe(
+        &self,
+        it: &mut Iterates,
+        start: &AnalysisState,
+        iteration: usize,
+    ) -> Result<(IterationRecord, f64), IncrementFailure> {
+        let residual = self.free_norm_inf();
+        if !residual.is_finite() {
+            return Err(IncrementFailure::Diverged { iteration });
+        }
+        it.residuals.push(residual);
+        if it.merits.is_empty() {
+            it.merits.push(self.free_norm2());
+        }
+        it.progress.statuses.push(self.parts.statuses());
+        let moved = max_abs_difference(&it.u, &start.displacement);
+        let displacement_scale = moved.max(max_abs(&it.u)).max(1e-9 * self.length_scale);
+        let force_scale = max_abs(&self.work.internal).max(self.force_floor);
+        let s = self.settings;
+        let record = IterationRecord {
+            iteration,
+            residual,
+            residual_tolerance: s.residual_tolerance * force_scale,
+            correction: it.correction,
+            correction_tolerance: s.displacement_tolerance * displacement_scale,
+        };
+        Ok((record, force_scale))
+    }
+
+    /// The failure of an increment at `record`: stalled, or at the iteration limit.
+    fn failure(&self, it: &Iterates, record: IterationRecord, stalled: bool) -> IncrementFailure {
+        let chattering = self.chattering(&it.progress.statuses);
+        let flipping = self.flipping_elements(&it.previous_u, &it.u);
+        let compressed = self.compressed_elements(&it.u);
+        if stalled {
+            IncrementFailure::Stalled {
+                iteration: record.iteration,
+                closest: it.progress.closest.unwrap_or(record),
+                chattering,
+                flipping,
+                compressed,
+            }
+        } else {
+            IncrementFailure::MaxIterations {
+                first_residual: it.residuals[0],
+                last: record,
+                matrix: self.settings.iteration_matrix,
+                chattering,
+                flipping,
+                compressed,
+            }
+        }
+    }
+
+    /// One iteration from the assembled `it.u`: the correction with the pseudo-time shift, then
+    /// the line search along it ([`Self::step_along`]), `c` by SER after a full step and
+    /// lengthened where no step is found or the matrix is singular.
+    fn advance(
+        &mut self,
+        it: &mut Iterates,
+        levels: &LoadLevels,
+        iteration: usize,
+        tolerance: f64,
+    ) -> Result<(), IncrementFailure> {
+        let c = it.ptc.c;
+        match self.correction(&mut it.ptc) {
+            Ok(norm) if norm.is_finite() => it.correction = norm,
+            Ok(_) => return Err(IncrementFailure::Diverged { iteration }),
+            Err(_) => {
+                // A singular matrix: a shorter pseudo-time step from the same iterate.
+                it.ptc.reject();
+                it.assembled = false;
+                return Ok(());
+            }
+        }
+        let reference = [
+            it.merits.iter().copied().fold(0.0, f64::max),
+            it.merits[it.merits.len() - 1],
+        ];
+        it.previous_u.clone_from(&it.u);
+        let statuses = it.progress.statuses.last().cloned().unwrap_or_default();
+        let next = iteration + 1;
+        match self.step_along(&mut it.u, levels, next, reference, tolerance, &statuses) {
+            Some((step, merit)) => {
+                let (work, force) =
+                    it.ptc
+                        .work_and_force(c * step, &self.work.rhs, &self.work.pseudo_mass);
+                self.work.pseudo_time_work += work * step;
+                it.stepped(step, merit, force);
+            }
+            None => {
+                it.ptc.reject();
+                (it.assembled, it.correction) = (false, f64::INFINITY);
+            }
+        }
+        Ok(())
     }
 
     /// The converged iterate `u` of the increment from `start`: the state with the trial history

@@ -71,6 +71,13 @@ pub const STABILIZATION_BOUND: f64 = 2e-4;
 pub const DISSIPATION_BOUND: f64 = 0.05;
 
 impl StepReport {
+    /// Notes an increment that converged with the residual `history` (one per iterate).
+    pub(crate) fn note_converged(&mut self, history: Vec<f64>) {
+        self.iterations.push(history.len().saturating_sub(1));
+        self.residual = *history.last().unwrap_or(&0.0);
+        self.residual_history = history;
+    }
+
     /// [`Self::stabilization_energy`] over [`Self::strain_energy`] (0 without stabilization).
     pub fn stabilization_ratio(&self) -> f64 {
         ratio(self.stabilization_energy, self.strain_energy)
