@@ -858,7 +858,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "solver.dissipationRatio",
         "1",
         "work of the viscous stabilization over the last step over the film's strain energy (Abaqus' \
-         ALLSD/ALLIE); above 0.05 the step warns, above 1 it is discarded",
+         ALLSD/ALLIE); above 0.05 the step warns, above 1 the warning says the state is the damping's",
         Binding::DissipationRatio,
     );
     table.0

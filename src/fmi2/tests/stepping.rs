@@ -43,7 +43,7 @@ fn a_step_that_cannot_converge_is_discarded_and_can_be_retried() {
     }
     for (name, value) in [
         ("solver.maxCutbacks", 0),
-        ("solver.maxIterations", 5),
+        ("solver.maxIterations", 10),
         ("solver.incrementsPerStep", 1),
     ] {
         assert_eq!(fmu.set_integer(name, value), 0, "{name}");
@@ -104,7 +104,7 @@ fn repeating_a_refused_step_identically_reports_terminated() {
     let (u, log) = (Unpacked::specimen("terminated"), Log::default());
     let settings = [
         ("solver.maxCutbacks", 0),
-        ("solver.maxIterations", 5),
+        ("solver.maxIterations", 10),
         ("solver.incrementsPerStep", 1),
     ];
     // Without the viscous stabilization, whose rows of the strategy table would try on.

@@ -140,6 +140,8 @@ struct Iterates {
     /// `‖R‖₂` of the last accepted iterates (the nonmonotone line search's reference).
     merits: Vec<f64>,
     hold: Hold,
+    /// The smallest positive `c` so far: the pseudo-time reached.
+    lowest_c: f64,
 }
 
 impl Iterates {
@@ -163,7 +165,22 @@ impl Iterates {
             },
             merits: Vec::new(),
             hold: Hold::default(),
+            lowest_c: f64::INFINITY,
         }
+    }
+
+    /// Notes `record`; true where it made progress: its residual or correction
+    /// [`Analysis::PROGRESS`] below the best, or the continuation's `c` that much below its
+    /// smallest (the pseudo-time step lengthens while the residual waits for it: a film held by
+    /// the pseudo-mass until its own stiffness takes over).
+    fn progressed(&mut self, record: IterationRecord) -> bool {
+        let c = self.ptc.c;
+        let continuing = c > 0.0 && c < Analysis::PROGRESS * self.lowest_c;
+        if continuing {
+            self.lowest_c = c;
+            self.progress.best_at = record.iteration;
+        }
+        self.progress.note(record) || continuing
     }
 
     /// Newton's iteration afresh from the same iterate at `iteration` (the laws were held or
@@ -174,6 +191,7 @@ impl Iterates {
         self.ptc.c = 0.0;
         (self.progress.best, self.progress.best_correction) = (f64::INFINITY, f64::INFINITY);
         self.progress.best_at = iteration;
+        self.lowest_c = f64::INFINITY;
     }
 
     /// After the line search moved `u` by the share `step` of the correction to the merit
@@ -227,7 +245,7 @@ impl Analysis {
             if met && it.hold.held.is_empty() {
                 return self.commit_increment(start, motion, levels, it.u, it.residuals, iteration);
             }
-            let improved = it.progress.note(record);
+            let improved = it.progressed(record);
             if iteration == s.max_iterations {
                 return Err(self.failure(&it, record, false));
             }
