@@ -1,4 +1,4 @@
-//! `fmu-pack`: packs the FMI 2.0 Co-Simulation FMU.
+//! `fmu-pack`: packs the FMI 2.0 (or, with `--fmi-version 3`, 3.0) Co-Simulation FMU.
 //!
 //! ```text
 //! fmu-pack                       → target/fmu/ParallelArch.fmu (the paper's specimen, 300 mm)
@@ -6,6 +6,7 @@
 //! fmu-pack model.json --out DIR  → DIR/<model name>.fmu
 //! fmu-pack model.json -o FILE    → FILE (any name ending in .fmu)
 //! fmu-pack --platforms linux64,win64,aarch64-linux   → one FMU with three binaries
+//! fmu-pack --fmi-version 3       → target/fmu/ParallelArch_fmi3.fmu (FMI 3.0)
 //! ```
 //!
 //! The archive holds
@@ -24,6 +25,14 @@
 //! * `resources/parallel_arch.json` or `resources/model.json`, from which `fmi2Instantiate`
 //!   rebuilds the model, the variable table and the GUID;
 //! * `documentation/index.html`.
+//!
+//! With `--fmi-version 3` the description is the FMI 3.0 one rendered from the same variable
+//! table (`membrane_contact::fmi3::description`, its instantiation token the 2.0 GUID), the
+//! archive has `terminalsAndIcons/terminalsAndIcons.xml` (a terminal per boundary group,
+//! `membrane_contact::fmi3::terminals`), the binaries go to FMI 3.0's `<arch>-<os>` folders
+//! (`x86_64-linux`, …), and the default file name
+//! is `<modelIdentifier>_fmi3.fmu`, so that it never replaces the FMI 2.0 FMU. The library is
+//! the same: it exports both interfaces.
 //!
 //! A model file that does not validate is refused before anything is written; one that looks
 //! wrong (`mech::summary::model_warnings`: E in MPa, …) is packed with the warnings on stderr.
@@ -53,9 +62,9 @@ use zip::{CompressionMethod, ZipWriter};
 
 const USAGE: &str = "\
 usage: fmu-pack [MODEL.json] [--out DIR | -o FILE] [--force] [--platforms LIST]
-                [--library [PLATFORM=]PATH]...
+                [--library [PLATFORM=]PATH]... [--fmi-version 2|3]
 
-Packs an FMI 2.0 Co-Simulation FMU. Without MODEL.json it packs the paper's parallel-arch
+Packs an FMI 2.0 (or 3.0) Co-Simulation FMU. Without MODEL.json it packs the paper's parallel-arch
 specimen (ParallelArch.fmu); with it, an FMU of that model, named after the model's `name`.
 
 options:
@@ -77,6 +86,10 @@ options:
                    one found: for linux64 the newest libmembrane_contact.so next to this
                    program, in target/release or target/release/deps (for an fmu-pack installed
                    with pip, PREFIX/lib/membrane-contact/); repeatable
+  --fmi-version 2|3
+                   the FMI version of the FMU (default 2); a 3.0 FMU is named
+                   <modelIdentifier>_fmi3.fmu by default, its binaries are in FMI 3.0's folders
+                   (x86_64-linux, x86_64-windows, aarch64-linux, x86_64-darwin, aarch64-darwin)
   -h, --help       this text";
 
 const LIBRARY: &str = "libmembrane_contact.so";
@@ -93,6 +106,8 @@ struct Platform {
     cargo_file: &'static str,
     /// The extension of `<modelIdentifier>.<ext>` in the FMU.
     extension: &'static str,
+    /// The folder under `binaries/` in an FMI 3.0 FMU (`<arch>-<os>`, FMI 3.0 §2.5.1.1).
+    fmi3_folder: &'static str,
 }
 
 /// Every platform `--platforms` knows, the host's (linux64) first.
@@ -102,30 +117,35 @@ const PLATFORMS: [Platform; 5] = [
         triple: "x86_64-unknown-linux-gnu",
         cargo_file: LIBRARY,
         extension: "so",
+        fmi3_folder: "x86_64-linux",
     },
     Platform {
         folder: "win64",
         triple: "x86_64-pc-windows-gnu",
         cargo_file: "membrane_contact.dll",
         extension: "dll",
+        fmi3_folder: "x86_64-windows",
     },
     Platform {
         folder: "aarch64-linux",
         triple: "aarch64-unknown-linux-gnu",
         cargo_file: LIBRARY,
         extension: "so",
+        fmi3_folder: "aarch64-linux",
     },
     Platform {
         folder: "darwin64",
         triple: "x86_64-apple-darwin",
         cargo_file: "libmembrane_contact.dylib",
         extension: "dylib",
+        fmi3_folder: "x86_64-darwin",
     },
     Platform {
         folder: "aarch64-darwin",
         triple: "aarch64-apple-darwin",
         cargo_file: "libmembrane_contact.dylib",
         extension: "dylib",
+        fmi3_folder: "aarch64-darwin",
     },
 ];
 
@@ -148,6 +168,8 @@ struct Options {
     platforms: Vec<Platform>,
     /// Libraries given with `--library`, by platform.
     libraries: Vec<(Platform, PathBuf)>,
+    /// 2 or 3 (`--fmi-version`).
+    fmi_version: u8,
 }
 
 fn parse(args: &[String]) -> Result<Options, String> {
@@ -158,6 +180,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         force: false,
         platforms: vec![PLATFORMS[0]],
         libraries: Vec::new(),
+        fmi_version: 2,
     };
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -171,6 +194,13 @@ fn parse(args: &[String]) -> Result<Options, String> {
             "--out" => o.out = Some(value("--out")?),
             "-o" | "--output" => o.file = Some(value(a)?),
             "--force" => o.force = true,
+            "--fmi-version" => {
+                o.fmi_version = match value("--fmi-version")?.to_str() {
+                    Some("2") | Some("2.0") => 2,
+                    Some("3") | Some("3.0") => 3,
+                    v => return Err(format!("--fmi-version {v:?}: 2 or 3")),
+                }
+            }
             "--platforms" => {
                 let list = value("--platforms")?;
                 let list = list.to_string_lossy();
@@ -325,6 +355,7 @@ fn write_fmu(
     d: &Description,
     source: &Source,
     libraries: &[(Platform, Vec<u8>)],
+    fmi_version: u8,
 ) -> Result<(), String> {
     let io = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let tmp = path.with_extension("fmu.partial");
@@ -336,19 +367,34 @@ fn write_fmu(
     let binary = text.unix_permissions(0o755);
     let (resource_name, resource_text) = source.resource_file();
     let documentation = documentation_html(d);
+    let xml = match fmi_version {
+        3 => membrane_contact::fmi3::description::model_description(d),
+        _ => d.xml.clone(),
+    };
     let binaries = libraries.iter().map(|(p, bytes)| {
+        let folder = if fmi_version == 3 {
+            p.fmi3_folder
+        } else {
+            p.folder
+        };
         (
-            format!(
-                "binaries/{}/{}.{}",
-                p.folder, d.model_identifier, p.extension
-            ),
+            format!("binaries/{folder}/{}.{}", d.model_identifier, p.extension),
             bytes.as_slice(),
             binary,
         )
     });
+    let terminals = match fmi_version {
+        3 => membrane_contact::fmi3::terminals::terminals_and_icons(d),
+        _ => None,
+    };
+    let terminals = terminals.as_ref().map(|t| {
+        let name = "terminalsAndIcons/terminalsAndIcons.xml".to_string();
+        (name, t.as_bytes(), text)
+    });
     let entries: Vec<(String, &[u8], SimpleFileOptions)> =
-        std::iter::once(("modelDescription.xml".into(), d.xml.as_bytes(), text))
+        std::iter::once(("modelDescription.xml".into(), xml.as_bytes(), text))
             .chain(binaries)
+            .chain(terminals)
             .chain([
                 (
                     format!("resources/{resource_name}"),
@@ -445,13 +491,15 @@ fn run(o: &Options) -> Result<(), String> {
         libraries.push((p, bytes));
     }
     let cargo_fmu = cargo_target_fmu_dir(&dir);
+    let suffix = if o.fmi_version == 3 { "_fmi3" } else { "" };
+    let file_name = format!("{}{suffix}.fmu", description.model_identifier);
     let path = match (&o.file, &o.out) {
         (Some(file), _) => file.clone(),
-        (None, Some(d)) => d.join(format!("{}.fmu", description.model_identifier)),
+        (None, Some(d)) => d.join(file_name),
         (None, None) => cargo_fmu
             .clone()
             .unwrap_or_else(|| PathBuf::from("."))
-            .join(format!("{}.fmu", description.model_identifier)),
+            .join(file_name),
     };
     let out_dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -464,12 +512,19 @@ fn run(o: &Options) -> Result<(), String> {
         let specimen = cargo_fmu.map(|d| d.join(format!("{MODEL_NAME}.fmu")));
         refuse_to_replace_the_specimen(&path, specimen.as_deref(), &model.name)?;
     }
-    write_fmu(&path, &description, &source, &libraries)?;
+    write_fmu(&path, &description, &source, &libraries, o.fmi_version)?;
     let size = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    let (version, arrays) = match o.fmi_version {
+        3 => {
+            let arrays = membrane_contact::fmi3::arrays::Arrays::of(&description);
+            (" FMI 3.0,", arrays.fields().count())
+        }
+        _ => ("", 0),
+    };
     println!(
-        "{}: {} variables, GUID {}, {:.1} MB (library {})",
+        "{}:{version} {} variables, GUID {}, {:.1} MB (library {})",
         path.display(),
-        description.variables.len(),
+        description.variables.len() + arrays,
         description.guid,
         size as f64 / 1e6,
         shipped.join("; ")
@@ -498,6 +553,43 @@ mod tests {
 
     fn options(args: &[&str]) -> Result<Options, String> {
         parse(&args.iter().map(|a| a.to_string()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn every_platform_has_its_fmi3_folder_arch_then_os() {
+        let folders: Vec<(&str, &str)> = PLATFORMS
+            .iter()
+            .map(|p| (p.folder, p.fmi3_folder))
+            .collect();
+        assert_eq!(
+            folders,
+            [
+                ("linux64", "x86_64-linux"),
+                ("win64", "x86_64-windows"),
+                ("aarch64-linux", "aarch64-linux"),
+                ("darwin64", "x86_64-darwin"),
+                ("aarch64-darwin", "aarch64-darwin"),
+            ]
+        );
+        for p in PLATFORMS {
+            let (arch, os) = p.fmi3_folder.split_once('-').unwrap();
+            assert!(
+                p.triple.starts_with(arch) && p.triple.contains(os),
+                "{}",
+                p.triple
+            );
+        }
+    }
+
+    #[test]
+    fn fmi_version_defaults_to_2_and_takes_only_2_or_3() {
+        assert_eq!(options(&[]).unwrap().fmi_version, 2);
+        assert_eq!(options(&["--fmi-version", "3"]).unwrap().fmi_version, 3);
+        assert_eq!(options(&["--fmi-version", "2.0"]).unwrap().fmi_version, 2);
+        for bad in ["1", "3.1", "x"] {
+            let e = options(&["--fmi-version", bad]).err().unwrap();
+            assert!(e.contains("2 or 3"), "{e}");
+        }
     }
 
     #[test]

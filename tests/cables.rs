@@ -80,6 +80,7 @@ fn strip(cables: bool, n0: f64) -> Model {
         },
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
     }
 }
 

@@ -5,7 +5,7 @@
 use membrane_contact::mech::elements::load::LoadLevels;
 use membrane_contact::mech::elements::triangle::Material;
 use membrane_contact::mech::model::{
-    AllElements, ChamberSpec, ClosingPlane, ElementSelection, Model, PressureSet, Towards,
+    AllElements, ChamberSpec, ClosingPlane, ElementSelection, Layer, Model, PressureSet, Towards,
 };
 use membrane_contact::mech::solve::assembly::{Dof, System};
 use membrane_contact::mech::solve::contributions::{Chambers, Contribution, Evaluation};
@@ -344,14 +344,14 @@ fn cushion_air_example_encloses_0_196_cubic_metres_at_300_pa() {
 /// Föppl–Hencky membrane under its own net pressure: the top rises under 300 Pa, the middle
 /// under 100 Pa, the bottom sags under 400 Pa, each crown within 1 % (24 rings a layer), and the
 /// chambers' volumes are the differences of the layers' (within 1 %).
-#[test]
-fn the_middle_layer_of_a_three_layer_cushion_carries_the_chambers_pressure_difference() {
-    let (a, rings) = (1.0, 24);
-    let material = film(1.0e6);
+/// A three-layer cushion of `rings` rings a layer over a disc of radius `a`: the two-layer
+/// cushion's top copied once more as a middle layer (the rim shared, facing +Z), the upper
+/// chamber supplied at 300 Pa between top and middle, the lower at 400 Pa between middle and
+/// bottom. Returns the model, the first node of the middle layer and the bottom's crown node.
+fn three_layer(a: f64, rings: usize, material: Material) -> (Model, usize, usize) {
     let mut model = cushion(a, rings, material, 300.0);
     let per_layer = model.triangles.len() / 2;
     let disc_nodes = 1 + 3 * rings * (rings + 1);
-    // A middle layer: the top's interior copied once more, the rim shared, facing +Z.
     let first = model.nodes.len();
     let rim = disc_nodes - 6 * rings;
     let middle = |v: usize| if v >= rim { v } else { first + v };
@@ -371,6 +371,14 @@ fn the_middle_layer_of_a_three_layer_cushion_carries_the_chambers_pressure_diffe
     model.chambers[0].name = "upper".into();
     model.chambers[0].elements = ElementSelection::List(upper);
     model.chambers.push(lower_air);
+    (model, first, disc_nodes)
+}
+
+#[test]
+fn the_middle_layer_of_a_three_layer_cushion_carries_the_chambers_pressure_difference() {
+    let (a, rings) = (1.0, 24);
+    let material = film(1.0e6);
+    let (model, first, disc_nodes) = three_layer(a, rings, material);
     model.validate().unwrap();
     let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
     let full = LoadLevels::of_model(&model);
@@ -455,4 +463,88 @@ fn a_sealed_cushion_heated_by_30_k_matches_foppl_hencky_with_the_ideal_gas() {
     assert!((rise / w - 1.0).abs() < 0.005);
     assert!((c.mass / mass - 1.0).abs() < 1e-9);
     assert!((c.temperature - (t0 + 30.0)).abs() < 1e-12);
+}
+
+/// The issue's 250/100/250 µm cushion (issue 43 item 2): the middle layer given its own 100 µm
+/// by a `"layers"` item, the outer ones the material's 250 µm. Each layer is a Föppl–Hencky
+/// membrane of its own thickness under its net pressure: crowns within 1 % (24 rings a layer);
+/// the middle crown is also not the one a 250 µm middle layer takes (more than 10 % apart), so
+/// the test fails where the layer's thickness is ignored.
+#[test]
+fn a_middle_layer_of_its_own_thickness_deflects_as_foppl_hencky_with_that_thickness() {
+    let (a, rings) = (1.0, 24);
+    let outer = Material {
+        thickness: 250e-6,
+        ..film(1.0e6)
+    };
+    let (mut model, first, disc_nodes) = three_layer(a, rings, outer.clone());
+    let per_layer = model.triangles.len() / 3;
+    model.layers.push(Layer {
+        name: "middle".into(),
+        elements: ElementSelection::List((2 * per_layer..3 * per_layer).collect()),
+        thickness: 100e-6,
+    });
+    model.validate().unwrap();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(f), 4)
+            .unwrap();
+    }
+    let inner = Material {
+        thickness: 100e-6,
+        ..outer.clone()
+    };
+    let rise = |v: usize| analysis.node_displacement(v).z;
+    for (name, fe, hencky) in [
+        ("top", rise(0), layer_volume(&outer, a, 300.0).1),
+        ("middle", rise(first), layer_volume(&inner, a, 100.0).1),
+        (
+            "bottom",
+            rise(disc_nodes),
+            layer_volume(&outer, a, -400.0).1,
+        ),
+    ] {
+        println!("{name}: crown {fe:.5e} m vs Föppl–Hencky {hencky:.5e} m");
+        assert!((fe / hencky - 1.0).abs() < 0.01, "{name}: {fe} vs {hencky}");
+    }
+    let thick_middle = layer_volume(&outer, a, 100.0).1;
+    assert!((rise(first) / thick_middle - 1.0).abs() > 0.1);
+}
+
+/// A layer is refused, naming it, with a thickness that is not positive, with an unknown
+/// triangle, or sharing a triangle with another layer.
+#[test]
+fn malformed_layers_are_refused_naming_the_layer() {
+    let (model, _, _) = three_layer(1.0, 4, film(1.0e6));
+    let with = |layers: Vec<Layer>| {
+        let mut m = model.clone();
+        m.layers = layers;
+        m.validate().map(|_| ()).map_err(|e| e.to_string())
+    };
+    let layer = |name: &str, elements: Vec<usize>, thickness: f64| Layer {
+        name: name.into(),
+        elements: ElementSelection::List(elements),
+        thickness,
+    };
+    assert_eq!(with(vec![layer("mid", vec![0, 1], 1e-4)]), Ok(()));
+    for (layers, said) in [
+        (
+            vec![layer("mid", vec![0], 0.0)],
+            "thickness = 0 must be > 0",
+        ),
+        (vec![layer("mid", vec![0], f64::NAN)], "must be > 0"),
+        (vec![layer("mid", vec![100_000], 1e-4)], "100000"),
+        (
+            vec![
+                layer("mid", vec![0, 1], 1e-4),
+                layer("outer", vec![1], 2e-4),
+            ],
+            "triangle 1 is also in layer 'mid'",
+        ),
+    ] {
+        let err = with(layers).unwrap_err();
+        assert!(err.contains("layer '") && err.contains(said), "{err}");
+    }
 }

@@ -453,7 +453,14 @@ fn element_results_are_written_as_csv() {
 fn help_lists_every_command_and_the_solver_options() {
     let (ok, out, _) = cli(&["--help"]);
     assert!(ok);
-    for command in ["specimen", "model", "check", "export-specimen"] {
+    for command in [
+        "specimen",
+        "model",
+        "check",
+        "export-specimen",
+        "form-find",
+        "pattern",
+    ] {
         assert!(out.contains(command), "{out}");
     }
     let (ok, out, _) = cli(&["model", "--help"]);
@@ -650,6 +657,39 @@ fn check_and_model_report_each_chamber() {
         out.contains("chamber air: pressure 300.000 Pa, volume 0.196035 m³ (held by its supply)"),
         "{out}"
     );
+}
+
+/// TEST GOAL (issue 43): `check` prints each layer's triangles and thickness, and a layer that
+/// shares a triangle with another is refused naming both.
+#[test]
+fn check_reports_each_layer_and_refuses_a_triangle_in_two() {
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion_air.json");
+    let mut model: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(example).unwrap()).unwrap();
+    model["layers"] = serde_json::json!([
+        { "name": "thin", "elements": [0, 1, 2], "thickness": 100e-6 }
+    ]);
+    let dir = std::env::temp_dir().join(format!("mc-cli-layers-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("layers.json");
+    std::fs::write(&file, model.to_string()).unwrap();
+    let (ok, out, err) = cli(&["check", file.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("layer thin: 3 triangles, thickness 100.0 µm (the material's: "),
+        "{out}"
+    );
+    model["layers"]
+        .as_array_mut()
+        .unwrap()
+        .push(serde_json::json!({ "name": "thick", "elements": [2], "thickness": 1e-3 }));
+    std::fs::write(&file, model.to_string()).unwrap();
+    let (ok, _, err) = cli(&["check", file.to_str().unwrap()]);
+    assert!(
+        !ok && err.contains("layer 'thick'") && err.contains("also in layer 'thin'"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// TEST GOAL (issue 47 item 8): a prestressed film with free edges starts out of equilibrium

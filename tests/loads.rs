@@ -54,6 +54,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         cables: vec![],
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
     }
 }
 

@@ -70,6 +70,7 @@ fn strip(nx: usize) -> Model {
         cables: vec![],
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
         name: "Strip".into(),
         description: String::new(),
         nodes,

@@ -81,6 +81,7 @@ fn strip() -> Model {
         cables: vec![],
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
     }
 }
 

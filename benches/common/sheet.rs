@@ -64,5 +64,6 @@ pub fn sheet(n: usize) -> Model {
         cables: vec![],
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
     }
 }

@@ -10,7 +10,9 @@ mesh into a model file.
   to a model file, gaps along arches from :mod:`membrane_contact.arches`;
 * :mod:`membrane_contact.plot` — slip along a support, reactions against a load, stress maps;
 * :mod:`membrane_contact.inverse` — fit μ, parameters or boundary-movement scales to measured
-  outputs through the FMU.
+  outputs through the FMU;
+* :mod:`membrane_contact.design` — form finding and cutting patterns (the program's ``form-find``
+  and ``pattern``).
 
 The FMU names (:class:`Film` and the rest, which need fmpy) are imported on first use, so that
 the mesh importer (:mod:`membrane_contact.mesh`: numpy and meshio) imports without fmpy.

@@ -67,6 +67,22 @@ def installed_file(name: str, folder: str) -> Path | None:
     return None
 
 
+#: Environment variable naming the ``membrane-contact`` program to run (else the installed one).
+CLI_VARIABLE = "MEMBRANE_CONTACT_CLI"
+
+
+def cli_program() -> str | None:
+    """The ``membrane-contact`` program: ``$MEMBRANE_CONTACT_CLI``, the one installed with this
+    package, the checkout's release build, or the one on PATH; None where there is none."""
+    import shutil
+
+    program = os.environ.get(CLI_VARIABLE) or installed_program("membrane-contact")
+    root = repository_root()
+    if not program and root is not None and (root / "target" / "release" / "membrane-contact").is_file():
+        program = str(root / "target" / "release" / "membrane-contact")
+    return str(program) if program else shutil.which("membrane-contact")
+
+
 def find_fmu(path=None, model: str | None = None) -> Path:
     """The FMU to use: ``path`` if given, else ``$MEMBRANE_CONTACT_FMU``, else
     ``target/fmu/<model>.fmu`` of the repository (``ParallelArch`` when ``model`` is None).

@@ -39,7 +39,7 @@ import numpy as np
 # A module of the package (``python -m membrane_contact.mesh``, or the console script
 # ``membrane-contact-import`` of [project.scripts]), not a script that patches sys.path.
 from .arches import ArchError, gaps_on_curve, make_curve
-from .fmu import installed_program, repository_root
+from .fmu import CLI_VARIABLE, cli_program
 from .tubes import DEFAULT_TOLERANCE_SHARE, TubeError, fit_centreline, tube_nodes
 
 
@@ -785,7 +785,6 @@ def _pressure_kind(entry: dict, where: str) -> dict:
 #: The solver's command line, run by :func:`solver_check` (default: the one installed with this
 #: package from the wheel, else the checkout's ``target/release/membrane-contact``, else
 #: ``membrane-contact`` on the PATH: the order in which ``build_fmu`` finds ``fmu-pack``).
-CLI_VARIABLE = "MEMBRANE_CONTACT_CLI"
 
 
 @dataclass
@@ -803,16 +802,11 @@ def solver_check(model: dict) -> SolverCheck | None:
     ``$MEMBRANE_CONTACT_CLI`` or build the checkout) or cannot be run (a
     :class:`MeshImportWarning` says so: a wrong ``$MEMBRANE_CONTACT_CLI``)."""
     import os
-    import shutil
     import subprocess
     import tempfile
 
     given = os.environ.get(CLI_VARIABLE)
-    program = given or installed_program("membrane-contact")
-    root = repository_root()
-    if not program and root is not None and (root / "target" / "release" / "membrane-contact").is_file():
-        program = str(root / "target" / "release" / "membrane-contact")
-    program = program or shutil.which("membrane-contact")
+    program = cli_program()
     if not program:
         return None
     with tempfile.TemporaryDirectory() as tmp:

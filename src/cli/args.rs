@@ -61,6 +61,73 @@ pub enum Command {
         /// The model file (JSON).
         file: PathBuf,
     },
+    /// Finds the shape in which the film carries its prestress (the model's, or --prestress)
+    /// with the boundary held where the model puts it (updated reference strategy,
+    /// docs/mechanics.md "Form finding and patterning"); writes the model with the found
+    /// geometry and the target prestress.
+    FormFind {
+        /// The model file (JSON).
+        file: PathBuf,
+        /// The model file to write (default: standard output).
+        #[arg(short, long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// Target prestress `SX,SY[,TXY]` in MPa in each element's frame (e1 along global X
+        /// projected); default: the model's `material.prestress`.
+        #[arg(long, value_name = "SX,SY[,TXY]", value_parser = parse_prestress, allow_negative_numbers = true)]
+        prestress: Option<[f64; 3]>,
+        /// Start from the force density shape (Schek 1974) instead of the model's geometry.
+        #[arg(long)]
+        force_density_start: bool,
+        /// Largest out-of-balance force accepted, relative to t·|σ|·(mean edge length).
+        #[arg(long, value_name = "TOL", default_value_t = 1e-4)]
+        tolerance: f64,
+        /// Most reference updates.
+        #[arg(long, value_name = "N", default_value_t = 5000)]
+        max_steps: usize,
+    },
+    /// Cuts a (form found) model's film into strips along seams, flattens each with the least
+    /// distortion, compensates it and prints each strip's size and distortion
+    /// (docs/mechanics.md "Form finding and patterning").
+    Pattern {
+        /// The model file (JSON).
+        file: PathBuf,
+        /// A seam plane through a point with a normal (m); repeat for more seams.
+        #[arg(long, value_name = "PX,PY,PZ,NX,NY,NZ", value_parser = parse_plane, allow_negative_numbers = true)]
+        seam_plane: Vec<[f64; 6]>,
+        /// A seam along a line of mesh nodes; repeat for more seams.
+        #[arg(long, value_name = "N1,N2,…")]
+        seam_nodes: Vec<String>,
+        /// `prestress` (the strain of the model's prestress, D⁻¹σ, along and across each strip) or
+        /// the compensation in percent, `C` or `CX,CY` (along, across).
+        #[arg(long, value_name = "prestress|C[,C]", default_value = "prestress")]
+        compensation: String,
+        /// Write the strips' outlines with their dimensions as SVG (mm).
+        #[arg(long, value_name = "FILE")]
+        svg: Option<PathBuf>,
+        /// Write the strips' outlines as DXF (R12, mm; one layer per strip) for a cutting
+        /// plotter or CAD.
+        #[arg(long, value_name = "FILE")]
+        dxf: Option<PathBuf>,
+        /// Compensate by erection: erect the cut with the model's own supports, contacts and
+        /// friction (the analysis), correct each strip's compensation by the prestress missed,
+        /// at most N erections (0: none); the compensation given is the first.
+        #[arg(long, value_name = "N", default_value_t = 0)]
+        erect: usize,
+        /// Stop the erections when the area-mean prestress error is below this (percent).
+        #[arg(long, value_name = "PERCENT", default_value_t = 1.0)]
+        erect_tolerance: f64,
+        /// Increments of each erection.
+        #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+        erect_increments: u32,
+        /// Write the erection model: the film's compensated reference geometry (fitted to the
+        /// cut strips), no prestress, each held node driven back to its place by its own group.
+        #[arg(long, value_name = "FILE")]
+        erection_model: Option<PathBuf>,
+        /// Write what the strip lines and erection lines say as JSON (for scripts: the Python
+        /// package's `membrane_contact.design.pattern` reads it).
+        #[arg(long, value_name = "FILE")]
+        report: Option<PathBuf>,
+    },
     /// Prints a specimen as a model file (JSON) on standard output.
     ExportSpecimen {
         #[command(flatten)]
@@ -213,6 +280,29 @@ pub struct RunArgs {
     /// was refused, its iterations and residual, the cut-backs so far.
     #[arg(long)]
     pub log_increments: bool,
+}
+
+/// `SX,SY[,TXY]` in MPa → Pa.
+fn parse_prestress(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [x, y] => Ok([x * 1e6, y * 1e6, 0.0]),
+        [x, y, t] => Ok([x * 1e6, y * 1e6, t * 1e6]),
+        _ => Err("two or three numbers: SX,SY[,TXY] (MPa)".into()),
+    }
+}
+
+/// `PX,PY,PZ,NX,NY,NZ` → a plane's point and normal.
+fn parse_plane(s: &str) -> Result<[f64; 6], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>().map_err(|e| format!("{p:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    v.try_into()
+        .map_err(|_| "six numbers: PX,PY,PZ,NX,NY,NZ".to_string())
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {

@@ -20,6 +20,7 @@ use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, etfe_
 use nalgebra::Vector3;
 
 mod args;
+mod design;
 mod path;
 mod report;
 
@@ -898,7 +899,8 @@ fn import(
 }
 
 /// `membrane-contact check FILE`: validates the model, prints its warnings on stderr (as a run
-/// does), how each pressure set faces and what each chamber encloses on stdout.
+/// does), how each pressure set faces, what each chamber encloses and each layer's thickness on
+/// stdout.
 fn check(file: &std::path::Path) -> Result<(), String> {
     let name = file.display();
     let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
@@ -912,6 +914,15 @@ fn check(file: &std::path::Path) -> Result<(), String> {
     }
     for line in membrane_contact::mech::elements::chamber::chamber_report(&model) {
         out!("{line}");
+    }
+    for l in &model.layers {
+        out!(
+            "layer {}: {} triangles, thickness {:.1} µm (the material's: {:.1} µm)",
+            l.name,
+            model.selected_triangles(&l.elements).len(),
+            l.thickness * 1e6,
+            model.material.thickness * 1e6
+        );
     }
     Ok(())
 }
@@ -939,6 +950,46 @@ fn main() -> ExitCode {
             output,
             python,
         } => import(mesh, mapping, output.as_deref(), python.as_deref()),
+        Command::FormFind {
+            file,
+            out,
+            prestress,
+            force_density_start,
+            tolerance,
+            max_steps,
+        } => design::form_find(design::FormFindArgs {
+            file,
+            out: out.as_ref(),
+            prestress: *prestress,
+            force_density_start: *force_density_start,
+            settings: membrane_contact::mech::formfinding::update_reference::UpdateSettings {
+                tolerance: *tolerance,
+                max_steps: *max_steps,
+            },
+        }),
+        Command::Pattern {
+            file,
+            seam_plane,
+            seam_nodes,
+            compensation,
+            svg,
+            dxf,
+            erection_model,
+            erect,
+            erect_tolerance,
+            erect_increments,
+            report,
+        } => design::pattern(design::PatternArgs {
+            file,
+            seam_planes: seam_plane,
+            seam_nodes,
+            compensation,
+            svg: svg.as_ref(),
+            dxf: dxf.as_ref(),
+            erection_model: erection_model.as_ref(),
+            erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
+            report: report.as_ref(),
+        }),
         Command::ExportSpecimen {
             specimen: args,
             path_out,

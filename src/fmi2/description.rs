@@ -144,11 +144,20 @@ fn fill<'a>(template: &str, value: impl Fn(&str) -> Option<&'a str>) -> Result<S
     Ok(out)
 }
 
-fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
+pub(crate) fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
+    write_units_used(w, &|name| table.iter().any(|v| v.unit == Some(name)))
+}
+
+/// `<UnitDefinitions>` of the units for which `used` is true (FMI 3.0: the table's and the
+/// arrays').
+pub(crate) fn write_units_used(
+    w: &mut Writer<Vec<u8>>,
+    used: &dyn Fn(&str) -> bool,
+) -> io::Result<()> {
     w.create_element("UnitDefinitions")
         .write_inner_content(|w| {
             for (name, [kg, m, s, k, rad]) in UNITS {
-                if !table.iter().any(|v| v.unit == Some(name)) {
+                if !used(name) {
                     continue;
                 }
                 w.create_element("Unit")
@@ -178,7 +187,7 @@ fn write_units(w: &mut Writer<Vec<u8>>, table: &[Variable]) -> io::Result<()> {
     Ok(())
 }
 
-fn write_log_categories(w: &mut Writer<Vec<u8>>, _: &[Variable]) -> io::Result<()> {
+pub(crate) fn write_log_categories(w: &mut Writer<Vec<u8>>, _: &[Variable]) -> io::Result<()> {
     w.create_element("LogCategories").write_inner_content(|w| {
         for (name, description) in CATEGORIES {
             w.create_element("Category")

@@ -1,4 +1,6 @@
-//! All raw-pointer work of the FMU, and the panic barrier.
+//! All raw-pointer work of the FMI 2.0 functions, and the panic barrier; the barrier, the
+//! freeing and the array helpers are the shared glue's (`fmu/glue`), so the FMI 3.0 functions
+//! (`src/fmi3`) go through the same code.
 //!
 //! Every exported function goes through one of these helpers:
 //! * [`with_instance`]: NULL check of `fmi2Component`, the phase check against the function's
@@ -8,28 +10,21 @@
 //!   into Rust references after NULL and length checks.
 //!
 //! A panic becomes `fmi2Fatal` (or a NULL instance) plus a logged message, and the instance is
-//! marked [`Phase::Fatal`]; no panic unwinds into the importer.
+//! marked `Phase::Fatal`; no panic unwinds into the importer.
 
-use std::ffi::CStr;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+
+pub use fmi_glue::ffi::{input, out_ref, output, panic_message, string, strings};
 
 use super::instance::Instance;
 use super::logger::Logger;
-use super::phase::{Failure, Mask, Outcome, Phase};
+use super::phase::{Mask, Outcome};
 use super::types::{
     Fmi2CallbackFunctions, Fmi2Component, Fmi2FmuState, Fmi2Status, Fmi2String, Status,
 };
 
-/// The text of a panic payload.
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".into())
-}
-
-/// Runs `body` on the instance behind `c` if `allowed` permits the instance's phase.
+/// Runs `body` on the instance behind `c` if `allowed` permits the instance's phase: the shared
+/// glue's barrier (`fmi_glue::fmi2::with`, the one the FMI 3.0 functions go through too).
 ///
 /// # Safety
 /// `c` must be NULL or a pointer returned by [`instantiate`] and not yet passed to
@@ -41,43 +36,8 @@ pub unsafe fn with_instance(
     allowed: Mask,
     body: impl FnOnce(&mut Instance) -> Outcome,
 ) -> Fmi2Status {
-    if c.is_null() {
-        return Status::Error.raw();
-    }
-    // SAFETY: by this function's contract `c` is a live `Box<Instance>` pointer with no other
-    // reference to it in use.
-    let instance = unsafe { &mut *c.cast::<Instance>() };
-    let phase = instance.phase();
-    if !allowed.allows(phase) {
-        let why = if phase == Phase::Fatal {
-            " (an earlier call failed fatally: free the instance)"
-        } else {
-            ""
-        };
-        instance.logger.log(
-            Status::Error,
-            &format!("{function} must not be called in state {phase:?}{why}"),
-        );
-        return Status::Error.raw();
-    }
-    match catch_unwind(AssertUnwindSafe(|| body(&mut *instance))) {
-        Ok(Ok(())) => Status::Ok.raw(),
-        Ok(Err(Failure { status, message })) => {
-            instance
-                .logger
-                .log(status, &format!("{function}: {message}"));
-            status.raw()
-        }
-        Err(payload) => {
-            instance.mark_fatal();
-            let message = panic_message(&*payload);
-            instance.logger.log(
-                Status::Fatal,
-                &format!("{function}: internal error (panic): {message}"),
-            );
-            Status::Fatal.raw()
-        }
-    }
+    // SAFETY: this function's contract is the glue's.
+    unsafe { fmi_glue::fmi2::with::<Instance>(c, function, allowed, body) }
 }
 
 /// `fmi2Instantiate`: copies the callbacks, builds the instance and returns it as an opaque
@@ -131,100 +91,14 @@ pub unsafe fn instantiate(
     }
 }
 
-/// `fmi2FreeInstance`: drops the instance (and the FMU states it still holds).
+/// `fmi2FreeInstance`: drops the instance (and the FMU states it still holds); the shared
+/// glue's, which catches a panic of the destructor.
 ///
 /// # Safety
 /// As for [`with_instance`]; `c` must not be used afterwards.
 pub unsafe fn free_instance(c: Fmi2Component) {
-    if c.is_null() {
-        return;
-    }
-    // SAFETY: `c` came from `Box::into_raw` in `instantiate` and is freed once (contract).
-    let instance = unsafe { Box::from_raw(c.cast::<Instance>()) };
-    // A panic in a destructor must not unwind into C either.
-    let _ = catch_unwind(AssertUnwindSafe(move || drop(instance)));
-}
-
-/// A C array of `n` values to read. NULL is allowed only when `n` is 0.
-///
-/// # Safety
-/// `p` must be NULL or point to `n` initialized values that stay valid and unmodified while
-/// the returned slice is used.
-pub unsafe fn input<'a, T>(p: *const T, n: usize, what: &str) -> Outcome<&'a [T]> {
-    if n == 0 {
-        return Ok(&[]);
-    }
-    check_array(p.is_null(), n, size_of::<T>(), what)?;
-    // SAFETY: non-NULL, length checked against isize::MAX bytes; validity per the contract.
-    Ok(unsafe { std::slice::from_raw_parts(p, n) })
-}
-
-/// A C array of `n` values to write. NULL is allowed only when `n` is 0.
-///
-/// # Safety
-/// `p` must be NULL or point to `n` writable values not aliased while the slice is used.
-pub unsafe fn output<'a, T>(p: *mut T, n: usize, what: &str) -> Outcome<&'a mut [T]> {
-    if n == 0 {
-        return Ok(&mut []);
-    }
-    check_array(p.is_null(), n, size_of::<T>(), what)?;
-    // SAFETY: non-NULL, length checked against isize::MAX bytes; validity per the contract.
-    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
-}
-
-fn check_array(null: bool, n: usize, size: usize, what: &str) -> Outcome {
-    if null {
-        return Err(Failure::error(format!(
-            "{what} is NULL but {n} values were announced"
-        )));
-    }
-    if n.checked_mul(size).is_none_or(|b| b > isize::MAX as usize) {
-        return Err(Failure::error(format!(
-            "{what}: {n} values is not a valid array length"
-        )));
-    }
-    Ok(())
-}
-
-/// A pointer to one value to write.
-///
-/// # Safety
-/// `p` must be NULL or point to a writable `T` not aliased while the reference is used.
-pub unsafe fn out_ref<'a, T>(p: *mut T, what: &str) -> Outcome<&'a mut T> {
-    // SAFETY: NULL is handled; otherwise valid per the contract.
-    unsafe { p.as_mut() }.ok_or_else(|| Failure::error(format!("{what} is NULL")))
-}
-
-/// A C string as UTF-8; NULL gives `None`.
-///
-/// # Safety
-/// `p` must be NULL or a NUL-terminated string valid while the result is used.
-pub unsafe fn string<'a>(p: Fmi2String) -> Outcome<Option<&'a str>> {
-    if p.is_null() {
-        return Ok(None);
-    }
-    // SAFETY: non-NULL and NUL-terminated per the contract.
-    let s = unsafe { CStr::from_ptr(p) };
-    s.to_str()
-        .map(Some)
-        .map_err(|_| Failure::error("a string argument is not valid UTF-8"))
-}
-
-/// A C array of `n` non-NULL strings.
-///
-/// # Safety
-/// As for [`input`] and [`string`] for each element.
-pub unsafe fn strings<'a>(p: *const Fmi2String, n: usize, what: &str) -> Outcome<Vec<&'a str>> {
-    // SAFETY: forwarded contract.
-    let pointers = unsafe { input(p, n, what)? };
-    pointers
-        .iter()
-        .enumerate()
-        // SAFETY: each element is NULL or a NUL-terminated string (contract).
-        .map(|(i, &s)| {
-            unsafe { string(s) }?.ok_or_else(|| Failure::error(format!("{what}[{i}] is NULL")))
-        })
-        .collect()
+    // SAFETY: this function's contract is the glue's.
+    unsafe { fmi_glue::fmi2::free_instance::<Instance>(c) }
 }
 
 /// The opaque `fmi2FMUstate` of a saved-state handle. It is never dereferenced: the instance

@@ -12,6 +12,7 @@
 
 use std::collections::HashMap;
 use std::ffi::CString;
+use std::path::Path;
 
 use super::description::{Description, describe};
 use super::logger::Logger;
@@ -113,7 +114,13 @@ impl Instance {
         let uri = resource_location
             .filter(|u| !u.is_empty())
             .ok_or("fmuResourceLocation is NULL or empty: the FMU needs its resources folder")?;
-        let source = Source::load(&resource_dir(uri)?)?;
+        Self::instantiate_in(&resource_dir(uri)?, guid, logger)
+    }
+
+    /// An instance of the FMU whose resources are in `dir`, if its GUID (FMI 3.0: its
+    /// instantiation token) is `guid`.
+    pub fn instantiate_in(dir: &Path, guid: &str, logger: Logger) -> Result<Self, String> {
+        let source = Source::load(dir)?;
         let instance = Self::from_source(source, logger)?;
         if instance.description.guid != guid {
             return Err(format!(

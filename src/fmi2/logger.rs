@@ -12,7 +12,7 @@
 //! * `fmi2SetDebugLogging(on, 0, NULL)` switches all, `(on, n, names)` the named ones
 //!   (`logAll` stands for every category).
 
-use std::ffi::CString;
+use fmi_glue::logger::Sink;
 
 use super::types::{Fmi2CallbackLogger, Fmi2ComponentEnvironment, Status};
 use crate::mech::solve::{IncrementNote, IncrementObserver};
@@ -60,13 +60,11 @@ fn category_of(status: Status) -> usize {
     }
 }
 
-/// One instance's logger: a copy of the callback, the environment pointer, the instance name
-/// and the enabled categories.
+/// One instance's logger: the importer's callback of either FMI version (the shared glue's
+/// [`Sink`]) and the enabled categories.
 #[derive(Clone, Debug)]
 pub struct Logger {
-    callback: Fmi2CallbackLogger,
-    environment: Fmi2ComponentEnvironment,
-    instance_name: CString,
+    sink: Sink,
     enabled: [bool; CATEGORIES.len()],
 }
 
@@ -78,17 +76,17 @@ impl Logger {
         instance_name: &str,
         logging_on: bool,
     ) -> Self {
+        Self::with_sink(Sink::fmi2(callback, environment, instance_name), logging_on)
+    }
+
+    /// A logger over `sink` (FMI 2.0 or 3.0) with the categories `loggingOn` enables.
+    pub fn with_sink(sink: Sink, logging_on: bool) -> Self {
         let mut enabled = [logging_on; CATEGORIES.len()];
         for status in [Status::Discard, Status::Error, Status::Fatal] {
             enabled[category_of(status)] = true;
         }
         enabled[INCREMENTS] = false;
-        Self {
-            callback,
-            environment,
-            instance_name: c_string(instance_name),
-            enabled,
-        }
+        Self { sink, enabled }
     }
 
     /// A logger that drops every message.
@@ -128,12 +126,12 @@ impl Logger {
 
     /// Whether a message of `status` would be passed on.
     pub fn is_enabled(&self, status: Status) -> bool {
-        self.callback.is_some() && self.enabled[category_of(status)]
+        self.sink.is_some() && self.enabled[category_of(status)]
     }
 
     /// Whether `logIncrements` messages would be passed on.
     pub fn increments_enabled(&self) -> bool {
-        self.callback.is_some() && self.enabled[INCREMENTS]
+        self.sink.is_some() && self.enabled[INCREMENTS]
     }
 
     /// Sends an increment's line ([`Self::increments_enabled`]) to the importer, status OK.
@@ -158,28 +156,10 @@ impl Logger {
 
     /// Sends `message` in `category` with `status` if the category is enabled.
     fn send(&self, category: usize, status: Status, message: &str) {
-        let Some(callback) = self.callback else {
-            return;
-        };
-        if !self.enabled[category] {
-            return;
+        if self.enabled[category] {
+            self.sink
+                .send(status, Some(CATEGORIES[category].0), message);
         }
-        let category = c_string(CATEGORIES[category].0);
-        let message = c_string(message);
-        // SAFETY: `callback` is the importer's fmi2CallbackLogger, copied from the callbacks
-        // struct in fmi2Instantiate (FMI 2.0 §2.1.5 requires it to stay callable for the life of
-        // the instance). Every pointer passed is a NUL-terminated string that outlives the call,
-        // and the format "%s" consumes exactly the one vararg that follows it, a C string.
-        unsafe {
-            callback(
-                self.environment,
-                self.instance_name.as_ptr(),
-                status.raw(),
-                category.as_ptr(),
-                c"%s".as_ptr(),
-                message.as_ptr(),
-            )
-        };
     }
 }
 
@@ -202,11 +182,6 @@ unsafe impl Send for SteppingLogger {}
 // SAFETY: as for `Send`: no two threads call the observer at once (it is only called inside
 // the instance's fmi2DoStep), so shared references never race.
 unsafe impl Sync for SteppingLogger {}
-
-/// A C string of `text`; an interior NUL (which C would read as the end) becomes U+FFFD.
-fn c_string(text: &str) -> CString {
-    CString::new(text.replace('\0', "\u{FFFD}")).expect("no NUL left")
-}
 
 #[cfg(test)]
 mod tests {
@@ -244,10 +219,5 @@ mod tests {
             l.enabled[category_of(Status::Error)],
             "a failed call changes nothing"
         );
-    }
-
-    #[test]
-    fn c_string_replaces_nul() {
-        assert_eq!(c_string("a\0b").to_str().unwrap(), "a\u{FFFD}b");
     }
 }

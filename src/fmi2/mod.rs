@@ -45,6 +45,7 @@
 //! (`tests/threads.rs`). It is linked with `-z nodelete` (see `fmu/build.rs`), so an
 //! importer's `dlclose` cannot unload code that is still referenced.
 
+mod core;
 mod derivatives;
 pub mod description;
 pub mod exports;

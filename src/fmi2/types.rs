@@ -40,35 +40,8 @@ pub const FMI2_PENDING_STATUS: c_int = 1;
 pub const FMI2_LAST_SUCCESSFUL_TIME: c_int = 2;
 pub const FMI2_TERMINATED: c_int = 3;
 
-/// `fmi2Status`, ordered by severity so that "the worst status wins" is `max`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Status {
-    Ok = 0,
-    Warning = 1,
-    Discard = 2,
-    Error = 3,
-    Fatal = 4,
-    Pending = 5,
-}
-
-impl Status {
-    /// The value returned to C.
-    pub fn raw(self) -> Fmi2Status {
-        self as Fmi2Status
-    }
-
-    /// The C name, for messages.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Ok => "fmi2OK",
-            Self::Warning => "fmi2Warning",
-            Self::Discard => "fmi2Discard",
-            Self::Error => "fmi2Error",
-            Self::Fatal => "fmi2Fatal",
-            Self::Pending => "fmi2Pending",
-        }
-    }
-}
+/// `fmi2Status` (the shared glue's, whose values are FMI 2.0's and FMI 3.0's).
+pub use fmi_glue::Status;
 
 /// `fmi2CallbackLogger`: variadic, printf semantics. Always called with `"%s"` and a
 /// pre-formatted message (see `logger.rs`).

@@ -7,11 +7,15 @@
 //! |---|---|
 //! | [`model`] | the model file's format, its validation, the restraint check |
 //! | [`elements`] | what adds force and stiffness: membrane triangle and its film law, cables, gaps, curved-support contact, external loads |
+//! | [`formfinding`] | the prestressed shape: force density first shape, updated reference strategy |
+//! | [`patterning`] | cutting patterns: strips, flattening, distortion, compensation, outlines |
 //! | [`solve`] | DOF map and assembly, the linear solvers, Newton, line search, increment control |
 //! | [`results`] | results of a converged state: summaries, reaction lines, finiteness, VTK |
 
 pub mod elements;
+pub mod formfinding;
 pub mod model;
+pub mod patterning;
 pub mod results;
 pub mod solve;
 

@@ -407,6 +407,7 @@ impl ParallelArch {
             cables: vec![],
             curved_supports,
             chambers: vec![],
+            layers: vec![],
             name: MODEL_NAME.into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

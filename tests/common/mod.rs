@@ -25,6 +25,7 @@ pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) 
         cables: vec![],
         curved_supports: vec![],
         chambers: vec![],
+        layers: vec![],
     }
 }
 

@@ -273,7 +273,7 @@ impl Loads {
         if m.density > 0.0 {
             for (nodes, tri) in &system.triangles {
                 for &v in nodes {
-                    nodal_mass[v] += m.density * m.thickness * tri.area() / 3.0;
+                    nodal_mass[v] += m.density * tri.thickness(m) * tri.area() / 3.0;
                 }
             }
         }

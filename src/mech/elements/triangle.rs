@@ -88,6 +88,8 @@ pub struct MembraneTriangle {
     gradients: [Vector2<f64>; 3],
     /// Initial area `A0` (m²).
     area: f64,
+    /// Its layer's thickness (m; `"layers"` of the model file), None: the material's.
+    layer_thickness: Option<f64>,
 }
 
 impl MembraneTriangle {
@@ -119,12 +121,36 @@ impl MembraneTriangle {
             initial_frame: Matrix3x2::from_columns(&[e1, e2]),
             gradients: [g0, g1, g2],
             area: 0.5 * doubled_area,
+            layer_thickness: None,
         })
+    }
+
+    /// The element with the thickness `t` (m) of its layer instead of the material's.
+    pub fn with_thickness(self, t: f64) -> Self {
+        Self {
+            layer_thickness: Some(t),
+            ..self
+        }
     }
 
     /// Initial area `A0` (m²).
     pub fn area(&self) -> f64 {
         self.area
+    }
+
+    /// Shape-function gradients `∇N_k` in the local frame (eq. 2.2's `G`, per node).
+    pub fn shape_gradients(&self) -> [Vector2<f64>; 3] {
+        self.gradients
+    }
+
+    /// Initial thickness `t0` (m): its layer's, else the material's.
+    pub fn thickness(&self, material: &Material) -> f64 {
+        self.layer_thickness.unwrap_or(material.thickness)
+    }
+
+    /// Initial volume `A0 t0` (m³).
+    pub fn volume(&self, material: &Material) -> f64 {
+        self.area * self.thickness(material)
     }
 
     /// Unit vectors `(e1, e2)` of the local frame the strains and stresses are given in.
@@ -237,7 +263,7 @@ impl MembraneTriangle {
         with_tangent: bool,
         tangent: impl FnOnce() -> Matrix3<f64>,
     ) -> (ElementVector, ElementMatrix) {
-        let volume = self.area * material.thickness;
+        let volume = self.volume(material);
         let S = Matrix2::new(s.x, s.z, s.z, s.y);
         let FS = f * S;
         let mut r = ElementVector::zeros();
@@ -331,7 +357,7 @@ impl MembraneTriangle {
             tension_direction,
             plastic: Some(PlasticOutput {
                 equivalent_plastic_strain: r.history.equivalent_plastic_strain,
-                thickness: material.thickness * r.thickness_ratio,
+                thickness: self.thickness(material) * r.thickness_ratio,
             }),
         }
     }
@@ -373,6 +399,41 @@ mod tests {
 
     fn pseudo_random_displacement(scale: f64) -> ElementVector {
         ElementVector::from_fn(|i, _| scale * ((i as f64 * 1.7 + 0.3).sin()))
+    }
+
+    /// A layer's own thickness scales the element's force and tangent as the material's would,
+    /// and its tangent matches central differences of its force.
+    #[test]
+    fn a_layer_thickness_acts_as_the_materials_and_its_tangent_matches_finite_differences() {
+        let mat = etfe();
+        let layered = skew_triangle().with_thickness(3.0 * mat.thickness);
+        let thick = Material {
+            thickness: 3.0 * mat.thickness,
+            ..mat.clone()
+        };
+        let u = pseudo_random_displacement(0.05);
+        assert_eq!(layered.thickness(&mat), thick.thickness);
+        let (f, k) = (
+            layered.internal_force(&mat, &u),
+            layered.tangent_stiffness(&mat, &u),
+        );
+        let (f3, k3) = (
+            skew_triangle().internal_force(&thick, &u),
+            skew_triangle().tangent_stiffness(&thick, &u),
+        );
+        assert!((f - f3).amax() <= 1e-12 * f3.amax() && (k - k3).amax() <= 1e-12 * k3.amax());
+        let h = 1e-7;
+        for j in 0..9 {
+            let (mut up, mut um) = (u, u);
+            up[j] += h;
+            um[j] -= h;
+            let column =
+                (layered.internal_force(&mat, &up) - layered.internal_force(&mat, &um)) / (2.0 * h);
+            assert!(
+                (column - k.column(j)).amax() < 1e-6 * k.amax(),
+                "column {j}"
+            );
+        }
     }
 
     #[test]

@@ -483,6 +483,23 @@ pub struct Model {
     /// [`crate::mech::elements::chamber`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<ChamberSpec>,
+    /// Film layers of their own thickness (a cushion's 250/100/250 µm layers); the triangles of
+    /// no layer have the material's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub layers: Vec<Layer>,
+}
+
+/// A set of film triangles with a thickness of its own (the material's elasticity, prestress
+/// and plasticity are the model's).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layer {
+    /// Name (an identifier).
+    pub name: String,
+    /// Its triangles (each in at most one layer).
+    pub elements: ElementSelection,
+    /// Its thickness `t` (m).
+    pub thickness: f64,
 }
 
 /// A closed volume of gas bounded by film triangles (issue 43): held at a gauge pressure by a

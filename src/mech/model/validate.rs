@@ -287,6 +287,7 @@ impl Model {
         self.validate_cables(&mut names)?;
         self.validate_curved_supports(&mut names)?;
         self.validate_chambers(&mut names)?;
+        self.validate_layers(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -542,6 +543,34 @@ impl Model {
             }
             self.check_selection(&c.elements).map_err(error)?;
             ChamberGeometry::new(self, c).map_err(error)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the `layers` section (names join the namespace): a positive, finite thickness,
+    /// known triangles, and no triangle in two layers.
+    fn validate_layers(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        let mut owner: Vec<Option<&str>> = vec![None; self.triangles.len()];
+        for l in &self.layers {
+            check_name(names, "layer", &l.name)?;
+            let error = |message: String| ModelError::Load {
+                item: format!("layer '{}'", l.name),
+                message,
+            };
+            if !(l.thickness > 0.0 && l.thickness.is_finite()) {
+                return Err(error(format!(
+                    "thickness = {} must be > 0 (m)",
+                    message_number(l.thickness)
+                )));
+            }
+            self.check_selection(&l.elements).map_err(error)?;
+            for e in self.selected_triangles(&l.elements) {
+                if let Some(other) = owner[e].replace(&l.name) {
+                    return Err(error(format!(
+                        "triangle {e} is also in layer '{other}': a triangle has one thickness"
+                    )));
+                }
+            }
         }
         Ok(())
     }

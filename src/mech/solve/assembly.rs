@@ -127,13 +127,20 @@ impl System {
                 free_count += 1;
             }
         }
+        let mut thickness = vec![None; model.triangles.len()];
+        for l in &model.layers {
+            for e in model.selected_triangles(&l.elements) {
+                thickness[e] = Some(l.thickness);
+            }
+        }
         let triangles = model
             .triangles
             .iter()
-            .map(|t| {
+            .zip(thickness)
+            .map(|(t, layer)| {
                 let x = t.map(|v| Vector3::from(model.nodes[v]));
                 MembraneTriangle::new(x)
-                    .map(|e| (*t, e))
+                    .map(|e| (*t, layer.map_or(e, |h| e.with_thickness(h))))
                     .map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
             })
             .collect::<Result<Vec<_>, _>>()?;

@@ -129,7 +129,7 @@ impl Analysis {
                 let elastic: f64 = (0..3)
                     .map(|k| (e.stress[k] - m.prestress[k]) * e.strain[k])
                     .sum();
-                0.5 * tri.area() * m.thickness * elastic
+                0.5 * tri.area() * tri.thickness(m) * elastic
             })
             .sum()
     }

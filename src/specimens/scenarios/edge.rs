@@ -121,6 +121,7 @@ impl ArchEdge {
             cables: vec![],
             curved_supports: vec![],
             chambers: vec![],
+            layers: vec![],
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",

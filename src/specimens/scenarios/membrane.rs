@@ -115,6 +115,7 @@ impl CircularMembrane {
             cables: vec![],
             curved_supports: vec![],
             chambers: vec![],
+            layers: vec![],
         })
     }
 

@@ -143,6 +143,7 @@ impl ArchPanel {
             cables: vec![],
             curved_supports: vec![],
             chambers: vec![],
+            layers: vec![],
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",

@@ -112,6 +112,7 @@ impl CylinderStrip {
             cables: vec![],
             curved_supports: vec![],
             chambers: vec![],
+            layers: vec![],
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,

@@ -1,0 +1,260 @@
+//! The design commands (issue 46): `form-find` (the shape that carries a target prestress) and
+//! `pattern` (its cutting pattern).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use membrane_contact::mech::Model;
+use membrane_contact::mech::formfinding::force_density::force_density_shape;
+use membrane_contact::mech::formfinding::form_found_model;
+use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
+use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
+use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
+use membrane_contact::mech::patterning::outline::{OutlineLabel, dxf, svg};
+use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
+use membrane_contact::mech::patterning::seams::{
+    SeamPlane, strips_by_node_lines, strips_by_planes,
+};
+
+/// What `form-find` is asked.
+pub struct FormFindArgs<'a> {
+    pub file: &'a Path,
+    pub out: Option<&'a PathBuf>,
+    pub prestress: Option<[f64; 3]>,
+    pub force_density_start: bool,
+    pub settings: UpdateSettings,
+}
+
+/// Reads a model file.
+pub fn read_model(file: &Path) -> Result<Model, String> {
+    let name = file.display();
+    let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
+    Model::from_json(&text).map_err(|e| format!("{name}: {e}"))
+}
+
+/// Writes `text` to `out`, or to standard output.
+pub fn write_text(out: Option<&PathBuf>, text: &str) -> Result<(), String> {
+    match out {
+        Some(file) => std::fs::write(file, text).map_err(|e| format!("{}: {e}", file.display())),
+        None => {
+            print!("{text}");
+            Ok(())
+        }
+    }
+}
+
+/// `membrane-contact form-find FILE`: the found shape as a model file, a summary on stderr.
+pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
+    let model = read_model(a.file)?;
+    let prestress = a.prestress.unwrap_or(model.material.prestress);
+    if !model.gaps.is_empty() || !model.curved_supports.is_empty() {
+        eprintln!(
+            "warning: form finding does not take gaps or curved supports into account: their film nodes are free"
+        );
+    }
+    let started = Instant::now();
+    let start = if a.force_density_start {
+        force_density_shape(&model).map_err(|e| e.to_string())?
+    } else {
+        model.nodes.clone()
+    };
+    let found = find_shape(&model, start, prestress, a.settings).map_err(|e| e.to_string())?;
+    let moved = found
+        .nodes
+        .iter()
+        .zip(&model.nodes)
+        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).powi(2)).sum::<f64>().sqrt())
+        .fold(0.0, f64::max);
+    eprintln!(
+        "form found: {} reference updates, out-of-balance {:.2e} of t·|σ|·L̄, largest node move {:.4} m, {:.2?}",
+        found.steps,
+        found.residuals.last().copied().unwrap_or(0.0),
+        moved,
+        started.elapsed()
+    );
+    let result = form_found_model(&model, found.nodes, prestress);
+    write_text(a.out, &(result.to_json() + "\n"))
+}
+
+/// What `pattern` is asked.
+pub struct PatternArgs<'a> {
+    pub file: &'a Path,
+    pub seam_planes: &'a [[f64; 6]],
+    pub seam_nodes: &'a [String],
+    pub compensation: &'a str,
+    pub svg: Option<&'a PathBuf>,
+    pub dxf: Option<&'a PathBuf>,
+    pub erection_model: Option<&'a PathBuf>,
+    /// Erections at most, the mean error to stop at, increments per erection.
+    pub erect: (usize, f64, usize),
+    /// Where to write the report as JSON.
+    pub report: Option<&'a PathBuf>,
+}
+
+/// `prestress`, or `C` / `CX,CY` in percent.
+fn compensation(text: &str) -> Result<Compensation, String> {
+    if text == "prestress" {
+        return Ok(Compensation::Prestress);
+    }
+    let v: Vec<f64> = text
+        .split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .map_err(|e| format!("--compensation {p:?}: {e}"))
+        })
+        .collect::<Result<_, _>>()?;
+    match v[..] {
+        [c] => Ok(Compensation::Uniform([c / 100.0; 2])),
+        [cx, cy] => Ok(Compensation::Uniform([cx / 100.0, cy / 100.0])),
+        _ => Err("--compensation: prestress, C or CX,CY (percent)".into()),
+    }
+}
+
+/// The strips the seams cut (planes, then node lines within them; none: the whole film).
+fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String> {
+    let planes: Vec<SeamPlane> = a
+        .seam_planes
+        .iter()
+        .map(|p| SeamPlane {
+            point: [p[0], p[1], p[2]],
+            normal: [p[3], p[4], p[5]],
+        })
+        .collect();
+    let lines: Vec<Vec<usize>> = a
+        .seam_nodes
+        .iter()
+        .map(|l| {
+            l.split(',')
+                .map(|n| match n.trim().parse::<usize>() {
+                    Ok(v) if v < model.nodes.len() => Ok(v),
+                    _ => Err(format!("--seam-nodes: {n:?} is not a node of the model")),
+                })
+                .collect()
+        })
+        .collect::<Result<_, _>>()?;
+    let by_lines = strips_by_node_lines(model, &lines);
+    let by_planes = strips_by_planes(model, &planes);
+    // A strip is a set of triangles on the same side of every plane and connected across
+    // non-seam edges.
+    let mut strips: Vec<Vec<usize>> = Vec::new();
+    for p in &by_planes {
+        for l in &by_lines {
+            let both: Vec<usize> = p
+                .iter()
+                .copied()
+                .filter(|t| l.binary_search(t).is_ok())
+                .collect();
+            if !both.is_empty() {
+                strips.push(both);
+            }
+        }
+    }
+    Ok(strips)
+}
+
+/// The erection iterations, one line each on stdout; the last erection's compensation and the
+/// erections as JSON (mean and largest prestress error, each strip's compensation).
+fn compensate_with_erections(
+    model: &Model,
+    strips: Vec<Vec<usize>>,
+    start: Compensation,
+    (iterations, tolerance, increments): (usize, f64, usize),
+) -> Result<(Compensation, Vec<serde_json::Value>), String> {
+    let mut erect = |m: Model| erect_by_analysis(m, increments);
+    let history =
+        compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
+    for (k, h) in history.iter().enumerate() {
+        let worst = (0..h.element_errors.len())
+            .max_by(|&i, &j| h.element_errors[i].total_cmp(&h.element_errors[j]));
+        let per_strip: Vec<String> = h
+            .compensation
+            .iter()
+            .map(|c| format!("{:.3}/{:.3}", 100.0 * c[0], 100.0 * c[1]))
+            .collect();
+        println!(
+            "erection {k}: prestress error mean {:.3} %, max {:.3} % (triangle {}), compensation % {}",
+            100.0 * h.mean_error,
+            100.0 * h.max_error,
+            worst.unwrap_or(0),
+            per_strip.join(" ")
+        );
+    }
+    let last = history.last().ok_or("no erection was made")?;
+    let report = history
+        .iter()
+        .map(|h| {
+            serde_json::json!({
+                "mean_error": h.mean_error,
+                "max_error": h.max_error,
+                "compensation": h.compensation,
+            })
+        })
+        .collect();
+    Ok((Compensation::PerStrip(last.compensation.clone()), report))
+}
+
+/// A cut strip as JSON: its triangles, size (m), compensation and distortion (strains).
+fn strip_json(c: &CutStrip) -> serde_json::Value {
+    serde_json::json!({
+        "triangles": c.strip.triangles,
+        "size": c.size,
+        "compensation": c.compensation,
+        "distortion": { "max": c.distortion.max_strain, "rms": c.distortion.rms_strain },
+    })
+}
+
+/// `membrane-contact pattern FILE`: one line per strip on stdout, the outlines as SVG.
+pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
+    let model = read_model(a.file)?;
+    let started = Instant::now();
+    let strips = strips(&model, &a)?;
+    let mut compensation = compensation(a.compensation)?;
+    let mut erections = Vec::new();
+    if a.erect.0 > 0 {
+        (compensation, erections) =
+            compensate_with_erections(&model, strips.clone(), compensation, a.erect)?;
+    }
+    let cut = cut_pattern(&model, strips, compensation)?;
+    if let Some(file) = a.report {
+        let report = serde_json::json!({
+            "strips": cut.iter().map(strip_json).collect::<Vec<_>>(),
+            "erections": erections,
+        });
+        write_text(Some(file), &(report.to_string() + "\n"))?;
+    }
+    for (k, c) in cut.iter().enumerate() {
+        println!(
+            "strip {k}: {} triangles, cut {:.4} × {:.4} m, compensation {:.3} % × {:.3} %, distortion max {:.3} %, rms {:.3} %",
+            c.strip.triangles.len(),
+            c.size[0],
+            c.size[1],
+            100.0 * c.compensation[0],
+            100.0 * c.compensation[1],
+            100.0 * c.distortion.max_strain,
+            100.0 * c.distortion.rms_strain
+        );
+    }
+    eprintln!("patterned: {} strips, {:.2?}", cut.len(), started.elapsed());
+    if let Some(file) = a.erection_model {
+        let reference = reference_geometry(&model, &cut)?;
+        write_text(
+            Some(file),
+            &(erection_model(&model, reference).to_json() + "\n"),
+        )?;
+    }
+    let labels: Vec<OutlineLabel> = (0..cut.len())
+        .map(|k| OutlineLabel {
+            name: format!("strip {k}"),
+            compensation: cut[k].compensation,
+        })
+        .collect();
+    let strips: Vec<_> = cut.into_iter().map(|c| c.strip).collect();
+    if let Some(file) = a.svg {
+        write_text(Some(file), &svg(&model, &strips, &labels))?;
+    }
+    if let Some(file) = a.dxf {
+        write_text(Some(file), &dxf(&model, &strips, &labels))?;
+    }
+    Ok(())
+}
