@@ -940,6 +940,8 @@ struct StagedRun {
     /// step's to its strain energy.
     dissipated: f64,
     worst_ratio: f64,
+    /// Each step's ratio of the damping's work to its strain energy, and its warning about it.
+    dissipation: Vec<(f64, Option<String>)>,
     refusal: Option<String>,
 }
 
@@ -951,6 +953,8 @@ impl StagedRun {
         self.over_bound += usize::from(report.stabilization_warning().is_some());
         self.dissipated += report.stabilization_dissipated;
         self.worst_ratio = self.worst_ratio.max(report.dissipation_ratio());
+        self.dissipation
+            .push((report.dissipation_ratio(), report.dissipation_warning()));
     }
 }
 
@@ -1169,13 +1173,14 @@ fn the_held_out_paths_the_former_ladder_needed_converge_with_the_default_setting
 
 /// The plastic film's release on the 300 mm specimen (`examples/fig8_plastic.py`: wrapped over
 /// the curved support in 4 steps at the fitted extension, then retraced): a film that has flowed
-/// is longer than the frame that releases it and goes slack; Newton refuses those steps. The
-/// stabilization rows carry them (the damping took out less than 5 % of the strain energy in
-/// each), each released at its end to an undamped equilibrium: no step ends above the bound,
-/// and the damping's work over the steps is reported, not lost (fails with it set to 0:
-/// `tests/mutation.sh stab-energy`).
+/// is longer than the frame that releases it, goes slack and leaves the arch. Newton refuses
+/// steps 6 to 8 at every increment size; the stabilization rows carry them. Step 6 settles to
+/// an equilibrium (the damping took out less than 5 % of the strain energy); steps 7 and 8 have
+/// none near: the damped flow takes out more than the film stores on step 8, and the step says
+/// that its state is the damping's, not the model's. The damping's work is reported, not lost
+/// (fails with it set to 0: `tests/mutation.sh stab-energy`).
 #[test]
-fn a_slack_film_the_damping_carries_is_released_to_equilibrium() {
+fn a_slack_film_without_an_equilibrium_is_reported_as_the_dampings_state() {
     let (model, stages) = (
         "fig8_plastic_release.json",
         "fig8_plastic_release.stages.json",
@@ -1183,14 +1188,14 @@ fn a_slack_film_the_damping_carries_is_released_to_equilibrium() {
     let run = run_staged_until(model, stages, SolverSettings::default(), 8);
     assert!(run.refusal.is_none(), "{}", run.refusal.unwrap_or_default());
     assert!(run.stabilized > 0, "no increment stabilized");
+    assert!(run.dissipated > 0.0, "the damping's work is lost");
+    let settled = &run.dissipation[..6];
     assert!(
-        run.dissipated > 0.0 && run.worst_ratio > 0.0 && run.worst_ratio < 0.05,
-        "the damping's work: {} J, at most {} of a step's strain energy",
-        run.dissipated,
-        run.worst_ratio
+        settled.iter().all(|(r, w)| *r < 0.05 && w.is_none()),
+        "steps 1 to 6: {settled:?}"
     );
-    assert_eq!(
-        run.over_bound, 0,
-        "a step ends still damped above the bound"
-    );
+    let (ratio, warning) = &run.dissipation[7];
+    assert!(*ratio > 1.0, "step 8 took out {ratio} of the strain energy");
+    let warning = warning.as_deref().unwrap_or_default();
+    assert!(warning.contains("more than the film stores"), "{warning}");
 }

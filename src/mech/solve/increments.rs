@@ -4,6 +4,7 @@ use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
+use crate::mech::solve::newton::max_abs;
 use crate::mech::solve::progress::IncrementNote;
 use crate::mech::solve::report::{Attempt, IncrementFailure, StepError, StepReport};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
@@ -133,6 +134,11 @@ impl Controller {
         let ratio = (Analysis::TARGET_ITERATIONS as f64 / n).sqrt();
         self.size =
             (self.size * ratio.clamp(1.0 / Analysis::GROWTH, Analysis::GROWTH)).min(self.largest);
+        // The weakest damping that carries the step: one row back after each converged
+        // increment of a stronger one (the work taken out grows with `c`, not with the size).
+        if self.row > 1 {
+            self.row -= 1;
+        }
     }
 
     /// After a refused increment: halved, else the next row from the largest size; false where
@@ -197,10 +203,10 @@ impl Analysis {
             self.note_attempt(&mut report, row, (from, to), STRATEGIES[row].name, &attempt);
             match attempt {
                 Ok((state, history)) => {
-                    self.account_stabilized(&mut report, &state.displacement);
+                    let force = self.account_stabilized(&mut report, &state.displacement);
                     last_start = Some(std::mem::replace(&mut current, state));
                     control.converged(to, self.sizing_iterations(history.len() - 1));
-                    report.note_converged(history);
+                    report.note_converged(history, force);
                 }
                 Err(last) if !control.refused(&mut report) => {
                     self.parts.stabilization.set(0.0, 1.0);
@@ -257,13 +263,15 @@ impl Analysis {
         }
     }
 
-    /// At the end of a step the stabilization carried: the undamped equilibrium at the step's
-    /// target, solved from the damped one; where Newton refuses it, one more damped increment at
-    /// the target (the same pseudo-time step `last`: the film creeps on towards equilibrium and
-    /// the damping force falls with its motion), then the undamped one again, up to
-    /// [`Self::RELEASE_ROUNDS`] times. Where the undamped solve converges the answer carries no
-    /// damping force (`report.stabilization_energy` 0); else the damped state stays, its force's
-    /// work over the last increment reported against the bound.
+    /// At the end of a step the stabilization carried: a pseudo-time march at the step's target
+    /// from the damped state (implicit Euler on the damped flow, unconditionally stable), its
+    /// pseudo-time step `τ` growing [`Self::RELEASE_GROWTH`]-fold after each converged round
+    /// and cut as much after a refused one, until the damping force `c k̄ m ΔU/τ` is within the
+    /// residual tolerance: the state then balances the undamped model to the same tolerance as
+    /// a Newton answer (switched evolution relaxation, Mulder & van Leer 1985: as `τ → ∞` each
+    /// round becomes a Newton solve). At most [`Self::RELEASE_ROUNDS`] rounds; where they do
+    /// not settle, the last converged state stays, its damping force's work reported against
+    /// the bound.
     fn release_stabilization(
         &mut self,
         current: &mut AnalysisState,
@@ -273,33 +281,29 @@ impl Analysis {
         (row, last): (usize, f64),
     ) {
         let (motion, levels) = (path.motion(1.0), path.levels(1.0));
-        for round in 0..2 * Self::RELEASE_ROUNDS {
-            let damped = round % 2 == 1;
-            let (row, how) = if damped {
-                (row, "release, damped")
-            } else {
-                (0, "release")
-            };
-            self.parts.stabilization.set(STRATEGIES[row].damping, last);
+        let mut tau = last;
+        for _ in 0..Self::RELEASE_ROUNDS {
+            self.parts.stabilization.set(STRATEGIES[row].damping, tau);
             let attempt = self.solve_increment(current, &motion, &levels);
-            self.note_attempt(report, row, (1.0, 1.0), how, &attempt);
+            self.note_attempt(report, row, (1.0, 1.0), "release", &attempt);
             let Ok((mut state, history)) = attempt else {
-                if damped {
-                    return;
-                }
+                tau /= Self::RELEASE_GROWTH;
                 continue;
             };
-            self.account_stabilized(report, &state.displacement);
+            let force = self.account_stabilized(report, &state.displacement);
+            let tolerance = self.settings.residual_tolerance
+                * max_abs(&self.work.internal).max(self.force_floor);
             // The step's last increment, for the next step's predictor, is the motion from the
             // start of the last loaded increment to here.
             for (l, a) in state.last_increment.iter_mut().zip(&current.last_increment) {
                 *l += a;
             }
-            report.note_converged(history);
+            report.note_converged(history, force);
             *last_start = Some(std::mem::replace(current, state));
-            if !damped {
+            if force <= tolerance {
                 return;
             }
+            tau *= Self::RELEASE_GROWTH;
         }
     }
 
@@ -333,19 +337,25 @@ impl Analysis {
         });
     }
 
-    /// Most damped increments [`Self::release_stabilization`] adds at a step's end.
+    /// Most rounds [`Self::release_stabilization`] adds at a step's end.
     pub(crate) const RELEASE_ROUNDS: usize = 20;
+    /// The factor of the release's pseudo-time step after a converged round (its inverse after
+    /// a refused one).
+    pub(crate) const RELEASE_GROWTH: f64 = 4.0;
 
     /// Accounts an increment converged at `u` (the stabilization's work over it added to the
-    /// step's dissipated work; the work of the force the state carries is this increment's).
-    fn account_stabilized(&mut self, report: &mut StepReport, u: &[f64]) {
+    /// step's dissipated work; the work of the force the state carries is this increment's);
+    /// returns that force's largest magnitude (N; 0 without stabilization).
+    fn account_stabilized(&mut self, report: &mut StepReport, u: &[f64]) -> f64 {
         if self.parts.stabilization.is_on() {
             report.stabilized += 1;
             let work = self.parts.stabilization.work(&self.system, u);
             report.stabilization_dissipated += work;
             report.stabilization_energy = work;
+            self.parts.stabilization.force_inf(&self.system, u)
         } else {
             report.stabilization_energy = 0.0;
+            0.0
         }
     }
 

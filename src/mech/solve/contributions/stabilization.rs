@@ -88,6 +88,22 @@ impl ViscousStabilization {
     }
 }
 
+impl ViscousStabilization {
+    /// The largest magnitude of the damping force `c k̄ m_i (U_i − U_i,start)/Δλ` (N) at `u`:
+    /// the undamped residual of a state that balances the damped one.
+    pub fn force_inf(&self, system: &System, u: &[f64]) -> f64 {
+        let k = self.stiffness();
+        let mut largest = 0.0_f64;
+        for (i, d) in system.dofs.iter().enumerate() {
+            if let Dof::Free(eq) = d {
+                let du = u[i] - self.start.get(i).copied().unwrap_or(u[i]);
+                largest = largest.max((k * self.mass[*eq] * du).abs());
+            }
+        }
+        largest
+    }
+}
+
 impl Contribution for ViscousStabilization {
     fn restore(&mut self, start: &AnalysisState) {
         self.start.clone_from(&start.displacement);
