@@ -263,8 +263,9 @@ impl Analysis {
         }
     }
 
-    /// At the end of a step the stabilization carried: a pseudo-time march at the step's target
-    /// from the damped state (implicit Euler on the damped flow, unconditionally stable), its
+    /// At the end of a step the stabilization carried: the undamped equilibrium at the step's
+    /// target solved from the damped state, alternating with a pseudo-time march at the target
+    /// (implicit Euler on the damped flow, unconditionally stable), its
     /// pseudo-time step `τ` growing [`Self::RELEASE_GROWTH`]-fold after each converged round
     /// and cut as much after a refused one, until the damping force `c k̄ m ΔU/τ` is within the
     /// residual tolerance: the state then balances the undamped model to the same tolerance as
@@ -282,12 +283,22 @@ impl Analysis {
     ) {
         let (motion, levels) = (path.motion(1.0), path.levels(1.0));
         let mut tau = last;
-        for _ in 0..Self::RELEASE_ROUNDS {
+        for round in 0..2 * Self::RELEASE_ROUNDS {
+            // Each round tries the undamped equilibrium first (Newton from the damped state),
+            // then one step of the march.
+            let damped = round % 2 == 1;
+            let (row, how) = if damped {
+                (row, "release, damped")
+            } else {
+                (0, "release")
+            };
             self.parts.stabilization.set(STRATEGIES[row].damping, tau);
             let attempt = self.solve_increment(current, &motion, &levels);
-            self.note_attempt(report, row, (1.0, 1.0), "release", &attempt);
+            self.note_attempt(report, row, (1.0, 1.0), how, &attempt);
             let Ok((mut state, history)) = attempt else {
-                tau /= Self::RELEASE_GROWTH;
+                if damped {
+                    tau /= Self::RELEASE_GROWTH;
+                }
                 continue;
             };
             let force = self.account_stabilized(report, &state.displacement);

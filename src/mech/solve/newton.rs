@@ -240,8 +240,7 @@ impl Analysis {
             let (record, force_scale) = self.observe(&mut it, start, iteration)?;
             let met = (iteration > 0 || self.system.free_count == 0)
                 && record.correction <= record.correction_tolerance
-                && (record.residual <= record.residual_tolerance
-                    || record.at_rounding_floor(s.displacement_tolerance))
+                && record.residual <= record.residual_tolerance
                 && it.artificial <= record.residual_tolerance;
             if met && it.hold.held.is_empty() {
                 return self.commit_increment(start, motion, levels, it.u, it.residuals, iteration);
@@ -469,17 +468,14 @@ impl Analysis {
             self.assemble_at(u, levels, tangent);
             let merit = self.free_norm2();
             let phi = merit * merit;
-            // The first full step from the predictor that leaves every contact's status as it
-            // was stays on the same smooth piece of `R`, where Newton's model holds: kept unless
-            // it raises the residual [`Continuation::GROW`]-fold (the flat film's first pressure
-            // step). Later ones meet the nonmonotone test below (Grippo, Lampariello & Lucidi
-            // 1986): the film's taut/wrinkled switches are pieces the statuses do not name, on
-            // which full steps can cycle (isotropic μ = 0.2 → 1 in one step: 62 ↔ 65 N).
+            // A full step that leaves every contact's status as it was stays on the same smooth
+            // piece of `R`, where Newton's model holds: kept unless it raises the residual
+            // [`Continuation::GROW`]-fold (the flat film's first pressure step).
             let same = self.parts.statuses() == *statuses;
             // The event trial ends on the next piece's edge, where the merit's slope changes:
             // kept on the same allowance, so that the next iteration's tangent carries the
             // contact's new status.
-            let same_piece = (trial == 0 && same && next_iteration == 1 || trial == 1 && at_event)
+            let same_piece = (trial == 0 && same || trial == 1 && at_event)
                 && merit <= Continuation::GROW * reference;
             let phi_ref = if same { phi_max } else { phi0 };
             // A step to within the residual tolerance needs no decrease (at roundoff the merit

@@ -181,18 +181,6 @@ pub struct IterationRecord {
 }
 
 impl IterationRecord {
-    /// Whether the correction that led here is at the rounding of the displacements
-    /// (`‖ΔU‖∞ ≤ 1e3 ε U_ref`, `U_ref` the correction tolerance's scale, with the relative
-    /// `displacement_tolerance`) while the residual is within ten times its tolerance: Newton
-    /// cannot improve such an iterate, and its residual is the rounding of the forces' sums, the
-    /// floor a residual tolerance near 1e-12 meets (the specimen's 28 N gap forces leave 7e-11 N
-    /// against a tolerance of 5.5e-11 N).
-    pub(crate) fn at_rounding_floor(&self, displacement_tolerance: f64) -> bool {
-        let scale = self.correction_tolerance / displacement_tolerance;
-        self.correction <= 1e3 * f64::EPSILON * scale
-            && self.residual <= 10.0 * self.residual_tolerance
-    }
-
     /// How far this iterate is from convergence: the larger of the residual's and the
     /// correction's ratio to its tolerance (converged iterates have at most 1).
     pub(crate) fn distance(&self) -> f64 {

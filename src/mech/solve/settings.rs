@@ -13,9 +13,7 @@ use crate::mech::elements::gap::IterationMatrix;
 ///   bounding-box diagonal;
 /// * `‖R_free‖∞ ≤ residual_tolerance · F_ref`, `F_ref = max(‖R_all‖∞, 1e-6·E·t·L)`: the largest
 ///   out-of-balance force is small against the largest nodal force of the model (the reactions
-///   and gap forces; the floor is the membrane's own force scale, for unloaded states), or,
-///   where the last correction is at the displacements' rounding (`‖ΔU‖∞ ≤ 1e3 ε U_ref`), within
-///   ten times that: the residual's rounding floor, which a tolerance near 1e-12 meets.
+///   and gap forces; the floor is the membrane's own force scale, for unloaded states).
 ///
 /// Both are scaled by the model, so the same defaults serve a 1 N strip and a 10 kN roof.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
