@@ -536,6 +536,12 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
             return o;
         }
     };
+    if std::env::var_os("HELDOUT_LOG_INCREMENTS").is_some() {
+        let name = path.name.clone();
+        analysis.observe_increments(membrane_contact::mech::solve::IncrementObserver::new(
+            move |note| eprintln!("{name}: {note}"),
+        ));
+    }
     'stages: for stage in &path.stages {
         let s = analysis.state().clone();
         let target_loads = LoadLevels {
@@ -569,7 +575,10 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
                     o.increments += report.iterations.len();
                     o.cutbacks += report.cutbacks;
                     o.stabilized += report.stabilized;
-                    o.over_bound += usize::from(report.stabilization_warning().is_some());
+                    o.over_bound += usize::from(
+                        report.stabilization_warning().is_some()
+                            || report.dissipation_ratio() > 1.0,
+                    );
                     o.max_increment = o
                         .max_increment
                         .max(report.iterations.iter().copied().max().unwrap_or(0));

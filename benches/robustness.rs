@@ -65,9 +65,9 @@ fn main() {
     let wall = start.elapsed().as_secs_f64();
 
     println!(
-        "| family | paths | converged | % | iterations / increment (mean) | max per increment | cut-backs | enlarged | steps converged | path s | first failure |"
+        "| family | paths | converged | % | iterations / increment (mean) | max per increment | cut-backs | steps converged | path s | first failure |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut total = (0, 0, 0, 0, 0, 0.0);
     let row = |name: &str, sel: &[(&Scenario, &(RunOutcome, f64))]| {
         let n = sel.len();
@@ -75,7 +75,6 @@ fn main() {
         let iterations: usize = sel.iter().map(|(_, (r, _))| r.iterations()).sum();
         let incs: usize = sel.iter().map(|(_, (r, _))| r.increments()).sum();
         let cut: usize = sel.iter().map(|(_, (r, _))| r.cutbacks()).sum();
-        let enlarged: usize = sel.iter().map(|(_, (r, _))| r.enlarged()).sum();
         let steps_ok: usize = sel
             .iter()
             .map(|(_, (r, _))| r.steps.iter().filter(|s| s.error.is_none()).count())
@@ -92,7 +91,7 @@ fn main() {
             .find_map(|(s, (r, _))| r.failure_message().map(|m| format!("{}: {m}", s.name)))
             .unwrap_or_else(|| "–".into());
         println!(
-            "| {name} | {n} | {ok} | {:.1} | {:.2} | {max} | {cut} | {enlarged} | {steps_ok}/{steps_all} | {cpu:.1} | {} |",
+            "| {name} | {n} | {ok} | {:.1} | {:.2} | {max} | {cut} | {steps_ok}/{steps_all} | {cpu:.1} | {} |",
             100.0 * ok as f64 / n.max(1) as f64,
             iterations as f64 / incs.max(1) as f64,
             first.replace('|', "/")

@@ -400,14 +400,7 @@ fn inflate(model: &Model, q: f64, path: &[f64]) -> (f64, f64) {
 /// [`inflate`] with the model's own pressure sets.
 fn inflate_as_given(model: &Model, path: &[f64]) -> (f64, f64) {
     let model = model.clone();
-    // Plain Newton: its first correction from a flat film stretches it in-plane, which raises
-    // ‖R‖ before the next iterations converge quadratically (5–8 per step); the backtracking
-    // line search rejects that step and crawls (residual −10 % per iteration, 260 s here).
-    let settings = SolverSettings {
-        line_search: false,
-        ..SolverSettings::default()
-    };
-    let mut analysis = Analysis::new(model.clone(), settings).unwrap();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
     let full = LoadLevels::of_model(&model);
     for &fraction in path {
         analysis
@@ -977,40 +970,28 @@ fn inflated_cushion_reaches_the_spherical_cap_and_its_pressure_has_no_resultant(
     );
 }
 
-/// The line search's watchdog: from a flat prestressed disc, the first full Newton step of a
-/// pressure load raises the residual before the next ones converge quadratically; backtracking
-/// alone crawled there (18 damped iterations against 6 on the peers' sheet). With the default
-/// settings the disc now takes the plain Newton iterations and reaches the same answer.
+/// From a flat prestressed disc, the first full Newton step of a pressure load raises the
+/// residual (the film stretches in-plane) before the next ones converge quadratically; the line
+/// search keeps such steps where no contact changes status (only a tenfold rise is refused), so
+/// each of the five load steps converges in one increment, without a crawl (19 iterations at
+/// most measured; a backtracking crawl took hundreds).
 #[test]
-fn line_search_keeps_plain_newtons_full_steps_when_they_lead_to_the_answer() {
+fn a_pressure_step_from_a_flat_film_converges_in_one_increment_without_a_crawl() {
     let mut model = disc(1.0, 12, film(1.0e6));
     model.loads.pressures = vec![pressure_everywhere("top", 1000.0)];
     let full = LoadLevels::of_model(&model);
-    let run = |line_search: bool| {
-        let settings = SolverSettings {
-            line_search,
-            ..SolverSettings::default()
-        };
-        let mut analysis = Analysis::new(model.clone(), settings).unwrap();
-        let mut iterations = 0;
-        for k in 1..=5 {
-            let report = analysis
-                .step_to_with_loads(&[[0.0; 3]], &full.scaled(k as f64 / 5.0), 1)
-                .unwrap();
-            iterations += report.total_iterations();
-        }
-        (iterations, analysis.node_displacement(0).z)
-    };
-    let (plain, w_plain) = run(false);
-    let (default, w_default) = run(true);
-    assert_eq!(
-        default, plain,
-        "default {default} vs plain Newton {plain} iterations"
-    );
-    assert!(
-        (w_default / w_plain - 1.0).abs() < 1e-9,
-        "{w_default} vs {w_plain}"
-    );
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    for k in 1..=5 {
+        let report = analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(k as f64 / 5.0), 1)
+            .unwrap();
+        assert_eq!(report.cutbacks, 0, "step {k}: {report:?}");
+        assert!(
+            report.total_iterations() <= 25,
+            "step {k}: {} iterations",
+            report.total_iterations()
+        );
+    }
 }
 
 /// A load per plan area (pressure set `"kind": "plan"`, snow) on a flat patch tilted by `θ`

@@ -688,6 +688,7 @@ fn failed_step_keeps_the_last_converged_state() {
     let settings = SolverSettings {
         max_iterations: 2,
         max_cutbacks: 1,
+        stabilization: false,
         ..Default::default()
     };
     let mut a = Analysis::new(pressed_node_model(0.0, 0.2), settings).unwrap();

@@ -72,8 +72,7 @@ def markdown(results, *, title: str = "run", variables: dict | None = None, mess
 
     # -- load steps
     head = ["point", "time"] + [f"{n}" for n in results.input_names]
-    stats = [s for s in ("solver.iterations", "solver.cutbacks", "solver.liftOffReleases",
-                         "solver.smoothedIncrements") if s in names]
+    stats = [s for s in ("solver.iterations", "solver.cutbacks", "solver.stabilizedIncrements") if s in names]
     head += stats
     rows = []
     for k, t in enumerate(results.time):

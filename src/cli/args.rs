@@ -251,8 +251,9 @@ pub struct RunArgs {
     /// Newton iterations per increment before it is halved (default 100).
     #[arg(long, value_name = "N")]
     pub max_iterations: Option<usize>,
-    /// The largest increment is 1/N of a step (the FMU's solver.incrementsPerStep, with the
-    /// same default); increments halve on failure and grow back.
+    /// The smallest number of increments a step is cut into: the largest increment is 1/N of a
+    /// step (the FMU's solver.incrementsPerStep, with the same default); the controller sizes
+    /// the increments below it by their Newton iterations and halves a refused one.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_INCREMENTS_PER_STEP as u32, value_parser = clap::value_parser!(u32).range(1..))]
     pub increments: u32,
     /// Halvings of an increment before a step fails (default 12).
@@ -264,23 +265,10 @@ pub struct RunArgs {
     /// Relative Newton tolerance on the residual (default 1e-5).
     #[arg(allow_negative_numbers = true, long, value_name = "X")]
     pub residual_tolerance: Option<f64>,
-    /// Plain Newton steps: about half the iterations when each step starts near its answer,
-    /// no safeguard for a first step from a slack flat film.
-    #[arg(long)]
-    pub no_line_search: bool,
-    /// No pseudo-transient continuation: an increment plain Newton does not converge is halved
-    /// at once (the stabilization-free reference of a slack start; docs/mechanics.md)
-    #[arg(long)]
-    pub no_continuation: bool,
-    /// No viscous stabilization: a step whose increment neither plain Newton nor the
-    /// continuation converge is halved without it (the answer then carries no damping force;
-    /// docs/mechanics.md "Viscous stabilization")
+    /// No viscous stabilization: a step whose smallest increment Newton refuses is refused
+    /// (the answer then carries no damping force; docs/mechanics.md "The nonlinear method")
     #[arg(long)]
     pub no_stabilization: bool,
-    /// No smoothing homotopy: an increment every other attempt refused is not solved again with
-    /// the contact and wrinkling laws' switches rounded (docs/mechanics.md "Smoothing homotopy")
-    #[arg(long)]
-    pub no_smoothing: bool,
     /// Threads of the element assembly and the LDLᵀ factorization (0 = automatic: the idle
     /// cores, one below 100 000 triangles and 2^24 factor values; results are identical for
     /// every count).

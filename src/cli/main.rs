@@ -164,10 +164,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             .displacement_tolerance
             .unwrap_or(defaults.displacement_tolerance),
         residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
-        line_search: !o.no_line_search,
-        continuation: !o.no_continuation,
         stabilization: !o.no_stabilization,
-        smoothing: !o.no_smoothing,
         threads: o.threads,
         ..defaults
     };
@@ -227,15 +224,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             eprintln!("step {k}/{steps} ({t:.1} s): {note}");
         }));
     }
-    let (mut iterations, mut cutbacks, mut enlarged, mut increments) = (Vec::new(), 0, 0, 0);
-    // Increments solved by continuation, and the step of the largest stabilization ratio.
-    let (mut continued, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
-    // Increments solved with the viscous stabilization on.
-    let (mut stabilized, mut released, mut jumps) = (0, 0, 0);
-    // Cross holds released at sliding-direction contacts lifting off: how many, the largest (N).
-    let (mut lifted, mut largest_lift) = (0, 0.0_f64);
-    // Increments solved by the smoothing homotopy, and of them accepted on the law's residual.
-    let (mut smoothed, mut on_residual) = (0, 0);
+    let (mut iterations, mut cutbacks, mut increments) = (Vec::new(), 0, 0);
+    // Increments solved with the viscous stabilization on, and the step of the largest
+    // ratio of its work to the strain energy.
+    let (mut stabilized, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
     let count = path.steps.len();
     // The contact warnings of the last step (said with its number, not again at the end).
     let mut last_contacts = vec![];
@@ -268,29 +260,15 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             }
         };
         cutbacks += report.cutbacks;
-        enlarged += report.enlarged;
-        continued += report.continued;
         stabilized += report.stabilized;
-        released += report.released;
-        jumps += report.damped_jumps;
-        lifted += report.lifted_off.len();
-        smoothed += report.smoothed;
-        on_residual += report.smoothed_on_residual;
-        largest_lift = report
-            .lifted_off
-            .iter()
-            .fold(largest_lift, |m, &f| m.max(f));
-        if let Some(w) = report.dissipation_warning() {
+        for w in [report.stabilization_warning(), report.dissipation_warning()]
+            .into_iter()
+            .flatten()
+        {
             eprintln!("warning: step {step}: {w}");
         }
-        if report.continued > 0 || report.stabilized > 0 {
-            let ratio = report.stabilization_ratio();
-            if let Some(w) = report.stabilization_warning() {
-                eprintln!("warning: step {step}: {w}");
-            }
-            if let Some(w) = report.jump_warning() {
-                eprintln!("warning: step {step}: {w}");
-            }
+        if report.stabilized > 0 {
+            let ratio = report.dissipation_ratio();
             if stabilization.is_none_or(|(_, r, _, _)| ratio > r) {
                 stabilization = Some((
                     step,
@@ -340,7 +318,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     }
     let total: usize = iterations.iter().sum();
     out!(
-        "\nNewton: {count} steps, {increments} increments, {cutbacks} cut-backs, {enlarged} enlarged, \
+        "\nNewton: {count} steps, {increments} increments, {cutbacks} cut-backs, \
          {total} iterations ({:.1} per increment), iterations per step {:?}; {:.1} ms",
         total as f64 / increments.max(1) as f64,
         iterations,
@@ -348,30 +326,10 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     );
     if let Some((step, ratio, energy, dissipated)) = stabilization {
         out!(
-            "stabilization: {continued} increments by pseudo-transient continuation, {stabilized} viscously \
-             stabilized{}, {released} at steps' ends to release it; largest artificial energy left {energy:.3e} J at step {step} ({ratio:.2e} of the strain \
-             energy; bound {:.0e}; {dissipated:.3e} J taken out on the way)",
-            if jumps > 0 {
-                format!(" ({jumps} of them carried by the larger dampings)")
-            } else {
-                String::new()
-            },
-            membrane_contact::mech::solve::report::STABILIZATION_BOUND
-        );
-    }
-    if lifted > 0 {
-        out!(
-            "lift-off: {lifted} cross hold{} of the sliding-direction law released at contacts that lifted off \
-             where no equilibrium held on either side of the law's jump (largest {largest_lift:.3e} N; docs/mechanics.md)",
-            if lifted == 1 { "" } else { "s" }
-        );
-    }
-    if smoothed > 0 {
-        out!(
-            "smoothing: {smoothed} increment{} solved from the contact and wrinkling laws with their \
-             switches rounded, the rounding reduced ({on_residual} of them accepted on the law's residual \
-             at the rounded solution; docs/mechanics.md \"Smoothing homotopy\")",
-            if smoothed == 1 { "" } else { "s" }
+            "stabilization: {stabilized} increments viscously stabilized; largest work taken out \
+             {dissipated:.3e} J at step {step} ({ratio:.2e} of the strain energy; bound {}), \
+             {energy:.3e} J left in its answer",
+            membrane_contact::mech::solve::DISSIPATION_BOUND
         );
     }
     let [lu, ldlt, redone, gmres] = analysis.factorization_counts();

@@ -282,10 +282,7 @@ impl Instance {
                 (Binding::FrictionLaw, Value::String(name)) => {
                     model.set_friction_law(name.parse().map_err(|e| format!("{}: {e}", v.name))?)
                 }
-                (Binding::LineSearch, Value::Boolean(b)) => settings.line_search = b,
-                (Binding::Continuation, Value::Boolean(b)) => settings.continuation = b,
                 (Binding::Stabilization, Value::Boolean(b)) => settings.stabilization = b,
-                (Binding::Smoothing, Value::Boolean(b)) => settings.smoothing = b,
                 (Binding::Threads, Value::Integer(x)) => {
                     settings.threads = count(x, 0)?;
                     if settings.threads > MAX_THREADS {

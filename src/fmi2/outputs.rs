@@ -50,7 +50,7 @@ impl Instance {
         if let Some(w) = report.and_then(StepReport::stabilization_warning) {
             built.warnings.push(w);
         }
-        if let Some(w) = report.and_then(StepReport::jump_warning) {
+        if let Some(w) = report.and_then(StepReport::dissipation_warning) {
             built.warnings.push(w);
         }
         if let Some(w) = report.and_then(StepReport::dissipation_warning) {
@@ -80,8 +80,10 @@ impl Instance {
                 Binding::StabilizationRatio => {
                     Value::Real(report.map_or(0.0, |r| r.stabilization_ratio()))
                 }
-                Binding::LiftOffReleases => count(report.map_or(0, |r| r.lifted_off.len())),
-                Binding::SmoothedIncrements => count(report.map_or(0, |r| r.smoothed)),
+                Binding::StabilizedIncrements => count(report.map_or(0, |r| r.stabilized)),
+                Binding::DissipationRatio => {
+                    Value::Real(report.map_or(0.0, |r| r.dissipation_ratio()))
+                }
                 Binding::WrinkledElements => count(wrinkled),
                 Binding::SlackElements => count(slack),
                 Binding::YieldedElements => count(plastic.map_or(0, |p| p.yielded_elements)),

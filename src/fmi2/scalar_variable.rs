@@ -155,14 +155,8 @@ pub enum Binding {
     MaxCutbacks,
     IncrementsPerStep,
     UseJuRowlands,
-    /// Backtracking line search on (true) or off.
-    LineSearch,
-    /// Pseudo-transient continuation before halving (true) or halving only.
-    Continuation,
-    /// Viscous stabilization as the last resort of a step (true) or none.
+    /// The viscous stabilization's rows of the strategy table (true) or none.
     Stabilization,
-    /// The smoothing homotopy for an increment every other attempt refused (true) or none.
-    Smoothing,
     /// Threads of the element assembly (0: automatic).
     Threads,
     /// Directory of the VTK output (a String parameter; "" = none). Not a model parameter:
@@ -193,10 +187,10 @@ pub enum Binding {
     Residual,
     StabilizationEnergy,
     StabilizationRatio,
-    /// Contacts released at lift-off in the last step (`StepReport::lifted_off`).
-    LiftOffReleases,
-    /// Increments solved by the smoothing homotopy in the last step (`StepReport::smoothed`).
-    SmoothedIncrements,
+    /// Increments solved with the viscous stabilization in the last step.
+    StabilizedIncrements,
+    /// The stabilization's work over the last step over the strain energy.
+    DissipationRatio,
     MaxEquivalentStress,
     WrinkledElements,
     SlackElements,

@@ -114,12 +114,11 @@ impl Instance {
                 self.refresh_outputs(Some(&report))?;
                 self.event(|| {
                     format!(
-                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs{}, residual {:.3e} N{}",
+                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N{}",
                         self.time,
                         report.iterations.len(),
                         report.total_iterations(),
                         report.cutbacks,
-                        enlarged_note(report.enlarged),
                         report.residual,
                         report.attempts()
                     )
@@ -295,16 +294,4 @@ fn unavailable_status(kind: i32, function: &str) -> Failure {
     Failure::discard(format!(
         "{function}: {name} ({kind}) is not available from this synchronous FMU"
     ))
-}
-
-/// The step log's note on enlarged increments: "" on the ordinary step that had none.
-fn enlarged_note(enlarged: usize) -> String {
-    if enlarged == 0 {
-        String::new()
-    } else {
-        format!(
-            ", {enlarged} enlarged (larger than 1/solver.incrementsPerStep because every smaller \
-             one failed)"
-        )
-    }
 }

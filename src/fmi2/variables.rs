@@ -29,7 +29,7 @@
 //! | `gravity.x/.y/.z` | Real | parameter | m/s2 | gravity on the film's mass, ramped in over the first step (start: the model's) |
 //! | `<gap>.kn`, `<gap>.ks` | Real | parameter | N/m | gap penalties |
 //! | `frictionLaw` | String | parameter | | `isotropic` or `sliding-direction` for every gap and curved support; start: the model's when uniform, else "" (each keeps its own) |
-//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.lineSearch`, `solver.continuation`, `solver.stabilization`, `solver.smoothing` | | parameter | | Newton settings (`solver.smoothing` is appended after `solver.liftOffReleases`) |
+//! | `solver.*Tolerance`, `solver.maxIterations`, `solver.maxCutbacks`, `solver.incrementsPerStep`, `solver.useJuRowlands`, `solver.stabilization` | | parameter | | Newton settings |
 //! | `solver.threads` | Integer | parameter | | threads of the element assembly and the factorization (0: automatic); results identical for every count |
 //! | `results.directory` | String | parameter | | VTK output of every communication step ("": none) |
 //! | `results.vtkFormat` | String | parameter | | `binary` (raw appended, the default) or `ascii` VTK files |
@@ -559,7 +559,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          (the paper's: slides along the gap's local x, or along the support, only); empty: each keeps the model file's",
         Binding::FrictionLaw,
     );
-    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 10] = [
+    let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 8] = [
         (
             "displacementTolerance",
             Value::Real(solver.displacement_tolerance),
@@ -592,7 +592,8 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "incrementsPerStep",
             Value::Integer(DEFAULT_INCREMENTS_PER_STEP),
             None,
-            "equal load increments per communication step",
+            "the smallest number of increments a communication step is cut into (the controller cuts \
+             further where Newton needs it)",
             Binding::IncrementsPerStep,
         ),
         (
@@ -603,30 +604,12 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::UseJuRowlands,
         ),
         (
-            "lineSearch",
-            Value::Boolean(solver.line_search),
-            None,
-            "true: backtracking line search on the residual (safe first steps from a flat film, gaps opening \
-             and closing); false: plain Newton steps, about half the iterations when each step starts near \
-             its answer (a prestressed film under a gradually raised pressure)",
-            Binding::LineSearch,
-        ),
-        (
-            "continuation",
-            Value::Boolean(solver.continuation),
-            None,
-            "true: an increment plain Newton does not converge is solved by pseudo-transient continuation \
-             before it is halved (slack films, contacts opening; its remaining artificial energy is \
-             solver.stabilizationEnergy); false: halving only",
-            Binding::Continuation,
-        ),
-        (
             "stabilization",
             Value::Boolean(solver.stabilization),
             None,
-            "true: a step whose smallest increment nothing else converges is solved on with viscous \
-             stabilization (a film without a unique equilibrium; the work of its force is in \
-             solver.stabilizationEnergy); false: the step is discarded there",
+            "true: a step whose smallest increment Newton refuses is solved on with viscous \
+             stabilization (a film without a unique equilibrium; its work over the step is judged against \
+             the strain energy, solver.dissipationRatio); false: the step is discarded there",
             Binding::Stabilization,
         ),
         (
@@ -872,8 +855,8 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     table.output(
         "solver.stabilizationEnergy",
         "N.m",
-        "artificial energy the pseudo-transient continuation and the viscous stabilization left at the end \
-         of the last step (0 when no increment needed them)",
+        "work of the viscous stabilization's force over the last increment of the last step: the force the \
+         answer still carries (0 when the step ended without it)",
         Binding::StabilizationEnergy,
     );
     table.output(
@@ -925,29 +908,18 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
-    // Last, so that the value references of the variables above stay where they were.
     integer_output(
         &mut table,
-        "solver.liftOffReleases",
-        "sliding-direction contacts released at lift-off in the last step (their hold across the \
-         support: no equilibrium held on either side of the law's jump)",
-        Binding::LiftOffReleases,
+        "solver.stabilizedIncrements",
+        "increments of the last step solved with the viscous stabilization (solver.stabilization)",
+        Binding::StabilizedIncrements,
     );
-    // Appended after it for the same reason.
-    table.parameter(
-        "solver.smoothing",
-        Value::Boolean(solver.smoothing),
-        None,
-        "true: an increment every other attempt refused (curved contacts or a tension-field film) is \
-         solved again with the contact and wrinkling laws' switches rounded, the rounding reduced, and \
-         the law's own equilibrium solved from there; false: the step is discarded there",
-        Binding::Smoothing,
-    );
-    integer_output(
-        &mut table,
-        "solver.smoothedIncrements",
-        "increments of the last step solved by the smoothing homotopy (solver.smoothing)",
-        Binding::SmoothedIncrements,
+    table.output(
+        "solver.dissipationRatio",
+        "1",
+        "work of the viscous stabilization over the last step over the film's strain energy (Abaqus' \
+         ALLSD/ALLIE); above 0.05 the step warns, above 1 the warning says the state is the damping's",
+        Binding::DissipationRatio,
     );
     table.0
 }
@@ -1146,22 +1118,9 @@ mod tests {
             .count();
         assert_eq!(
             outputs,
-            9 * 7 + 3 + 3 + 8 + 2,
+            9 * 7 + 3 + 3 + 7 + 3,
             "gaps, group and total reactions, statistics (with the stabilization energy and ratio, \
-             the lift-off releases and the smoothed increments), film"
-        );
-        // Appended last: the value references before them are those of the earlier tables.
-        let names: Vec<_> = table[table.len() - 3..]
-            .iter()
-            .map(|v| (v.name.as_str(), v.var_type))
-            .collect();
-        assert_eq!(
-            names,
-            [
-                ("solver.liftOffReleases", VarType::Integer),
-                ("solver.smoothing", VarType::Boolean),
-                ("solver.smoothedIncrements", VarType::Integer)
-            ]
+             the stabilized increments and the dissipation ratio), film"
         );
         assert_eq!(find("film.wrinkling").start, Some(Value::Boolean(false)));
         assert_eq!(find("film.slackElements").var_type, VarType::Integer);

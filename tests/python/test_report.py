@@ -84,7 +84,7 @@ def test_film_report_has_every_section_with_the_recorded_numbers(fmu_path, tmp_p
     assert int(solver["solver.iterations (sum)"]) == int(results["solver.iterations"][1:].sum()) > 0
     assert re.search(r"\| rollbacks \| 0 \|", md)
     # Every Integer statistic of the solver, as a column of the steps and summed.
-    for s in ("solver.cutbacks", "solver.liftOffReleases", "solver.smoothedIncrements"):
+    for s in ("solver.cutbacks", "solver.stabilizedIncrements"):
         column = head_of(md, "## Load steps").index(s)
         assert [int(r[column]) for r in steps[1:]] == [int(v) for v in results[s][1:]], s
         assert int(solver[f"{s} (sum)"]) == int(results[s][1:].sum()), s

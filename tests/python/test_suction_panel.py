@@ -84,19 +84,19 @@ def _cli_disc(model: dict, tmp_path, *options):
 
 
 def test_the_flat_disc_under_self_weight_matches_a_curved_start_without_stabilization(tmp_path):
-    # Hencky's dead-load problem from the flat, stress-free disc needs the continuation (the
-    # first Newton matrix has no out-of-plane stiffness); 0.5 mm of initial sag is the least
-    # that converges without it, and changes the answer by less than 0.2 %.
+    # Hencky's dead-load problem from the flat, stress-free disc: the first Newton matrix has no
+    # out-of-plane stiffness, and the pseudo-time term (or the stabilized rows) hold the film until
+    # its own stress does; 0.5 mm of initial sag changes the answer by less than 0.2 %.
     flat_z, flat_stress, flat_out = _cli_disc(slack_films.disc(), tmp_path)
-    curved_z, curved_stress, curved_out = _cli_disc(slack_films.disc(sag=5e-4), tmp_path, "--no-continuation",
-                                                    "--no-stabilization")
+    curved_z, curved_stress, curved_out = _cli_disc(slack_films.disc(sag=5e-4), tmp_path, "--no-stabilization")
     assert flat_z < -5e-3, flat_z
     assert abs(flat_z / curved_z - 1) < 2e-3, (flat_z, curved_z)
     assert abs(flat_stress / curved_stress - 1) < 2e-3, (flat_stress, curved_stress)
-    stabilization = re.search(r"stabilization: (\d+) increments.*?left (\S+) J at step \d+ \((\S+) of the strain energy; "
-                              r"bound (\S+);", flat_out)
-    assert stabilization and int(stabilization.group(1)) > 0, flat_out[-500:]
-    assert float(stabilization.group(3)) <= float(stabilization.group(4))
+    stabilization = re.search(r"stabilization: (\d+) increments viscously stabilized; largest work taken out (\S+) J "
+                              r"at step \d+ \((\S+) of the strain energy; bound \S+\), (\S+) J left", flat_out)
+    if stabilization:  # where a stabilized row carried a step, the force its answer carries is within 2e-4
+        strain_energy = float(stabilization.group(2)) / float(stabilization.group(3))
+        assert float(stabilization.group(4)) <= 2e-4 * strain_energy, flat_out[-500:]
     assert "stabilization:" not in curved_out
 
 

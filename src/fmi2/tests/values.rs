@@ -95,8 +95,12 @@ fn friction_law_parameter_gives_every_gap_the_papers_law() {
         };
         let mut a = crate::mech::Analysis::new(spec.model().unwrap(), Default::default()).unwrap();
         for k in 1..=2 {
-            a.step_to(&[[0.0, 0.0, spec.target()[2] * (k as f64 / 20.0)]], 10)
-                .unwrap();
+            let increments = crate::mech::solve::DEFAULT_INCREMENTS_PER_STEP;
+            a.step_to(
+                &[[0.0, 0.0, spec.target()[2] * (k as f64 / 20.0)]],
+                increments,
+            )
+            .unwrap();
         }
         a.results().gaps[0]
     };

@@ -12,7 +12,6 @@
 //! | [`curved_contact`] | node-to-surface friction contact on rigid curved supports (and, in `surface`, their geometry) |
 //! | [`load`] | follower pressure, self-weight, nodal forces and their load stiffness |
 //! | [`plasticity`] | elasto-plastic film law: finite-strain plane-stress J2 with a hardening table (issue 20) |
-//! | [`smoothing`] | the laws' switches rounded (C¹ ramp, rounded tension field) for the smoothing homotopy |
 //! | [`temperature`] | ETFE's modulus and flow stress between 0 and 50 °C (`material.temperature`, issue 20) |
 
 pub mod cable;
@@ -22,6 +21,5 @@ pub mod gap;
 pub mod load;
 pub mod material;
 pub mod plasticity;
-pub mod smoothing;
 pub mod temperature;
 pub mod triangle;

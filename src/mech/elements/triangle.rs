@@ -225,20 +225,6 @@ impl MembraneTriangle {
         }
     }
 
-    /// Internal force and tangent of the tension-field film rounded over the strain width `w`
-    /// ([`Material::tension_field_rounded`]): the smoothing homotopy's film.
-    pub fn force_and_tangent_rounded(
-        &self,
-        material: &Material,
-        u: &ElementVector,
-        with_tangent: bool,
-        w: f64,
-    ) -> (ElementVector, ElementMatrix) {
-        let f = self.deformation_gradient(u);
-        let (stress, c) = material.tension_field_rounded(&strain_from(&f), w);
-        self.force_and_tangent_with(material, &f, stress, with_tangent, || c)
-    }
-
     /// Internal force, tangent (when `with_tangent`) and material response of an elasto-plastic
     /// film (`plasticity/`) starting from the committed `history`: `S` and the algorithmic
     /// `∂S/∂E` enter (2.6)–(2.7) in place of `σ` and `D`; wrinkled and slack points get `η D`

@@ -55,48 +55,18 @@ pub struct Analysis {
 /// Buffers reused by every iteration.
 #[derive(Clone, Debug)]
 pub(in crate::mech) struct Workspace {
-    /// Whether the line search may keep full steps that raise the residual (its watchdog):
-    /// until an increment of the step has been cut back.
-    pub(super) watchdog: bool,
     /// Residual `f_int − f_ext` of every DOF at the last evaluation.
     pub(in crate::mech) internal: Vec<f64>,
     /// Newton matrix values at the last evaluation with a tangent.
     pub(super) values: Vec<f64>,
     /// Right-hand side, then the Newton correction, over the free DOFs.
     pub(super) rhs: Vec<f64>,
-    /// Slot of each free DOF's diagonal entry in `values` (for the Levenberg–Marquardt shift).
+    /// Slot of each free DOF's diagonal entry in `values` (for the pseudo-time shift).
     pub(super) diagonal: Vec<usize>,
-    /// Whether the increment runs pseudo-transient continuation (`continuation.rs`).
-    pub(super) continuation: bool,
     /// Pseudo-mass of each free equation (`continuation::pseudo_mass`).
     pub(super) pseudo_mass: Vec<f64>,
-    /// Work of the pseudo-time term in the last correction of each increment solved by
-    /// continuation, and in all its corrections, over the current step (J).
-    pub(super) stabilization: f64,
-    pub(super) dissipated: f64,
-    /// Work of the viscous stabilization alone over the current step (J).
-    pub(super) viscous: f64,
-    /// The work of the current increment's last correction (J).
-    pub(super) last_work: f64,
-    /// The first iterate of the next increment instead of the predictor's (taken by it): the
-    /// smoothing homotopy's last solution (`smoothing.rs`).
-    pub(super) guess: Option<Vec<f64>>,
-    /// What ends an increment besides the residual tolerance (`newton.rs`).
-    pub(super) acceptance: Acceptance,
-}
-
-/// What ends an increment's Newton iteration besides the residual within its tolerance.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Acceptance {
-    /// The solver's own test: an iterate after the first, its last correction within the
-    /// displacement tolerance.
-    Law,
-    /// Any iterate after the first: the smoothing homotopy's rounded problems, whose solutions
-    /// are only starting points (`smoothing.rs`).
-    Residual,
-    /// The first iterate only: the smoothing homotopy's last resort, the law's residual at a
-    /// rounded problem's solution (`smoothing.rs`).
-    Start,
+    /// Work of the pseudo-time term over the current step's iterations (J).
+    pub(super) pseudo_time_work: f64,
 }
 
 impl Analysis {
@@ -110,8 +80,7 @@ impl Analysis {
         let mut linear = LinearSolver::new(&system, settings.symmetric_factorization)
             .map_err(|e| SetupError::System(e.0))?;
         linear.set_threads(settings.threads);
-        // Computed once: the workspace (Levenberg–Marquardt shift, continuation) and the viscous
-        // stabilization both use them.
+        // Computed once: the continuation and the viscous stabilization both use them.
         let (diagonal, mass) = (diagonal_slots(&system), pseudo_mass(&system));
         let parts = Contributions::new(&model, &system, diagonal.clone(), mass.clone());
         let laws = parts.gaps.laws();
@@ -127,7 +96,6 @@ impl Analysis {
                 .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
                 .collect(),
             last_increment: Vec::new(),
-            landing: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
             chambers: parts.chambers.initial_states(&model),
             plastic: system
@@ -141,15 +109,8 @@ impl Analysis {
             values: vec![0.0; system.nonzeros()],
             rhs: vec![0.0; system.free_count],
             diagonal,
-            watchdog: true,
-            continuation: false,
             pseudo_mass: mass,
-            stabilization: 0.0,
-            dissipated: 0.0,
-            viscous: 0.0,
-            last_work: 0.0,
-            guess: None,
-            acceptance: Acceptance::Law,
+            pseudo_time_work: 0.0,
         };
         let length_scale = bounding_diagonal(&model.nodes).max(f64::MIN_POSITIVE);
         let force_floor = 1e-6 * system.material.membrane_stiffness() * length_scale;
@@ -305,20 +266,9 @@ impl Analysis {
 
     /// Moves every boundary group to `target` (m) and the loads to `loads`, both interpolated
     /// linearly between the converged state and the targets, in increments of at most
-    /// `1/increments` of the step (eq. 2.11–2.12 in each). The increment size adapts: it is
-    /// halved when an increment fails (up to [`SolverSettings::max_cutbacks`] times below the
-    /// largest size) or needs many iterations, and doubled again, up to the largest, after easy
-    /// ones.
-    ///
-    /// When even the smallest increment fails, larger ones are tried from the same converged
-    /// state before the step is given up (twice the largest, four times, …, up to the rest of
-    /// the step; counted in [`StepReport::enlarged`]). A film whose start is a mechanism (slack
-    /// across, tensioned only once the boundary has moved far enough) converges in a larger
-    /// increment and in no smaller one: issue 7's arch edge lowered in 80 steps was refused in
-    /// its first step with 10 increments per step and passes in one increment per step. The
-    /// answer is still the converged equilibrium at the target; only the path between two
-    /// converged states is coarser, which friction may feel. On error the state (displacements
-    /// and load levels) is unchanged.
+    /// `1/increments` of the step (eq. 2.11–2.12 in each), sized by the controller of
+    /// [`Self::step_to_motion`]. On error the state (displacements and load levels) is
+    /// unchanged.
     pub fn step_to_with_loads(
         &mut self,
         target: &[[f64; 3]],

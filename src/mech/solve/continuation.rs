@@ -1,5 +1,5 @@
-//! Pseudo-transient continuation (Ψtc) for the increments plain Newton does not converge
-//! (issue 19).
+//! Pseudo-transient continuation (Ψtc), the one globalization of Newton's iteration
+//! (`newton.rs`; docs/mechanics.md, "The nonlinear method").
 //!
 //! Kelley & Keyes, *Convergence analysis of pseudo-transient continuation*, SIAM J. Numer.
 //! Anal. 35 (1998); Coffey, Kelley & Keyes, *Pseudotransient continuation and
@@ -7,37 +7,21 @@
 //!
 //! `(c k̄ M + K) ΔU = −R(U)`,   `U ← U + ΔU`,
 //!
-//! a backward-Euler step of the pseudo-dynamics `M U̇ = −R(U)/(c k̄)`: `M` is a lumped
-//! pseudo-mass (each free DOF's node's tributary reference area over the mean: the film's mass
-//! pattern, [`pseudo_mass`]), `k̄` the mean magnitude of the free diagonal of the Newton matrix at
-//! the increment's first iterate (so that `c` is dimensionless), and `c = 1/δ` the inverse
-//! pseudo-time step. `c` follows switched evolution relaxation (SER, `δ_{k+1} = δ_k
-//! ‖R_{k−1}‖/‖R_k‖`), with at least a halving per accepted step, so that it goes to zero as the
-//! residual does and the last iterations are Newton's; a step that raises `‖R‖₂` more than
-//! [`Continuation::REJECT`]-fold (a contact closing under a penalty, a slack film overshooting)
-//! or meets a singular matrix is taken back with `c` ten times larger (a shorter pseudo-time
-//! step). Where `K` has no stiffness at all (a flat unstressed film under its own weight) the
-//! pseudo-mass holds the film until its own stress does.
+//! a backward-Euler step `δ = 1/c` of the pseudo-dynamics `M U̇ = −R(U)/k̄`: `M` is a lumped
+//! pseudo-mass (each free DOF's node's tributary reference area over the mean, [`pseudo_mass`]),
+//! `k̄` the mean magnitude of the free diagonal of the increment's first matrix (so that `c` is
+//! dimensionless). `c` starts at 0: while full steps succeed the iteration is Newton's. A step
+//! that raises `‖R‖₂` more than [`Continuation::REJECT`]-fold, or a singular matrix, is taken
+//! back and the pseudo-time step shortened by the same factor (from [`Continuation::START`]);
+//! an accepted step scales `c` by switched evolution relaxation (SER:
+//! `c_{k+1} = c_k ‖R_k‖/‖R_{k−1}‖`, at least halved), so that `c → 0` as the residual does and
+//! the last iterations are Newton's again. Where `K` has no stiffness at all (an unstressed flat
+//! film) the pseudo-mass holds the film until its own stress does; a contact changing status
+//! raises `c` instead of cutting the step along a direction of the other status.
 //!
 //! **The converged answer is the equilibrium answer.** Only the iteration matrix carries the
-//! pseudo-time term, never the residual: convergence is tested on the true `R` with the plain
-//! Newton tolerances, and in addition the artificial force of the last correction,
-//! `max |c k̄ M ΔU|`, must be within the residual tolerance. The artificial energy left at the
-//! end of an increment is the work of that last correction, `ΔUᵀ c k̄ M ΔU`; it is reported per
-//! step ([`crate::mech::solve::report::StepReport::stabilization_energy`]) with its ratio to the
-//! film's elastic strain energy, and a ratio above
-//! [`crate::mech::solve::report::STABILIZATION_BOUND`] is reported as a warning, not as plain
-//! success. The work taken out over all the iterations (what Abaqus reports as the dissipated
-//! stabilization energy, ALLSD) is reported beside it.
-//!
-//! Contact status changes happen inside the continuation: a change that raises the residual
-//! raises `c`, which shortens the next pseudo-time step, instead of a line search that would cut
-//! the step along a direction computed in the other status (the open ↔ closed chatter).
-//!
-//! Used by [`Analysis::step_to_motion`](crate::mech::solve::analysis::Analysis): an increment is
-//! first tried by plain Newton (quadratic, no cost on easy increments); when that fails, the same
-//! increment is solved by continuation before it is halved
-//! ([`crate::mech::solve::settings::SolverSettings::continuation`]).
+//! pseudo-time term: convergence is tested on the true `R`, and in addition the pseudo-time
+//! force of the last correction, `max |c k̄ M ΔU|`, must be within the residual tolerance.
 
 use crate::mech::elements::triangle::ElementVector;
 use crate::mech::solve::analysis::Analysis;
@@ -46,43 +30,23 @@ use crate::mech::solve::assembly::{Dof, System};
 /// The pseudo-time controller of one increment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Continuation {
-    /// `c`, the inverse pseudo-time step (dimensionless: the shift is `c k̄ M`).
+    /// `c`, the inverse pseudo-time step (dimensionless: the shift is `c k̄ M`); 0: Newton.
     pub c: f64,
-    /// `k̄`: mean magnitude of the free diagonal at the increment's first iterate (0 until known).
+    /// `k̄`: mean magnitude of the free diagonal at the increment's first matrix (0 until known).
     pub scale: f64,
 }
 
-/// What the controller makes of a trial step.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) enum Verdict {
-    /// Keep the step; `c` has been updated.
-    Accept,
-    /// Take the step back; `c` has been raised.
-    Reject,
-}
-
 impl Continuation {
-    /// First `c`: the shift is a tenth of the mean diagonal.
+    /// `c` after the first rejected step: the shift is a tenth of the mean diagonal.
     pub const START: f64 = 0.1;
-    /// Factor on `c` after a rejected step or a singular matrix.
+    /// Factor on `c` where the line search finds no step along a correction.
     pub const GROW: f64 = 10.0;
-    /// Smallest `c` after a rejection (from a `c` that had reached 0).
-    pub const FLOOR: f64 = 1e-6;
-    /// Below this `c` is dropped: plain Newton steps.
-    pub const END: f64 = 1e-8;
     /// Largest factor on `c` after an accepted step (SER's ratio when the residual fell more).
     pub const SHRINK: f64 = 0.5;
-    /// A step that raises `‖R‖₂` by more than this factor is rejected.
-    pub const REJECT: f64 = 10.0;
-    /// Iterations without progress before a continuation increment is declared stalled.
-    pub const PATIENCE: usize = 30;
 
-    /// The controller at the start of an increment.
+    /// The controller at the start of an increment: Newton's iteration (`c = 0`).
     pub fn new() -> Self {
-        Self {
-            c: Self::START,
-            scale: 0.0,
-        }
+        Self { c: 0.0, scale: 0.0 }
     }
 
     /// Adds the shift `c k̄ M` to the diagonal slots of `values` (learning `k̄` from them at
@@ -99,29 +63,22 @@ impl Continuation {
         }
     }
 
-    /// After a singular matrix: a shorter pseudo-time step.
-    pub fn singular(&mut self) {
-        self.c = (Self::GROW * self.c).max(Self::FLOOR);
+    /// After a correction along which the line search found no step, or a singular matrix: a
+    /// shorter pseudo-time step.
+    pub fn reject(&mut self) {
+        self.c = (Self::GROW * self.c).max(Self::START);
     }
 
-    /// Judges a step that took `‖R‖₂` from `before` to `after` and updates `c` (SER on
-    /// acceptance, growth on rejection).
-    pub fn judge(&mut self, before: f64, after: f64) -> Verdict {
-        if !after.is_finite() || after > Self::REJECT * before {
-            self.singular();
-            return Verdict::Reject;
-        }
+    /// After a full step that took `‖R‖₂` from `before` to `after`: SER, `c` scaled by their
+    /// ratio, at least halved.
+    pub fn accept(&mut self, before: f64, after: f64) {
         self.c *= (after / before).min(Self::SHRINK);
-        if self.c < Self::END {
-            self.c = 0.0;
-        }
-        Verdict::Accept
     }
 
     /// The work `ΔUᵀ c k̄ M ΔU` of the pseudo-time term over the correction `delta` (J) and its
     /// largest nodal force `max |c k̄ M ΔU|` (N), for the `c` the correction was solved with.
-    pub fn work_and_force(c: f64, scale: f64, delta: &[f64], mass: &[f64]) -> (f64, f64) {
-        let k = c * scale;
+    pub fn work_and_force(&self, c: f64, delta: &[f64], mass: &[f64]) -> (f64, f64) {
+        let k = c * self.scale;
         delta
             .iter()
             .zip(mass)
@@ -182,39 +139,36 @@ impl Analysis {
 mod tests {
     use super::*;
 
-    /// SER: an accepted step scales `c` by the residual's ratio, at least halving it, and
-    /// drops it below `END`; a step that raises the residual past `REJECT` (or is not finite)
-    /// is rejected with `c` ten times larger, from `FLOOR` when it had reached 0.
+    /// Newton's iteration until a correction is rejected; then SER: a full step scales `c` by
+    /// the residual's ratio, at least halving it; a rejection makes it `GROW` times larger, from
+    /// `START`.
     #[test]
     fn ser_follows_the_residual_and_a_rejection_shortens_the_pseudo_time_step() {
         let mut p = Continuation::new();
-        assert_eq!(p.judge(1.0, 0.9), Verdict::Accept);
+        p.accept(1.0, 5.0);
+        assert_eq!(p.c, 0.0, "full steps are Newton's");
+        p.reject();
+        assert_eq!(p.c, Continuation::START);
+        p.accept(1.0, 0.9);
         assert_eq!(p.c, 0.5 * Continuation::START);
-        assert_eq!(p.judge(1.0, 0.01), Verdict::Accept);
+        p.accept(1.0, 0.01);
         assert!((p.c - 0.01 * 0.5 * Continuation::START).abs() < 1e-18);
-        // a modest rise is kept, and still halves c (no growth without rejection)
-        assert_eq!(p.judge(1.0, 5.0), Verdict::Accept);
-        let before = p.c;
-        assert_eq!(p.judge(1.0, 11.0), Verdict::Reject);
-        assert_eq!(p.c, 10.0 * before);
-        assert_eq!(p.judge(1.0, f64::NAN), Verdict::Reject);
-        p.c = 1e-8;
-        assert_eq!(p.judge(1.0, 0.5), Verdict::Accept);
-        assert_eq!(p.c, 0.0);
-        assert_eq!(p.judge(1.0, 100.0), Verdict::Reject);
-        assert_eq!(p.c, Continuation::FLOOR);
+        p.reject();
+        assert_eq!(p.c, Continuation::START);
+        p.reject();
+        assert_eq!(p.c, Continuation::GROW * Continuation::START);
     }
 
     /// The shift is `c k̄ m_i` on each diagonal slot, `k̄` the mean |diagonal| of the first
     /// matrix it sees (a zero diagonal, the slack direction, counts in the mean).
     #[test]
     fn the_shift_is_the_pseudo_mass_times_c_and_the_mean_diagonal() {
-        let mut p = Continuation::new();
+        let mut p = Continuation { c: 0.1, scale: 0.0 };
         let mut values = vec![4.0, 9.0, -2.0, 0.0];
         p.shift(&mut values, &[0, 2, 3], &[1.0, 2.0, 0.5]);
         assert_eq!(p.scale, 2.0);
         assert_eq!(values, vec![4.0 + 0.2, 9.0, -2.0 + 0.4, 0.1]);
-        let (work, force) = Continuation::work_and_force(0.1, 2.0, &[1.0, -2.0], &[1.0, 0.5]);
+        let (work, force) = p.work_and_force(0.1, &[1.0, -2.0], &[1.0, 0.5]);
         assert!((work - (0.2 + 0.4)).abs() < 1e-15);
         assert!((force - 0.2).abs() < 1e-15);
     }

@@ -9,11 +9,10 @@
 //! | `low_rank` | the chambers' pneumatic stiffness by Sherman–Morrison–Woodbury; sealing the chambers |
 //! | [`analysis`] | [`Analysis`]: setup, state, steps and their input checks |
 //! | `inputs` | checks of a step's targets, angles and load levels; prescribed values |
-//! | `increments` | the increment controller: cut-back, enlargement, predictor |
-//! | `newton` | Newton–Raphson for one increment |
+//! | `increments` | the increment controller (Ramm's rule, cut-back), the strategy table, the predictor |
+//! | `newton` | one increment: semismooth Newton on the laws' equations |
+//! | `continuation` | its globalization: pseudo-transient continuation (SER) |
 //! | [`progress`] | [`IncrementNote`]: each increment as it ends, for a front end's log |
-//! | `smoothing` | the smoothing homotopy of a refused increment with curved contacts |
-//! | `line_search` | backtracking line search with a watchdog |
 //! | [`settings`] | [`SolverSettings`] |
 //! | [`state`] | [`AnalysisState`], the converged state an FMU state serializes |
 //! | [`report`] | [`StepReport`], [`IncrementFailure`] and its advice, [`StepError`], [`SetupError`] |
@@ -25,7 +24,6 @@ mod continuation;
 pub mod contributions;
 mod increments;
 mod inputs;
-mod line_search;
 pub mod linear;
 mod low_rank;
 mod newton;
@@ -33,14 +31,15 @@ pub mod progress;
 pub mod report;
 mod sensitivity;
 pub mod settings;
-mod smoothing;
 pub mod state;
 
 pub use analysis::Analysis;
+pub use increments::{STRATEGIES, Strategy};
 pub use newton::max_abs;
 pub use progress::{IncrementNote, IncrementObserver};
 pub use report::{
-    IncrementFailure, IterationRecord, SettingNames, SetupError, StepError, StepReport,
+    Attempt, DISSIPATION_BOUND, IncrementFailure, IterationRecord, STABILIZATION_BOUND,
+    SettingNames, SetupError, StepError, StepReport,
 };
 pub use sensitivity::{Response, Seed};
 pub use settings::{DEFAULT_INCREMENTS_PER_STEP, MAX_THREADS, SolverSettings};

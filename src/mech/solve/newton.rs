@@ -1,342 +1,547 @@
-//! Newton–Raphson for one increment.
+//! One increment: semismooth Newton on the laws' equations, globalized by pseudo-transient
+//! continuation (docs/mechanics.md, "The nonlinear method").
+//!
+//! Each iteration solves `(K + c k̄ M) ΔU = −R(U)` and takes the full step `U ← U + ΔU`
+//! (`continuation.rs`): `K` is the generalized (Clarke) Jacobian of the residual — the
+//! consistent tangent of each law in the branch of the iterate (gap and curved-contact return
+//! mappings, the film's taut, wrinkled or slack state, the plastic return) — and `c k̄ M` the
+//! pseudo-time term, zero while full steps succeed (the iteration is then Newton's, locally
+//! quadratic: semismooth Newton, Qi & Sun 1993; Alart & Curnier 1991 for contact) and raised
+//! where a step is rejected (Kelley & Keyes 1998). Convergence is judged on the true residual.
 
 use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::LoadLevels;
-use crate::mech::solve::analysis::{Acceptance, Analysis};
+use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
-use crate::mech::solve::continuation::{Continuation, Verdict};
-use crate::mech::solve::line_search::Watchdog;
+use crate::mech::solve::continuation::Continuation;
 use crate::mech::solve::report::{IncrementFailure, IterationRecord};
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
+/// What the Newton loop keeps of its iterates to judge progress and name a failure.
+#[derive(Debug)]
+struct Progress {
+    /// Smallest residual and correction so far, and the iteration that set either.
+    best: f64,
+    best_correction: f64,
+    best_at: usize,
+    /// The iterate closest to meeting both tolerances (quoted if the increment fails).
+    closest: Option<IterationRecord>,
+    /// The contact statuses of each iterate (to name the contacts that keep switching).
+    statuses: Vec<Vec<GapStatus>>,
+}
+
+impl Progress {
+    /// Notes `record`; true when it improved on the best residual or correction by
+    /// [`Analysis::PROGRESS`].
+    fn note(&mut self, record: IterationRecord) -> bool {
+        if record.iteration > 0
+            && self
+                .closest
+                .is_none_or(|c| record.distance() < c.distance())
+        {
+            self.closest = Some(record);
+        }
+        let better = record.residual < Analysis::PROGRESS * self.best
+            || record.correction < Analysis::PROGRESS * self.best_correction;
+        if better {
+            self.best = self.best.min(record.residual);
+            self.best_correction = self.best_correction.min(record.correction);
+            self.best_at = record.iteration;
+        }
+        better
+    }
+}
+
+/// The hold of contacts that cycle between stick and slip (a generalized Newton iteration can
+/// alternate between the two pieces of a kinked law whose solution lies near the kink): their
+/// status is imposed, stick first, and Newton's iteration on the held laws converges on one
+/// smooth piece; its answer is then judged on the true laws, and where it fails there, held in
+/// slip instead (the active-set view of semismooth Newton: Hintermüller, Ito & Kunisch 2002).
+/// Once both have failed the increment goes on without a hold. Convergence is always judged on
+/// the true laws.
+#[derive(Debug, Default)]
+struct Hold {
+    /// 0: none tried; 1: stick held; 2: slip held; 3: both tried.
+    stage: u8,
+    /// The statuses imposed now (empty: none).
+    held: Vec<Option<GapStatus>>,
+    /// The statuses of the hold the current iterate is judged without.
+    judged: Vec<Option<GapStatus>>,
+}
+
+impl Hold {
+    /// The statuses to impose from now on (Some(empty): none) given whether the current
+    /// iterate `met` the tolerances and the statuses of the iterates so far; None: unchanged.
+    fn next(&mut self, met: bool, statuses: &[Vec<GapStatus>]) -> Option<Vec<Option<GapStatus>>> {
+        if !self.held.is_empty() {
+            // Converged on the held laws: judged on the true ones next.
+            return met.then(|| {
+                self.judged = std::mem::take(&mut self.held);
+                Vec::new()
+            });
+        }
+        if !self.judged.is_empty() {
+            let judged = std::mem::take(&mut self.judged);
+            if met || self.stage != 1 {
+                self.stage = 3;
+                return None;
+            }
+            self.stage = 2;
+            self.held = judged.iter().map(|h| h.map(|_| GapStatus::Slip)).collect();
+            return Some(self.held.clone());
+        }
+        if self.stage != 0 {
+            return None;
+        }
+        let held = cycling(statuses)?;
+        self.stage = 1;
+        self.held.clone_from(&held);
+        Some(held)
+    }
+}
+
+/// Stick for each contact whose status changed between stick and slip at least
+/// [`Analysis::CYCLE`] times over the last [`Analysis::CYCLE`]` + 3` iterates, None for the
+/// others; None where no contact did.
+fn cycling(statuses: &[Vec<GapStatus>]) -> Option<Vec<Option<GapStatus>>> {
+    let recent = &statuses[statuses.len().saturating_sub(Analysis::CYCLE + 3)..];
+    let last = recent.last()?;
+    let closed = |s: GapStatus| s != GapStatus::Open;
+    let held: Vec<Option<GapStatus>> = (0..last.len())
+        .map(|k| {
+            let changes = recent
+                .windows(2)
+                .filter(|w| {
+                    let (a, b) = (w[0].get(k).copied(), w[1].get(k).copied());
+                    matches!((a, b), (Some(a), Some(b)) if a != b && closed(a) && closed(b))
+                })
+                .count();
+            (changes >= Analysis::CYCLE).then_some(GapStatus::Stick)
+        })
+        .collect();
+    held.iter().any(Option::is_some).then_some(held)
+}
+
+/// The iteration state of one increment.
+struct Iterates {
+    /// The iterate, and the one before the last correction.
+    u: Vec<f64>,
+    previous_u: Vec<f64>,
+    /// `‖R_free‖∞` of every iterate.
+    residuals: Vec<f64>,
+    /// Whether the workspace holds the residual and the matrix at `u`.
+    assembled: bool,
+    /// `‖ΔU‖∞` of the last correction (infinite before the first).
+    correction: f64,
+    ptc: Continuation,
+    /// The pseudo-time force of the last correction (N).
+    artificial: f64,
+    progress: Progress,
+    /// `‖R‖₂` of the last accepted iterates (the nonmonotone line search's reference).
+    merits: Vec<f64>,
+    hold: Hold,
+    /// The smallest positive `c` so far: the pseudo-time reached.
+    lowest_c: f64,
+}
+
+impl Iterates {
+    /// The state at the predictor `u`; `fixed`: a model without free DOFs (every node
+    /// prescribed or fixed: how single elements are verified), converged at its first assembly.
+    fn new(u: Vec<f64>, fixed: bool) -> Self {
+        Self {
+            previous_u: u.clone(),
+            u,
+            residuals: Vec::new(),
+            assembled: false,
+            correction: if fixed { 0.0 } else { f64::INFINITY },
+            ptc: Continuation::new(),
+            artificial: 0.0,
+            progress: Progress {
+                best: f64::INFINITY,
+                best_correction: f64::INFINITY,
+                best_at: 0,
+                closest: None,
+                statuses: Vec::new(),
+            },
+            merits: Vec::new(),
+            hold: Hold::default(),
+            lowest_c: f64::INFINITY,
+        }
+    }
+
+    /// Notes `record`; true where it made progress: its residual or correction
+    /// [`Analysis::PROGRESS`] below the best, or the continuation's `c` that much below its
+    /// smallest (the pseudo-time step lengthens while the residual waits for it: a film held by
+    /// the pseudo-mass until its own stiffness takes over).
+    fn progressed(&mut self, record: IterationRecord) -> bool {
+        let c = self.ptc.c;
+        let continuing = c > 0.0 && c < Analysis::PROGRESS * self.lowest_c;
+        if continuing {
+            self.lowest_c = c;
+            self.progress.best_at = record.iteration;
+        }
+        self.progress.note(record) || continuing
+    }
+
+    /// Newton's iteration afresh from the same iterate at `iteration` (the laws were held or
+    /// released).
+    fn restart(&mut self, iteration: usize) {
+        (self.assembled, self.correction) = (false, f64::INFINITY);
+        self.merits.clear();
+        self.ptc.c = 0.0;
+        (self.progress.best, self.progress.best_correction) = (f64::INFINITY, f64::INFINITY);
+        self.progress.best_at = iteration;
+        self.lowest_c = f64::INFINITY;
+    }
+
+    /// After the line search moved `u` by the share `step` of the correction to the merit
+    /// `merit`, with the pseudo-time force `force`: SER after a full step (a shortened one keeps
+    /// `c`); a step back to the merit of two iterates ago is a two-cycle (between pieces of `R`
+    /// the contact statuses do not name): a shorter pseudo-time step next.
+    fn stepped(&mut self, step: f64, merit: f64, force: f64) {
+        let n = self.merits.len();
+        if n >= 2 && (merit - self.merits[n - 2]).abs() <= 1e-9 * merit {
+            self.ptc.reject();
+        } else if step == 1.0 {
+            self.ptc.accept(self.merits[n - 1], merit);
+        }
+        self.assembled = step == 1.0;
+        self.correction *= step;
+        self.artificial = force;
+        self.merits.push(merit);
+        if self.merits.len() > Analysis::MEMORY {
+            self.merits.remove(0);
+        }
+    }
+}
+
 impl Analysis {
-    /// Newton–Raphson for one increment from the converged `start` to the group motion
-    /// `motion` and the load levels `levels`.
+    /// Newton's iteration for one increment from the converged `start` to the group motion
+    /// `motion` and the load levels `levels`: the full correction of
+    /// `(K + c k̄ M) ΔU = −R`, `c` by switched evolution relaxation (`continuation.rs`).
+    /// Converged when the correction and the residual of the true laws are within their
+    /// tolerances and the pseudo-time force of the last correction is within the residual's.
     pub(crate) fn solve_increment(
         &mut self,
         start: &AnalysisState,
         motion: &GroupMotion,
         levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
-        let mut u = match self.work.guess.take() {
-            Some(guess) => guess,
-            None => self.predict(start, motion),
-        };
-        // Trial history from the converged start (also after a cut-back or for an enlarged retry).
+        let u = self.predict(start, motion);
         for c in self.parts.all_mut() {
             c.restore(start);
         }
-        // A model without free DOFs (every node prescribed or fixed: how single elements are
-        // verified) has nothing to solve: the first assembly evaluates the forces, the gaps'
-        // return mapping and the reactions at the prescribed configuration, and converges.
-        let mut correction_norm = if self.system.free_count == 0 {
-            0.0
-        } else {
-            f64::INFINITY
-        };
-        // The iterate before the last correction (to name elements whose state flips).
-        let mut previous_u = u.clone();
-        let mut residuals = Vec::new();
-        let mut assembled = false;
-        let (mut best, mut best_correction, mut best_at) = (f64::INFINITY, f64::INFINITY, 0);
-        // The iterate closest to meeting both tolerances (quoted if the increment stalls).
-        let mut closest: Option<IterationRecord> = None;
-        // Levenberg–Marquardt shift of the free diagonal, relative to its mean.
-        let mut damping = 0.0_f64;
-        // Whether the last correction was solved with the shift (its size then says nothing
-        // of progress: the shift alone shrinks it).
-        let mut shifted = false;
-        // The watchdog of the line search: non-monotone excursions until one fails.
-        let mut watch = if self.work.watchdog {
-            Watchdog::Ready
-        } else {
-            Watchdog::Used
-        };
-        // Pseudo-transient continuation instead of the line search and the shift
-        // (`continuation.rs`), and the artificial force of its last correction.
-        let mut ptc = self.work.continuation.then(Continuation::new);
-        let mut artificial = 0.0_f64;
-        // Active-set iteration (`ActiveSet`): the contacts' statuses are held fixed while Newton
-        // converges, and changed only at a converged iterate, which is then solved again.
-        let mut active = self.parts.curved.active_set.then(ActiveSet::default);
-        self.parts.curved.frozen = None;
-        self.work.last_work = 0.0;
+        let mut it = Iterates::new(u, self.system.free_count == 0);
         let s = self.settings;
         for iteration in 0..=s.max_iterations {
-            let mut residual = if assembled {
-                self.free_norm_inf()
-            } else {
-                self.assemble_at(&u, levels, Some(iteration))
-            };
-            if active.is_some() && self.parts.curved.frozen.is_none() {
-                // The set of the first iterate (the predictor's).
-                self.parts.curved.frozen = Some(self.parts.curved.natural());
-                residual = self.assemble_at(&u, levels, Some(iteration));
+            if !it.assembled {
+                self.assemble_at(&it.u, levels, Some(iteration));
             }
-            if !residual.is_finite() {
-                return Err(IncrementFailure::Diverged { iteration });
+            let (record, force_scale) = self.observe(&mut it, start, iteration)?;
+            let met = (iteration > 0 || self.system.free_count == 0)
+                && record.correction <= record.correction_tolerance
+                && record.residual <= record.residual_tolerance
+                && it.artificial <= record.residual_tolerance;
+            if met && it.hold.held.is_empty() {
+                return self.commit_increment(start, motion, levels, it.u, it.residuals, iteration);
             }
-            residuals.push(residual);
-            for c in self.parts.all_mut() {
-                c.note_iteration(iteration);
-            }
-            let moved = max_abs_difference(&u, &start.displacement);
-            let displacement_scale = moved.max(max_abs(&u)).max(1e-9 * self.length_scale);
-            let force_scale = max_abs(&self.work.internal).max(self.force_floor);
-            let tolerance = s.residual_tolerance * force_scale;
-            let record = IterationRecord {
-                iteration,
-                residual,
-                residual_tolerance: tolerance,
-                correction: correction_norm,
-                correction_tolerance: s.displacement_tolerance * displacement_scale,
-            };
-            let mut converged = match self.work.acceptance {
-                Acceptance::Law => {
-                    (iteration > 0 || self.system.free_count == 0)
-                        && record.correction <= record.correction_tolerance
-                }
-                Acceptance::Residual => iteration > 0,
-                Acceptance::Start => iteration == 0,
-            } && residual <= tolerance
-                && artificial <= tolerance;
-            if converged && let Some(set) = active.as_mut() {
-                let natural = self.parts.curved.natural();
-                let frozen = self.parts.curved.frozen.take().unwrap_or_default();
-                if natural != frozen {
-                    // Equilibrium under the held statuses, not under the law's: solve again
-                    // with the law's statuses at this iterate (a set seen before is a cycle).
-                    if !set.next(frozen, &natural) {
-                        return Err(IncrementFailure::Stalled {
-                            iteration,
-                            closest: closest.unwrap_or(record),
-                            chattering: set.cycling(&self.parts.curved.names),
-                            flipping: Vec::new(),
-                            compressed: Vec::new(),
-                            lifting: self.lifting_contacts(),
-                        });
-                    }
-                    self.parts.curved.frozen = Some(natural);
-                    residual = self.assemble_at(&u, levels, Some(iteration));
-                    (best, best_correction, best_at) = (f64::INFINITY, f64::INFINITY, iteration);
-                    (damping, watch) = (0.0, Watchdog::Used);
-                    converged = false;
-                } else {
-                    self.parts.curved.frozen = Some(frozen);
-                }
-            }
-            if !converged && self.work.acceptance == Acceptance::Start {
-                // Only the first iterate is judged.
-                return Err(IncrementFailure::Stalled {
-                    iteration,
-                    closest: record,
-                    chattering: Vec::new(),
-                    flipping: Vec::new(),
-                    compressed: Vec::new(),
-                    lifting: Vec::new(),
-                });
-            }
-            if converged {
-                let mut state = AnalysisState {
-                    boundary: motion.translation.clone(),
-                    angles: motion.angles.clone(),
-                    loads: levels.clone(),
-                    last_increment: u
-                        .iter()
-                        .zip(&start.displacement)
-                        .map(|(a, b)| a - b)
-                        .collect(),
-                    displacement: u,
-                    ..start.clone()
-                };
-                // Commit: the trial history of the converged iterate becomes the state's.
-                for c in self.parts.all() {
-                    c.commit(start, &mut state);
-                }
-                if !state.is_finite() {
-                    return Err(IncrementFailure::Diverged { iteration });
-                }
-                return Ok((state, residuals));
-            }
-            // Gaps that changed status in the last few iterations: the usual cause of a stall.
-            let recent = iteration.saturating_sub(Self::STALL_PATIENCE / 2);
-            let chattering = || -> Vec<String> {
-                let mut names = Vec::new();
-                for c in self.parts.all() {
-                    c.chattering(recent, &mut names);
-                }
-                names
-            };
-            if iteration > 0 && closest.is_none_or(|c| record.distance() < c.distance()) {
-                closest = Some(record);
-            }
+            let improved = it.progressed(record);
             if iteration == s.max_iterations {
-                return Err(IncrementFailure::MaxIterations {
-                    first_residual: residuals[0],
-                    last: record,
-                    matrix: s.iteration_matrix,
-                    chattering: chattering(),
-                    flipping: self.flipping_elements(&previous_u, &u),
-                    compressed: self.compressed_elements(&u),
-                    lifting: self.lifting_contacts(),
-                });
+                return Err(self.failure(&it, record, false));
             }
-            if iteration > 3 && residual > 1e6 * residuals[0].max(force_scale) {
-                return Err(IncrementFailure::Diverged { iteration });
-            }
-            // Progress (`made_progress`), else a stall after the patience. The Ju–Rowlands
-            // matrix converges linearly and slowly by design (docs/mechanics.md): it is judged
-            // by the limit only.
-            if made_progress(residual, best, correction_norm, best_correction, shifted) {
-                best = best.min(residual);
-                best_correction = best_correction.min(correction_norm);
-                best_at = iteration;
-            } else if s.iteration_matrix == IterationMatrix::Consistent
-                && iteration
-                    >= best_at
-                        + if ptc.is_some() {
-                            Continuation::PATIENCE
-                        } else {
-                            Self::STALL_PATIENCE
-                        }
-            {
-                return Err(IncrementFailure::Stalled {
-                    iteration,
-                    closest: closest.unwrap_or(record),
-                    chattering: chattering(),
-                    flipping: self.flipping_elements(&previous_u, &u),
-                    compressed: self.compressed_elements(&u),
-                    lifting: self.lifting_contacts(),
-                });
-            }
-            shifted = damping > 0.0;
-            correction_norm = match (self.correction(damping, ptc.as_mut()), ptc.as_mut()) {
-                (Ok(norm), _) => norm,
-                (Err(_), Some(p)) => {
-                    // A singular matrix: a shorter pseudo-time step from the same iterate.
-                    p.singular();
-                    assembled = false;
-                    continue;
-                }
-                (Err(e), None) => return Err(e),
-            };
-            if !correction_norm.is_finite() {
-                return Err(IncrementFailure::Diverged { iteration });
-            }
-            previous_u.clone_from(&u);
-            if let Some(p) = ptc.as_mut() {
-                // The full pseudo-time step; `c` follows the residual (SER), a step that
-                // raised it too far is taken back.
-                let (before, c) = (self.free_norm2(), p.c);
-                for (i, d) in self.system.dofs.iter().enumerate() {
-                    if let Dof::Free(eq) = d {
-                        u[i] += self.work.rhs[*eq];
-                    }
-                }
-                self.assemble_at(&u, levels, Some(iteration + 1));
-                assembled = true;
-                if p.judge(before, self.free_norm2()) == Verdict::Reject {
-                    u.clone_from(&previous_u);
-                    assembled = false;
-                    correction_norm = f64::INFINITY;
-                } else {
-                    let (work, force) = Continuation::work_and_force(
-                        c,
-                        p.scale,
-                        &self.work.rhs,
-                        &self.work.pseudo_mass,
-                    );
-                    self.work.dissipated += work;
-                    self.work.last_work = work;
-                    artificial = force;
-                }
+            if let Some(held) = it.hold.next(met, &it.progress.statuses) {
+                // The laws changed: the same iterate evaluated again, Newton's iteration afresh.
+                self.parts.hold(&held);
+                it.restart(iteration);
                 continue;
             }
-            let (step, with_tangent, decreased) =
-                self.line_search(&mut u, levels, iteration + 1, &mut watch);
-            assembled = with_tangent;
-            if step.is_infinite() {
-                // The watchdog went back to where its excursion started: the iterations spent
-                // on it are not a stall of the iteration from here.
-                best_at = iteration + 1;
+            if iteration > 3 && record.residual > 1e6 * it.residuals[0].max(force_scale) {
+                return Err(IncrementFailure::Diverged { iteration });
             }
-            correction_norm *= step;
-            if s.iteration_matrix == IterationMatrix::Consistent {
-                damping = next_damping(damping, step, decreased);
+            // The Ju–Rowlands matrix converges linearly by design: judged by the limit only.
+            if !improved
+                && s.iteration_matrix == IterationMatrix::Consistent
+                && iteration >= it.progress.best_at + Self::STALL_PATIENCE
+            {
+                return Err(self.failure(&it, record, true));
             }
+            self.advance(&mut it, levels, iteration, record.residual_tolerance)?;
         }
         unreachable!("the loop returns at max_iterations")
     }
 
+    /// The figures of the assembled iterate `it.u` against the tolerances (and the force scale
+    /// `F_ref`), noted in `it`.
+    fn observe(
+        &self,
+        it: &mut Iterates,
+        start: &AnalysisState,
+        iteration: usize,
+    ) -> Result<(IterationRecord, f64), IncrementFailure> {
+        let residual = self.free_norm_inf();
+        if !residual.is_finite() {
+            return Err(IncrementFailure::Diverged { iteration });
+        }
+        it.residuals.push(residual);
+        if it.merits.is_empty() {
+            it.merits.push(self.free_norm2());
+        }
+        it.progress.statuses.push(self.parts.statuses());
+        let moved = max_abs_difference(&it.u, &start.displacement);
+        let displacement_scale = moved.max(max_abs(&it.u)).max(1e-9 * self.length_scale);
+        let force_scale = max_abs(&self.work.internal).max(self.force_floor);
+        let s = self.settings;
+        let record = IterationRecord {
+            iteration,
+            residual,
+            residual_tolerance: s.residual_tolerance * force_scale,
+            correction: it.correction,
+            correction_tolerance: s.displacement_tolerance * displacement_scale,
+        };
+        Ok((record, force_scale))
+    }
+
+    /// The failure of an increment at `record`: stalled, or at the iteration limit.
+    fn failure(&self, it: &Iterates, record: IterationRecord, stalled: bool) -> IncrementFailure {
+        let chattering = self.chattering(&it.progress.statuses);
+        let flipping = self.flipping_elements(&it.previous_u, &it.u);
+        let compressed = self.compressed_elements(&it.u);
+        if stalled {
+            IncrementFailure::Stalled {
+                iteration: record.iteration,
+                closest: it.progress.closest.unwrap_or(record),
+                chattering,
+                flipping,
+                compressed,
+            }
+        } else {
+            IncrementFailure::MaxIterations {
+                first_residual: it.residuals[0],
+                last: record,
+                matrix: self.settings.iteration_matrix,
+                chattering,
+                flipping,
+                compressed,
+            }
+        }
+    }
+
+    /// One iteration from the assembled `it.u`: the correction with the pseudo-time shift, then
+    /// the line search along it ([`Self::step_along`]), `c` by SER after a full step and
+    /// lengthened where no step is found or the matrix is singular.
+    fn advance(
+        &mut self,
+        it: &mut Iterates,
+        levels: &LoadLevels,
+        iteration: usize,
+        tolerance: f64,
+    ) -> Result<(), IncrementFailure> {
+        let c = it.ptc.c;
+        match self.correction(&mut it.ptc) {
+            Ok(norm) if norm.is_finite() => it.correction = norm,
+            Ok(_) => return Err(IncrementFailure::Diverged { iteration }),
+            Err(_) => {
+                // A singular matrix: a shorter pseudo-time step from the same iterate.
+                it.ptc.reject();
+                it.assembled = false;
+                return Ok(());
+            }
+        }
+        let reference = [
+            it.merits.iter().copied().fold(0.0, f64::max),
+            it.merits[it.merits.len() - 1],
+        ];
+        it.previous_u.clone_from(&it.u);
+        let statuses = it.progress.statuses.last().cloned().unwrap_or_default();
+        let next = iteration + 1;
+        match self.step_along(&mut it.u, levels, next, reference, tolerance, &statuses) {
+            Some((step, merit)) => {
+                let (work, force) =
+                    it.ptc
+                        .work_and_force(c * step, &self.work.rhs, &self.work.pseudo_mass);
+                self.work.pseudo_time_work += work * step;
+                it.stepped(step, merit, force);
+            }
+            None => {
+                it.ptc.reject();
+                (it.assembled, it.correction) = (false, f64::INFINITY);
+            }
+        }
+        Ok(())
+    }
+
+    /// The converged iterate `u` of the increment from `start`: the state with the trial history
+    /// of every contribution committed.
+    fn commit_increment(
+        &self,
+        start: &AnalysisState,
+        motion: &GroupMotion,
+        levels: &LoadLevels,
+        u: Vec<f64>,
+        residuals: Vec<f64>,
+        iteration: usize,
+    ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
+        let mut state = AnalysisState {
+            boundary: motion.translation.clone(),
+            angles: motion.angles.clone(),
+            loads: levels.clone(),
+            last_increment: u
+                .iter()
+                .zip(&start.displacement)
+                .map(|(a, b)| a - b)
+                .collect(),
+            displacement: u,
+            ..start.clone()
+        };
+        for c in self.parts.all() {
+            c.commit(start, &mut state);
+        }
+        if !state.is_finite() {
+            return Err(IncrementFailure::Diverged { iteration });
+        }
+        Ok((state, residuals))
+    }
+
+    /// The contacts whose status changed within the last [`Self::STALL_PATIENCE`] iterates of
+    /// `statuses` (one status list per iterate). Called once when an increment fails.
+    fn chattering(&self, statuses: &[Vec<GapStatus>]) -> Vec<String> {
+        let names = self.parts.status_names();
+        let recent = &statuses[statuses.len().saturating_sub(Self::STALL_PATIENCE)..];
+        let Some(last) = recent.last() else {
+            return Vec::new();
+        };
+        (0..last.len())
+            .filter(|&k| recent.iter().any(|s| s.get(k) != last.get(k)))
+            .filter_map(|k| names.get(k).cloned())
+            .collect()
+    }
+
     /// Film elements whose tension-field state differs between the displacements `a` and `b`
-    /// (none without wrinkling). Called once when an increment fails, never per iteration.
+    /// (none without wrinkling). Called once when an increment fails.
     fn flipping_elements(&self, a: &[f64], b: &[f64]) -> Vec<usize> {
-        let mut elements = Vec::new();
-        for c in self.parts.all() {
-            c.flipping(&self.system, a, b, &mut elements);
-        }
-        elements
+        self.parts.triangles.flipping(&self.system, a, b)
     }
 
-    /// Film elements in compression (`σ2 < 0`) at `u` where the film law carries compression
-    /// (`wrinkling: "none"`, elastic or plastic). Called once when an increment fails.
+    /// Film elements in compression (`σ2 < 0`) at `u` where the film law carries compression.
     fn compressed_elements(&self, u: &[f64]) -> Vec<usize> {
-        let mut elements = Vec::new();
-        for c in self.parts.all() {
-            c.compressed(&self.system, u, &mut elements);
-        }
-        elements
+        self.parts.triangles.compressed(&self.system, u)
     }
 
-    /// Contacts of the sliding-direction law that opened and closed in this attempt while
-    /// holding more than `μN` across (`contributions::LiftOff`). Called once when an increment fails.
-    fn lifting_contacts(&self) -> Vec<String> {
-        let mut names = Vec::new();
-        for c in self.parts.all() {
-            c.lifting_off(&mut names);
+    /// Moves `u` along the correction in `work.rhs` by the first `α` of 1, then of a
+    /// backtracking by quadratic interpolation of `φ(α) = ‖R(u + αΔ)‖₂²` (within `[α/10, α/2]`,
+    /// [`Self::TRIALS`] in all), that meets the Armijo test `φ(α) ≤ (1 − 2·10⁻⁴ α) φ_ref`, or
+    /// that ends with `‖R‖∞` within `tolerance`. `reference` = `[√φ_max, √φ(0)]`: on the smooth
+    /// piece of the iterate (every contact's status as in `statuses`) `φ_ref` is the largest of
+    /// the last [`Self::MEMORY`] merits, the nonmonotone test (Grippo, Lampariello & Lucidi
+    /// 1986), and a full step is kept unless it raises `‖R‖₂` [`Continuation::GROW`]-fold;
+    /// across a kink (a status changed) it is the iterate's own `φ(0)`, the monotone test, so
+    /// that a contact cannot cycle between two statuses (open ↔ pressed) on the memory's
+    /// allowance. Where no trial meets it, the best trial below `φ(0)`.
+    /// Some((α, ‖R‖₂)) with the workspace holding the residual at the new `u` (and its matrix
+    /// where α = 1); None with `u` back where it was.
+    fn step_along(
+        &mut self,
+        u: &mut [f64],
+        levels: &LoadLevels,
+        next_iteration: usize,
+        [reference, current]: [f64; 2],
+        tolerance: f64,
+        statuses: &[GapStatus],
+    ) -> Option<(f64, f64)> {
+        let apply = |u: &mut [f64], dofs: &[Dof], delta: &[f64], scale: f64| {
+            for (i, d) in dofs.iter().enumerate() {
+                if let Dof::Free(eq) = d {
+                    u[i] += scale * delta[*eq];
+                }
+            }
+        };
+        let delta = std::mem::take(&mut self.work.rhs);
+        let before = self.parts.gaps();
+        let (phi_max, phi0) = (reference * reference, current * current);
+        let (mut alpha, mut applied) = (1.0_f64, 0.0);
+        let (mut accepted, mut best) = (None, (0.0, current));
+        let mut at_event = false;
+        for trial in 0..Self::TRIALS {
+            apply(u, &self.system.dofs, &delta, alpha - applied);
+            applied = alpha;
+            let tangent = (trial == 0).then_some(next_iteration);
+            self.assemble_at(u, levels, tangent);
+            let merit = self.free_norm2();
+            let phi = merit * merit;
+            // A full step that leaves every contact's status as it was stays on the same smooth
+            // piece of `R`, where Newton's model holds: kept unless it raises the residual
+            // [`Continuation::GROW`]-fold (the flat film's first pressure step).
+            let same = self.parts.statuses() == *statuses;
+            // The event trial ends on the next piece's edge, where the merit's slope changes:
+            // kept on the same allowance, so that the next iteration's tangent carries the
+            // contact's new status.
+            let same_piece = (trial == 0 && same || trial == 1 && at_event)
+                && merit <= Continuation::GROW * reference;
+            let phi_ref = if same { phi_max } else { phi0 };
+            // A step to within the residual tolerance needs no decrease (at roundoff the merit
+            // cannot fall).
+            if phi <= (1.0 - 2e-4 * alpha) * phi_ref
+                || same_piece
+                || self.free_norm_inf() <= tolerance
+            {
+                accepted = Some((alpha, merit));
+                break;
+            }
+            if merit < best.1 {
+                best = (alpha, merit);
+            }
+            let event = if trial == 0 && !same {
+                first_event(&before, &self.parts.gaps())
+            } else {
+                None
+            };
+            let curvature = (phi - phi0 + 2.0 * phi0 * alpha) / (alpha * alpha);
+            let next = if curvature.is_finite() && curvature > 0.0 {
+                phi0 / curvature
+            } else {
+                0.5 * alpha
+            };
+            at_event = event.is_some();
+            alpha = event.unwrap_or_else(|| next.clamp(0.1 * alpha, 0.5 * alpha));
         }
-        names
+        if accepted.is_none() {
+            // No trial met the test: the best one that lowered the merit at all (across a kink
+            // of `R` a generalized Newton direction need not be one of sufficient descent), else
+            // none.
+            apply(u, &self.system.dofs, &delta, best.0 - applied);
+            if best.0 > 0.0 {
+                self.assemble_at(u, levels, None);
+                accepted = Some(best);
+            }
+        }
+        self.work.rhs = delta;
+        accepted
     }
 
-    /// First Levenberg–Marquardt shift (fraction of the mean diagonal of the Newton matrix).
-    pub(crate) const DAMPING_START: f64 = 1e-4;
-    /// A residual below this fraction of the best so far counts as progress.
+    /// A residual or correction below this fraction of the best so far counts as progress.
     pub(crate) const PROGRESS: f64 = 0.9;
     /// Iterations without progress before an increment is declared stalled and cut back.
-    pub(crate) const STALL_PATIENCE: usize = 8;
+    pub(crate) const STALL_PATIENCE: usize = 12;
+    /// Changes between stick and slip that make a contact's status a cycle ([`Hold`]).
+    pub(crate) const CYCLE: usize = 3;
+    /// Merits the nonmonotone line search compares against.
+    pub(crate) const MEMORY: usize = 4;
+    /// Trial steps of the line search before the pseudo-time step is shortened instead.
+    pub(crate) const TRIALS: usize = 6;
 
-    /// The Newton correction `ΔU` of the free DOFs into `work.rhs` from the last assembly, with
-    /// the pseudo-time shift of `ptc` or else the Levenberg–Marquardt shift `damping` (times the
-    /// mean of the free diagonal's magnitudes) added to the matrix's diagonal; returns `‖ΔU‖∞`.
-    fn correction(
-        &mut self,
-        damping: f64,
-        ptc: Option<&mut Continuation>,
-    ) -> Result<f64, IncrementFailure> {
+    /// The correction `ΔU` of the free DOFs into `work.rhs` from the last assembly, with the
+    /// pseudo-time shift of `ptc` on the matrix's diagonal; returns `‖ΔU‖∞`.
+    fn correction(&mut self, ptc: &mut Continuation) -> Result<f64, IncrementFailure> {
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Free(eq) = d {
                 self.work.rhs[*eq] = -self.work.internal[i];
             }
         }
-        if let Some(p) = ptc {
-            p.shift(
-                &mut self.work.values,
-                &self.work.diagonal,
-                &self.work.pseudo_mass,
-            );
-        } else if damping > 0.0 {
-            let values = &mut self.work.values;
-            let mean = self
-                .work
-                .diagonal
-                .iter()
-                .map(|&d| values[d].abs())
-                .sum::<f64>()
-                / self.work.diagonal.len() as f64;
-            for &d in &self.work.diagonal {
-                values[d] += damping * mean;
-            }
-        }
+        ptc.shift(
+            &mut self.work.values,
+            &self.work.diagonal,
+            &self.work.pseudo_mass,
+        );
         let matrix = self.system.matrix(&self.work.values);
         self.linear
             .factorize_and_solve(matrix, &mut self.work.rhs)
@@ -347,7 +552,6 @@ impl Analysis {
         low_rank.map_err(|e| IncrementFailure::Singular { message: e.0 })?;
         Ok(max_abs(&self.work.rhs))
     }
-
     /// `‖R_free‖∞` of the last assembly.
     pub(crate) fn free_norm_inf(&self) -> f64 {
         max_abs(
@@ -373,78 +577,22 @@ impl Analysis {
     }
 }
 
-/// Whether an iterate made progress: a residual or a correction [`Analysis::PROGRESS`] times
-/// the best so far. A cycle between two states repeats both to round-off and never makes it,
-/// while the slow approach along a soft direction of the film (small residual, shrinking
-/// corrections) does. A correction solved with the Levenberg–Marquardt shift (`shifted`) does
-/// not count by its size: the shift alone shrinks it (to 1e-65 m over a 100-iteration attempt,
-/// which then ran to the iteration limit instead of being cut back as stalled).
-fn made_progress(
-    residual: f64,
-    best: f64,
-    correction: f64,
-    best_correction: f64,
-    shifted: bool,
-) -> bool {
-    residual < Analysis::PROGRESS * best
-        || (!shifted && correction < Analysis::PROGRESS * best_correction)
-}
-
-/// The Levenberg–Marquardt shift after a line search that took `step` and `decreased` (or
-/// not) the merit: a direction that cannot lower the residual (a mechanism of an unstressed
-/// film, an indefinite compressed one) gets a diagonal shift, raised until steps succeed and
-/// lowered again after full ones, to 0 below [`Analysis::DAMPING_START`]`/64`. Only the
-/// iteration matrix changes, never the residual: the converged state is the same, and with the
-/// shift gone the last iterations are Newton's again.
-fn next_damping(damping: f64, step: f64, decreased: bool) -> f64 {
-    if !decreased {
-        (4.0 * damping).max(Analysis::DAMPING_START)
-    } else if step == 1.0 && damping > 0.0 {
-        let lower = damping / 4.0;
-        if lower < Analysis::DAMPING_START / 64.0 {
-            0.0
-        } else {
-            lower
-        }
-    } else {
-        damping
-    }
-}
-
-/// The active-set strategy for the curved contacts (Wriggers, *Computational Contact
-/// Mechanics*, 2nd ed. 2006, §6.3.2 and §5.2; Alart & Curnier 1991 for the semi-smooth view it
-/// avoids): Newton iterates with each contact's status (open, stick, slip) held at the set of
-/// the increment's first iterate, so that the residual is smooth and no status switches between
-/// iterations; at a converged iterate the law's own statuses are compared with the held ones,
-/// and if any differs the set is replaced by the law's and the increment solved again from
-/// there. Sets already tried are remembered: a set that comes back is a cycle (the increment
-/// fails and names the contacts that switch). A converged increment's statuses are the law's,
-/// so its answer is the equilibrium of the contact law, not of the held set.
-#[derive(Debug, Default)]
-struct ActiveSet {
-    /// The sets tried so far in this increment.
-    tried: Vec<Vec<GapStatus>>,
-}
-
-impl ActiveSet {
-    /// Most sets tried in one increment.
-    const MAX_SETS: usize = 12;
-
-    /// Records the set `held` (just converged) before `next` replaces it; false when `next` was
-    /// tried before or too many sets were.
-    fn next(&mut self, held: Vec<GapStatus>, next: &[GapStatus]) -> bool {
-        self.tried.push(held);
-        !self.tried.iter().any(|t| t == next) && self.tried.len() < Self::MAX_SETS
-    }
-
-    /// The contacts whose status differs between the tried sets (named by `names`).
-    fn cycling(&self, names: &[String]) -> Vec<String> {
-        let first = self.tried.first().cloned().unwrap_or_default();
-        (0..first.len())
-            .filter(|&k| self.tried.iter().any(|t| t.get(k) != first.get(k)))
-            .filter_map(|k| names.get(k).cloned())
-            .collect()
-    }
+/// The event trial of the line search: where the full correction moved a contact across its
+/// surface (a gap from `before` to `after` changed sign), the step just past the first such
+/// crossing along the line, `1.01 α_k` with `α_k = g₀/(g₀ − g₁)` the smallest (a linear estimate
+/// of the crossing): the end of the smooth piece on which Newton's model holds, and the first
+/// iterate on the next piece, whose tangent then carries the contact's new status (an open
+/// contact has no stiffness, so its correction pushes the node deep into the support; a pressed
+/// one is pulled far off). None where no gap changed sign before the full step.
+fn first_event(before: &[f64], after: &[f64]) -> Option<f64> {
+    before
+        .iter()
+        .zip(after)
+        .filter(|(g0, g1)| (**g0 > 0.0) != (**g1 > 0.0))
+        .map(|(g0, g1)| g0 / (g0 - g1))
+        .filter(|a| a.is_finite())
+        .fold(None, |m: Option<f64>, a| Some(m.map_or(a, |m| m.min(a))))
+        .map(|a| (1.01 * a).min(0.5))
 }
 
 /// `max |v|`, NaN when any value is NaN (`f64::max` alone would skip a NaN and report the
@@ -485,57 +633,80 @@ mod tests {
         assert_eq!(max_abs(&[]), 0.0);
     }
 
-    /// The active set accepts new sets and refuses one tried before (a cycle between two sets
-    /// of statuses) and more than `MAX_SETS`; the contacts it names as cycling are those whose
-    /// status differs between the sets tried.
+    /// A contact whose status alternates between stick and slip three times is held in stick;
+    /// once the held iteration meets the tolerances the hold is released to judge it on the true
+    /// laws; failing there it is held in slip, and after a second failure nothing is held
+    /// again. Changes to or from open, and fewer than three changes, are no cycle.
     #[test]
-    fn active_set_refuses_a_set_tried_before_and_names_the_contacts_that_switch() {
+    fn a_contact_cycling_between_stick_and_slip_is_held_then_judged_on_the_true_laws() {
         use GapStatus::{Open, Slip, Stick};
-        let names: Vec<String> = ["a", "b", "c"].iter().map(|n| n.to_string()).collect();
-        let mut set = ActiveSet::default();
-        assert!(set.next(vec![Open, Stick, Stick], &[Stick, Stick, Stick]));
-        assert!(set.next(vec![Stick, Stick, Stick], &[Stick, Slip, Stick]));
-        // back to the first set: a cycle
-        assert!(!set.next(vec![Stick, Slip, Stick], &[Open, Stick, Stick]));
-        assert_eq!(set.cycling(&names), vec!["a".to_string(), "b".to_string()]);
-        let mut long = ActiveSet::default();
-        let mut fresh = true;
-        for k in 0..ActiveSet::MAX_SETS {
-            let held = vec![if k % 2 == 0 { Open } else { Stick }; k + 1];
-            fresh = long.next(held, &vec![Slip; k + 2]);
-        }
-        assert!(!fresh, "more than MAX_SETS sets accepted");
+        let iterates = |seq: &[[GapStatus; 2]]| -> Vec<Vec<GapStatus>> {
+            seq.iter().map(|s| s.to_vec()).collect()
+        };
+        let open = iterates(&[[Open, Stick], [Stick, Stick], [Open, Stick], [Stick, Stick]]);
+        assert_eq!(cycling(&open), None);
+        assert_eq!(
+            cycling(&iterates(&[[Stick, Stick], [Slip, Stick], [Stick, Stick]])),
+            None
+        );
+        let cycle = iterates(&[[Stick, Open], [Slip, Stick], [Stick, Open], [Slip, Stick]]);
+        assert_eq!(cycling(&cycle), Some(vec![Some(Stick), None]));
+        let mut hold = Hold::default();
+        assert_eq!(hold.next(false, &cycle[..2]), None, "no cycle yet");
+        assert_eq!(hold.next(false, &cycle), Some(vec![Some(Stick), None]));
+        assert_eq!(hold.next(false, &cycle), None, "held: iterating");
+        assert_eq!(
+            hold.next(true, &cycle),
+            Some(vec![]),
+            "converged held: released"
+        );
+        assert_eq!(
+            hold.next(false, &cycle),
+            Some(vec![Some(Slip), None]),
+            "failed: slip"
+        );
+        assert_eq!(hold.next(true, &cycle), Some(vec![]));
+        assert_eq!(
+            hold.next(false, &cycle),
+            None,
+            "failed twice: no more holds"
+        );
+        assert_eq!(hold.next(false, &cycle), None);
+        let mut hold = Hold::default();
+        hold.next(false, &cycle);
+        hold.next(true, &cycle);
+        assert_eq!(
+            hold.next(true, &cycle),
+            None,
+            "the stick hold met the true laws"
+        );
+        assert_eq!(hold.stage, 3);
     }
 
-    /// Progress is a residual or a correction 10 % below its best; a correction shrunk by the
-    /// Levenberg–Marquardt shift is not progress, a smaller residual still is.
+    /// Progress is a residual or a correction 10 % below its best; the closest iterate is the
+    /// one nearest to both tolerances.
     #[test]
-    fn shifted_corrections_are_not_progress_by_their_size() {
-        let (best, best_correction) = (1.0, 1e-3);
-        assert!(made_progress(0.5, best, 1.0, best_correction, false));
-        assert!(made_progress(0.5, best, 1.0, best_correction, true));
-        assert!(made_progress(1.0, best, 1e-6, best_correction, false));
-        assert!(!made_progress(1.0, best, 1e-6, best_correction, true));
-        assert!(!made_progress(0.95, best, 0.95e-3, best_correction, false));
-    }
-
-    /// The shift starts at `DAMPING_START` when a step fails to decrease the merit, grows
-    /// fourfold while they keep failing, falls fourfold after each full step and vanishes
-    /// below `DAMPING_START / 64`; partial steps keep it.
-    #[test]
-    fn damping_grows_on_failures_and_vanishes_after_full_steps() {
-        let start = Analysis::DAMPING_START;
-        assert_eq!(next_damping(0.0, 1.0, false), start);
-        assert_eq!(next_damping(start, 0.1, false), 4.0 * start);
-        assert_eq!(next_damping(4.0 * start, 0.5, true), 4.0 * start);
-        let mut d = 4.0 * start;
-        let mut full_steps = 0;
-        while d > 0.0 {
-            d = next_damping(d, 1.0, true);
-            full_steps += 1;
-        }
-        // 4·s → s → s/4 → s/16 → s/64 → 0 (s/256 is below s/64).
-        assert_eq!(full_steps, 5);
-        assert_eq!(next_damping(0.0, 1.0, true), 0.0);
+    fn progress_is_a_tenth_below_the_best_residual_or_correction() {
+        let record = |iteration, residual, correction| IterationRecord {
+            iteration,
+            residual,
+            residual_tolerance: 1.0,
+            correction,
+            correction_tolerance: 1.0,
+        };
+        let mut p = Progress {
+            best: f64::INFINITY,
+            best_correction: f64::INFINITY,
+            best_at: 0,
+            closest: None,
+            statuses: Vec::new(),
+        };
+        assert!(p.note(record(1, 10.0, 5.0)));
+        assert!(!p.note(record(2, 9.5, 4.6)));
+        assert!(p.note(record(3, 9.5, 4.4)));
+        assert_eq!(p.best_at, 3);
+        assert!(p.note(record(4, 8.0, 100.0)));
+        assert_eq!((p.best, p.best_correction), (8.0, 4.4));
+        assert_eq!(p.closest.unwrap().iteration, 2);
     }
 }

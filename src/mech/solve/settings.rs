@@ -30,23 +30,13 @@ pub struct SolverSettings {
     pub max_iterations: usize,
     /// How many times an increment may be halved before the step fails.
     pub max_cutbacks: usize,
-    /// Backtracking on `‖R‖₂` along each Newton correction (see `Analysis::line_search`).
-    pub line_search: bool,
     /// Factorize a consistent tangent that is symmetric (no slipping gap, no follower pressure)
     /// by LDLᵀ instead of LU (`solve/linear`); false: always LU.
     pub symmetric_factorization: bool,
-    /// Pseudo-transient continuation (`continuation.rs`) for the increments plain Newton does
-    /// not converge, before they are halved; false: halving only (the stabilization-free
-    /// reference).
-    pub continuation: bool,
-    /// Viscous stabilization (`contributions/stabilization.rs`) for the rest of a step whose
-    /// increment neither plain Newton nor the continuation converge, before it is halved; its
-    /// work is reported against the strain energy. false: never (the stabilization-free answer).
+    /// The viscous stabilization's rows of the strategy table (`increments.rs`) for the rest of
+    /// a step whose smallest increment Newton refused; its work is reported and judged against
+    /// the strain energy. false: the first row only (the stabilization-free answer).
     pub stabilization: bool,
-    /// The smoothing homotopy (`smoothing.rs`) for an increment every other attempt refused,
-    /// with curved contacts or an elastic tension-field film: the laws' switches rounded, the
-    /// rounding reduced, the law's own equilibrium solved from there. false: never.
-    pub smoothing: bool,
     /// Threads of the element assembly and of the LDLᵀ factorizations (each scoped: none
     /// outlives a call); 0 = automatic: the assembly one below
     /// [`PARALLEL_MIN_TRIANGLES`](crate::mech::solve::assembly::PARALLEL_MIN_TRIANGLES)
@@ -59,12 +49,11 @@ pub struct SolverSettings {
     pub threads: usize,
 }
 
-/// Default number of increments a step is split into (the largest increment is this fraction
-/// of a step): the CLI's `--increments` and the FMU's `solver.incrementsPerStep` both start
-/// from it, so that a CLI check predicts an FMU run with default parameters. Ten keeps a
-/// master's coarse communication step robust; on the specimens it changes the CLI's slips by
-/// at most 0.001 mm against one increment per step.
-pub const DEFAULT_INCREMENTS_PER_STEP: usize = 10;
+/// Default of the smallest number of increments a step is cut into (the largest increment is
+/// this fraction of a step; the controller cuts further where Newton needs it): the CLI's
+/// `--increments` and the FMU's `solver.incrementsPerStep` both start from it, so that a CLI
+/// check predicts an FMU run with default parameters.
+pub const DEFAULT_INCREMENTS_PER_STEP: usize = 1;
 
 impl Default for SolverSettings {
     fn default() -> Self {
@@ -74,11 +63,8 @@ impl Default for SolverSettings {
             residual_tolerance: 1e-5,
             max_iterations: 100,
             max_cutbacks: 12,
-            line_search: true,
             symmetric_factorization: true,
-            continuation: true,
             stabilization: true,
-            smoothing: true,
             threads: 0,
         }
     }

@@ -43,11 +43,6 @@ pub struct AnalysisState {
     /// increment converges (empty for the elastic film).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plastic: Vec<PlasticHistory>,
-    /// Gaps lifting off at the start of the increment and landing again within it (the
-    /// sliding-direction law's lift-off release, `Analysis::step_to_motion`;
-    /// [`crate::mech::elements::gap::GapLaw::evaluate_landing`]). Empty in a converged state.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub landing: Vec<usize>,
     /// The gas of each chamber ([`crate::mech::solve::contributions::ChamberState`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<crate::mech::solve::contributions::ChamberState>,

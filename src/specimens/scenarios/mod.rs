@@ -217,8 +217,6 @@ pub struct StepOutcome {
     pub increments: usize,
     /// Halved increments.
     pub cutbacks: usize,
-    /// Increments made larger than asked because every smaller one failed.
-    pub enlarged: usize,
     /// Increments solved with the viscous stabilization on.
     pub stabilized: usize,
     /// Whether the artificial energy left exceeds `STABILIZATION_BOUND` of the strain energy.
@@ -289,11 +287,6 @@ impl RunOutcome {
         self.converged() && self.steps.iter().all(|s| !s.over_bound)
     }
 
-    /// Enlarged increments over all steps.
-    pub fn enlarged(&self) -> usize {
-        self.steps.iter().map(|s| s.enlarged).sum()
-    }
-
     /// Most Newton iterations of one converged increment.
     pub fn max_increment_iterations(&self) -> usize {
         self.steps
@@ -355,7 +348,6 @@ impl Scenario {
                     max_increment_iterations: 0,
                     increments: 0,
                     cutbacks: 0,
-                    enlarged: 0,
                     stabilized: 0,
                     over_bound: false,
                     residual: 0.0,
@@ -369,7 +361,6 @@ impl Scenario {
                             report.iterations.iter().copied().max().unwrap_or(0);
                         record.increments = report.iterations.len();
                         record.cutbacks = report.cutbacks;
-                        record.enlarged = report.enlarged;
                         record.stabilized = report.stabilized;
                         record.over_bound = report.stabilization_warning().is_some();
                         record.residual = report.residual;

@@ -38,7 +38,9 @@
 //! Normal: gap `g = d − r`, contact force `λN = k_n ⟨−g⟩` along `n` (the paper's penalty).
 //! Friction (penalty `k_s`, history `ξ̄` of the last converged state): trial
 //! `f = −k_s (ξ − ξ̄)`; `isotropic`: Coulomb cone `|f| ≤ μλN`, returned to it along `f`;
-//! `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays elastic.
+//! `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays elastic up to
+//! the cross hold `|f2| ≤ κλN` (`FrictionLaw::CROSS_HOLD`; the gap module's "cross hold at
+//! lift-off": the hold goes to zero with the normal force).
 //! Force on the film `F = λN n + Σ fα ∇ξα`; consistent tangent of `−F`:
 //! `k_n n⊗n − λN ∂n/∂x − Σ (∂fα/∂ξβ) ∇ξα⊗∇ξβ − Σ (∂fα/∂λN) ∇ξα⊗∇λN − Σ fα ∇²ξα`
 //! (`∇λN = −k_n n`), checked against central differences in every status and region
@@ -52,7 +54,6 @@
 //! |---|---|
 //! | `mod.rs` | the contact law: [`SurfaceContact`], [`SurfaceContacts`], histories, responses |
 //! | [`surface`] | the supports' geometry: centrelines, frames, closest-point projection |
-//! | [`smoothing`] | the law with its corners rounded: the smoothing homotopy's problems |
 //! | `tests` | tangent against central differences, caps, corners, slip |
 
 use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
@@ -62,7 +63,6 @@ use crate::mech::elements::gap::{FrictionLaw, GapStatus};
 use crate::mech::elements::triangle::ElementMatrix;
 use crate::mech::model::Model;
 use crate::mech::solve::assembly::{System, node_vector};
-pub mod smoothing;
 pub mod surface;
 
 use surface::*;
@@ -94,12 +94,6 @@ pub struct ContactHistory {
     pub status: GapStatus,
     /// Friction coefficient.
     pub friction: f64,
-    /// Lifted off at the start of the increment and landing again within it (the
-    /// sliding-direction law's lift-off release, `Analysis::step_to_motion`): it holds nothing
-    /// across until the increment converges, and then holds from where it ended. Never set in a
-    /// converged state.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub lands: bool,
 }
 
 /// Force on the film, tangent and status of a contact at one iterate.
@@ -111,10 +105,10 @@ pub struct ContactResponse {
     pub tangent: Matrix3<f64>,
     /// The status whose law gave this response (imposed in an active-set iteration).
     pub status: GapStatus,
-    /// The law's own status at this iterate (equal to `status` unless one was imposed).
-    pub natural: GapStatus,
     /// `λN ≥ 0` (N; negative only where a closed status was imposed on an open gap).
     pub normal_force: f64,
+    /// The signed gap to the surface (m; negative: pressed in).
+    pub gap: f64,
     /// Friction force components `[f1, f2]` along `ξ1`, `ξ2` (N).
     pub friction: Vector2<f64>,
     /// `ξ` at this iterate, and the anchor to commit if it converges.
@@ -293,42 +287,29 @@ impl SurfaceContact {
 
     /// The contact's response at node position `x` from the converged `history`.
     pub fn respond(&self, x: &Vector3<f64>, history: &ContactHistory) -> ContactResponse {
-        self.respond_as(x, history, None)
+        self.respond_held(x, history, None)
     }
 
-    /// The tube's radius (m).
-    pub fn tube_radius(&self) -> f64 {
-        self.tube_radius
-    }
-
-    /// The friction law.
-    pub fn law(&self) -> FrictionLaw {
-        self.law
-    }
-
-    /// The response with the status `frozen` imposed when given (an active-set iteration:
-    /// closed means the penalty force `−k_n g` even where the gap has opened, open means no
-    /// force even where it penetrates, stick or slip picks that branch of the friction law);
-    /// [`ContactResponse::natural`] is the law's own status at `x` either way.
-    pub fn respond_as(
+    /// [`Self::respond`] with the friction status `held` imposed where the contact is closed
+    /// (stick: the elastic law; slip: on the bound along the slip direction; None: the law's
+    /// own): the Newton loop's hold of a contact cycling between stick and slip (`newton.rs`).
+    pub fn respond_held(
         &self,
         x: &Vector3<f64>,
         history: &ContactHistory,
-        frozen: Option<GapStatus>,
+        held: Option<GapStatus>,
     ) -> ContactResponse {
         let p = self.project(x, history.angle);
         let anchor = Vector2::from(history.anchor);
         let lambda = -self.kn * p.gap;
         let limit = history.friction * lambda;
-        let mut trial = -(p.xi - anchor) * self.ks;
-        if history.lands {
-            trial.y = 0.0;
-        }
-        let natural = if p.gap >= 0.0 {
+        let trial = -(p.xi - anchor) * self.ks;
+        let cross = FrictionLaw::cross_limit(lambda, history.friction);
+        let status = if p.gap >= 0.0 {
             GapStatus::Open
         } else if match self.law {
             FrictionLaw::Isotropic => trial.norm() <= limit,
-            FrictionLaw::SlidingDirection => trial.x.abs() <= limit,
+            FrictionLaw::SlidingDirection => trial.x.abs() <= limit && trial.y.abs() <= cross,
         } {
             GapStatus::Stick
         } else {
@@ -338,18 +319,18 @@ impl SurfaceContact {
             residual: Vector3::zeros(),
             tangent: Matrix3::zeros(),
             status: GapStatus::Open,
-            natural,
             normal_force: 0.0,
+            gap: p.gap,
             friction: Vector2::zeros(),
             xi: p.xi,
             // An open contact forgets its anchor: it sticks where it touches down next.
             next_anchor: p.xi,
             angle: p.parameter,
         };
-        let used = frozen.unwrap_or(natural);
-        if used == GapStatus::Open {
+        if status == GapStatus::Open {
             return open;
         }
+        let used = held.unwrap_or(status);
         let n = p.normal;
         // f, ∂f/∂ξ and ∂f/∂λN per law and status.
         let (status, f, df_dxi, df_dlambda) = match self.law {
@@ -371,22 +352,28 @@ impl SurfaceContact {
                 }
             }
             FrictionLaw::SlidingDirection => {
+                // Each direction elastic inside its bound (μN along, κN across the support)
+                // and on it beyond: `f = ±bound`, `∂f/∂λN = ±ratio`.
                 let mut dfd = -Matrix2::identity() * self.ks;
-                if history.lands {
-                    dfd[(1, 1)] = 0.0;
+                let mut dfl = Vector2::zeros();
+                let mut f = trial;
+                let kappa = FrictionLaw::CROSS_HOLD.max(history.friction);
+                for (i, (bound, ratio)) in [(limit, history.friction), (cross, kappa)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    let on_bound = match held {
+                        Some(GapStatus::Stick) => false,
+                        Some(GapStatus::Slip) if i == 0 => true,
+                        _ => trial[i].abs() > bound,
+                    };
+                    if on_bound {
+                        f[i] = trial[i].signum() * bound;
+                        dfd[(i, i)] = 0.0;
+                        dfl[i] = trial[i].signum() * ratio;
+                    }
                 }
-                if used == GapStatus::Stick {
-                    (GapStatus::Stick, trial, dfd, Vector2::zeros())
-                } else {
-                    let s = trial.x.signum();
-                    dfd[(0, 0)] = 0.0;
-                    (
-                        GapStatus::Slip,
-                        Vector2::new(s * limit, trial.y),
-                        dfd,
-                        Vector2::new(s * history.friction, 0.0),
-                    )
-                }
+                (used, f, dfd, dfl)
             }
         };
         let force = n * lambda + p.grad[0] * f.x + p.grad[1] * f.y;
@@ -403,8 +390,8 @@ impl SurfaceContact {
             residual: -force,
             tangent: k,
             status,
-            natural,
             normal_force: lambda,
+            gap: p.gap,
             friction: f,
             xi: p.xi,
             // f = −k_s (ξ − ξ̄_new): the anchor the committed friction force implies.
@@ -413,11 +400,22 @@ impl SurfaceContact {
         }
     }
 
+    /// The tube's radius (m).
+    pub fn tube_radius(&self) -> f64 {
+        self.tube_radius
+    }
+
+    /// The friction law.
+    pub fn law(&self) -> FrictionLaw {
+        self.law
+    }
+
     /// Checks a converged `history` read back, at node position `x`, against this contact's own
     /// law ([`SurfaceContact::respond`], either friction law): open where the gap is not
     /// negative; in contact (stick or slip) where it is not positive, with an anchor that the
     /// law's return map leaves where it is (stick inside the limit, slip on it), and for slip
-    /// the trial force on or beyond the limit (`|f|` isotropic, `|f1|` sliding-direction). The
+    /// the trial force on or beyond the limit (`|f|` isotropic; `|f1|` or the cross hold `|f2|`,
+    /// sliding-direction). The
     /// gap to `length_tolerance` (m), forces to `force_tolerance` (N). Err: what differs.
     pub fn check_committed(
         &self,
@@ -431,16 +429,18 @@ impl SurfaceContact {
         let anchor = Vector2::from(history.anchor);
         let moved = (r.next_anchor - anchor).norm() * self.ks;
         let trial = -(r.xi - anchor) * self.ks;
-        let measure = match self.law {
-            FrictionLaw::Isotropic => trial.norm(),
-            FrictionLaw::SlidingDirection => trial.x.abs(),
-        };
         let limit = history.friction * r.normal_force;
+        // How far the trial force is beyond its bound (≥ 0 on it).
+        let measure = match self.law {
+            FrictionLaw::Isotropic => trial.norm() - limit,
+            FrictionLaw::SlidingDirection => (trial.x.abs() - limit)
+                .max(trial.y.abs() - FrictionLaw::cross_limit(r.normal_force, history.friction)),
+        };
         let in_contact = gap <= length_tolerance && moved <= force_tolerance;
         let consistent = match history.status {
             GapStatus::Open => gap >= -length_tolerance,
             GapStatus::Stick => in_contact,
-            GapStatus::Slip => in_contact && measure >= limit - force_tolerance,
+            GapStatus::Slip => in_contact && measure >= -force_tolerance,
         };
         if consistent {
             return Ok(());
@@ -471,7 +471,6 @@ impl SurfaceContact {
                 GapStatus::Open
             },
             friction: mu,
-            lands: false,
         }
     }
 }
@@ -594,19 +593,15 @@ impl SurfaceContacts {
             .collect()
     }
 
-    /// Adds the contacts' residuals and tangents at `u` (from `histories`; with the statuses
-    /// `frozen` imposed when given, [`SurfaceContact::respond_as`]; under the law smoothed over
-    /// the width `smoothing` where it is positive, [`SurfaceContact::respond_smoothed`]) to `residual` and
-    /// the Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
+    /// Adds the contacts' residuals and tangents at `u` (from `histories`, with the statuses
+    /// `held` imposed: [`SurfaceContact::respond_held`]; empty: none) to `residual` and the
+    /// Newton matrix `values`; leaves the responses in `responses` (reused: no allocation
     /// once it has grown).
-    #[allow(clippy::too_many_arguments)] // the evaluation's inputs and outputs, each needed
     pub fn add_to(
         &self,
         system: &System,
         u: &[f64],
-        histories: &[ContactHistory],
-        frozen: Option<&[GapStatus]>,
-        smoothing: f64,
+        (histories, held): (&[ContactHistory], &[Option<GapStatus>]),
         residual: &mut [f64],
         mut values: Option<&mut [f64]>,
         responses: &mut Vec<ContactResponse>,
@@ -618,12 +613,7 @@ impl SurfaceContacts {
                 .zip(histories)
                 .enumerate()
                 .map(|(k, (c, h))| {
-                    let x = self.position(c, u);
-                    if smoothing > 0.0 {
-                        c.respond_smoothed(&x, h, smoothing)
-                    } else {
-                        c.respond_as(&x, h, frozen.map(|f| f[k]))
-                    }
+                    c.respond_held(&self.position(c, u), h, held.get(k).copied().flatten())
                 }),
         );
         for ((c, r), &(triangle, local)) in
@@ -662,7 +652,6 @@ impl SurfaceContacts {
                 } else {
                     h.origin
                 },
-                lands: false,
                 ..*h
             })
             .collect()

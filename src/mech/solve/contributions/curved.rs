@@ -2,9 +2,9 @@
 //! origin, status, μ) of each contact at the increment's start, the responses of the last
 //! evaluation, and the histories committed from them.
 
-use super::{Contribution, Evaluation, LiftOff, StatusChanges};
+use super::{Contribution, Evaluation};
 use crate::mech::elements::curved_contact::{ContactHistory, ContactResponse, SurfaceContacts};
-use crate::mech::elements::gap::{FrictionLaw, GapStatus};
+use crate::mech::elements::gap::GapStatus;
 use crate::mech::model::Model;
 use crate::mech::results::Results;
 use crate::mech::solve::assembly::{Dof, System};
@@ -19,19 +19,10 @@ pub struct CurvedContacts {
     start: Vec<ContactHistory>,
     /// Responses at the last evaluation.
     responses: Vec<ContactResponse>,
-    /// The statuses imposed on the contacts during an active-set iteration (`newton.rs`).
-    pub frozen: Option<Vec<GapStatus>>,
-    /// Whether the next increments hold the statuses fixed (active-set iteration, `newton.rs`).
-    pub active_set: bool,
-    /// The width (m) over which the contact law's corners are rounded in the smoothing
-    /// homotopy (`curved_contact::smoothing`); 0: the law itself.
-    pub smoothing: f64,
     /// Each contact's name in messages: `<support>.<k>` (k-th node of the support).
     pub names: Vec<String>,
-    /// The law's status changes over the Newton iterations.
-    changes: StatusChanges,
-    /// Sliding-direction contacts lifting off with more than `μN` across ([`LiftOff`]).
-    lift: LiftOff,
+    /// Statuses imposed until the next restore ([`Contribution::hold`]; empty: none).
+    held: Vec<Option<GapStatus>>,
 }
 
 impl CurvedContacts {
@@ -42,16 +33,12 @@ impl CurvedContacts {
             start: contacts.initial_histories(model),
             contacts,
             responses: Vec::new(),
-            frozen: None,
-            active_set: false,
-            smoothing: 0.0,
+            held: Vec::new(),
             names: model
                 .curved_supports
                 .iter()
                 .flat_map(|s| (0..s.nodes.len()).map(move |k| format!("{}.{k}", s.name)))
                 .collect(),
-            changes: StatusChanges::default(),
-            lift: LiftOff::default(),
         }
     }
 
@@ -62,31 +49,6 @@ impl CurvedContacts {
 }
 
 impl CurvedContacts {
-    /// The law's own status of each contact at the last evaluation (whatever was imposed).
-    pub fn natural(&self) -> Vec<GapStatus> {
-        self.responses.iter().map(|r| r.natural).collect()
-    }
-
-    /// The first width (m) of the smoothing homotopy from the converged `u`, `histories`: the
-    /// larger of [`Self::SMOOTHING_START`] times the largest penetration of a closed contact
-    /// (the scale of the penalty's forces, `λN/k_n`) and [`Self::SMOOTHING_FLOOR`] times the
-    /// largest tube radius.
-    pub fn smoothing_width(&self, u: &[f64], histories: &[ContactHistory]) -> f64 {
-        let depth = self.contacts.largest_penetration(u, histories);
-        let radius = self
-            .contacts
-            .contacts
-            .iter()
-            .map(|c| c.tube_radius())
-            .fold(0.0, f64::max);
-        (Self::SMOOTHING_START * depth).max(Self::SMOOTHING_FLOOR * radius)
-    }
-
-    /// The first smoothing width in penetrations.
-    const SMOOTHING_START: f64 = 4.0;
-    /// The least first smoothing width in tube radii.
-    const SMOOTHING_FLOOR: f64 = 1e-3;
-
     /// Whether the model has any curved-support contact.
     pub fn is_empty(&self) -> bool {
         self.contacts.contacts.is_empty()
@@ -96,63 +58,26 @@ impl CurvedContacts {
 impl Contribution for CurvedContacts {
     fn restore(&mut self, start: &AnalysisState) {
         self.start.clone_from(&start.contacts);
-        self.changes.reset(start.contacts.iter().map(|h| h.status));
-        self.lift.reset(self.start.len());
+        self.held.clear();
     }
 
-    fn note_iteration(&mut self, iteration: usize) {
-        self.changes
-            .note(iteration, self.responses.iter().map(|r| r.natural));
+    fn hold(&mut self, held: &[Option<GapStatus>]) {
+        self.held = held.to_vec();
     }
 
-    fn chattering(&self, since: usize, out: &mut Vec<String>) {
-        self.changes.changed_since(since, &self.names, out);
-    }
-
-    fn lifting_off(&self, out: &mut Vec<String>) {
-        self.lift.lifted(&self.names, out);
+    fn status_names(&self, out: &mut Vec<String>) {
+        out.extend(self.names.iter().cloned());
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
         self.contacts.add_to(
             at.system,
             at.u,
-            &self.start,
-            self.frozen.as_deref(),
-            self.smoothing,
+            (&self.start, &self.held),
             residual,
             values,
             &mut self.responses,
         );
-        for (k, ((c, h), r)) in self
-            .contacts
-            .contacts
-            .iter()
-            .zip(&self.start)
-            .zip(&self.responses)
-            .enumerate()
-        {
-            if c.law() == FrictionLaw::SlidingDirection {
-                let open = r.status == GapStatus::Open;
-                self.lift
-                    .note(k, open, r.friction.y, h.friction * r.normal_force);
-            }
-        }
-    }
-
-    fn release_lift_off(
-        &mut self,
-        names: &[String],
-        start: &mut AnalysisState,
-        out: &mut Vec<f64>,
-    ) {
-        for (k, name) in self.names.iter().enumerate() {
-            let h = &mut start.contacts[k];
-            if names.contains(name) && !h.lands {
-                h.lands = true;
-                out.push(self.lift.hold(k));
-            }
-        }
     }
 
     fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {
@@ -170,6 +95,10 @@ impl Contribution for CurvedContacts {
 
     fn statuses(&self, out: &mut Vec<GapStatus>) {
         out.extend(self.responses.iter().map(|r| r.status));
+    }
+
+    fn gaps(&self, out: &mut Vec<f64>) {
+        out.extend(self.responses.iter().map(|r| r.gap));
     }
 
     fn results(

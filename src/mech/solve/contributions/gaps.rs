@@ -4,8 +4,8 @@
 
 use nalgebra::Vector2;
 
-use super::{Contribution, Evaluation, LiftOff, StatusChanges};
-use crate::mech::elements::gap::{FrictionLaw, GapLaw, GapResponse, GapStatus, IterationMatrix};
+use super::{Contribution, Evaluation};
+use crate::mech::elements::gap::{GapLaw, GapResponse, GapStatus, IterationMatrix};
 use crate::mech::model::Model;
 use crate::mech::results::{GapResult, Results};
 use crate::mech::solve::state::AnalysisState;
@@ -25,15 +25,8 @@ pub struct Gaps {
     latched: Vec<Option<Vector2<f64>>>,
     /// Gaps found closed at some iteration of the current Newton loop.
     closed: Vec<bool>,
-    /// Status changes over the Newton iterations.
-    changes: StatusChanges,
     /// Names (for the advice of a stalled increment).
     pub names: Vec<String>,
-    /// Sliding-direction gaps lifting off with more than `μN` across ([`LiftOff`]).
-    lift: LiftOff,
-    /// Gaps landing again within this increment after a lift-off release
-    /// ([`AnalysisState::landing`]).
-    landing: Vec<bool>,
 }
 
 impl Gaps {
@@ -48,12 +41,9 @@ impl Gaps {
             responses: idle.map_or_else(Vec::new, |r| vec![r; n]),
             latched: vec![None; n],
             closed: vec![false; n],
-            changes: StatusChanges::default(),
             trial: Vec::new(),
             history: Vec::new(),
             names: model.gaps.iter().map(|g| g.name.clone()).collect(),
-            lift: LiftOff::default(),
-            landing: vec![false; n],
             laws,
         }
     }
@@ -76,10 +66,6 @@ impl Gaps {
             .iter()
             .map(|s| Vector2::from(*s))
             .collect();
-        self.landing.iter_mut().for_each(|l| *l = false);
-        for &g in &state.landing {
-            self.landing[g] = true;
-        }
     }
 }
 
@@ -88,8 +74,6 @@ impl Contribution for Gaps {
         self.take_history(start);
         self.latched.iter_mut().for_each(|l| *l = None);
         self.closed.iter_mut().for_each(|c| *c = false);
-        self.changes.reset(start.status.iter().copied());
-        self.lift.reset(self.laws.len());
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
@@ -99,17 +83,12 @@ impl Contribution for Gaps {
             responses,
             latched,
             closed,
-            landing,
             ..
         } = self;
         let (mode, iteration) = (at.matrix, at.iteration);
         at.system.add_gaps(at.u, residual, values, |g, d| {
             let law = &laws[g];
-            let response = if landing[g] {
-                law.evaluate_landing(d, history[g])
-            } else {
-                law.evaluate(d, history[g])
-            };
+            let response = law.evaluate(d, history[g]);
             responses[g] = response;
             let matrix = match mode {
                 IterationMatrix::Consistent => law.consistent_tangent(&response),
@@ -140,20 +119,8 @@ impl Contribution for Gaps {
                     }
                 }
             };
-            let matrix = if landing[g] {
-                GapLaw::landing_matrix(matrix)
-            } else {
-                matrix
-            };
             (response.force, matrix)
         });
-        for (g, (law, r)) in self.trial.iter().zip(&self.responses).enumerate() {
-            if law.friction_law == FrictionLaw::SlidingDirection {
-                let open = r.status == GapStatus::Open;
-                self.lift
-                    .note(g, open, r.force.y, law.friction * r.normal_force);
-            }
-        }
     }
 
     fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
@@ -163,21 +130,6 @@ impl Contribution for Gaps {
             .map(|r| r.plastic_slip.into())
             .collect();
         state.status = self.responses.iter().map(|r| r.status).collect();
-        state.landing.clear();
-    }
-
-    fn release_lift_off(
-        &mut self,
-        names: &[String],
-        start: &mut AnalysisState,
-        out: &mut Vec<f64>,
-    ) {
-        for (g, name) in self.names.iter().enumerate() {
-            if names.contains(name) && !start.landing.contains(&g) {
-                start.landing.push(g);
-                out.push(self.lift.hold(g));
-            }
-        }
     }
 
     /// The law at the converged point with the updated history gives the same forces.
@@ -189,17 +141,13 @@ impl Contribution for Gaps {
         out.extend(self.responses.iter().map(|r| r.status));
     }
 
-    fn note_iteration(&mut self, iteration: usize) {
-        self.changes
-            .note(iteration, self.responses.iter().map(|r| r.status));
+    fn gaps(&self, out: &mut Vec<f64>) {
+        let gap = |(r, l): (&GapResponse, &GapLaw)| l.initial_gap + r.relative.z;
+        out.extend(self.responses.iter().zip(&self.laws).map(gap));
     }
 
-    fn chattering(&self, since: usize, out: &mut Vec<String>) {
-        self.changes.changed_since(since, &self.names, out);
-    }
-
-    fn lifting_off(&self, out: &mut Vec<String>) {
-        self.lift.lifted(&self.names, out);
+    fn status_names(&self, out: &mut Vec<String>) {
+        out.extend(self.names.iter().cloned());
     }
 
     /// The status is the one found when the increment converged.

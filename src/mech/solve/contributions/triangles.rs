@@ -20,9 +20,33 @@ pub struct Triangles {
     start: Vec<PlasticHistory>,
     /// Plastic history of the last evaluation (the trial).
     trial: Vec<PlasticHistory>,
-    /// The strain width over which an elastic tension-field film's switches are rounded in the
-    /// smoothing homotopy (`elements/smoothing.rs`); 0: the law itself.
-    pub smoothing: f64,
+}
+
+/// What a failed increment names (called once when it fails, never per iteration).
+impl Triangles {
+    /// Film elements whose tension-field state differs between `a` and `b` (none without
+    /// wrinkling).
+    pub fn flipping(&self, system: &System, a: &[f64], b: &[f64]) -> Vec<usize> {
+        if system.material.wrinkling == Wrinkling::None {
+            return Vec::new();
+        }
+        let state = |u: &[f64], e: usize| stress_state(system, &self.start, e, u).state;
+        (0..system.triangles.len())
+            .filter(|&e| state(a, e) != state(b, e))
+            .collect()
+    }
+
+    /// Elements in compression at `u` for a film without wrinkling: the elastic film's stress,
+    /// or the plastic film's from the increment's start history (a film elongated by plastic
+    /// flow and then unloaded goes into compression while its Green strain is still positive).
+    pub fn compressed(&self, system: &System, u: &[f64]) -> Vec<usize> {
+        if system.material.wrinkling != Wrinkling::None {
+            return Vec::new();
+        }
+        (0..system.triangles.len())
+            .filter(|&e| stress_state(system, &self.start, e, u).principal[1] < 0.0)
+            .collect()
+    }
 }
 
 impl Contribution for Triangles {
@@ -34,19 +58,6 @@ impl Contribution for Triangles {
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], values: Option<&mut [f64]>) {
         let material = &at.system.material;
         match material.plastic_film() {
-            None if self.smoothing > 0.0 && material.wrinkling == Wrinkling::TensionField => {
-                at.system.add_triangles_keeping(
-                    at.u,
-                    residual,
-                    values,
-                    |_, tri, ue, tangent| {
-                        let (r, k) =
-                            tri.force_and_tangent_rounded(material, ue, tangent, self.smoothing);
-                        (r, k, ())
-                    },
-                    &mut [],
-                );
-            }
             None => at.system.add_triangles(at.u, residual, values),
             Some(film) => {
                 let start = &self.start;
@@ -76,29 +87,6 @@ impl Contribution for Triangles {
 
     fn at_converged(&mut self, state: &AnalysisState) {
         self.restore(state);
-    }
-
-    /// Film elements whose tension-field state differs between `a` and `b` (none without
-    /// wrinkling).
-    fn flipping(&self, system: &System, a: &[f64], b: &[f64], out: &mut Vec<usize>) {
-        if system.material.wrinkling == Wrinkling::None {
-            return;
-        }
-        let state = |u: &[f64], e: usize| stress_state(system, &self.start, e, u).state;
-        out.extend((0..system.triangles.len()).filter(|&e| state(a, e) != state(b, e)));
-    }
-
-    /// Elements in compression at `u` for a film without wrinkling: the elastic film's stress,
-    /// or the plastic film's from the increment's start history (a film elongated by plastic
-    /// flow and then unloaded goes into compression while its Green strain is still positive).
-    fn compressed(&self, system: &System, u: &[f64], out: &mut Vec<usize>) {
-        if system.material.wrinkling != Wrinkling::None {
-            return;
-        }
-        out.extend(
-            (0..system.triangles.len())
-                .filter(|&e| stress_state(system, &self.start, e, u).principal[1] < 0.0),
-        );
     }
 
     /// Element stresses and the summaries of the model's element sets.
