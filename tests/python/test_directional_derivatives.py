@@ -241,7 +241,12 @@ def test_model_structure_declares_the_dependencies_the_derivatives_answer(fmu_pa
         film.step(1.0)
         real = [n for n in film.outputs if film.variables[n].type == "Real"]
         statistics = [n for n in real if n.startswith("solver.")]
-        assert statistics == ["solver.residual", "solver.stabilizationEnergy", "solver.stabilizationRatio"]
+        assert statistics == [
+            "solver.residual",
+            "solver.stabilizationEnergy",
+            "solver.stabilizationRatio",
+            "solver.dissipationRatio",
+        ]
         for known in names:
             d = derivative(film, real_outputs(film), known)
             assert np.all(np.isfinite(d)), known

@@ -230,13 +230,13 @@ def test_erection_sequence(tmp_path, fmu_path):
 
 
 def test_discard_is_retried_in_halves(fmu_path, archfmu):
-    """One step to dz = -H/2 in a single increment without cut-backs, at most 15 iterations and
+    """One step to dz = -H/2 in a single increment without cut-backs, at most 10 iterations and
     without the viscous stabilization is refused by the FMU (with it, the FMU converges it);
     ArchFMU.step_to splits it in halves from the last converged point and lands where the
     FMU's own cut-backs land."""
     reference = archfmu.ramp(0.3, 0.2, 1, fmu_path=fmu_path)[-1]["gaps"]
     params = {"archHeight": 0.3, "solver.incrementsPerStep": 1, "solver.maxCutbacks": 0,
-              "solver.maxIterations": 15, "solver.stabilization": False}
+              "solver.maxIterations": 10, "solver.stabilization": False}
     with archfmu.ArchFMU(fmu_path, parameters=params, inputs={"mu": 0.2}) as fmu:
         assert not fmu.step(1.0, {"frame.dz": -0.15})
         assert fmu.time == 0.0 and fmu.reached["frame.dz"] == 0.0
@@ -373,8 +373,8 @@ def test_fig8_plastic_refits_both_films_and_keeps_the_plastic_films_residual_str
     the plastic film's largest von Mises stress is at most the data-sheet curve's flow stress
     at its largest plastic strain (Cauchy ≤ Kirchhoff = flow stress) and below the linear
     film's; released, the linear film is back at the flat start with no residual strain and its
-    slips back under 1 mm, the plastic film stops short of it (slack) with residual strain and
-    more than 1 mm of slip at points 2-5."""
+    slips back under 1 mm, the plastic film (slack once 60-70 % released, carried on by the
+    stabilization) keeps residual strain and more than 1 mm of slip at points 2-5."""
     run_example("fig8_plastic.py", tmp_path, "--heights", "300", "--no-lowered")
     assert_png(tmp_path / "fig8_plastic.png")
     rows = read_csv(tmp_path / "fig8_plastic.csv")
@@ -398,7 +398,7 @@ def test_fig8_plastic_refits_both_films_and_keeps_the_plastic_films_residual_str
     assert float(plastic[1]["von_mises_max_MPa"]) <= flow + 1e-3
     assert float(plastic[1]["von_mises_max_MPa"]) < float(linear[1]["von_mises_max_MPa"])
     assert float(linear[1]["released_to_time"]) == 0.0
-    assert 0.0 < float(plastic[1]["released_to_time"]) < 1.0
+    assert float(plastic[1]["released_to_time"]) < 1.0
     for p in (2, 3, 4, 5):
         assert float(linear[p]["residual_plastic_strain"]) == 0.0
         # Friction leaves the linear film a fraction of a mm on a 4-step path (0.03 mm at 40).

@@ -79,7 +79,7 @@ def test_specimen_variables(fmu_path):
     assert v["archHeight"].start == "0.3" and v["archHeight"].causality == "parameter"
     assert v["G5.status"].type == "Integer" and v["G5.status"].variability == "discrete"
     assert v["solver.useJuRowlands"].type == "Boolean" and v["solver.useJuRowlands"].start == "false"
-    assert v["solver.incrementsPerStep"].start == "10"
+    assert v["solver.incrementsPerStep"].start == "1"
     law = v["frictionLaw"]
     assert (law.type, law.causality, law.start) == ("String", "parameter", "isotropic")
     assert v["film.wrinkling"].type == "Boolean" and v["film.wrinkling"].start == "false"
