@@ -74,7 +74,11 @@ impl Analysis {
     pub fn new(model: Model, settings: SolverSettings) -> Result<Self, SetupError> {
         model.validate().map_err(SetupError::Model)?;
         settings.validate().map_err(SetupError::Settings)?;
-        let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands;
+        // The Ju–Rowlands matrix is symmetric, stored as its lower triangle; without gaps or
+        // curved supports it is the consistent tangent, stored whole (a follower pressure's
+        // load stiffness is unsymmetric).
+        let contacts = !model.gaps.is_empty() || !model.curved_supports.is_empty();
+        let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands && contacts;
         let mut system = System::new(&model, lower_only)?;
         system.set_threads(settings.threads);
         let mut linear = LinearSolver::new(&system, settings.symmetric_factorization)

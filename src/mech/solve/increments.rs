@@ -141,10 +141,27 @@ impl Controller {
         }
     }
 
+    /// Whether an increment that converged in `n` iterations, changing a history or not
+    /// (`dissipative`), is kept: not where it took more than `2 N*`, changed a history and a
+    /// halving is left. Newton's many iterations say the increment left the region where the
+    /// last state predicts the path; where friction or plasticity make the answer depend on
+    /// the path, the backward-Euler increment then may reach another equilibrium than the
+    /// quasi-static one (the edge-cabled suction panel's last lowering step: mid −55.0 mm
+    /// whole, −9.9 mm in ten increments). Without a history the answer is the same however the
+    /// step is cut, and a slow increment stands.
+    fn keeps(&self, n: f64, dissipative: bool) -> bool {
+        n <= 2.0 * Analysis::TARGET_ITERATIONS as f64 || !dissipative || !self.can_halve()
+    }
+
+    /// Whether the next increment can be halved within `max_cutbacks`.
+    fn can_halve(&self) -> bool {
+        self.size / 2.0 >= self.smallest * (1.0 - 1e-9)
+    }
+
     /// After a refused increment: halved, else the next row from the largest size; false where
     /// no row is left.
     fn refused(&mut self, report: &mut StepReport) -> bool {
-        if self.size / 2.0 >= self.smallest * (1.0 - 1e-9) {
+        if self.can_halve() {
             report.cutbacks += 1;
             self.size /= 2.0;
         } else if self.row + 1 < self.rows {
@@ -200,9 +217,14 @@ impl Analysis {
                 .stabilization
                 .set(STRATEGIES[row].damping, to - from);
             let attempt = self.solve_increment(&current, &path.motion(to), &path.levels(to));
-            self.note_attempt(&mut report, row, (from, to), STRATEGIES[row].name, &attempt);
+            let kept = attempt.as_ref().map_or(true, |(state, history)| {
+                let n = self.sizing_iterations(history.len() - 1);
+                control.keeps(n, state.history_changed_from(&current))
+            });
+            let how = (STRATEGIES[row].name, kept);
+            self.note_attempt(&mut report, row, (from, to), how, &attempt);
             match attempt {
-                Ok((state, history)) => {
+                Ok((state, history)) if kept => {
                     let force = self.account_stabilized(&mut report, &state.displacement);
                     last_start = Some(std::mem::replace(&mut current, state));
                     control.converged(to, self.sizing_iterations(history.len() - 1));
@@ -216,6 +238,7 @@ impl Analysis {
                         last,
                     });
                 }
+                Ok(_) => _ = control.refused(&mut report),
                 Err(_) => {}
             }
         }
@@ -254,13 +277,18 @@ impl Analysis {
     /// converged in: the Ju–Rowlands matrix converges linearly by design, so its iterations do
     /// not measure the increment's nonlinearity (`N*` then).
     fn sizing_iterations(&self, n: usize) -> f64 {
-        let linear = self.settings.iteration_matrix == IterationMatrix::JuRowlands
-            && (!self.parts.curved.is_empty() || !self.state.status.is_empty());
-        if linear {
+        if self.converges_linearly() {
             Self::TARGET_ITERATIONS as f64
         } else {
             n.max(1) as f64
         }
+    }
+
+    /// Whether Newton's iterations converge linearly by design: the Ju–Rowlands matrix with
+    /// gaps or curved supports (without them it is the consistent tangent).
+    pub(super) fn converges_linearly(&self) -> bool {
+        self.settings.iteration_matrix == IterationMatrix::JuRowlands
+            && (!self.parts.curved.is_empty() || !self.state.status.is_empty())
     }
 
     /// At the end of a step the stabilization carried: the undamped equilibrium at the step's
@@ -294,7 +322,7 @@ impl Analysis {
             };
             self.parts.stabilization.set(STRATEGIES[row].damping, tau);
             let attempt = self.solve_increment(current, &motion, &levels);
-            self.note_attempt(report, row, (1.0, 1.0), how, &attempt);
+            self.note_attempt(report, row, (1.0, 1.0), (how, true), &attempt);
             let Ok((mut state, history)) = attempt else {
                 if damped {
                     tau /= Self::RELEASE_GROWTH;
@@ -325,7 +353,7 @@ impl Analysis {
         report: &mut StepReport,
         row: usize,
         (from, to): (f64, f64),
-        how: &'static str,
+        (how, kept): (&'static str, bool),
         attempt: &Result<(AnalysisState, Vec<f64>), IncrementFailure>,
     ) {
         let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
@@ -336,7 +364,11 @@ impl Analysis {
             attempt: how,
             iterations,
             residual: outcome.map_or(f64::NAN, |h| h.last().copied().unwrap_or(0.0)),
-            refused: outcome.err().map(IncrementFailure::phrase),
+            refused: match outcome {
+                Err(failure) => Some(failure.phrase()),
+                Ok(_) if !kept => Some("more than 2 N* iterations"),
+                Ok(_) => None,
+            },
             cutbacks: report.cutbacks,
         });
         report.attempts.push(Attempt {
@@ -344,7 +376,7 @@ impl Analysis {
             from,
             to,
             iterations,
-            converged: attempt.is_ok(),
+            converged: attempt.is_ok() && kept,
         });
     }
 

@@ -9,7 +9,7 @@
 //! quadratic: semismooth Newton, Qi & Sun 1993; Alart & Curnier 1991 for contact) and raised
 //! where a step is rejected (Kelley & Keyes 1998). Convergence is judged on the true residual.
 
-use crate::mech::elements::gap::{GapStatus, IterationMatrix};
+use crate::mech::elements::gap::GapStatus;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
@@ -260,7 +260,7 @@ impl Analysis {
             }
             // The Ju–Rowlands matrix converges linearly by design: judged by the limit only.
             if !improved
-                && s.iteration_matrix == IterationMatrix::Consistent
+                && !self.converges_linearly()
                 && iteration >= it.progress.best_at + Self::STALL_PATIENCE
             {
                 return Err(self.failure(&it, record, true));

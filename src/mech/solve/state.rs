@@ -49,6 +49,14 @@ pub struct AnalysisState {
 }
 
 impl AnalysisState {
+    /// Whether a path-dependent history differs from `start`'s: a gap's slip, a curved-support
+    /// contact's (anchor, angle, status) or an element's plastic history.
+    pub fn history_changed_from(&self, start: &AnalysisState) -> bool {
+        self.plastic_slip != start.plastic_slip
+            || self.contacts != start.contacts
+            || self.plastic != start.plastic
+    }
+
     /// Whether every number of the state is finite.
     pub fn is_finite(&self) -> bool {
         self.displacement
