@@ -36,9 +36,12 @@ from membrane_contact.film import FmuError
 
 #: One increment per step (the derivatives are the last increment's: module doc of the core's
 #: sensitivity; the steps checked are small enough not to be cut back), tight Newton
-#: tolerances so that the differences of steps are smooth.
+#: tolerances so that the differences of steps are smooth. The residual's at 1e-11: on the
+#: specimen at mu = 1 Newton's iterates reach corrections of 1e-17 m and then alternate between
+#: residuals of 0.92e-9 and 1.09e-9 N, 1.5e-12 of the force scale (its rounding floor), so
+#: 1e-12 is met by chance or refused as a stall.
 EXACT = {"solver.incrementsPerStep": 1,
-         "solver.displacementTolerance": 1e-12, "solver.residualTolerance": 1e-12}
+         "solver.displacementTolerance": 1e-12, "solver.residualTolerance": 1e-11}
 
 
 def real_outputs(film):
@@ -110,7 +113,9 @@ def test_specimen_derivatives_agree_with_steps_with_gaps_open_sticking_and_slipp
     with Film(fmu_path, logging=True, quiet=True) as film:
         # mu = 1: the crown gaps G1..G3 stick, G4 slips, G5..G9 are open.
         end = lowered_specimen(film, 1.0)
-        d = check_against_steps(film, {}, end, "frame.dz", 1e-5)
+        # delta: central differences converge as delta² (G4.frictionY, slipping: 1.1e-6 off at
+        # 1e-5, 1e-7 at 3e-6, measured), and the residual's floor adds 1e-9 N / delta.
+        d = check_against_steps(film, {}, end, "frame.dz", 3e-6)
         statuses = statuses_after(film, end)
         assert set(statuses) == {0, 1, 2}, statuses
         assert d["frame.Rz"] > 0 and d["G1.normalForce"] != 0 and d["G9.normalForce"] == 0

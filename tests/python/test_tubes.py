@@ -264,8 +264,9 @@ def test_feet_report_no_slip_before_they_touch_unlike_gaps(tube_model, mesh_file
     for v in s_nodes:
         slip, travel, _, status = c[("archS", v)]
         row = contact_rows[str(v)]
-        assert row[6] == status and float(row[1]) == pytest.approx(slip, abs=5e-4)
-        assert float(row[2]) == pytest.approx(travel, abs=5e-4)
+        # half a unit of the table's third decimal and of the report's fourth (31.6605 and 31.661)
+        assert row[6] == status and float(row[1]) == pytest.approx(slip, abs=5.5e-4)
+        assert float(row[2]) == pytest.approx(travel, abs=5.5e-4)
 
 
 def report_rows(path, heading: str) -> dict:
