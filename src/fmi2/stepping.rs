@@ -35,6 +35,51 @@ const SETTING_NAMES: SettingNames = SettingNames {
 impl Instance {
     /// `fmi2DoStep`: moves every group to its inputs over `[t, t + h]`.
     pub fn do_step(&mut self, t: f64, h: f64) -> Outcome {
+        self.check_step_times(t, h)?;
+        let StepInputs {
+            targets,
+            angles,
+            mut loads,
+            mu,
+            sealed,
+        } = step_inputs(
+            &self.description.model,
+            &self.description.variables,
+            &self.values,
+            self.mu_set,
+        );
+        let built = self
+            .analysis
+            .as_mut()
+            .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
+        // Gravity is a parameter: the built model holds it, and the first step ramps it in.
+        loads.gravity = built.analysis.model().loads.gravity;
+        // Air fed into sealed chambers (`<chamber>.massFlow`, issue 43): its running total.
+        let (table, values) = (&self.description.variables, &self.values);
+        match super::variables::supplied_air(&built.analysis, table, values, &sealed, h) {
+            Ok(air) => loads.air = air,
+            Err(e) => {
+                self.phase = Phase::StepFailed;
+                return Err(Failure::discard(e));
+            }
+        }
+        // μ and the chambers' valves change the state before the step; a refused step goes back.
+        let before = change_state_for_step(&mut built.analysis, mu, &sealed)?;
+        match checked_step(built, &targets, &angles, &loads, &self.logger) {
+            Ok(report) => self.step_converged(t + h, &report),
+            Err(e) => {
+                if let Some(before) = before {
+                    built.analysis.set_state(before).map_err(Failure::error)?;
+                    built.step_increments = 0;
+                }
+                Err(self.step_refused(t, h, e))
+            }
+        }
+    }
+
+    /// The communication point `t` and step size `h` of `fmi2DoStep` against the FMU's time
+    /// and stop time.
+    fn check_step_times(&self, t: f64, h: f64) -> Outcome {
         if !(t.is_finite() && h.is_finite()) {
             return Err(Failure::error(format!(
                 "currentCommunicationPoint = {} and step size = {} must be finite",
@@ -74,97 +119,70 @@ impl Instance {
                 t + h
             )));
         }
-        let StepInputs {
-            targets,
-            angles,
-            mut loads,
-            mu,
-            sealed,
-        } = step_inputs(
-            &self.description.model,
-            &self.description.variables,
-            &self.values,
-            self.mu_set,
-        );
-        let built = self
-            .analysis
-            .as_mut()
-            .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
-        // Gravity is a parameter: the built model holds it, and the first step ramps it in.
-        loads.gravity = built.analysis.model().loads.gravity;
-        // Air fed into sealed chambers (`<chamber>.massFlow`, issue 43): its running total.
-        let (table, values) = (&self.description.variables, &self.values);
-        match super::variables::supplied_air(&built.analysis, table, values, &sealed, h) {
-            Ok(air) => loads.air = air,
-            Err(e) => {
-                self.phase = Phase::StepFailed;
-                return Err(Failure::discard(e));
-            }
+        Ok(())
+    }
+
+    /// After a converged step to `time`: the time, phase, outputs, log line, results files and
+    /// warnings.
+    fn step_converged(&mut self, time: f64, report: &StepReport) -> Outcome {
+        if let Some(b) = self.analysis.as_mut() {
+            b.step_increments = report.iterations.len();
         }
-        // μ and the chambers' valves change the state before the step; a refused step goes back.
-        let before = change_state_for_step(&mut built.analysis, mu, &sealed)?;
-        match checked_step(built, &targets, &angles, &loads, &self.logger) {
-            Ok(report) => {
-                if let Some(b) = self.analysis.as_mut() {
-                    b.step_increments = report.iterations.len();
-                }
-                self.time = t + h;
-                self.phase = Phase::StepComplete;
-                self.discarded = None;
-                self.refresh_outputs(Some(&report))?;
-                self.event(|| {
-                    format!(
-                        "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N{}",
-                        self.time,
-                        report.iterations.len(),
-                        report.total_iterations(),
-                        report.cutbacks,
-                        report.residual,
-                        report.attempts()
-                    )
+        self.time = time;
+        self.phase = Phase::StepComplete;
+        self.discarded = None;
+        self.refresh_outputs(Some(report))?;
+        self.event(|| {
+            format!(
+                "step to t = {}: {} increments, {} Newton iterations, {} cut-backs, residual {:.3e} N{}",
+                self.time,
+                report.iterations.len(),
+                report.total_iterations(),
+                report.cutbacks,
+                report.residual,
+                report.attempts()
+            )
+        });
+        self.steps += 1;
+        let written = self.write_results();
+        self.warn_about_assumptions(written)
+    }
+
+    /// The failure of a step from `t` over `h` that the solver refused with `e` (the state
+    /// already restored): fmi2Discard for a step that did not converge, noting it so that the
+    /// identical step asked again terminates; fmi2Error for invalid inputs.
+    fn step_refused(&mut self, t: f64, h: f64, e: StepError) -> Failure {
+        self.phase = Phase::StepFailed;
+        let message = format!(
+            "step from t = {t} to {}: {}",
+            t + h,
+            e.message(&SETTING_NAMES)
+        );
+        match e {
+            StepError::NotConverged { .. } => {
+                let inputs = self.input_values();
+                let repeated = self
+                    .discarded
+                    .as_ref()
+                    .is_some_and(|d| d.time == self.time && d.inputs == inputs);
+                self.discarded = Some(RefusedStep {
+                    time: self.time,
+                    inputs,
+                    repeated,
                 });
-                self.steps += 1;
-                let written = self.write_results();
-                self.warn_about_assumptions(written)
-            }
-            Err(e) => {
-                if let Some(before) = before {
-                    built.analysis.set_state(before).map_err(Failure::error)?;
-                    built.step_increments = 0;
-                }
-                self.phase = Phase::StepFailed;
-                let message = format!(
-                    "step from t = {t} to {}: {}",
-                    t + h,
-                    e.message(&SETTING_NAMES)
-                );
-                Err(match e {
-                    StepError::NotConverged { .. } => {
-                        let inputs = self.input_values();
-                        let repeated = self
-                            .discarded
-                            .as_ref()
-                            .is_some_and(|d| d.time == self.time && d.inputs == inputs);
-                        self.discarded = Some(RefusedStep {
-                            time: self.time,
-                            inputs,
-                            repeated,
-                        });
-                        Failure::discard(if repeated {
-                            format!(
-                                "{message}. The identical step was refused before: fmi2GetBooleanStatus(fmi2Terminated) \
-                                 is now true. Time stays {t}; only a smaller change of the inputs can succeed"
-                            )
-                        } else {
-                            format!(
-                                "{message}. Time stays {t}: set a smaller change of the inputs and call fmi2DoStep again \
-                                 (asking the identical step again makes fmi2GetBooleanStatus(fmi2Terminated) true)"
-                            )
-                        })
-                    }
-                    StepError::InvalidInput { .. } => Failure::error(message),
+                Failure::discard(if repeated {
+                    format!(
+                        "{message}. The identical step was refused before: fmi2GetBooleanStatus(fmi2Terminated) \
+                         is now true. Time stays {t}; only a smaller change of the inputs can succeed"
+                    )
+                } else {
+                    format!(
+                        "{message}. Time stays {t}: set a smaller change of the inputs and call fmi2DoStep again \
+                         (asking the identical step again makes fmi2GetBooleanStatus(fmi2Terminated) true)"
+                    )
                 })
             }
+            StepError::InvalidInput { .. } => Failure::error(message),
         }
     }
 
