@@ -23,3 +23,6 @@ pub mod terminals;
 use crate::fmi2::instance::Instance;
 
 fmi_glue::export_fmi3!(Instance);
+
+#[cfg(test)]
+mod tests;
