@@ -1,10 +1,12 @@
 //! The instance as the shared glue's [`Core`]: what the FMI 3.0 C layer (`src/fmi3`, exported
 //! by `fmi_glue::export_fmi3!`) calls. Each method forwards to the instance's own, the one the
-//! FMI 2.0 functions call, so both versions drive the same code.
+//! FMI 2.0 functions call, so both versions drive the same code; the FMI 3.0 directional
+//! derivative is made of the 2.0 one's columns (one per known, [`Columns`]), so that the
+//! adjoint is its exact transpose.
 
 use std::path::Path;
 
-use fmi_glue::core::{Core, Instantiation};
+use fmi_glue::core::{Columns, Core, Instantiation};
 
 use super::instance::Instance;
 use super::logger::Logger;
@@ -172,7 +174,11 @@ impl Core for Instance {
         seed: &[f64],
         out: &mut [f64],
     ) -> Outcome {
-        Instance::directional_derivative(self, unknowns, knowns, seed, out)
+        // J's columns, the ones the adjoint contracts (the glue's `Core::adjoint_derivative`):
+        // `J s` is then linear in the seed to the last bit and `fmi3GetAdjointDerivative` its
+        // exact transpose; one linear response per known, each from the held factor.
+        let columns = Columns::of(self, unknowns, knowns, Instance::directional_derivative)?;
+        columns.apply((knowns, seed), unknowns, false, out)
     }
 }
 
