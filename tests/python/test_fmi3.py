@@ -258,9 +258,9 @@ def test_the_fmi3_shape_example_plots_the_film_lowered_by_the_frame(specimen3, t
 
 def test_fmi3_adjoint_is_the_transpose_of_the_film_jacobian_and_of_its_directional_derivatives(specimen3):
     """Jᵀv from fmi3GetAdjointDerivative against J s from fmi3GetDirectionalDerivative: their
-    columns agree to the last bit; with one combined seed, vᵀ(J s) = (Jᵀ v)ᵀ s holds to 1e-7
-    only (measured 5e-10 to 7e-9): the film's derivative is a five-point difference of the
-    results along the linear response, not exactly linear in the seed (docs/fmu.md)."""
+    columns agree to the last bit, and with one combined seed vᵀ(J s) = (Jᵀ v)ᵀ s holds to
+    1e-12: both are made of J's columns (docs/fmu.md; it held to 5e-10 … 7e-9 only while J s
+    was one response to the combined seed)."""
     f = Film3(specimen3)
     for k in range(3):
         f.step(-0.01 * (k + 1))
@@ -274,7 +274,8 @@ def test_fmi3_adjoint_is_the_transpose_of_the_film_jacobian_and_of_its_direction
     assert np.array_equal(jtv, v @ columns)
     assert (np.abs(columns).max(axis=0) > 0).all() and (np.abs(columns).max(axis=1) > 0).all()
     js = np.array(f.fmu.getDirectionalDerivative(unknowns, knowns, list(s)))
-    assert v @ js == pytest.approx(jtv @ s, rel=1e-7, abs=0.0)
+    assert v @ js == pytest.approx(jtv @ s, rel=1e-12, abs=0.0)
+    assert np.allclose(js, columns @ s, rtol=1e-14, atol=0.0)
     with pytest.raises(FMICallException):  # the default sensitivity size (one per unknown)
         f.fmu.getAdjointDerivative(unknowns, knowns, list(v))
     f.close()
