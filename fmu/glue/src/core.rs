@@ -105,6 +105,36 @@ pub trait Core: Sized {
     fn terminate_requested(&self) -> bool {
         false
     }
+    /// `fmi2GetStatus` of `kind` (`fmi2StatusKind`); by default not supported.
+    fn get_status(&self, _kind: i32) -> Outcome<Status> {
+        Err(not_supported("fmi2GetStatus"))
+    }
+    /// `fmi2GetRealStatus`: by default `fmi2LastSuccessfulTime` (2), `Discard` for another kind.
+    fn get_real_status(&self, kind: i32) -> Outcome<f64> {
+        match kind {
+            2 => Ok(self.last_successful_time()),
+            _ => Err(Failure::discard(format!(
+                "status kind {kind}: no Real status"
+            ))),
+        }
+    }
+    /// `fmi2GetIntegerStatus`; by default not supported.
+    fn get_integer_status(&self, _kind: i32) -> Outcome<i32> {
+        Err(not_supported("fmi2GetIntegerStatus"))
+    }
+    /// `fmi2GetBooleanStatus`: by default `fmi2Terminated` (3), `Discard` for another kind.
+    fn get_boolean_status(&self, kind: i32) -> Outcome<bool> {
+        match kind {
+            3 => Ok(self.terminate_requested()),
+            _ => Err(Failure::discard(format!(
+                "status kind {kind}: no Boolean status"
+            ))),
+        }
+    }
+    /// `fmi2GetStringStatus` (nothing is written); by default not supported.
+    fn get_string_status(&self, _kind: i32) -> Outcome {
+        Err(not_supported("fmi2GetStringStatus"))
+    }
     /// `GetFMUstate` into the state `handle` (0: a new one); the handle of the saved state.
     fn get_fmu_state(&mut self, _handle: usize) -> Outcome<usize> {
         Err(not_supported("FMU states"))
@@ -135,6 +165,17 @@ pub trait Core: Sized {
         _out: &mut [f64],
     ) -> Outcome {
         Err(not_supported("directional derivatives"))
+    }
+    /// `fmi2GetDirectionalDerivative`: by default [`Core::directional_derivative`], which the
+    /// FMI 3.0 function calls (an FMU whose two versions answer differently overrides this).
+    fn directional_derivative_fmi2(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome {
+        self.directional_derivative(unknowns, knowns, seed, out)
     }
     /// `GetAdjointDerivative`: `out = Jᵀ seed` (a seed per unknown, a value per known), J as
     /// [`Core::directional_derivative`] gives it. By default J's [`Columns`], one directional

@@ -44,9 +44,9 @@ pub unsafe fn instantiate<C: Core>(
     // SAFETY: NULL or NUL-terminated strings valid for this call (contract).
     let (name, token, resources) = unsafe { (string(name), string(token), string(resources)) };
     instantiate_with::<C>("fmi3InstantiateCoSimulation", &sink.clone(), || {
-        let name = name.map_err(|f| f.message)?.unwrap_or_default();
+        let name = name.map_err(|f| f.message)?.ok_or("instanceName is NULL")?;
         if name.trim().is_empty() {
-            return Err("the instance name is NULL or empty".into());
+            return Err("instanceName is empty".into());
         }
         if event_mode_used != 0 {
             return Err(
