@@ -511,24 +511,24 @@ macro_rules! export_fmi2 {
                 "fmi2SetupExperiment" setup_experiment(c: *mut c_void, _td: c_int, _tol: f64, start: f64, sd: c_int, stop: f64) -> c_int
                     = g::setup_experiment::<C>(c, start, sd, stop);
                 "fmi2EnterInitializationMode" enter_initialization_mode(c: *mut c_void) -> c_int
-                    = g::transition::<C>(c, "fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION, C::enter_initialization_mode);
+                    = g::transition::<C>(c, "fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION, <C as Core>::enter_initialization_mode);
                 "fmi2ExitInitializationMode" exit_initialization_mode(c: *mut c_void) -> c_int
-                    = g::transition::<C>(c, "fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION, C::exit_initialization_mode);
+                    = g::transition::<C>(c, "fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION, <C as Core>::exit_initialization_mode);
                 "fmi2Terminate" terminate(c: *mut c_void) -> c_int
-                    = g::transition::<C>(c, "fmi2Terminate", allowed::TERMINATE, C::terminate);
-                "fmi2Reset" reset(c: *mut c_void) -> c_int = g::transition::<C>(c, "fmi2Reset", allowed::RESET, C::reset);
+                    = g::transition::<C>(c, "fmi2Terminate", allowed::TERMINATE, <C as Core>::terminate);
+                "fmi2Reset" reset(c: *mut c_void) -> c_int = g::transition::<C>(c, "fmi2Reset", allowed::RESET, <C as Core>::reset);
                 "fmi2GetReal" get_real(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut f64) -> c_int
-                    = g::get::<C, f64>(c, "fmi2GetReal", vr, n, v, C::get_real);
+                    = g::get::<C, f64>(c, "fmi2GetReal", vr, n, v, <C as Core>::get_real);
                 "fmi2GetInteger" get_integer(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut c_int) -> c_int
-                    = g::get::<C, i32>(c, "fmi2GetInteger", vr, n, v, C::get_integer);
+                    = g::get::<C, i32>(c, "fmi2GetInteger", vr, n, v, <C as Core>::get_integer);
                 "fmi2GetBoolean" get_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut c_int) -> c_int
                     = g::get_boolean::<C>(c, vr, n, v);
                 "fmi2GetString" get_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut *const c_char) -> c_int
-                    = g::get::<C, *const c_char>(c, "fmi2GetString", vr, n, v, C::get_string);
+                    = g::get::<C, *const c_char>(c, "fmi2GetString", vr, n, v, <C as Core>::get_string);
                 "fmi2SetReal" set_real(c: *mut c_void, vr: *const c_uint, n: usize, v: *const f64) -> c_int
-                    = g::set::<C, f64>(c, "fmi2SetReal", vr, n, v, C::set_real);
+                    = g::set::<C, f64>(c, "fmi2SetReal", vr, n, v, <C as Core>::set_real);
                 "fmi2SetInteger" set_integer(c: *mut c_void, vr: *const c_uint, n: usize, v: *const c_int) -> c_int
-                    = g::set::<C, i32>(c, "fmi2SetInteger", vr, n, v, C::set_integer);
+                    = g::set::<C, i32>(c, "fmi2SetInteger", vr, n, v, <C as Core>::set_integer);
                 "fmi2SetBoolean" set_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *const c_int) -> c_int
                     = g::set_boolean::<C>(c, vr, n, v);
                 "fmi2SetString" set_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *const *const c_char) -> c_int
@@ -547,13 +547,13 @@ macro_rules! export_fmi2 {
                 "fmi2DoStep" do_step(c: *mut c_void, t: f64, h: f64, _no_prior: c_int) -> c_int = g::do_step::<C>(c, t, h);
                 "fmi2CancelStep" cancel_step(c: *mut c_void) -> c_int = g::cancel_step::<C>(c);
                 "fmi2GetStatus" get_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int
-                    = g::status::<C, _, _>(c, "fmi2GetStatus", (k, v), C::get_status, |s| s.raw());
+                    = g::status::<C, _, _>(c, "fmi2GetStatus", (k, v), <C as Core>::get_status, |s| s.raw());
                 "fmi2GetRealStatus" get_real_status(c: *mut c_void, k: c_int, v: *mut f64) -> c_int
-                    = g::status::<C, _, _>(c, "fmi2GetRealStatus", (k, v), C::get_real_status, |x| x);
+                    = g::status::<C, _, _>(c, "fmi2GetRealStatus", (k, v), <C as Core>::get_real_status, |x| x);
                 "fmi2GetIntegerStatus" get_integer_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int
-                    = g::status::<C, _, _>(c, "fmi2GetIntegerStatus", (k, v), C::get_integer_status, |x| x);
+                    = g::status::<C, _, _>(c, "fmi2GetIntegerStatus", (k, v), <C as Core>::get_integer_status, |x| x);
                 "fmi2GetBooleanStatus" get_boolean_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int
-                    = g::status::<C, _, _>(c, "fmi2GetBooleanStatus", (k, v), C::get_boolean_status, c_int::from);
+                    = g::status::<C, _, _>(c, "fmi2GetBooleanStatus", (k, v), <C as Core>::get_boolean_status, c_int::from);
                 "fmi2GetStringStatus" get_string_status(c: *mut c_void, k: c_int, _v: *mut *const c_char) -> c_int
                     = g::get_string_status::<C>(c, k);
             );
