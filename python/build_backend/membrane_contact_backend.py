@@ -8,8 +8,9 @@ target is reused, not rebuilt) and staged as wheel data, ``lib/membrane-contact/
 it to ``PREFIX/lib/membrane-contact/libmembrane_contact.so`` beside ``PREFIX/bin/fmu-pack``, where
 fmu-pack looks for it. The hydraulic jack of the coupled erection system (``fmu/jack``, a small
 crate of the workspace) is built the same way and staged beside it with its model description
-(``libhydraulic_jack.so``, ``hydraulic_jack.xml``), so that the installed
-``membrane_contact.ssp.pack_jack_fmu`` packs ``HydraulicJack.fmu`` without a Rust toolchain.
+(``libhydraulic_jack.so``, ``hydraulic_jack.xml``, ``hydraulic_jack3.xml``: FMI 2.0 and 3.0),
+so that the installed ``membrane_contact.ssp.pack_jack_fmu`` packs ``HydraulicJack.fmu`` (and
+``HydraulicJack_fmi3.fmu``) without a Rust toolchain.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ LIBRARY = "libmembrane_contact.so"
 #: The jack's package, library and model description as staged (keep in step with
 #: membrane_contact/ssp.py: INSTALLED_JACK_LIBRARY, INSTALLED_JACK_DESCRIPTION).
 JACK_PACKAGE, JACK_LIBRARY, JACK_DESCRIPTION = "hydraulic-jack-fmu", "libhydraulic_jack.so", "hydraulic_jack.xml"
+JACK_DESCRIPTION3 = "hydraulic_jack3.xml"  # its FMI 3.0 description (INSTALLED_JACK_DESCRIPTION3)
 #: Wheel data → PREFIX/lib/membrane-contact (keep in step with INSTALLED_LIBRARY_DIR in fmu/pack.rs).
 STAGED = PYTHON / "membrane_contact.data" / "data" / "lib" / "membrane-contact"
 
@@ -74,6 +76,7 @@ def stage_library() -> Path:
     staged = _stage(_build_cdylib(cargo, "membrane-contact", LIBRARY), LIBRARY, 0o755)
     _stage(_build_cdylib(cargo, JACK_PACKAGE, JACK_LIBRARY), JACK_LIBRARY, 0o755)
     _stage(ROOT / "fmu" / "jack" / "modelDescription.xml", JACK_DESCRIPTION, 0o644)
+    _stage(ROOT / "fmu" / "jack" / "modelDescription3.xml", JACK_DESCRIPTION3, 0o644)
     return staged
 
 

@@ -4,7 +4,8 @@ in one ``.ssp`` file that fmpy and libcosim run as it is.
 
 * :func:`pack_jack_fmu` packs ``HydraulicJack.fmu`` from the jack's library
   (``target/release/libhydraulic_jack.so``, built by ``cargo build --release``) and its
-  ``fmu/jack/modelDescription.xml``; installed from the wheel, from the copies the wheel ships
+  ``fmu/jack/modelDescription.xml`` (``fmi_version=3``: ``HydraulicJack_fmi3.fmu`` with
+  ``modelDescription3.xml``); installed from the wheel, from the copies the wheel ships
   (``PREFIX/lib/membrane-contact/``), no Rust toolchain needed;
 * :func:`write_ssp` writes ``SystemStructure.ssd`` and both FMUs (``resources/``) into the
   archive: the connections ``jack.dz → film.<group>.dz`` and ``film.<group>.Rz → jack.force``
@@ -49,18 +50,20 @@ SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
 
 
-#: The jack's library and model description as the wheel installs them (in
+#: The jack's library and model descriptions (FMI 2.0, FMI 3.0) as the wheel installs them (in
 #: ``PREFIX/lib/membrane-contact``; python/build_backend stages them).
 INSTALLED_JACK_LIBRARY, INSTALLED_JACK_DESCRIPTION = f"lib{JACK_IDENTIFIER}.so", "hydraulic_jack.xml"
+INSTALLED_JACK_DESCRIPTION3 = "hydraulic_jack3.xml"
 
 
-def _installed_jack() -> tuple[Path, Path] | None:
-    """The wheel's jack library and model description when this package is installed (not a
-    checkout's ``python/``, no ``$MEMBRANE_CONTACT_ROOT``), else None."""
+def _installed_jack(fmi_version: int = 2) -> tuple[Path, Path] | None:
+    """The wheel's jack library and model description of ``fmi_version`` when this package is
+    installed (not a checkout's ``python/``, no ``$MEMBRANE_CONTACT_ROOT``), else None."""
     if _own_checkout() is not None or os.environ.get(ROOT_VARIABLE):
         return None
     lib = installed_file(INSTALLED_JACK_LIBRARY, "membrane-contact")
-    md = installed_file(INSTALLED_JACK_DESCRIPTION, "membrane-contact")
+    name = INSTALLED_JACK_DESCRIPTION if fmi_version == 2 else INSTALLED_JACK_DESCRIPTION3
+    md = installed_file(name, "membrane-contact")
     return (lib, md) if lib is not None and md is not None else None
 
 
@@ -101,14 +104,24 @@ CROSS_PLATFORMS = {
 }
 
 
-def pack_jack_fmu(out=None, library=None, root=None, platforms=()) -> Path:
-    """Packs ``HydraulicJack.fmu`` (``out``: a file name ending in ``.fmu`` or a directory;
-    default the repository's ``target/fmu``, installed the current directory) from ``library``
-    (default :func:`jack_library`) and the model description (the repository's
-    ``fmu/jack/modelDescription.xml``, or installed from the wheel, its copy). Returns its path.
-    ``platforms``: further binaries (folders of :data:`CROSS_PLATFORMS`), each the repository's
-    cross build ``target/<triple>/release/<file>``."""
-    installed = _installed_jack() if root is None else None
+#: The FMI 3.0 folders under ``binaries/`` of the platforms of :data:`CROSS_PLATFORMS` (FMI 3.0
+#: §2.5.1.4 names them by architecture and operating system), and of the host.
+FMI3_FOLDERS = {"linux64": "x86_64-linux", "win64": "x86_64-windows", "aarch64-linux": "aarch64-linux",
+                "darwin64": "x86_64-darwin", "aarch64-darwin": "aarch64-darwin"}
+
+
+def pack_jack_fmu(out=None, library=None, root=None, platforms=(), fmi_version: int = 2) -> Path:
+    """Packs ``HydraulicJack.fmu`` (``fmi_version=3``: ``HydraulicJack_fmi3.fmu``, FMI 3.0, the
+    same library under ``binaries/x86_64-linux/``) into ``out`` (a file name ending in ``.fmu``
+    or a directory; default the repository's ``target/fmu``, installed the current directory)
+    from ``library`` (default :func:`jack_library`) and the model description (the repository's
+    ``fmu/jack/modelDescription.xml``, 3.0: ``modelDescription3.xml``, both generated from the
+    jack's table; installed from the wheel, their copies). Returns its path. ``platforms``:
+    further binaries (folders of :data:`CROSS_PLATFORMS`, or for 3.0 their
+    :data:`FMI3_FOLDERS`), each the repository's cross build ``target/<triple>/release/<file>``."""
+    if fmi_version not in (2, 3):
+        raise ValueError(f"fmi_version {fmi_version}: 2 or 3")
+    installed = _installed_jack(fmi_version) if root is None else None
     if installed is not None:
         description = installed[1]
         library = Path(library) if library is not None else installed[0]
@@ -118,24 +131,32 @@ def pack_jack_fmu(out=None, library=None, root=None, platforms=()) -> Path:
         if root is None:
             raise RuntimeError("the jack FMU is packed from the repository (fmu/jack) or installed with the "
                                "membrane-contact wheel: neither found")
-        description = root / "fmu" / "jack" / "modelDescription.xml"
+        description = root / "fmu" / "jack" / ("modelDescription.xml" if fmi_version == 2 else "modelDescription3.xml")
         library = Path(library) if library is not None else jack_library(root)
         out = Path(out) if out is not None else root / "target" / "fmu"
     if out.suffix != ".fmu":
-        out = out / "HydraulicJack.fmu"
+        out = out / ("HydraulicJack.fmu" if fmi_version == 2 else "HydraulicJack_fmi3.fmu")
+    host = "linux64" if fmi_version == 2 else FMI3_FOLDERS["linux64"]
+    # Each further platform by the key of CROSS_PLATFORMS (3.0 also takes its 3.0 folder name).
+    keys = {f: f for f in CROSS_PLATFORMS}
+    if fmi_version == 3:
+        keys.update({FMI3_FOLDERS[f]: f for f in CROSS_PLATFORMS})
+    cross = [keys.get(f, f) for f in platforms if f not in ("linux64", host)]
+    for key in cross:
+        if key not in CROSS_PLATFORMS:
+            raise ValueError(f"unknown platform {key!r} (known: {host}, {', '.join(keys)})")
     out.parent.mkdir(parents=True, exist_ok=True)
     with zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as z:
         z.write(description, "modelDescription.xml")
-        z.write(library, f"binaries/linux64/{JACK_IDENTIFIER}.so")
-        for folder in (f for f in platforms if f != "linux64"):
-            if folder not in CROSS_PLATFORMS:
-                raise ValueError(f"unknown platform {folder!r} (known: linux64, {', '.join(CROSS_PLATFORMS)})")
-            triple, name, extension = CROSS_PLATFORMS[folder]
-            cross = (root or repository_root() or Path.cwd()) / "target" / triple / "release" / name
-            if not cross.is_file():
-                raise RuntimeError(f"no {cross}: run `cargo build --release --lib -p hydraulic-jack-fmu "
+        z.write(library, f"binaries/{host}/{JACK_IDENTIFIER}.so")
+        for key in cross:
+            triple, name, extension = CROSS_PLATFORMS[key]
+            built = (root or repository_root() or Path.cwd()) / "target" / triple / "release" / name
+            if not built.is_file():
+                raise RuntimeError(f"no {built}: run `cargo build --release --lib -p hydraulic-jack-fmu "
                                    f"--target {triple}` first (tests/platforms.sh does)")
-            z.write(cross, f"binaries/{folder}/{JACK_IDENTIFIER}.{extension}")
+            folder = key if fmi_version == 2 else FMI3_FOLDERS[key]
+            z.write(built, f"binaries/{folder}/{JACK_IDENTIFIER}.{extension}")
     return out
 
 

@@ -1,10 +1,12 @@
-//! The instance as the shared glue's [`Core`]: what the FMI 3.0 C layer (`src/fmi3`, exported
-//! by `fmi_glue::export_fmi3!`) calls. Each method forwards to the instance's own, the one the
-//! FMI 2.0 functions call, so both versions drive the same code.
+//! The instance as the shared glue's [`Core`]: what its FMI 2.0 and FMI 3.0 C layers
+//! (`fmi_glue::export_fmi2!` in `exports.rs`, `fmi_glue::export_fmi3!` in `src/fmi3`) call.
+//! Each method forwards to the instance's own, so both versions drive the same code; the FMI 3.0 directional
+//! derivative is made of the 2.0 one's columns (one per known, [`Columns`]), so that the
+//! adjoint is its exact transpose.
 
 use std::path::Path;
 
-use fmi_glue::core::{Core, Instantiation};
+use fmi_glue::core::{Columns, Core, Instantiation};
 
 use super::instance::Instance;
 use super::logger::Logger;
@@ -145,6 +147,26 @@ impl Core for Instance {
         self.get_boolean_status(FMI2_TERMINATED).unwrap_or(false)
     }
 
+    fn get_status(&self, kind: i32) -> Outcome<Status> {
+        Instance::get_status(self, kind)
+    }
+
+    fn get_real_status(&self, kind: i32) -> Outcome<f64> {
+        Instance::get_real_status(self, kind)
+    }
+
+    fn get_integer_status(&self, kind: i32) -> Outcome<i32> {
+        Instance::get_integer_status(self, kind)
+    }
+
+    fn get_boolean_status(&self, kind: i32) -> Outcome<bool> {
+        Instance::get_boolean_status(self, kind)
+    }
+
+    fn get_string_status(&self, kind: i32) -> Outcome {
+        Instance::get_string_status(self, kind)
+    }
+
     fn get_fmu_state(&mut self, handle: usize) -> Outcome<usize> {
         Instance::get_fmu_state(self, handle)
     }
@@ -165,7 +187,8 @@ impl Core for Instance {
         Instance::deserialize_fmu_state(self, bytes, handle)
     }
 
-    fn directional_derivative(
+    /// FMI 2.0: one linear response to the combined seed, as before the FMI 3.0 columns.
+    fn directional_derivative_fmi2(
         &mut self,
         unknowns: &[u32],
         knowns: &[u32],
@@ -173,6 +196,20 @@ impl Core for Instance {
         out: &mut [f64],
     ) -> Outcome {
         Instance::directional_derivative(self, unknowns, knowns, seed, out)
+    }
+
+    fn directional_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome {
+        // J's columns, the ones the adjoint contracts (the glue's `Core::adjoint_derivative`):
+        // `J s` is then linear in the seed to the last bit and `fmi3GetAdjointDerivative` its
+        // exact transpose; one linear response per known, each from the held factor.
+        let columns = Columns::of(self, unknowns, knowns, Instance::directional_derivative)?;
+        columns.apply((knowns, seed), unknowns, false, out)
     }
 }
 

@@ -1,18 +1,19 @@
-//! The FMI 2.0 Co-Simulation glue: the only module with `unsafe`.
+//! The FMI 2.0 Co-Simulation glue: the instance behind the shared glue's C layers (`fmu/glue`,
+//! where the `unsafe` code is; here only what its macros write and the tests' calls).
 //!
 //! Call chain of every entry point:
 //!
 //! ```text
-//! importer ── fmi2DoStep(c, t, h, …)              exports.rs   #[unsafe(export_name)] extern "C", one line
-//!          └─ guard::with_instance(c, mask, …)    guard.rs     NULL/phase checks, catch_unwind, log, status
-//!             └─ Instance::do_step(t, h)          stepping.rs  safe: one file per duty of the instance
+//! importer ── fmi2DoStep(c, t, h, …)              exports.rs   fmi_glue::export_fmi2!(Instance): the glue's C layer
+//!          └─ fmi_glue::fmi2::with(c, mask, …)    fmu/glue     NULL/phase checks, catch_unwind, log, status
+//!             └─ Core::do_step → Instance::do_step core.rs, stepping.rs  safe: one file per duty
 //!                └─ mech::Analysis::step_to(…)    the mechanics core (knows nothing of FMI)
 //! ```
 //!
 //! | module | what |
 //! |---|---|
 //! | [`types`] | the FMI 2.0 C types, written from the standard headers |
-//! | [`guard`] | every raw pointer, `Box::into_raw`/`from_raw`, the panic barrier |
+//! | [`guard`] | the glue's barrier (`with_instance`), freeing and array helpers, re-exported |
 //! | [`logger`] | the variadic C logger, called with `"%s"`; log categories |
 //! | [`variables`] | the variable table, derived from the model: the one source of the interface |
 //! | [`scalar_variable`] | one variable: type, causality, variability, value, binding, value check |
@@ -28,7 +29,8 @@
 //! | `derivatives` | `fmi2GetDirectionalDerivative` from the core's linear response |
 //! | `fmu_states` | the instance's saved FMU states: get, set, free, (de)serialize |
 //! | [`state`] | one FMU state: the snapshot, its serialized byte format and its checks |
-//! | [`exports`] | the 44 exported `fmi2*` functions (25 common, 9 CS, 10 ME error stubs) |
+//! | [`exports`] | the 44 exported `fmi2*` functions (25 common, 9 CS, 10 ME error stubs): `fmi_glue::export_fmi2!` |
+//! | `core` | the instance as the glue's `Core`: what both C layers call |
 //! | `tests/` | tests through the exported functions, as an importer calls them, one file per duty |
 //! | `wiring_tests` | every FMU parameter and input against the core, from the variable table |
 //!

@@ -44,17 +44,8 @@ pub const FMI2_TERMINATED: c_int = 3;
 pub use fmi_glue::Status;
 
 /// `fmi2CallbackLogger`: variadic, printf semantics. Always called with `"%s"` and a
-/// pre-formatted message (see `logger.rs`).
-pub type Fmi2CallbackLogger = Option<
-    unsafe extern "C" fn(
-        component_environment: Fmi2ComponentEnvironment,
-        instance_name: Fmi2String,
-        status: Fmi2Status,
-        category: Fmi2String,
-        message: Fmi2String,
-        ...
-    ),
->;
+/// pre-formatted message (see `logger.rs`); the shared glue's type.
+pub type Fmi2CallbackLogger = Option<fmi_glue::logger::Fmi2LoggerFn>;
 /// `fmi2CallbackAllocateMemory` (not used: the FMU declares `canNotUseMemoryManagementFunctions`).
 pub type Fmi2CallbackAllocateMemory =
     Option<unsafe extern "C" fn(nobj: usize, size: usize) -> *mut c_void>;
@@ -65,16 +56,9 @@ pub type Fmi2StepFinished = Option<
     unsafe extern "C" fn(component_environment: Fmi2ComponentEnvironment, status: Fmi2Status),
 >;
 
-/// `fmi2CallbackFunctions`. Only valid during `fmi2Instantiate`: the instance keeps a copy.
-#[repr(C)]
-#[derive(Clone, Copy, Debug)]
-pub struct Fmi2CallbackFunctions {
-    pub logger: Fmi2CallbackLogger,
-    pub allocate_memory: Fmi2CallbackAllocateMemory,
-    pub free_memory: Fmi2CallbackFreeMemory,
-    pub step_finished: Fmi2StepFinished,
-    pub component_environment: Fmi2ComponentEnvironment,
-}
+/// `fmi2CallbackFunctions`. Only valid during `fmi2Instantiate`: the instance keeps a copy. The
+/// shared glue's struct (`fmi_glue::fmi2::Callbacks`), which its `fmi2Instantiate` reads.
+pub type Fmi2CallbackFunctions = fmi_glue::fmi2::Callbacks;
 
 /// `fmi2EventInfo` (Model Exchange only; appears in the signature of an error stub).
 #[repr(C)]

@@ -12,9 +12,10 @@
 //! references (which are unique across types, as 3.0 requires), the film's fields as arrays
 //! sized by structural parameters ([`arrays`]), `fmi3DoStep` without early return (a refused
 //! step returns `fmi3Discard` and keeps the last converged state, as in 2.0), FMU states and
-//! their serialization, `fmi3GetDirectionalDerivative` and `fmi3GetAdjointDerivative` (J's
-//! columns, the glue's default), a terminal per boundary group ([`terminals`]). Not yet: the
-//! adjoint from the held factorization (see `docs/fmu.md`).
+//! their serialization, `fmi3GetDirectionalDerivative` and `fmi3GetAdjointDerivative`, both made
+//! of J's columns (`fmi_glue::core::Columns`: the adjoint is the directional derivative's exact
+//! transpose, at one held solve per known; `docs/fmu.md` says why not one transpose solve), a
+//! terminal per boundary group ([`terminals`]). Checked against steps in `tests/derivatives.rs`.
 
 pub mod arrays;
 pub mod description;
@@ -23,3 +24,6 @@ pub mod terminals;
 use crate::fmi2::instance::Instance;
 
 fmi_glue::export_fmi3!(Instance);
+
+#[cfg(test)]
+mod tests;

@@ -17,7 +17,8 @@ TEST GOAL:
   that the installed fmu-pack accepts;
 * the hydraulic jack of the coupled erection system ships with the wheel: the installed
   ``pack_jack_fmu`` packs ``HydraulicJack.fmu`` (into the current directory) from the wheel's
-  library and model description, and it steps (the coupling and SSP tests of tests/python use it).
+  library and model description, and it steps (the coupling and SSP tests of tests/python use it);
+  ``pack_jack_fmu(fmi_version=3)`` packs ``HydraulicJack_fmi3.fmu`` from its 3.0 description.
 """
 
 from __future__ import annotations
@@ -146,3 +147,10 @@ def test_the_wheel_ships_the_jack_and_packs_its_fmu_without_the_checkout(tmp_pat
         jack.set({"force": -100.0})
         jack.step(5.0)
         assert jack["piston"] == pytest.approx(-5.0 * 5e-4)  # pumping at its 0.5 mm/s
+    # Its FMI 3.0 FMU from the wheel's copy of the 3.0 description.
+    fmu3 = pack_jack_fmu(fmi_version=3)
+    assert fmu3 == tmp_path / "HydraulicJack_fmi3.fmu"
+    with zipfile.ZipFile(fmu3) as z:
+        assert z.read("modelDescription.xml") == (ROOT / "fmu" / "jack" / "modelDescription3.xml").read_bytes()
+        assert z.read("binaries/x86_64-linux/hydraulic_jack.so") == shipped_library(fmu)
+    assert validate_fmu(str(fmu3)) == []

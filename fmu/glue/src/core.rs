@@ -105,6 +105,36 @@ pub trait Core: Sized {
     fn terminate_requested(&self) -> bool {
         false
     }
+    /// `fmi2GetStatus` of `kind` (`fmi2StatusKind`); by default not supported.
+    fn get_status(&self, _kind: i32) -> Outcome<Status> {
+        Err(not_supported("fmi2GetStatus"))
+    }
+    /// `fmi2GetRealStatus`: by default `fmi2LastSuccessfulTime` (2), `Discard` for another kind.
+    fn get_real_status(&self, kind: i32) -> Outcome<f64> {
+        match kind {
+            2 => Ok(self.last_successful_time()),
+            _ => Err(Failure::discard(format!(
+                "status kind {kind}: no Real status"
+            ))),
+        }
+    }
+    /// `fmi2GetIntegerStatus`; by default not supported.
+    fn get_integer_status(&self, _kind: i32) -> Outcome<i32> {
+        Err(not_supported("fmi2GetIntegerStatus"))
+    }
+    /// `fmi2GetBooleanStatus`: by default `fmi2Terminated` (3), `Discard` for another kind.
+    fn get_boolean_status(&self, kind: i32) -> Outcome<bool> {
+        match kind {
+            3 => Ok(self.terminate_requested()),
+            _ => Err(Failure::discard(format!(
+                "status kind {kind}: no Boolean status"
+            ))),
+        }
+    }
+    /// `fmi2GetStringStatus` (nothing is written); by default not supported.
+    fn get_string_status(&self, _kind: i32) -> Outcome {
+        Err(not_supported("fmi2GetStringStatus"))
+    }
     /// `GetFMUstate` into the state `handle` (0: a new one); the handle of the saved state.
     fn get_fmu_state(&mut self, _handle: usize) -> Outcome<usize> {
         Err(not_supported("FMU states"))
@@ -136,8 +166,19 @@ pub trait Core: Sized {
     ) -> Outcome {
         Err(not_supported("directional derivatives"))
     }
+    /// `fmi2GetDirectionalDerivative`: by default [`Core::directional_derivative`], which the
+    /// FMI 3.0 function calls (an FMU whose two versions answer differently overrides this).
+    fn directional_derivative_fmi2(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome {
+        self.directional_derivative(unknowns, knowns, seed, out)
+    }
     /// `GetAdjointDerivative`: `out = Jᵀ seed` (a seed per unknown, a value per known), J as
-    /// [`Core::directional_derivative`] gives it. By default J's columns, one directional
+    /// [`Core::directional_derivative`] gives it. By default J's [`Columns`], one directional
     /// derivative per known, contracted with the seed: J's exact transpose, at the cost of
     /// `knowns.len()` directional derivatives. A warning of one of them (the film's
     /// path-dependent derivatives) is passed on once the whole product is written.
@@ -148,25 +189,88 @@ pub trait Core: Sized {
         seed: &[f64],
         out: &mut [f64],
     ) -> Outcome {
-        let (mut column, mut result) = (vec![0.0; unknowns.len()], vec![0.0; knowns.len()]);
+        let columns = Columns::of(self, unknowns, knowns, Self::directional_derivative)?;
+        columns.apply((unknowns, seed), knowns, true, out)
+    }
+}
+
+/// A Jacobian as its columns `J e_j`, one directional derivative per known with a unit seed:
+/// `J s` and `Jᵀ v` from the same numbers, so that `vᵀ (J s) = (Jᵀ v)ᵀ s` holds to rounding
+/// whatever the directional derivative's own accuracy (the film's is a difference of results).
+pub struct Columns {
+    /// `values[j][i] = ∂unknown_i/∂known_j`.
+    values: Vec<Vec<f64>>,
+    /// The last warning a column came with, passed on with the product.
+    warning: Option<Failure>,
+}
+
+impl Columns {
+    /// The columns of `unknowns` along each of `knowns`, each from `column` (a directional
+    /// derivative) with the seed 1.
+    pub fn of<C>(
+        core: &mut C,
+        unknowns: &[u32],
+        knowns: &[u32],
+        column: impl Fn(&mut C, &[u32], &[u32], &[f64], &mut [f64]) -> Outcome,
+    ) -> Outcome<Self> {
         let mut warning = None;
-        for (j, &known) in knowns.iter().enumerate() {
-            match self.directional_derivative(unknowns, &[known], &[1.0], &mut column) {
+        let mut values = Vec::with_capacity(knowns.len());
+        for &known in knowns {
+            let mut c = vec![0.0; unknowns.len()];
+            match column(core, unknowns, &[known], &[1.0], &mut c) {
                 Ok(()) => {}
                 Err(f) if f.status == Status::Warning => warning = Some(f),
                 Err(f) => return Err(f),
             }
-            result[j] = column.iter().zip(seed).map(|(c, v)| c * v).sum();
+            values.push(c);
         }
-        if let Some((j, _)) = result.iter().enumerate().find(|(_, x)| !x.is_finite()) {
+        Ok(Self { values, warning })
+    }
+
+    /// `J s` (a value per known in `s`, a result per unknown).
+    pub fn times(&self, s: &[f64]) -> Vec<f64> {
+        let n = self.values.first().map_or(0, Vec::len);
+        (0..n)
+            .map(|i| self.values.iter().zip(s).map(|(c, s)| c[i] * s).sum())
+            .collect()
+    }
+
+    /// `Jᵀ v` (a value per unknown in `v`, a result per known).
+    pub fn transpose_times(&self, v: &[f64]) -> Vec<f64> {
+        self.values
+            .iter()
+            .map(|c| c.iter().zip(v).map(|(c, v)| c * v).sum())
+            .collect()
+    }
+
+    /// Writes `J seed` (`transpose` false: a seed per known, a value per unknown) or `Jᵀ seed`
+    /// (true: a seed per unknown, a value per known) into `out`; `seed_refs` and `out_refs`
+    /// name them. An error names a seed that is not finite or a value that overflows; else the
+    /// columns' warning, if any, is the outcome.
+    pub fn apply(
+        self,
+        (seed_refs, seed): (&[u32], &[f64]),
+        out_refs: &[u32],
+        transpose: bool,
+        out: &mut [f64],
+    ) -> Outcome {
+        if let Some((r, d)) = seed_refs.iter().zip(seed).find(|(_, d)| !d.is_finite()) {
             return Err(Failure::error(format!(
-                "the adjoint derivative with respect to value reference {} overflows: scale the \
-                 seed down",
-                knowns[j]
+                "seed of value reference {r} = {d}: values must be finite"
+            )));
+        }
+        let result = if transpose {
+            self.transpose_times(seed)
+        } else {
+            self.times(seed)
+        };
+        if let Some((r, _)) = out_refs.iter().zip(&result).find(|(_, x)| !x.is_finite()) {
+            return Err(Failure::error(format!(
+                "the derivative at value reference {r} overflows for this seed: scale the seed down"
             )));
         }
         out.copy_from_slice(&result);
-        warning.map_or(Ok(()), Err)
+        self.warning.map_or(Ok(()), Err)
     }
 }
 

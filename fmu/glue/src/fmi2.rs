@@ -127,9 +127,9 @@ pub unsafe fn instantiate<C: Core>(
         None => Sink::None,
     };
     instantiate_with::<C>("fmi2Instantiate", &sink.clone(), || {
-        let name = name.map_err(|f| f.message)?.unwrap_or_default();
+        let name = name.map_err(|f| f.message)?.ok_or("instanceName is NULL")?;
         if name.trim().is_empty() {
-            return Err("the instance name is NULL or empty".into());
+            return Err("instanceName is empty".into());
         }
         if fmu_type != 1 {
             return Err(format!(
@@ -286,42 +286,39 @@ pub unsafe fn do_step<C: Core>(c: *mut c_void, t: f64, h: f64) -> c_int {
     unsafe { with::<C>(c, "fmi2DoStep", allowed::DO_STEP, |i| i.do_step(t, h)) }
 }
 
-/// `fmi2GetRealStatus`: `fmi2LastSuccessfulTime` (2); `fmi2Discard` for another kind.
-pub unsafe fn get_real_status<C: Core>(c: *mut c_void, kind: c_int, value: *mut f64) -> c_int {
+/// `fmi2GetStatus`, `fmi2GetRealStatus`, `fmi2GetIntegerStatus`, `fmi2GetBooleanStatus`: the
+/// value of `kind` from `get` (a [`Core`] method) written to `value`.
+pub unsafe fn status<C: Core, T, V>(
+    c: *mut c_void,
+    function: &str,
+    (kind, value): (c_int, *mut V),
+    get: fn(&C, i32) -> Outcome<T>,
+    to_c: fn(T) -> V,
+) -> c_int {
     // SAFETY: contract: `value` is NULL or writable.
     unsafe {
-        with::<C>(c, "fmi2GetRealStatus", allowed::STATUS, |i| {
+        with::<C>(c, function, allowed::STATUS, |i| {
             let value = out_ref(value, "value")?;
-            match kind {
-                2 => {
-                    *value = i.last_successful_time();
-                    Ok(())
-                }
-                _ => Err(Failure::discard(format!(
-                    "status kind {kind}: no Real status"
-                ))),
-            }
+            *value = to_c(get(i, kind)?);
+            Ok(())
         })
     }
 }
 
-/// `fmi2GetBooleanStatus`: `fmi2Terminated` (3); `fmi2Discard` for another kind.
-pub unsafe fn get_boolean_status<C: Core>(c: *mut c_void, kind: c_int, value: *mut c_int) -> c_int {
-    // SAFETY: contract: `value` is NULL or writable.
+/// `fmi2GetStringStatus`: [`Core::get_string_status`]; `value` is not written.
+pub unsafe fn get_string_status<C: Core>(c: *mut c_void, kind: c_int) -> c_int {
+    // SAFETY: contract (module doc).
     unsafe {
-        with::<C>(c, "fmi2GetBooleanStatus", allowed::STATUS, |i| {
-            let value = out_ref(value, "value")?;
-            match kind {
-                3 => {
-                    *value = c_int::from(i.terminate_requested());
-                    Ok(())
-                }
-                _ => Err(Failure::discard(format!(
-                    "status kind {kind}: no Boolean status"
-                ))),
-            }
+        with::<C>(c, "fmi2GetStringStatus", allowed::STATUS, |i| {
+            i.get_string_status(kind)
         })
     }
+}
+
+/// `fmi2CancelStep`: never allowed, as no step runs asynchronously (`allowed::CANCEL_STEP`).
+pub unsafe fn cancel_step<C: Core>(c: *mut c_void) -> c_int {
+    // SAFETY: contract (module doc).
+    unsafe { with::<C>(c, "fmi2CancelStep", allowed::CANCEL_STEP, |_| Ok(())) }
 }
 
 /// `fmi2GetFMUstate`: a new state where `*state` is NULL, else `*state` overwritten.
@@ -399,13 +396,13 @@ pub unsafe fn serialize<C: Core>(
         with::<C>(c, function, allowed::FMU_STATE, |i| {
             let data = i.serialize_fmu_state(state.addr())?;
             let out = output(bytes.cast::<u8>(), n, "serializedState")?;
-            if out.len() != data.len() {
+            if out.len() < data.len() {
                 return Err(Failure::error(format!(
-                    "size = {n}, but the state takes {} bytes (SerializedFMUstateSize)",
+                    "the buffer holds {n} bytes, the state needs {} (ask fmi2SerializedFMUstateSize)",
                     data.len()
                 )));
             }
-            out.copy_from_slice(&data);
+            out[..data.len()].copy_from_slice(&data);
             Ok(())
         })
     }
@@ -447,7 +444,7 @@ pub unsafe fn directional_derivative<C: Core>(
             "fmi2GetDirectionalDerivative",
             allowed::DIRECTIONAL_DERIVATIVE,
             |i| {
-                i.directional_derivative(
+                i.directional_derivative_fmi2(
                     input(unknowns, n_unknown, "vUnknown_ref")?,
                     input(knowns, n_known, "vKnown_ref")?,
                     input(seed, n_known, "dvKnown")?,
@@ -462,6 +459,18 @@ pub unsafe fn directional_derivative<C: Core>(
 pub unsafe fn refused<C: Core>(c: *mut c_void, function: &str) -> c_int {
     // SAFETY: contract (module doc).
     unsafe { with::<C>(c, function, allowed::ANY, |_| Err(not_supported(function))) }
+}
+
+/// A Model Exchange function: logged, `fmi2Error` (the FMUs are Co-Simulation FMUs).
+pub unsafe fn model_exchange<C: Core>(c: *mut c_void, function: &str) -> c_int {
+    // SAFETY: contract (module doc).
+    unsafe {
+        with::<C>(c, function, allowed::ANY, |_| {
+            Err(Failure::error(
+                "not provided by this FMU (Model Exchange: this is a Co-Simulation FMU)",
+            ))
+        })
+    }
 }
 
 /// The opaque `fmi2FMUstate` of a saved-state handle: never dereferenced, the instance looks
@@ -502,24 +511,24 @@ macro_rules! export_fmi2 {
                 "fmi2SetupExperiment" setup_experiment(c: *mut c_void, _td: c_int, _tol: f64, start: f64, sd: c_int, stop: f64) -> c_int
                     = g::setup_experiment::<C>(c, start, sd, stop);
                 "fmi2EnterInitializationMode" enter_initialization_mode(c: *mut c_void) -> c_int
-                    = g::transition::<C>(c, "fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION, C::enter_initialization_mode);
+                    = g::transition::<C>(c, "fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION, <C as Core>::enter_initialization_mode);
                 "fmi2ExitInitializationMode" exit_initialization_mode(c: *mut c_void) -> c_int
-                    = g::transition::<C>(c, "fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION, C::exit_initialization_mode);
+                    = g::transition::<C>(c, "fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION, <C as Core>::exit_initialization_mode);
                 "fmi2Terminate" terminate(c: *mut c_void) -> c_int
-                    = g::transition::<C>(c, "fmi2Terminate", allowed::TERMINATE, C::terminate);
-                "fmi2Reset" reset(c: *mut c_void) -> c_int = g::transition::<C>(c, "fmi2Reset", allowed::RESET, C::reset);
+                    = g::transition::<C>(c, "fmi2Terminate", allowed::TERMINATE, <C as Core>::terminate);
+                "fmi2Reset" reset(c: *mut c_void) -> c_int = g::transition::<C>(c, "fmi2Reset", allowed::RESET, <C as Core>::reset);
                 "fmi2GetReal" get_real(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut f64) -> c_int
-                    = g::get::<C, f64>(c, "fmi2GetReal", vr, n, v, C::get_real);
+                    = g::get::<C, f64>(c, "fmi2GetReal", vr, n, v, <C as Core>::get_real);
                 "fmi2GetInteger" get_integer(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut c_int) -> c_int
-                    = g::get::<C, i32>(c, "fmi2GetInteger", vr, n, v, C::get_integer);
+                    = g::get::<C, i32>(c, "fmi2GetInteger", vr, n, v, <C as Core>::get_integer);
                 "fmi2GetBoolean" get_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut c_int) -> c_int
                     = g::get_boolean::<C>(c, vr, n, v);
                 "fmi2GetString" get_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut *const c_char) -> c_int
-                    = g::get::<C, *const c_char>(c, "fmi2GetString", vr, n, v, C::get_string);
+                    = g::get::<C, *const c_char>(c, "fmi2GetString", vr, n, v, <C as Core>::get_string);
                 "fmi2SetReal" set_real(c: *mut c_void, vr: *const c_uint, n: usize, v: *const f64) -> c_int
-                    = g::set::<C, f64>(c, "fmi2SetReal", vr, n, v, C::set_real);
+                    = g::set::<C, f64>(c, "fmi2SetReal", vr, n, v, <C as Core>::set_real);
                 "fmi2SetInteger" set_integer(c: *mut c_void, vr: *const c_uint, n: usize, v: *const c_int) -> c_int
-                    = g::set::<C, i32>(c, "fmi2SetInteger", vr, n, v, C::set_integer);
+                    = g::set::<C, i32>(c, "fmi2SetInteger", vr, n, v, <C as Core>::set_integer);
                 "fmi2SetBoolean" set_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *const c_int) -> c_int
                     = g::set_boolean::<C>(c, vr, n, v);
                 "fmi2SetString" set_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *const *const c_char) -> c_int
@@ -536,16 +545,23 @@ macro_rules! export_fmi2 {
                 "fmi2DeSerializeFMUstate" deserialize(c: *mut c_void, b: *const c_char, n: usize, s: *mut *mut c_void) -> c_int
                     = g::deserialize::<C>(c, "fmi2DeSerializeFMUstate", b, n, s);
                 "fmi2DoStep" do_step(c: *mut c_void, t: f64, h: f64, _no_prior: c_int) -> c_int = g::do_step::<C>(c, t, h);
-                "fmi2GetRealStatus" get_real_status(c: *mut c_void, k: c_int, v: *mut f64) -> c_int = g::get_real_status::<C>(c, k, v);
-                "fmi2GetBooleanStatus" get_boolean_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int = g::get_boolean_status::<C>(c, k, v);
+                "fmi2CancelStep" cancel_step(c: *mut c_void) -> c_int = g::cancel_step::<C>(c);
+                "fmi2GetStatus" get_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int
+                    = g::status::<C, _, _>(c, "fmi2GetStatus", (k, v), <C as Core>::get_status, |s| s.raw());
+                "fmi2GetRealStatus" get_real_status(c: *mut c_void, k: c_int, v: *mut f64) -> c_int
+                    = g::status::<C, _, _>(c, "fmi2GetRealStatus", (k, v), <C as Core>::get_real_status, |x| x);
+                "fmi2GetIntegerStatus" get_integer_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int
+                    = g::status::<C, _, _>(c, "fmi2GetIntegerStatus", (k, v), <C as Core>::get_integer_status, |x| x);
+                "fmi2GetBooleanStatus" get_boolean_status(c: *mut c_void, k: c_int, v: *mut c_int) -> c_int
+                    = g::status::<C, _, _>(c, "fmi2GetBooleanStatus", (k, v), <C as Core>::get_boolean_status, c_int::from);
+                "fmi2GetStringStatus" get_string_status(c: *mut c_void, k: c_int, _v: *mut *const c_char) -> c_int
+                    = g::get_string_status::<C>(c, k);
             );
             $crate::export_fmi2!(@refused
                 "fmi2SetRealInputDerivatives" set_input_derivatives(_r: *const c_uint, _n: usize, _o: *const c_int, _v: *const f64);
                 "fmi2GetRealOutputDerivatives" get_output_derivatives(_r: *const c_uint, _n: usize, _o: *const c_int, _v: *mut f64);
-                "fmi2CancelStep" cancel_step();
-                "fmi2GetStatus" get_status(_k: c_int, _v: *mut c_int);
-                "fmi2GetIntegerStatus" get_integer_status(_k: c_int, _v: *mut c_int);
-                "fmi2GetStringStatus" get_string_status(_k: c_int, _v: *mut *const c_char);
+            );
+            $crate::export_fmi2!(@model_exchange
                 "fmi2EnterEventMode" enter_event_mode();
                 "fmi2NewDiscreteStates" new_discrete_states(_info: *mut c_void);
                 "fmi2EnterContinuousTimeMode" enter_continuous_time_mode();
@@ -565,6 +581,14 @@ macro_rules! export_fmi2 {
             // SAFETY: the FMI 2.0 caller contract (`fmi_glue::fmi2`'s module doc) is the one
             // the generic function requires; the arguments are passed on unchanged.
             unsafe { $call }
+        }
+    )*};
+    (@model_exchange $($export:literal $name:ident($($arg:ident: $ty:ty),*);)*) => {$(
+        #[unsafe(export_name = $export)]
+        pub unsafe extern "C" fn $name(c: *mut c_void $(, $arg: $ty)*) -> c_int {
+            // SAFETY: the FMI 2.0 caller contract: `c` is NULL or a live instance; no other
+            // argument is read.
+            unsafe { $crate::fmi2::model_exchange::<C>(c, $export) }
         }
     )*};
     (@refused $($export:literal $name:ident($($arg:ident: $ty:ty),*);)*) => {$(

@@ -44,9 +44,9 @@ pub unsafe fn instantiate<C: Core>(
     // SAFETY: NULL or NUL-terminated strings valid for this call (contract).
     let (name, token, resources) = unsafe { (string(name), string(token), string(resources)) };
     instantiate_with::<C>("fmi3InstantiateCoSimulation", &sink.clone(), || {
-        let name = name.map_err(|f| f.message)?.unwrap_or_default();
+        let name = name.map_err(|f| f.message)?.ok_or("instanceName is NULL")?;
         if name.trim().is_empty() {
-            return Err("the instance name is NULL or empty".into());
+            return Err("instanceName is empty".into());
         }
         if event_mode_used != 0 {
             return Err(
@@ -315,26 +315,26 @@ macro_rules! export_fmi3 {
                 "fmi3EnterInitializationMode" enter_initialization_mode(c: *mut c_void, _td: u8, _tol: f64, start: f64, sd: u8, stop: f64) -> c_int
                     = g::enter_initialization_mode::<C>(c, start, sd, stop);
                 "fmi3ExitInitializationMode" exit_initialization_mode(c: *mut c_void) -> c_int
-                    = g2::transition::<C>(c, "fmi3ExitInitializationMode", allowed::EXIT_INITIALIZATION, C::exit_initialization_mode);
+                    = g2::transition::<C>(c, "fmi3ExitInitializationMode", allowed::EXIT_INITIALIZATION, <C as Core>::exit_initialization_mode);
                 "fmi3Terminate" terminate(c: *mut c_void) -> c_int
-                    = g2::transition::<C>(c, "fmi3Terminate", allowed::TERMINATE, C::terminate);
-                "fmi3Reset" reset(c: *mut c_void) -> c_int = g2::transition::<C>(c, "fmi3Reset", allowed::RESET, C::reset);
+                    = g2::transition::<C>(c, "fmi3Terminate", allowed::TERMINATE, <C as Core>::terminate);
+                "fmi3Reset" reset(c: *mut c_void) -> c_int = g2::transition::<C>(c, "fmi3Reset", allowed::RESET, <C as Core>::reset);
                 "fmi3GetFloat64" get_float64(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut f64, nv: usize) -> c_int
-                    = g::get_values::<C, f64>(c, "fmi3GetFloat64", (vr, n), (v, nv), C::get_float64);
+                    = g::get_values::<C, f64>(c, "fmi3GetFloat64", (vr, n), (v, nv), <C as Core>::get_float64);
                 "fmi3SetFloat64" set_float64(c: *mut c_void, vr: *const c_uint, n: usize, v: *const f64, nv: usize) -> c_int
-                    = g::set::<C, f64>(c, "fmi3SetFloat64", (vr, n), (v, nv), C::set_real);
+                    = g::set::<C, f64>(c, "fmi3SetFloat64", (vr, n), (v, nv), <C as Core>::set_real);
                 "fmi3GetInt32" get_int32(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut i32, nv: usize) -> c_int
-                    = g::get_values::<C, i32>(c, "fmi3GetInt32", (vr, n), (v, nv), C::get_int32);
+                    = g::get_values::<C, i32>(c, "fmi3GetInt32", (vr, n), (v, nv), <C as Core>::get_int32);
                 "fmi3SetInt32" set_int32(c: *mut c_void, vr: *const c_uint, n: usize, v: *const i32, nv: usize) -> c_int
-                    = g::set::<C, i32>(c, "fmi3SetInt32", (vr, n), (v, nv), C::set_integer);
+                    = g::set::<C, i32>(c, "fmi3SetInt32", (vr, n), (v, nv), <C as Core>::set_integer);
                 "fmi3GetUInt64" get_uint64(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut u64, nv: usize) -> c_int
-                    = g::get_values::<C, u64>(c, "fmi3GetUInt64", (vr, n), (v, nv), C::get_uint64);
+                    = g::get_values::<C, u64>(c, "fmi3GetUInt64", (vr, n), (v, nv), <C as Core>::get_uint64);
                 "fmi3GetBoolean" get_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut u8, nv: usize) -> c_int
                     = g::get_boolean::<C>(c, vr, n, v, nv);
                 "fmi3SetBoolean" set_boolean(c: *mut c_void, vr: *const c_uint, n: usize, v: *const u8, nv: usize) -> c_int
                     = g::set_boolean::<C>(c, vr, n, v, nv);
                 "fmi3GetString" get_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *mut *const c_char, nv: usize) -> c_int
-                    = g::get_values::<C, *const c_char>(c, "fmi3GetString", (vr, n), (v, nv), C::get_strings);
+                    = g::get_values::<C, *const c_char>(c, "fmi3GetString", (vr, n), (v, nv), <C as Core>::get_strings);
                 "fmi3SetString" set_string(c: *mut c_void, vr: *const c_uint, n: usize, v: *const *const c_char, nv: usize) -> c_int
                     = g::set_string::<C>(c, vr, n, v, nv);
                 "fmi3GetFMUState" get_fmu_state(c: *mut c_void, s: *mut *mut c_void) -> c_int = g2::get_fmu_state::<C>(c, "fmi3GetFMUState", s);
