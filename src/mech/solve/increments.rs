@@ -148,9 +148,13 @@ impl Controller {
     /// the path, the backward-Euler increment then may reach another equilibrium than the
     /// quasi-static one (the edge-cabled suction panel's last lowering step: mid −55.0 mm
     /// whole, −9.9 mm in ten increments). Without a history the answer is the same however the
-    /// step is cut, and a slow increment stands.
+    /// step is cut, and a slow increment stands; so does a stabilized one, whose path the
+    /// damping's pseudo-time already follows increment by increment.
     fn keeps(&self, n: f64, dissipative: bool) -> bool {
-        n <= 2.0 * Analysis::TARGET_ITERATIONS as f64 || !dissipative || !self.can_halve()
+        n <= 2.0 * Analysis::TARGET_ITERATIONS as f64
+            || !dissipative
+            || self.row > 0
+            || !self.can_halve()
     }
 
     /// Whether the next increment can be halved within `max_cutbacks`.
