@@ -68,6 +68,6 @@ pub mod variables;
 mod vtk_output;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 #[cfg(test)]
 mod wiring_tests;

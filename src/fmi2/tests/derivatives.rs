@@ -19,6 +19,7 @@ use crate::fmi2::scalar_variable::{Causality, VarType};
 use crate::mech::FrictionLaw;
 use crate::mech::Model;
 use crate::mech::model::format::{AllElements, ElementSelection, Hinge, PressureSet};
+use crate::specimens::parallel_arch::SpecimenContact;
 
 /// Derivative, backward and forward difference of one output.
 #[derive(Clone, Copy, Debug)]
@@ -122,12 +123,13 @@ const SEEDS: [&str; 6] = [
     "mu",
 ];
 
-/// The default specimen under `law`, its frame turning about a hinge (the line through the
-/// first frame node along global y) and a pressure set on every triangle (0 Pa at the start):
-/// every kind of input of the FMU moves it.
-fn every_input_specimen(law: FrictionLaw) -> Model {
+/// The default specimen with `contact` under `law`, its frame turning about a hinge (the line
+/// through the first frame node along global y) and a pressure set on every triangle (0 Pa at
+/// the start): every kind of input of the FMU moves it.
+pub(crate) fn every_input_specimen(law: FrictionLaw, contact: SpecimenContact) -> Model {
     let spec = ParallelArch {
         friction_law: law,
+        contact,
         ..ParallelArch::default()
     };
     let mut model = spec.model().unwrap();
@@ -253,7 +255,7 @@ fn directional_derivatives_of_every_input_match_both_one_sided_differences_of_th
     for (law, mu, statuses) in cases {
         let u = Unpacked::new(
             &format!("derivatives {law} {mu}"),
-            Source::Model(every_input_specimen(law)),
+            Source::Model(every_input_specimen(law, SpecimenContact::Gaps)),
         );
         let log = Log::default();
         let fmu = Fmu::initialized(

@@ -28,7 +28,7 @@
 //! or NUL-terminated literals holding the announced number of elements; the deliberately bad
 //! arguments are NULL pointers, which the functions must reject without dereferencing.
 
-mod derivatives;
+pub(crate) mod derivatives;
 mod fmu_states;
 mod lifecycle;
 mod stepping;

@@ -26,9 +26,8 @@
 
 use super::*;
 use crate::fmi2::scalar_variable::{Causality, VarType};
-use crate::mech::model::format::{AllElements, ElementSelection, Hinge, PressureSet};
-use crate::mech::{FrictionLaw, Model};
-use crate::specimens::ParallelArch;
+use crate::fmi2::tests::derivatives::every_input_specimen;
+use crate::mech::FrictionLaw;
 use crate::specimens::parallel_arch::SpecimenContact;
 
 /// The inputs seeded, each with the step of its differences on gaps (curved supports: ×10).
@@ -55,31 +54,6 @@ struct Case {
     all_stick: bool,
     /// Largest deviation of a derivative from a one-sided difference that keeps the statuses.
     tolerance: f64,
-}
-
-/// The default specimen with `contact` under `law`, a hinge on its frame and a pressure set on
-/// every triangle.
-fn every_input_specimen(law: FrictionLaw, contact: SpecimenContact) -> Model {
-    let spec = ParallelArch {
-        friction_law: law,
-        contact,
-        ..ParallelArch::default()
-    };
-    let mut model = spec.model().unwrap();
-    let first = model.nodes[model.groups[0].nodes[0]];
-    model.groups[0].hinge = Some(Hinge {
-        point: first,
-        axis: [0.0, 1.0, 0.0],
-        target_angle: 0.0,
-    });
-    model.loads.pressures.push(PressureSet {
-        kind: Default::default(),
-        name: "cover".into(),
-        elements: ElementSelection::All(AllElements::All),
-        pressure: 0.0,
-        towards: None,
-    });
-    model
 }
 
 /// A pseudo-random sequence in [−1, 1] (a fixed LCG: the test is reproducible).
