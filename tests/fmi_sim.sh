@@ -2,7 +2,8 @@
 # The FMI 3.0 FMUs in fmi-sim, the simulator of rust-fmi (issue 45): not part of tests/run.sh (CI
 # has no fmi-sim). Without fmi-sim on PATH (or FMI_SIM=/path/to/fmi-sim) it says so and exits 0.
 #
-#   cargo install fmi-sim --locked     # once (fmi-sim 0.7.0 was run here)
+#   cargo install fmi-sim --locked     # once (fmi-sim 0.7.0 was run here); its fmi-sys crate runs
+#                                      # bindgen, which needs libclang (Debian: apt-get install libclang-dev)
 #   bash tests/fmi_sim.sh
 #
 # 1. builds the release programs and packs the specimen (ParallelArch) and a user model
