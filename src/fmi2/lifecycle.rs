@@ -97,7 +97,7 @@ impl Instance {
         }
         (!said.is_empty()).then(|| {
             format!(
-                "load inputs start at nonzero values, so the first fmi2DoStep applies these \
+                "load inputs start at nonzero values, so the first DoStep applies these \
                  loads at once (from zero to the inputs' values then) unless the master changes \
                  them first: {}; set an input to 0 to apply its load in a later step",
                 said.join(", ")

@@ -173,12 +173,14 @@ impl Instance {
                 Failure::discard(if repeated {
                     format!(
                         "{message}. The identical step was refused before: fmi2GetBooleanStatus(fmi2Terminated) \
-                         is now true. Time stays {t}; only a smaller change of the inputs can succeed"
+                         (FMI 3.0: the step's terminateSimulation) is now true. Time stays {t}; only a smaller \
+                         change of the inputs can succeed"
                     )
                 } else {
                     format!(
-                        "{message}. Time stays {t}: set a smaller change of the inputs and call fmi2DoStep again \
-                         (asking the identical step again makes fmi2GetBooleanStatus(fmi2Terminated) true)"
+                        "{message}. Time stays {t}: set a smaller change of the inputs and call DoStep again \
+                         (asking the identical step again makes fmi2GetBooleanStatus(fmi2Terminated), in FMI 3.0 \
+                         the step's terminateSimulation, true)"
                     )
                 })
             }

@@ -128,7 +128,7 @@ fn repeating_a_refused_step_identically_reports_terminated() {
     // now the FMU asks the master to stop.
     assert_eq!(fmu.step(0.0, 0.5), Status::Discard.raw());
     assert_eq!(terminated(), 1);
-    assert!(log.contains(Status::Discard, "fmi2Terminated) is now true"));
+    assert!(log.contains(Status::Discard, "terminateSimulation) is now true"));
     // A master that ignores the Discard and goes on is refused with a message that the outputs
     // are stale, at every call.
     for _ in 0..2 {
@@ -392,7 +392,7 @@ fn the_loads_the_first_step_applies_are_named_at_the_end_of_initialization() {
         log.take()
             .into_iter()
             .filter(|(s, _, m)| {
-                *s == Status::Warning.raw() && m.contains("first fmi2DoStep applies these loads")
+                *s == Status::Warning.raw() && m.contains("first DoStep applies these loads")
             })
             .map(|(_, _, m)| m)
             .collect::<Vec<_>>()
