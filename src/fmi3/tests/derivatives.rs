@@ -225,18 +225,14 @@ struct Measured {
 }
 
 /// Runs one case (module doc) and checks it; returns what it measured.
-fn check(case: &Case) -> Measured {
-    let tag = format!("fd {} {:?} {}", case.law, case.contact, case.mu);
-    let u = Unpacked::new(
-        &tag,
-        Source::Model(every_input_specimen(case.law, case.contact)),
-    );
-    let log = Log::default();
+/// The FMU of `case` at the start of the step checked: lowered by 5 mm per step with μ = 0.2 to
+/// −0.05, then to −0.055 with the case's μ (module doc), one increment per step.
+fn lowered<'a>(case: &Case, u: &'a Unpacked, log: &'a Log) -> Fmu3<'a> {
     let curved = case.contact == SpecimenContact::CurvedSupport;
     let tol = if curved { 1e-8 } else { 1e-12 };
     let fmu = Fmu3::initialized(
-        &u,
-        &log,
+        u,
+        log,
         &[
             ("solver.displacementTolerance", tol),
             ("solver.residualTolerance", tol),
@@ -255,47 +251,29 @@ fn check(case: &Case) -> Measured {
         let status = fmu.step(k as f64 - 1.0, 1.0);
         assert!(status <= 1, "{status}: {:?}", log.take());
     }
-    let end = [
-        ("frame.dx", 0.0),
-        ("frame.dy", 0.0),
-        ("frame.dz", -0.06),
-        ("frame.angle", 0.0),
-        ("cover.pressure", 0.0),
-        ("mu", case.mu),
-    ];
-    let (outputs, statuses) = names(&u);
-    let outputs: Vec<&str> = outputs.iter().map(String::as_str).collect();
-    let statuses: Vec<&str> = statuses.iter().map(String::as_str).collect();
-    let start = fmu.save();
-    // Where every closed contact sticks, nothing moves with μ (checked exactly below): its
-    // differences would be the steps' noise alone.
-    let knowns: Vec<(&str, f64)> = SEEDS
-        .iter()
-        .filter(|(k, _)| *k != "mu" || !case.all_stick)
-        .map(|&(k, h)| (k, if curved { 10.0 * h } else { h }))
-        .collect();
-    let diffs: Vec<Differences> = knowns
-        .iter()
-        .map(|&known| fmu.differences(start, &end, known, (&outputs, &statuses)))
-        .collect();
-    // The FMU at the end of the step checked (unmoved inputs), where the derivatives are asked.
-    let at = fmu.repeated(start, &end, ("", 0.0), (&outputs, &statuses));
-    fmu.free(start);
-    let mut m = Measured {
-        statuses: at.statuses[..statuses.len()].to_vec(),
-        ..Measured::default()
-    };
-    let names: Vec<&str> = knowns.iter().map(|k| k.0).collect();
-    // Columns: one directional derivative per input, against both sides of its differences;
-    // a side it does not follow must cross a switch: a contact changes status, or the output's
-    // slope changes within the difference (a kink of `film.maxEquivalentStress`, the largest of
-    // the elements' stresses, shows only there). `follows[j][i]`: a side the derivative
-    // follows, which the adjoint is checked against.
+    fmu
+}
+
+/// Checks one directional derivative per input (`names`) against both sides of its
+/// differences; a side it does not follow must cross a switch: a contact changes status, or the
+/// output's slope changes within the difference (a kink of `film.maxEquivalentStress`, the
+/// largest of the elements' stresses, shows only there). Notes the largest deviation and the
+/// switches in `m`; returns `follows[j][i]`, a side the derivative follows, which the adjoint
+/// is checked against.
+fn check_columns(
+    fmu: &Fmu3<'_>,
+    case: &Case,
+    (outputs, names): (&[&str], &[&str]),
+    diffs: &[Differences],
+    m: &mut Measured,
+) -> Vec<Vec<usize>> {
+    let tag = format!("fd {} {:?} {}", case.law, case.contact, case.mu);
+    let u = fmu.u;
     let mut follows = vec![];
     for (j, d) in diffs.iter().enumerate() {
-        let (status, column) = fmu.directional(&outputs, &[names[j]], &[1.0]);
-        assert_eq!(status, 0, "{tag} {}: {:?}", names[j], log.take());
-        let scale = scales(&u, &outputs, d);
+        let (status, column) = fmu.directional(outputs, &[names[j]], &[1.0]);
+        assert_eq!(status, 0, "{tag} {}: {:?}", names[j], fmu.log.take());
+        let scale = scales(u, outputs, d);
         let mut side_of = vec![];
         for i in 0..outputs.len() {
             let deviation = |s: &Side| (column[i] - s.slope[i]).abs() / scale[i];
@@ -340,23 +318,71 @@ fn check(case: &Case) -> Measured {
         }
         follows.push(side_of);
     }
+    follows
+}
+
+/// The weights `v` of the adjoint check: each output weighed by the inverse of its unit's
+/// largest difference, times a pseudo-random factor.
+fn adjoint_weights(u: &Unpacked, outputs: &[&str], diffs: &[Differences]) -> Vec<f64> {
+    let largest = |i: usize| {
+        let unit = u.variable(outputs[i]).unit;
+        (0..outputs.len())
+            .filter(|&k| u.variable(outputs[k]).unit == unit)
+            .flat_map(|k| diffs.iter().map(move |d| d.sides[0].slope[k].abs()))
+            .fold(0.0_f64, f64::max)
+    };
+    random(outputs.len(), 45)
+        .iter()
+        .enumerate()
+        .map(|(i, r)| r / largest(i).max(f64::MIN_POSITIVE))
+        .collect()
+}
+
+fn check(case: &Case) -> Measured {
+    let tag = format!("fd {} {:?} {}", case.law, case.contact, case.mu);
+    let u = Unpacked::new(
+        &tag,
+        Source::Model(every_input_specimen(case.law, case.contact)),
+    );
+    let log = Log::default();
+    let curved = case.contact == SpecimenContact::CurvedSupport;
+    let fmu = lowered(case, &u, &log);
+    let end = [
+        ("frame.dx", 0.0),
+        ("frame.dy", 0.0),
+        ("frame.dz", -0.06),
+        ("frame.angle", 0.0),
+        ("cover.pressure", 0.0),
+        ("mu", case.mu),
+    ];
+    let (outputs, statuses) = names(&u);
+    let outputs: Vec<&str> = outputs.iter().map(String::as_str).collect();
+    let statuses: Vec<&str> = statuses.iter().map(String::as_str).collect();
+    let start = fmu.save();
+    // Where every closed contact sticks, nothing moves with μ (checked exactly below): its
+    // differences would be the steps' noise alone.
+    let knowns: Vec<(&str, f64)> = SEEDS
+        .iter()
+        .filter(|(k, _)| *k != "mu" || !case.all_stick)
+        .map(|&(k, h)| (k, if curved { 10.0 * h } else { h }))
+        .collect();
+    let diffs: Vec<Differences> = knowns
+        .iter()
+        .map(|&known| fmu.differences(start, &end, known, (&outputs, &statuses)))
+        .collect();
+    // The FMU at the end of the step checked (unmoved inputs), where the derivatives are asked.
+    let at = fmu.repeated(start, &end, ("", 0.0), (&outputs, &statuses));
+    fmu.free(start);
+    let mut m = Measured {
+        statuses: at.statuses[..statuses.len()].to_vec(),
+        ..Measured::default()
+    };
+    let names: Vec<&str> = knowns.iter().map(|k| k.0).collect();
+    let follows = check_columns(&fmu, case, (&outputs, &names), &diffs, &mut m);
     m.switches.dedup();
     // The adjoint against vᵀ times the differences the columns were checked against: v weighs
     // each output by the inverse of its unit's largest difference.
-    let weights: Vec<f64> = {
-        let largest = |i: usize| {
-            let unit = u.variable(outputs[i]).unit;
-            (0..outputs.len())
-                .filter(|&k| u.variable(outputs[k]).unit == unit)
-                .flat_map(|k| diffs.iter().map(move |d| d.sides[0].slope[k].abs()))
-                .fold(0.0_f64, f64::max)
-        };
-        random(outputs.len(), 45)
-            .iter()
-            .enumerate()
-            .map(|(i, r)| r / largest(i).max(f64::MIN_POSITIVE))
-            .collect()
-    };
+    let weights = adjoint_weights(&u, &outputs, &diffs);
     let (status, jtv) = fmu.adjoint(&outputs, &names, &weights);
     assert_eq!(status, 0, "{tag}: {:?}", log.take());
     for (j, d) in diffs.iter().enumerate() {
