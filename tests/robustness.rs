@@ -945,6 +945,10 @@ struct StagedRun {
     /// Each step's ratio of the damping's work to its strain energy, and its warning about it.
     dissipation: Vec<(f64, Option<String>)>,
     refusal: Option<String>,
+    /// Release rounds at the steps' ends, and the undamped tries among them made again after a
+    /// refusal with no converged damped round between.
+    release_rounds: usize,
+    undamped_retried: usize,
 }
 
 impl StagedRun {
@@ -957,6 +961,20 @@ impl StagedRun {
         self.worst_ratio = self.worst_ratio.max(report.dissipation_ratio());
         self.dissipation
             .push((report.dissipation_ratio(), report.dissipation_warning()));
+        let mut refused = false;
+        for a in report
+            .attempts
+            .iter()
+            .filter(|a| a.from == 1.0 && a.to == 1.0)
+        {
+            self.release_rounds += 1;
+            if a.strategy == 0 {
+                self.undamped_retried += usize::from(refused);
+                refused = !a.converged;
+            } else if a.converged {
+                refused = false;
+            }
+        }
     }
 }
 
@@ -1196,6 +1214,13 @@ fn a_slack_film_without_an_equilibrium_is_reported_as_the_dampings_state() {
     assert!(
         settled.iter().all(|(r, w)| *r < 0.05 && w.is_none()),
         "steps 1 to 6: {settled:?}"
+    );
+    // The release does not try Newton again from the state it refused it at.
+    assert!(run.release_rounds > 0, "no release");
+    assert_eq!(
+        run.undamped_retried, 0,
+        "of {} release rounds",
+        run.release_rounds
     );
     let (ratio, warning) = &run.dissipation[7];
     assert!(*ratio > 1.0, "step 8 took out {ratio} of the strain energy");

@@ -302,7 +302,9 @@ impl Analysis {
     /// and cut as much after a refused one, until the damping force `c k̄ m ΔU/τ` is within the
     /// residual tolerance: the state then balances the undamped model to the same tolerance as
     /// a Newton answer (switched evolution relaxation, Mulder & van Leer 1985: as `τ → ∞` each
-    /// round becomes a Newton solve). At most [`Self::RELEASE_ROUNDS`] rounds; where they do
+    /// round becomes a Newton solve). Newton refused from a state is tried again only once the
+    /// march has taken [`Self::PROGRESS`]'s tenth off the damping force. At most
+    /// [`Self::RELEASE_ROUNDS`] rounds; where they do
     /// not settle, the last converged state stays, its damping force's work reported against
     /// the bound.
     fn release_stabilization(
@@ -315,10 +317,19 @@ impl Analysis {
     ) {
         let (motion, levels) = (path.motion(1.0), path.levels(1.0));
         let mut tau = last;
+        // The damping force of the last converged round, and at the last refusal of the
+        // undamped equilibrium (∞: before any converged round).
+        let (mut force, mut refused_at) = (f64::INFINITY, None::<f64>);
         for round in 0..2 * Self::RELEASE_ROUNDS {
             // Each round tries the undamped equilibrium first (Newton from the damped state),
             // then one step of the march.
             let damped = round % 2 == 1;
+            // Refused from a state, Newton is not tried again before the march has taken a
+            // tenth off the damping force: its iterations are most of the release's cost, and
+            // a wrinkled film without a unique equilibrium refuses every one.
+            if !damped && refused_at.is_some_and(|f| force >= Self::PROGRESS * f) {
+                continue;
+            }
             let (row, how) = if damped {
                 (row, "release, damped")
             } else {
@@ -330,10 +341,12 @@ impl Analysis {
             let Ok((mut state, history)) = attempt else {
                 if damped {
                     tau /= Self::RELEASE_GROWTH;
+                } else {
+                    refused_at = Some(force);
                 }
                 continue;
             };
-            let force = self.account_stabilized(report, &state.displacement);
+            force = self.account_stabilized(report, &state.displacement);
             let tolerance = self.settings.residual_tolerance
                 * max_abs(&self.work.internal).max(self.force_floor);
             // The step's last increment, for the next step's predictor, is the motion from the

@@ -187,6 +187,8 @@ pub struct LinearSolver {
     krylov: Krylov,
     /// Whether the LDLᵀ and Krylov paths may be taken (else LU for full patterns).
     fast: bool,
+    /// When LU is affordable, the fast paths are skipped after they failed ([`FastBackoff`]).
+    backoff: FastBackoff,
     method: UnsymmetricMethod,
     profile: SolveProfile,
     /// The factor the last factorization left, and its identity (0: none).
@@ -227,6 +229,7 @@ impl Clone for LinearSolver {
             counts: [0; 4],
             krylov: Krylov::default(),
             fast: true,
+            backoff: FastBackoff::default(),
             method: self.method,
             profile: SolveProfile::default(),
             // The copy's factor values are not copied: it holds none.
@@ -290,6 +293,7 @@ impl LinearSolver {
             counts: [0; 4],
             krylov: Krylov::default(),
             fast: true,
+            backoff: FastBackoff::default(),
             method: UnsymmetricMethod::Auto,
             profile: SolveProfile::default(),
             held: Held::None,
@@ -389,8 +393,8 @@ impl LinearSolver {
         (values / n).saturating_sub(1).min(WOODBURY_MOST)
     }
 
-    /// Whether an LU of this system is cheap enough to replace the fast paths for the rest of
-    /// a cut-back step: the symmetric part's LDLᵀ factor holds at most [`LU_AFFORDABLE`]
+    /// Whether an LU of this system is cheap enough to replace the fast paths after they failed
+    /// ([`FastBackoff`]): the symmetric part's LDLᵀ factor holds at most [`LU_AFFORDABLE`]
     /// values (the LU of the unsymmetric pattern was measured at about 6× the LDLᵀ's memory
     /// and 4–6× its time on the refined specimens).
     pub fn lu_affordable(&self) -> bool {
@@ -591,6 +595,7 @@ impl LinearSolver {
             UnsymmetricMethod::Gmres => 0,
             UnsymmetricMethod::Woodbury => WOODBURY_MOST,
         };
+        let affordable = self.lu_affordable();
         match &mut self.kind {
             Kind::Ldlt { symbolic, factor } => {
                 let start = Instant::now();
@@ -610,13 +615,16 @@ impl LinearSolver {
                 if self.fast
                     && let Some(part) = symmetric.as_mut()
                     && part.structural
+                    && self.backoff.tries(affordable)
                 {
                     let mut ctx = Context {
                         krylov: &mut self.krylov,
                         profile: &mut self.profile,
                         counts: &mut self.counts,
                     };
-                    if part.solve(matrix, rhs, limit, &mut ctx) {
+                    let solved = part.solve(matrix, rhs, limit, &mut ctx);
+                    self.backoff.note(solved);
+                    if solved {
                         self.held = Held::Symmetric;
                         return Ok(());
                     }
@@ -654,11 +662,42 @@ impl LinearSolver {
     }
 }
 
+/// The fast paths' record on an unsymmetric pattern whose LU is affordable: after `k` failures
+/// in a row (a wrinkled film's skew part is too large for the Krylov space, and every attempt
+/// costs an LDLᵀ and [`KRYLOV_DIMENSION`](gmres::KRYLOV_DIMENSION) preconditioned products
+/// before the LU), the next `2^k − 1` solves (at most 31) go to LU directly; a success clears it.
+#[derive(Clone, Copy, Debug, Default)]
+struct FastBackoff {
+    failures: u32,
+    skip: u32,
+}
+
+impl FastBackoff {
+    /// Whether this solve tries the fast paths (always where LU is not `affordable`).
+    fn tries(&mut self, affordable: bool) -> bool {
+        if !affordable || self.skip == 0 {
+            return true;
+        }
+        self.skip -= 1;
+        false
+    }
+
+    /// Notes the outcome of a fast attempt.
+    fn note(&mut self, solved: bool) {
+        if solved {
+            *self = Self::default();
+        } else {
+            self.failures = (self.failures + 1).min(5);
+            self.skip = (1 << self.failures) - 1;
+        }
+    }
+}
+
 /// Most DOFs of the skew part for the Woodbury correction (its dense `|C| × |C|` system).
 const WOODBURY_MOST: usize = 512;
 
 /// LDLᵀ factors of up to this many values (32 MiB; the refined specimen up to ≈ 30 k DOF)
-/// let a cut-back step fall back to LU (see [`LinearSolver::lu_affordable`]).
+/// let LU replace fast paths that fail (see [`LinearSolver::lu_affordable`]).
 const LU_AFFORDABLE: usize = 1 << 22;
 
 /// Woodbury blocks of up to this many values are always affordable (512 KiB).

@@ -130,6 +130,44 @@ fn symmetric_matrix_the_ldlt_cannot_pivot_is_solved_by_the_lu() {
     assert_eq!((rhs[4], rhs[5]), (3.0, 1.0));
 }
 
+/// Fast paths that keep failing are skipped for `2^k − 1` solves after `k` failures in a row (at
+/// most 31), every solution still right; one that succeeds is tried at the next solve again.
+#[test]
+fn failing_fast_paths_are_skipped_for_twice_as_many_solves_after_each_failure() {
+    let system = system(false);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    let (v, rhs) = indefinite_pair(&system);
+    let mut attempts = Vec::new();
+    for _ in 0..16 {
+        let mut x = rhs.clone();
+        let redone = solver.counts()[2];
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut x)
+            .unwrap();
+        assert_eq!((x[4], x[5]), (3.0, 1.0));
+        attempts.push(solver.counts()[2] - redone);
+    }
+    // Tried at solves 1, 3 (after 1 skipped), 7 (after 3), 15 (after 7).
+    let tried: Vec<usize> = (0..16)
+        .filter(|&i| attempts[i] == 1)
+        .map(|i| i + 1)
+        .collect();
+    assert_eq!(tried, [1, 3, 7, 15]);
+    assert_eq!(solver.counts()[0], 16, "every solve by the LU");
+    // After a success the next solve tries them again.
+    let mut b = FastBackoff::default();
+    b.note(false);
+    assert!(!b.tries(true) && b.tries(true));
+    b.note(true);
+    assert!(b.tries(true));
+    (0..10).for_each(|_| b.note(false));
+    assert_eq!(b.skip, 31, "at most 31 skipped");
+    assert!(
+        b.tries(false),
+        "always tried where the LU is not affordable"
+    );
+}
+
 /// A diagonally dominant symmetric matrix on the six equations plus `skew` (row, column,
 /// value) added as `+v` at (row, column) and `−v` at (column, row).
 fn unsymmetric(skew: &[(usize, usize, f64)]) -> Vec<(usize, usize, f64)> {
