@@ -1,0 +1,279 @@
+//! Film-to-film contacts between layers as a contribution: the contact search at every
+//! evaluation (each slave node's nearest candidate triangle), the anchors carried from the
+//! increment's start (moved to the new triangle when the node has slid onto another one), the
+//! pairs' responses and the histories committed from them.
+
+use nalgebra::{Vector2, Vector3};
+
+use super::{Contribution, Evaluation};
+use crate::mech::elements::gap::GapStatus;
+use crate::mech::elements::layer_contact::{
+    EXTEND, LayerContactHistory, LayerContactResult, PairLaw, PairResponse, SlaveNode,
+    closest_point, inside, plane_coordinates, respond,
+};
+use crate::mech::model::Model;
+use crate::mech::results::Results;
+use crate::mech::solve::assembly::System;
+use crate::mech::solve::state::AnalysisState;
+
+/// Each slave node's response at the last evaluation.
+#[derive(Clone, Copy, Debug)]
+struct NodeResponse {
+    /// The candidate (index in the node's list) it was projected on, if any.
+    candidate: Option<usize>,
+    /// Its triangle (model index).
+    triangle: Option<usize>,
+    response: PairResponse,
+}
+
+/// The layer contacts with their trial history.
+#[derive(Clone, Debug, Default)]
+pub struct LayerContacts {
+    /// `(k_n, k_s, μ)` of each layer contact.
+    laws: Vec<(f64, f64, f64)>,
+    /// Each slave node's name in messages: `<contact>.<node>` or `<contact>.back.<node>`.
+    names: Vec<String>,
+    /// Histories at the start of the increment.
+    start: Vec<LayerContactHistory>,
+    /// Displacements at the start of the increment (where anchors are moved between triangles).
+    start_u: Vec<f64>,
+    /// Responses at the last evaluation.
+    responses: Vec<NodeResponse>,
+    /// Statuses imposed until the next restore ([`Contribution::hold`]; empty: none).
+    held: Vec<Option<GapStatus>>,
+    /// Reference node positions.
+    reference: Vec<Vector3<f64>>,
+}
+
+impl LayerContacts {
+    /// The layer contacts of `model` on `system` (whose setup holds the slave nodes).
+    pub fn new(model: &Model, system: &System) -> Self {
+        let names = system
+            .layer_contacts
+            .slaves
+            .iter()
+            .map(|s| {
+                let name = &model.layer_contacts[s.contact].name;
+                let back = if s.reverse { ".back" } else { "" };
+                format!("{name}{back}.{}", s.node)
+            })
+            .collect();
+        Self {
+            laws: model
+                .layer_contacts
+                .iter()
+                .map(|c| (c.normal_stiffness, c.tangential_stiffness, c.friction))
+                .collect(),
+            names,
+            reference: model.nodes.iter().map(|&p| Vector3::from(p)).collect(),
+            ..Self::default()
+        }
+    }
+
+    fn position(&self, u: &[f64], v: usize) -> Vector3<f64> {
+        self.reference[v] + Vector3::new(u[3 * v], u[3 * v + 1], u[3 * v + 2])
+    }
+
+    fn corners(&self, system: &System, u: &[f64], t: usize) -> [Vector3<f64>; 3] {
+        system.triangles[t].0.map(|v| self.position(u, v))
+    }
+
+    /// The candidate whose triangle is nearest to the slave at `u` and the node's `ξ` on it;
+    /// None where the projection falls outside the triangle by more than [`EXTEND`].
+    fn nearest(
+        &self,
+        system: &System,
+        slave: &SlaveNode,
+        u: &[f64],
+    ) -> Option<(usize, Vector2<f64>)> {
+        let x = self.position(u, slave.node);
+        let (k, (_, xi)) = slave
+            .candidates
+            .iter()
+            .map(|c| closest_point(&x, &self.corners(system, u, c.triangle)))
+            .enumerate()
+            .min_by(|a, b| a.1.0.total_cmp(&b.1.0))?;
+        (inside(&xi) >= -EXTEND).then_some((k, xi))
+    }
+
+    /// The histories of the reference configuration: each node anchored where it projects.
+    pub fn initial_histories(&self, system: &System) -> Vec<LayerContactHistory> {
+        let u = vec![0.0; self.reference.len() * 3];
+        system
+            .layer_contacts
+            .slaves
+            .iter()
+            .map(|s| match self.nearest(system, s, &u) {
+                Some((k, xi)) => LayerContactHistory {
+                    triangle: Some(s.candidates[k].triangle),
+                    anchor: xi.into(),
+                    ..LayerContactHistory::default()
+                },
+                None => LayerContactHistory::default(),
+            })
+            .collect()
+    }
+
+    /// The anchor of history `h` in triangle `t`: its own, or the anchor's point at the
+    /// increment's start expressed in `t` there (the node slid onto `t`); the node's `xi` where
+    /// it has none.
+    fn anchor_in(
+        &self,
+        system: &System,
+        h: &LayerContactHistory,
+        t: usize,
+        xi: Vector2<f64>,
+    ) -> Vector2<f64> {
+        match h.triangle {
+            Some(own) if own == t => Vector2::from(h.anchor),
+            Some(own) => {
+                let x = self.corners(system, &self.start_u, own);
+                let point = x[0] + (x[1] - x[0]) * h.anchor[0] + (x[2] - x[0]) * h.anchor[1];
+                plane_coordinates(&point, &self.corners(system, &self.start_u, t))
+            }
+            None => xi,
+        }
+    }
+
+    /// The response of slave `k` at `u` (open with no triangle where it projects on none).
+    fn respond_node(&self, system: &System, k: usize, u: &[f64]) -> NodeResponse {
+        let slave = &system.layer_contacts.slaves[k];
+        let h = &self.start[k];
+        let Some((c, xi)) = self.nearest(system, slave, u) else {
+            let open = respond(&[Vector3::zeros(); 4], Vector2::zeros(), &OPEN, None);
+            return NodeResponse {
+                candidate: None,
+                triangle: None,
+                response: PairResponse {
+                    gap: f64::MAX,
+                    ..open
+                },
+            };
+        };
+        let candidate = &slave.candidates[c];
+        let (kn, ks, mu) = self.laws[slave.contact];
+        let law = PairLaw {
+            kn,
+            ks,
+            mu,
+            sign: candidate.sign,
+        };
+        let t = self.corners(system, u, candidate.triangle);
+        let x = [self.position(u, slave.node), t[0], t[1], t[2]];
+        let anchor = self.anchor_in(system, h, candidate.triangle, xi);
+        let held = self.held.get(k).copied().flatten();
+        NodeResponse {
+            candidate: Some(c),
+            triangle: Some(candidate.triangle),
+            response: respond(&x, anchor, &law, held),
+        }
+    }
+}
+
+/// The law of a node that touches nothing (its response is open whatever it is).
+const OPEN: PairLaw = PairLaw {
+    kn: 0.0,
+    ks: 1.0,
+    mu: 0.0,
+    sign: -1.0,
+};
+
+impl Contribution for LayerContacts {
+    fn restore(&mut self, start: &AnalysisState) {
+        self.start.clone_from(&start.layer_contacts);
+        self.start_u.clone_from(&start.displacement);
+        self.held.clear();
+    }
+
+    fn hold(&mut self, held: &[Option<GapStatus>]) {
+        self.held = held.to_vec();
+    }
+
+    fn status_names(&self, out: &mut Vec<String>) {
+        out.extend(self.names.iter().cloned());
+    }
+
+    fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], mut values: Option<&mut [f64]>) {
+        let system = at.system;
+        let slaves = &system.layer_contacts.slaves;
+        if self.start.len() != slaves.len() {
+            self.start = self.initial_histories(system);
+            self.start_u = vec![0.0; at.u.len()];
+        }
+        self.responses.clear();
+        for k in 0..slaves.len() {
+            let r = self.respond_node(system, k, at.u);
+            self.responses.push(r);
+            let Some(c) = r.candidate else { continue };
+            let candidate = &slaves[k].candidates[c];
+            let tri = system.triangles[candidate.triangle].0;
+            for (i, v) in [slaves[k].node, tri[0], tri[1], tri[2]]
+                .into_iter()
+                .enumerate()
+            {
+                for j in 0..3 {
+                    residual[3 * v + j] += r.response.residual[3 * i + j];
+                }
+            }
+            if let Some(values) = values.as_deref_mut()
+                && r.response.status != GapStatus::Open
+            {
+                system.add_pair_matrix(candidate.block, &r.response.tangent, values);
+            }
+        }
+    }
+
+    fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {
+        state.layer_contacts = self
+            .responses
+            .iter()
+            .zip(&start.layer_contacts)
+            .map(|(r, h)| LayerContactHistory {
+                triangle: r.triangle,
+                anchor: r.response.next_anchor.into(),
+                status: r.response.status,
+                slip: h.slip + r.response.slip,
+            })
+            .collect();
+    }
+
+    fn statuses(&self, out: &mut Vec<GapStatus>) {
+        out.extend(self.responses.iter().map(|r| r.response.status));
+    }
+
+    fn gaps(&self, out: &mut Vec<f64>) {
+        out.extend(self.responses.iter().map(|r| r.response.gap));
+    }
+
+    fn results(
+        &self,
+        at: &Evaluation<'_>,
+        state: &AnalysisState,
+        _model: &Model,
+        out: &mut Results,
+    ) {
+        let mut me = self.clone();
+        me.start.clone_from(&state.layer_contacts);
+        me.start_u.clone_from(&state.displacement);
+        me.held.clear();
+        let slaves = &at.system.layer_contacts.slaves;
+        out.layer_contacts = (0..slaves.len())
+            .map(|k| {
+                let r = me.respond_node(at.system, k, at.u);
+                let s = &slaves[k];
+                let h = &state.layer_contacts[k];
+                LayerContactResult {
+                    name: me.names[k].clone(),
+                    node: s.node,
+                    triangle: r.triangle,
+                    gap: r.response.gap,
+                    normal_force: r.response.normal_force,
+                    pressure: r.response.normal_force / s.area.max(f64::MIN_POSITIVE),
+                    friction: r.response.friction.into(),
+                    slip: h.slip,
+                    status: h.status,
+                }
+            })
+            .collect();
+    }
+}
