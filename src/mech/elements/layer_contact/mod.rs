@@ -322,6 +322,24 @@ pub struct PairResponse {
     pub slip: f64,
 }
 
+impl PairResponse {
+    /// An open pair at `gap` whose node projects at `xi`: no force, no stiffness.
+    pub fn open(gap: f64, xi: Vector2<f64>) -> Self {
+        Self {
+            residual: PairVector::zeros(),
+            tangent: PairMatrix::zeros(),
+            status: GapStatus::Open,
+            normal_force: 0.0,
+            gap,
+            friction: Vector3::zeros(),
+            xi,
+            // An open pair forgets its anchor: it sticks where it touches down next.
+            next_anchor: xi,
+            slip: 0.0,
+        }
+    }
+}
+
 /// The pair's response at positions `x` (slave, then the triangle's nodes) from the anchor
 /// `anchor` (`ξ̄` in this triangle), with the friction status `held` imposed where closed
 /// (None: the law's own).
@@ -349,18 +367,7 @@ pub fn respond(
     let xi2 = (g11 * b2 - g12 * b1) / det;
     let gap = dual::dot(&r, &n);
     let xi = Vector2::new(xi1.v, xi2.v);
-    let mut out = PairResponse {
-        residual: PairVector::zeros(),
-        tangent: PairMatrix::zeros(),
-        status: GapStatus::Open,
-        normal_force: 0.0,
-        gap: gap.v,
-        friction: Vector3::zeros(),
-        xi,
-        // An open pair forgets its anchor: it sticks where it touches down next.
-        next_anchor: xi,
-        slip: 0.0,
-    };
+    let mut out = PairResponse::open(gap.v, xi);
     if gap.v >= 0.0 {
         return out;
     }

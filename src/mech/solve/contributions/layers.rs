@@ -29,8 +29,8 @@ struct NodeResponse {
 /// The layer contacts with their trial history.
 #[derive(Clone, Debug, Default)]
 pub struct LayerContacts {
-    /// `(k_n, k_s, μ)` of each layer contact.
-    laws: Vec<(f64, f64, f64)>,
+    /// `(k_n, k_s, μ, search distance)` of each layer contact.
+    laws: Vec<(f64, f64, f64, f64)>,
     /// Each slave node's name in messages: `<contact>.<node>` or `<contact>.back.<node>`.
     names: Vec<String>,
     /// Histories at the start of the increment.
@@ -62,7 +62,14 @@ impl LayerContacts {
             laws: model
                 .layer_contacts
                 .iter()
-                .map(|c| (c.normal_stiffness, c.tangential_stiffness, c.friction))
+                .map(|c| {
+                    (
+                        c.normal_stiffness,
+                        c.tangential_stiffness,
+                        c.friction,
+                        c.search_distance,
+                    )
+                })
                 .collect(),
             names,
             reference: model.nodes.iter().map(|&p| Vector3::from(p)).collect(),
@@ -140,18 +147,15 @@ impl LayerContacts {
         let slave = &system.layer_contacts.slaves[k];
         let h = &self.start[k];
         let Some((c, xi)) = self.nearest(system, slave, u) else {
-            let open = respond(&[Vector3::zeros(); 4], Vector2::zeros(), &OPEN, None);
+            // Nothing within reach: open, its gap as large as the search's reach.
             return NodeResponse {
                 candidate: None,
                 triangle: None,
-                response: PairResponse {
-                    gap: f64::MAX,
-                    ..open
-                },
+                response: PairResponse::open(self.laws[slave.contact].3, Vector2::zeros()),
             };
         };
         let candidate = &slave.candidates[c];
-        let (kn, ks, mu) = self.laws[slave.contact];
+        let (kn, ks, mu, _) = self.laws[slave.contact];
         let law = PairLaw {
             kn,
             ks,
@@ -169,14 +173,6 @@ impl LayerContacts {
         }
     }
 }
-
-/// The law of a node that touches nothing (its response is open whatever it is).
-const OPEN: PairLaw = PairLaw {
-    kn: 0.0,
-    ks: 1.0,
-    mu: 0.0,
-    sign: -1.0,
-};
 
 impl Contribution for LayerContacts {
     fn restore(&mut self, start: &AnalysisState) {
