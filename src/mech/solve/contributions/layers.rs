@@ -273,3 +273,123 @@ impl Contribution for LayerContacts {
             .collect();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mech::elements::gap::IterationMatrix;
+    use crate::mech::elements::layer_contact::{LayerContactSpec, LayerSurface, Side};
+    use crate::mech::elements::load::LoadLevels;
+    use crate::mech::solve::assembly::Dof;
+
+    /// A unit square of two master triangles and one slave triangle over it, pressed in.
+    fn model() -> Model {
+        let json = serde_json::json!({
+            "name": "Touch",
+            "nodes": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+                      [0.3, 0.2, 0.01], [0.7, 0.3, 0.01], [0.4, 0.7, 0.01]],
+            "triangles": [[0, 1, 2], [0, 2, 3], [4, 5, 6]],
+            "material": crate::specimens::ParallelArch::default().material,
+            "layer_contacts": [{
+                "name": "T", "slave": [2], "master": [0, 1], "normal_stiffness": 1e5,
+                "tangential_stiffness": 1e4, "friction": 0.3, "search_distance": 1.0
+            }]
+        });
+        let model: Model = serde_json::from_value(json).unwrap();
+        assert_eq!(model.layer_contacts[0].side, Side::Front);
+        assert_eq!(
+            model.layer_contacts[0].master,
+            LayerSurface::Triangles(vec![0, 1])
+        );
+        let _ = LayerContactSpec::triangles(&model, &model.layer_contacts[0].slave).unwrap();
+        model
+    }
+
+    /// Residual and matrix (dense, free DOFs) of the layer contacts at `u`.
+    fn assemble(lc: &mut LayerContacts, system: &System, u: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let levels = LoadLevels::default();
+        let at = Evaluation {
+            system,
+            u,
+            levels: &levels,
+            iteration: Some(1),
+            matrix: IterationMatrix::Consistent,
+        };
+        let mut residual = vec![0.0; u.len()];
+        let mut values = vec![0.0; system.nonzeros()];
+        lc.add(&at, &mut residual, Some(&mut values));
+        let n = system.free_count;
+        let mut dense = vec![0.0; n * n];
+        let pattern = system.pattern();
+        let (col_ptr, row_idx) = (pattern.col_ptr(), pattern.row_idx());
+        for j in 0..n {
+            for s in col_ptr[j]..col_ptr[j + 1] {
+                dense[row_idx[s] * n + j] += values[s];
+            }
+        }
+        (residual, dense)
+    }
+
+    #[test]
+    fn assembled_tangent_matches_central_differences_across_triangles_and_statuses() {
+        let model = model();
+        let system = System::new(&model, false).unwrap();
+        let mut lc = LayerContacts::new(&model, &system);
+        // Slave nodes pressed 10 mm in; the master's far corner lifted (a fold between its
+        // triangles). Node 4 sticks 5 mm from its anchor, node 5 slides 0.1 m from its own, and
+        // node 6 slid from triangle 0 onto triangle 1 (its anchor moved across the fold).
+        let mut u = vec![0.0; 21];
+        u[3 * 2 + 2] = 0.003;
+        for v in 4..7 {
+            u[3 * v + 2] = -0.02;
+        }
+        // Anchors in triangle 0 (a1 = x̂, a2 = x̂ + ŷ): ξ = (px − py, py).
+        let anchor = |px: f64, py: f64| [px - py, py];
+        lc.start = vec![
+            LayerContactHistory {
+                triangle: Some(0),
+                anchor: anchor(0.305, 0.2),
+                status: GapStatus::Stick,
+                slip: 0.0,
+            },
+            LayerContactHistory {
+                triangle: Some(0),
+                anchor: anchor(0.6, 0.3),
+                status: GapStatus::Stick,
+                slip: 0.0,
+            },
+            LayerContactHistory {
+                triangle: Some(0),
+                anchor: anchor(0.42, 0.69),
+                status: GapStatus::Stick,
+                slip: 0.0,
+            },
+        ];
+        lc.start_u = vec![0.0; 21];
+        let (_, k) = assemble(&mut lc, &system, &u);
+        let statuses: Vec<_> = lc.responses.iter().map(|r| r.response.status).collect();
+        assert_eq!(
+            statuses,
+            [GapStatus::Stick, GapStatus::Slip, GapStatus::Stick]
+        );
+        assert_eq!(lc.responses[2].triangle, Some(1));
+        let n = system.free_count;
+        let h = 1e-7;
+        let mut worst: f64 = 0.0;
+        for (gj, dof) in system.dofs.iter().enumerate() {
+            let Dof::Free(j) = *dof else { continue };
+            let (mut plus, mut minus) = (u.clone(), u.clone());
+            plus[gj] += h;
+            minus[gj] -= h;
+            let (rp, _) = assemble(&mut lc, &system, &plus);
+            let (rm, _) = assemble(&mut lc, &system, &minus);
+            for (gi, row) in system.dofs.iter().enumerate() {
+                let Dof::Free(i) = *row else { continue };
+                let fd = (rp[gi] - rm[gi]) / (2.0 * h);
+                worst = worst.max((fd - k[i * n + j]).abs());
+            }
+        }
+        let scale = k.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(worst < 1e-6 * scale, "worst {worst:e} of {scale:e}");
+    }
+}
