@@ -228,3 +228,12 @@ fn a_layer_contact_naming_an_unknown_layer_is_refused_by_name() {
     let err = model.validate().unwrap_err().to_string();
     assert!(err.contains("'Touch'") && err.contains("friction"), "{err}");
 }
+
+#[test]
+fn the_example_is_the_two_way_pressed_model_of_these_tests() {
+    let (mut model, _) = two_layers(false, true);
+    model.description = "A 1 m square top layer pressed by 400 Pa of snow onto a fixed 1.5 m \
+                         bottom layer, in two-way frictional contact (tests/layer_contact.rs)"
+        .into();
+    common::assert_example_file("two_layers_touching.json", &model);
+}

@@ -468,5 +468,41 @@ pub struct LayerContactResult {
     pub status: GapStatus,
 }
 
+/// One line per layer contact: its total normal force, nodes in contact (of which sliding),
+/// largest contact pressure and slip (the CLI's report).
+pub fn summary(model: &Model, results: &crate::mech::results::Results) -> Vec<String> {
+    model
+        .layer_contacts
+        .iter()
+        .map(|spec| {
+            let own = results
+                .layer_contacts
+                .iter()
+                .filter(|c| c.name.split('.').next() == Some(spec.name.as_str()));
+            let (mut force, mut closed, mut sliding, mut pressure, mut slip) =
+                (0.0, 0, 0, 0.0f64, 0.0f64);
+            for c in own {
+                force += c.normal_force;
+                closed += usize::from(c.status != GapStatus::Open);
+                sliding += usize::from(c.status == GapStatus::Slip);
+                pressure = pressure.max(c.pressure);
+                slip = slip.max(c.slip);
+            }
+            format!(
+                "layer contact {}: normal force {force:.3} N, {closed} nodes in contact \
+                 ({sliding} sliding), largest contact pressure {pressure:.3} Pa, largest slip \
+                 {:.3} mm{}",
+                spec.name,
+                slip * 1e3,
+                if spec.both_ways {
+                    " (two-way: each pass carries about half the pressure between the layers)"
+                } else {
+                    ""
+                }
+            )
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests;
