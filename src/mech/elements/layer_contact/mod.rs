@@ -450,6 +450,8 @@ impl Default for LayerContactHistory {
 pub struct LayerContactResult {
     /// `<contact>.<node>` (forward pass) or `<contact>.back.<node>` (reverse pass).
     pub name: String,
+    /// The layer contact (model order).
+    pub contact: usize,
     /// The slave node.
     pub node: usize,
     /// The master triangle it is projected on (None: none within reach).
@@ -468,32 +470,54 @@ pub struct LayerContactResult {
     pub status: GapStatus,
 }
 
+/// What a layer contact carries over all its slave nodes (both passes).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Totals {
+    /// Total normal force (N).
+    pub normal_force: f64,
+    /// Nodes in contact.
+    pub closed: usize,
+    /// Nodes sliding.
+    pub sliding: usize,
+    /// Largest contact pressure (Pa).
+    pub max_pressure: f64,
+    /// Largest slip (m).
+    pub max_slip: f64,
+}
+
+impl Totals {
+    /// The totals of layer contact `k` in `results`.
+    pub fn of(results: &crate::mech::results::Results, k: usize) -> Self {
+        let mut t = Self::default();
+        for c in results.layer_contacts.iter().filter(|c| c.contact == k) {
+            t.normal_force += c.normal_force;
+            t.closed += usize::from(c.status != GapStatus::Open);
+            t.sliding += usize::from(c.status == GapStatus::Slip);
+            t.max_pressure = t.max_pressure.max(c.pressure);
+            t.max_slip = t.max_slip.max(c.slip);
+        }
+        t
+    }
+}
+
 /// One line per layer contact: its total normal force, nodes in contact (of which sliding),
 /// largest contact pressure and slip (the CLI's report).
 pub fn summary(model: &Model, results: &crate::mech::results::Results) -> Vec<String> {
     model
         .layer_contacts
         .iter()
-        .map(|spec| {
-            let own = results
-                .layer_contacts
-                .iter()
-                .filter(|c| c.name.split('.').next() == Some(spec.name.as_str()));
-            let (mut force, mut closed, mut sliding, mut pressure, mut slip) =
-                (0.0, 0, 0, 0.0f64, 0.0f64);
-            for c in own {
-                force += c.normal_force;
-                closed += usize::from(c.status != GapStatus::Open);
-                sliding += usize::from(c.status == GapStatus::Slip);
-                pressure = pressure.max(c.pressure);
-                slip = slip.max(c.slip);
-            }
+        .enumerate()
+        .map(|(k, spec)| {
+            let t = Totals::of(results, k);
             format!(
-                "layer contact {}: normal force {force:.3} N, {closed} nodes in contact \
-                 ({sliding} sliding), largest contact pressure {pressure:.3} Pa, largest slip \
-                 {:.3} mm{}",
+                "layer contact {}: normal force {:.3} N, {} nodes in contact ({} sliding), \
+                 largest contact pressure {:.3} Pa, largest slip {:.3} mm{}",
                 spec.name,
-                slip * 1e3,
+                t.normal_force,
+                t.closed,
+                t.sliding,
+                t.max_pressure,
+                t.max_slip * 1e3,
                 if spec.both_ways {
                     " (two-way: each pass carries about half the pressure between the layers)"
                 } else {

@@ -260,6 +260,7 @@ impl Contribution for LayerContacts {
                 let h = &state.layer_contacts[k];
                 LayerContactResult {
                     name: me.names[k].clone(),
+                    contact: s.contact,
                     node: s.node,
                     triangle: r.triangle,
                     gap: r.response.gap,
