@@ -5,7 +5,8 @@
 //! snow pressure `p` pressing it down. Closed forms: the contact pressure is `p` at every node
 //! away from the held corner, and the contact forces plus the corner's reaction are `p A`;
 //! pulled sideways as a whole, the top layer sticks with `k_s δ` per node and slides once the
-//! force reaches `μ N` (then exactly `μ N`).
+//! force reaches `μ N` (then exactly `μ N`). A clamped disc pressed into an identical one
+//! that shares its rim (frictionless) rises with it as one disc of twice the thickness.
 
 mod common;
 
@@ -236,4 +237,86 @@ fn the_example_is_the_two_way_pressed_model_of_these_tests() {
                          bottom layer, in two-way frictional contact (tests/layer_contact.rs)"
         .into();
     common::assert_example_file("two_layers_touching.json", &model);
+}
+
+/// A clamped disc (`CircularMembrane`, 4 rings, radius 1 m) and a second identical layer on it
+/// sharing its rim (both clamped in one extrusion), the first pressed into the second by
+/// `pressure`; frictionless. Returns the model and the second layer's centre node.
+fn pressed_pair_of_discs(pressure: f64) -> (Model, usize) {
+    let disc = disc(1.0, pressure);
+    let mut model = disc.model().unwrap();
+    let rim: Vec<usize> = disc.ring(disc.rings).collect();
+    let first = model.triangles.len();
+    let n = model.nodes.len();
+    // Interior nodes doubled; the rim shared.
+    let copy = |v: usize| if rim.contains(&v) { v } else { n + v };
+    for v in 0..n {
+        model.nodes.push(model.nodes[v]);
+    }
+    let second: Vec<[usize; 3]> = model.triangles.iter().map(|t| t.map(copy)).collect();
+    model.triangles.extend(second);
+    // Rim copies are unused: hold them so that the model stays well posed.
+    for &v in &rim {
+        model.supports.push(Support {
+            node: n + v,
+            fixed: vec![Axis::X, Axis::Y, Axis::Z],
+            name: None,
+        });
+    }
+    model.loads.pressures[0].elements =
+        membrane_contact::mech::model::ElementSelection::List((0..first).collect());
+    model.layer_contacts.push(LayerContactSpec {
+        name: "Touch".into(),
+        slave: LayerSurface::Triangles((0..first).collect()),
+        master: LayerSurface::Triangles((first..2 * first).collect()),
+        // The pressure pushes the first layer along its normal (+z) into the second.
+        side: Side::Back,
+        both_ways: false,
+        normal_stiffness: 1e6,
+        tangential_stiffness: 1e5,
+        friction: 0.0,
+        friction_law: Default::default(),
+        search_distance: 0.3,
+    });
+    (model, n)
+}
+
+/// The 4-ring disc of radius 1 m of the specimens' film, its thickness `scale` times theirs.
+fn disc(scale: f64, pressure: f64) -> membrane_contact::specimens::scenarios::CircularMembrane {
+    let mut material = membrane_contact::specimens::ParallelArch::default().material;
+    material.thickness *= scale;
+    membrane_contact::specimens::scenarios::CircularMembrane {
+        radius: 1.0,
+        rings: 4,
+        material,
+        pressure,
+    }
+}
+
+/// The centre's rise of `model` (node `centre`) under its pressure.
+fn centre_rise(model: Model, nodes: &[usize]) -> Vec<f64> {
+    let levels = LoadLevels::of_model(&model);
+    let mut analysis = Analysis::new(model, settings()).unwrap();
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+        .unwrap();
+    nodes
+        .iter()
+        .map(|&v| analysis.node_displacement(v).z)
+        .collect()
+}
+
+#[test]
+fn two_discs_pressed_together_deflect_as_one_disc_of_twice_the_thickness() {
+    let p = 100.0;
+    let (model, second_centre) = pressed_pair_of_discs(p);
+    let pair = centre_rise(model, &[0, second_centre]);
+    let one = centre_rise(disc(2.0, p).model().unwrap(), &[0])[0];
+    assert!(one > 0.01, "{one}");
+    for w in pair {
+        assert!(
+            (w - one).abs() < 2e-4 * one,
+            "layer centre {w} m vs one disc of 2t {one} m"
+        );
+    }
 }

@@ -85,15 +85,28 @@ impl LayerContacts {
         system.triangles[t].0.map(|v| self.position(u, v))
     }
 
-    /// The candidate whose triangle is nearest to the slave at `u` and the node's `ξ` on it;
-    /// None where the projection falls outside the triangle by more than [`EXTEND`].
+    /// The candidate the slave at `u` is projected on and the node's `ξ` on it: the triangle
+    /// `keep` (the history's) while the projection stays in it (within [`EXTEND`]), else the
+    /// nearest; None where the projection falls outside that one by more than [`EXTEND`].
+    /// Keeping the triangle keeps the residual smooth within an increment where a node sits
+    /// over an edge or a vertex of a curved master, whose triangles' normals differ: choosing
+    /// the nearest afresh there flips between them at round-off, and Newton stalls.
     fn nearest(
         &self,
         system: &System,
         slave: &SlaveNode,
         u: &[f64],
+        keep: Option<usize>,
     ) -> Option<(usize, Vector2<f64>)> {
         let x = self.position(u, slave.node);
+        let kept = keep.and_then(|t| slave.candidates.iter().position(|c| c.triangle == t));
+        if let Some(k) = kept {
+            let t = self.corners(system, u, slave.candidates[k].triangle);
+            let xi = plane_coordinates(&x, &t);
+            if inside(&xi) >= -EXTEND {
+                return Some((k, xi));
+            }
+        }
         let (k, (_, xi)) = slave
             .candidates
             .iter()
@@ -110,7 +123,7 @@ impl LayerContacts {
             .layer_contacts
             .slaves
             .iter()
-            .map(|s| match self.nearest(system, s, &u) {
+            .map(|s| match self.nearest(system, s, &u, None) {
                 Some((k, xi)) => LayerContactHistory {
                     triangle: Some(s.candidates[k].triangle),
                     anchor: xi.into(),
@@ -146,7 +159,7 @@ impl LayerContacts {
     fn respond_node(&self, system: &System, k: usize, u: &[f64]) -> NodeResponse {
         let slave = &system.layer_contacts.slaves[k];
         let h = &self.start[k];
-        let Some((c, xi)) = self.nearest(system, slave, u) else {
+        let Some((c, xi)) = self.nearest(system, slave, u, h.triangle) else {
             // Nothing within reach: open, its gap as large as the search's reach.
             return NodeResponse {
                 candidate: None,
