@@ -73,6 +73,8 @@ impl Neg for Dual {
     }
 }
 
+// The product and quotient rules mix the operations.
+#[allow(clippy::suspicious_arithmetic_impl)]
 impl Mul for Dual {
     type Output = Dual;
     fn mul(self, o: Dual) -> Dual {
@@ -90,6 +92,7 @@ impl Mul<f64> for Dual {
     }
 }
 
+#[allow(clippy::suspicious_arithmetic_impl)]
 impl Div for Dual {
     type Output = Dual;
     fn div(self, o: Dual) -> Dual {

@@ -392,10 +392,10 @@ pub fn respond(
     };
     let force = dual::add(&dual::scale(&n, lambda), &f);
     let shape = [Dual::constant(1.0) - xi1 - xi2, xi1, xi2];
-    for k in 0..3 {
-        let rows = [-force[k]]
+    for (k, &component) in force.iter().enumerate() {
+        let rows = [-component]
             .into_iter()
-            .chain(shape.iter().map(|&s| s * force[k]));
+            .chain(shape.iter().map(|&s| s * component));
         for (i, value) in rows.enumerate() {
             out.residual[3 * i + k] = value.v;
             for j in 0..12 {

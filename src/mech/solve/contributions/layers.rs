@@ -210,16 +210,13 @@ impl Contribution for LayerContacts {
             self.start_u = vec![0.0; at.u.len()];
         }
         self.responses.clear();
-        for k in 0..slaves.len() {
+        for (k, slave) in slaves.iter().enumerate() {
             let r = self.respond_node(system, k, at.u);
             self.responses.push(r);
             let Some(c) = r.candidate else { continue };
-            let candidate = &slaves[k].candidates[c];
+            let candidate = &slave.candidates[c];
             let tri = system.triangles[candidate.triangle].0;
-            for (i, v) in [slaves[k].node, tri[0], tri[1], tri[2]]
-                .into_iter()
-                .enumerate()
-            {
+            for (i, v) in [slave.node, tri[0], tri[1], tri[2]].into_iter().enumerate() {
                 for j in 0..3 {
                     residual[3 * v + j] += r.response.residual[3 * i + j];
                 }
