@@ -216,7 +216,7 @@ fn both_ways_contact_carries_the_same_resultant() {
 }
 
 #[test]
-fn a_layer_contact_naming_an_unknown_layer_is_refused_by_name() {
+fn a_malformed_layer_contact_is_refused_naming_it_and_the_fault() {
     let (mut model, _) = two_layers(false, false);
     model.layer_contacts[0].master = LayerSurface::Layer("Middle".into());
     let err = model.validate().unwrap_err().to_string();
@@ -228,6 +228,27 @@ fn a_layer_contact_naming_an_unknown_layer_is_refused_by_name() {
     model.layer_contacts[0].friction = -0.1;
     let err = model.validate().unwrap_err().to_string();
     assert!(err.contains("'Touch'") && err.contains("friction"), "{err}");
+    let (mut model, _) = two_layers(false, false);
+    model.layer_contacts[0].master = LayerSurface::Triangles(vec![3, 80]);
+    let err = model.validate().unwrap_err().to_string();
+    assert!(
+        err.contains("'Touch'") && err.contains("triangle 80 is in both"),
+        "{err}"
+    );
+    let (mut model, _) = two_layers(false, false);
+    model.layer_contacts[0].slave = LayerSurface::Triangles(vec![500]);
+    let err = model.validate().unwrap_err().to_string();
+    assert!(
+        err.contains("'Touch'") && err.contains("slave triangle 500"),
+        "{err}"
+    );
+    let (mut model, _) = two_layers(false, false);
+    model.layer_contacts[0].friction_law = membrane_contact::mech::FrictionLaw::SlidingDirection;
+    let err = model.validate().unwrap_err().to_string();
+    assert!(
+        err.contains("'Touch'") && err.contains("isotropic"),
+        "{err}"
+    );
 }
 
 #[test]
