@@ -28,8 +28,9 @@
 //! **Search.** Each slave node's candidate triangles are those of the master within
 //! `search_distance` of it in the reference configuration (brute force once at setup,
 //! `O(slave nodes × master triangles)`; they also fix the sparsity pattern). At every
-//! evaluation the node takes the candidate whose closest point (clamped to the triangle) is
-//! nearest: `O(candidates)` per node and iterate. A node that leaves its candidates' reach loses
+//! evaluation the node keeps its history's triangle while it projects in it, else takes the
+//! candidate whose closest point (clamped to the triangle) is nearest: `O(candidates)` per node
+//! and iterate. A node that leaves its candidates' reach loses
 //! contact: choose `search_distance` above the largest sliding expected.
 //!
 //! | file | what |

@@ -1,5 +1,6 @@
 //! Film-to-film contacts between layers as a contribution: the contact search at every
-//! evaluation (each slave node's nearest candidate triangle), the anchors carried from the
+//! evaluation (each slave node keeps its history's triangle while it projects in it, else takes
+//! the nearest candidate), the anchors carried from the
 //! increment's start (moved to the new triangle when the node has slid onto another one), the
 //! pairs' responses and the histories committed from them.
 
