@@ -341,3 +341,34 @@ fn two_discs_pressed_together_deflect_as_one_disc_of_twice_the_thickness() {
         );
     }
 }
+
+#[test]
+fn frictional_discs_stick_and_both_iteration_matrices_reach_the_same_state() {
+    use membrane_contact::mech::IterationMatrix;
+    let one = centre_rise(disc(2.0, 100.0).model().unwrap(), &[0])[0];
+    let mut rises = vec![];
+    for matrix in [IterationMatrix::Consistent, IterationMatrix::JuRowlands] {
+        let (mut model, second_centre) = pressed_pair_of_discs(100.0);
+        model.layer_contacts[0].friction = 0.3;
+        let levels = LoadLevels::of_model(&model);
+        let settings = SolverSettings {
+            iteration_matrix: matrix,
+            ..settings()
+        };
+        let mut analysis = Analysis::new(model, settings).unwrap();
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+            .unwrap();
+        let r = analysis.results();
+        // Identical layers strain alike: nothing slides between them.
+        assert!(r.layer_contacts.iter().all(|c| c.status != GapStatus::Slip));
+        let w = [0, second_centre].map(|v| analysis.node_displacement(v).z);
+        for w in w {
+            assert!((w - one).abs() < 2e-4 * one, "{matrix:?}: {w} vs {one}");
+        }
+        rises.push(w);
+    }
+    for k in 0..2 {
+        assert!((rises[0][k] - rises[1][k]).abs() < 1e-8 * one, "{rises:?}");
+    }
+}
