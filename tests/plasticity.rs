@@ -71,6 +71,7 @@ fn strip(nx: usize) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        layer_contacts: vec![],
         name: "Strip".into(),
         description: String::new(),
         nodes,

@@ -65,5 +65,6 @@ pub fn sheet(n: usize) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        layer_contacts: vec![],
     }
 }

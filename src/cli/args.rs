@@ -280,6 +280,10 @@ pub struct RunArgs {
     /// Write the element results (stresses, strains, wrinkling state) of every step as CSV.
     #[arg(long, value_name = "FILE")]
     pub elements_csv: Option<PathBuf>,
+    /// Write the layer contacts' results (gap, normal force, contact pressure, friction, slip
+    /// and status of every slave node) of every step as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub layer_contacts_csv: Option<PathBuf>,
     /// Write the reactions per unit length along every boundary group and named support set
     /// of every step as CSV (N/m: each node's reaction over its tributary length, half its film
     /// edges along the line).

@@ -390,6 +390,7 @@ impl Progress {
 struct CsvFiles {
     gaps: Option<(std::fs::File, String)>,
     elements: Option<(std::fs::File, String)>,
+    layers: Option<(std::fs::File, String)>,
 }
 
 impl CsvFiles {
@@ -410,6 +411,11 @@ impl CsvFiles {
                 &o.csv,
                 "step,fraction,gap,slip_x_mm,slip_y_mm,normal_force_N,friction_force_N,status",
             )?,
+            layers: open(
+                &o.layer_contacts_csv,
+                "step,time,contact,node,triangle,gap_m,normal_force_N,pressure_Pa,\
+                 friction_x_N,friction_y_N,friction_z_N,slip_mm,status",
+            )?,
             elements: open(
                 &o.elements_csv,
                 &format!(
@@ -427,7 +433,7 @@ impl CsvFiles {
     }
 
     fn any(&self) -> bool {
-        self.gaps.is_some() || self.elements.is_some()
+        self.gaps.is_some() || self.elements.is_some() || self.layers.is_some()
     }
 
     fn write_step(
@@ -448,6 +454,27 @@ impl CsvFiles {
                     r.normal_force,
                     r.friction_force,
                     r.status
+                )
+                .map_err(|e| format!("{name}: {e}"))?;
+            }
+        }
+        if let Some((f, name)) = self.layers.as_mut() {
+            for c in &results.layer_contacts {
+                let [fx, fy, fz] = c.friction;
+                writeln!(
+                    f,
+                    "{step},{time},{},{},{},{:e},{:e},{:e},{:e},{:e},{:e},{:.6},{:?}",
+                    c.name,
+                    c.node,
+                    c.triangle.map_or(String::new(), |t| t.to_string()),
+                    c.gap,
+                    c.normal_force,
+                    c.pressure,
+                    fx,
+                    fy,
+                    fz,
+                    c.slip * 1e3,
+                    c.status
                 )
                 .map_err(|e| format!("{name}: {e}"))?;
             }
@@ -658,6 +685,9 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             c.friction_force,
             c.status
         );
+    }
+    for line in membrane_contact::mech::elements::layer_contact::summary(model, results) {
+        out!("{line}");
     }
     for (i, (g, r)) in model.groups.iter().zip(&results.reactions).enumerate() {
         out!(

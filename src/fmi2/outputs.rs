@@ -154,8 +154,16 @@ pub(super) fn state_result(binding: &Binding, results: &Results) -> Option<f64> 
         Binding::ChamberVolume(k) => results.chambers[k].volume,
         Binding::ChamberTemperature(k) => results.chambers[k].temperature,
         Binding::ChamberMass(k) => results.chambers[k].mass,
+        Binding::LayerNormalForce(k) => totals(results, k).0,
+        Binding::LayerMaxSlip(k) => totals(results, k).1,
         _ => return None,
     })
+}
+
+/// Layer contact `k`'s total normal force and largest slip.
+fn totals(results: &Results, k: usize) -> (f64, f64) {
+    let t = crate::mech::elements::layer_contact::Totals::of(results, k);
+    (t.normal_force, t.max_slip)
 }
 
 /// Whether `binding` is one of [`state_result`]'s.
@@ -182,5 +190,7 @@ pub(super) fn is_state_result(binding: &Binding) -> bool {
             | Binding::ChamberVolume(_)
             | Binding::ChamberTemperature(_)
             | Binding::ChamberMass(_)
+            | Binding::LayerNormalForce(_)
+            | Binding::LayerMaxSlip(_)
     )
 }

@@ -229,6 +229,10 @@ pub enum Binding {
     ChamberPressure(usize),
     /// Volume of a chamber.
     ChamberVolume(usize),
+    /// Total normal force of a layer contact (both passes).
+    LayerNormalForce(usize),
+    /// Largest slip between the layers of a layer contact.
+    LayerMaxSlip(usize),
     SurfaceStatus(usize),
     /// Displacement of an output point along axis 0, 1, 2.
     PointDisplacement {

@@ -800,6 +800,23 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         );
     }
     chamber_outputs(&mut table, model);
+    for (k, c) in model.layer_contacts.iter().enumerate() {
+        table.output(
+            &format!("{}.normalForce", c.name),
+            "N",
+            &format!(
+                "total normal force between the layers of contact '{}'",
+                c.name
+            ),
+            Binding::LayerNormalForce(k),
+        );
+        table.output(
+            &format!("{}.maxSlip", c.name),
+            "m",
+            &format!("largest slip between the layers of contact '{}'", c.name),
+            Binding::LayerMaxSlip(k),
+        );
+    }
     for (point, p) in model.outputs.points.iter().enumerate() {
         for (axis, a) in ["ux", "uy", "uz"].iter().enumerate() {
             table.output(

@@ -322,6 +322,14 @@ fn expected(name: &str, model: &Model, r: &Results, report: &StepReport) -> Valu
             "mass" => Some(Value::Real(r.chambers[c].mass)),
             _ => None,
         }
+    } else if let Some(c) = model.layer_contacts.iter().position(|c| c.name == prefix) {
+        // Summed here over the slave nodes, not through `Totals`.
+        let own = r.layer_contacts.iter().filter(|n| n.contact == c);
+        match suffix {
+            "normalForce" => Some(Value::Real(own.map(|n| n.normal_force).sum())),
+            "maxSlip" => Some(Value::Real(own.map(|n| n.slip).fold(0.0, f64::max))),
+            _ => None,
+        }
     } else if let Some((support, node)) = prefix.split_once(".node") {
         // Curved-support contacts in model order: supports, then their nodes.
         let mut k = 0;
@@ -729,6 +737,48 @@ fn every_parameter_and_input_of_the_cushion_with_a_chamber_reaches_the_solver() 
                 "air.massFlow",
                 "air is fed into a sealed chamber only, and the one step here inflates from the \
                  supply (fmi2/tests/stepping.rs feeds a sealed chamber and checks its mass)",
+            ),
+        ],
+    );
+}
+
+/// Two film layers pressed together by snow (`examples/two_layers_touching.json`): the layer
+/// contact's outputs (`Touch.normalForce`, `Touch.maxSlip`) equal the core's.
+#[test]
+fn every_parameter_and_input_of_two_touching_layers_reaches_the_solver() {
+    check_every_variable(
+        "two layers",
+        Source::Model(example("two_layers_touching.json")),
+        &[("solver.incrementsPerStep", Value::Integer(2))],
+        &[
+            NOTHING_SLIDES,
+            NEVER_WRINKLES,
+            (
+                "gravity.x",
+                "the film has no density: gravity weighs nothing",
+            ),
+            (
+                "gravity.y",
+                "the film has no density: gravity weighs nothing",
+            ),
+            (
+                "gravity.z",
+                "the film has no density: gravity weighs nothing",
+            ),
+            (
+                "solver.displacementTolerance",
+                "the penalty contact of a flat layer reaches round-off in the same iterations at \
+                 either tolerance",
+            ),
+            (
+                "solver.residualTolerance",
+                "the penalty contact of a flat layer reaches round-off in the same iterations at \
+                 either tolerance",
+            ),
+            (
+                "solver.useJuRowlands",
+                "pressed without sliding, the layer contact's tangent is symmetric: both matrices \
+                 are the same",
             ),
         ],
     );

@@ -408,6 +408,7 @@ impl ParallelArch {
             curved_supports,
             chambers: vec![],
             layers: vec![],
+            layer_contacts: vec![],
             name: MODEL_NAME.into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

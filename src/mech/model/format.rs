@@ -487,6 +487,10 @@ pub struct Model {
     /// no layer have the material's.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub layers: Vec<Layer>,
+    /// Pairs of film layers that may touch: node-to-surface friction contact between them
+    /// ([`crate::mech::elements::layer_contact`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub layer_contacts: Vec<crate::mech::elements::layer_contact::LayerContactSpec>,
 }
 
 /// A set of film triangles with a thickness of its own (the material's elasticity, prestress

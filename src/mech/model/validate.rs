@@ -13,6 +13,7 @@ use nalgebra::Vector3;
 use super::format::*;
 use crate::mech::elements::curved_contact::Centreline;
 use crate::mech::elements::curved_contact::SurfaceContact;
+use crate::mech::elements::gap::FrictionLaw;
 use crate::mech::elements::temperature::{TEMPERATURE_RANGE, in_range};
 use crate::mech::elements::triangle::MembraneTriangle;
 
@@ -288,6 +289,7 @@ impl Model {
         self.validate_curved_supports(&mut names)?;
         self.validate_chambers(&mut names)?;
         self.validate_layers(&mut names)?;
+        self.validate_layer_contacts(&mut names)?;
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -570,6 +572,58 @@ impl Model {
                         "triangle {e} is also in layer '{other}': a triangle has one thickness"
                     )));
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks the `layer_contacts` section (names join the namespace): known layers or
+    /// triangles on both sides, no triangle on both, positive finite penalties and search
+    /// reach, `μ ≥ 0`, and the isotropic friction law.
+    fn validate_layer_contacts(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        use crate::mech::elements::layer_contact::{LayerContactSpec, LayerSurface};
+        for c in &self.layer_contacts {
+            check_name(names, "layer contact", &c.name)?;
+            let error = |message: String| ModelError::Load {
+                item: format!("layer contact '{}'", c.name),
+                message,
+            };
+            let mut sides = Vec::new();
+            for (which, surface) in [("slave", &c.slave), ("master", &c.master)] {
+                if let LayerSurface::Triangles(list) = surface {
+                    self.check_selection(&ElementSelection::List(list.clone()))
+                        .map_err(|m| error(format!("{which} {m}")))?;
+                }
+                let list = LayerContactSpec::triangles(self, surface)
+                    .map_err(|m| error(format!("{which} {m}")))?;
+                sides.push(list.into_iter().collect::<HashSet<_>>());
+            }
+            if let Some(t) = sides[0].intersection(&sides[1]).min() {
+                return Err(error(format!(
+                    "triangle {t} is in both the slave and the master layer"
+                )));
+            }
+            for (what, v) in [
+                ("normal_stiffness", c.normal_stiffness),
+                ("tangential_stiffness", c.tangential_stiffness),
+                ("search_distance", c.search_distance),
+            ] {
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(error(format!("{what} = {} must be > 0", message_number(v))));
+                }
+            }
+            if !(c.friction >= 0.0 && c.friction.is_finite()) {
+                return Err(error(format!(
+                    "friction = {} must be ≥ 0",
+                    message_number(c.friction)
+                )));
+            }
+            if c.friction_law != FrictionLaw::Isotropic {
+                return Err(error(format!(
+                    "friction_law '{}' has a sliding direction, which film on film has not: \
+                     use 'isotropic'",
+                    c.friction_law
+                )));
             }
         }
         Ok(())

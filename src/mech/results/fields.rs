@@ -46,6 +46,10 @@ pub struct Results {
     /// Slip along the support, forces and status of each curved-support contact (model order:
     /// supports, then their nodes).
     pub surface_contacts: Vec<SurfaceContactResult>,
+    /// Gap, contact pressure, friction and slip of each layer-contact slave node (model order:
+    /// contacts, the forward pass's nodes, then the reverse pass's).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub layer_contacts: Vec<crate::mech::elements::layer_contact::LayerContactResult>,
     /// Pressure and volume of each gas chamber, model order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<crate::mech::solve::contributions::ChamberResult>,

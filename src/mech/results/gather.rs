@@ -80,6 +80,7 @@ impl Analysis {
             moments,
             cables: vec![],
             surface_contacts: vec![],
+            layer_contacts: vec![],
             chambers: vec![],
             support_reactions,
             total_reaction,

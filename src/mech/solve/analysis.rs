@@ -77,7 +77,9 @@ impl Analysis {
         // The Ju–Rowlands matrix is symmetric, stored as its lower triangle; without gaps or
         // curved supports it is the consistent tangent, stored whole (a follower pressure's
         // load stiffness is unsymmetric).
-        let contacts = !model.gaps.is_empty() || !model.curved_supports.is_empty();
+        let contacts = !model.gaps.is_empty()
+            || !model.curved_supports.is_empty()
+            || !model.layer_contacts.is_empty();
         let lower_only = settings.iteration_matrix == IterationMatrix::JuRowlands && contacts;
         let mut system = System::new(&model, lower_only)?;
         system.set_threads(settings.threads);
@@ -102,6 +104,7 @@ impl Analysis {
             last_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
             chambers: parts.chambers.initial_states(&model),
+            layer_contacts: parts.layers.initial_histories(&system),
             plastic: system
                 .material
                 .plastic_film()
@@ -209,6 +212,7 @@ impl Analysis {
             || state.boundary.len() != s.boundary.len()
             || state.angles.len() != s.angles.len()
             || state.contacts.len() != s.contacts.len()
+            || state.layer_contacts.len() != s.layer_contacts.len()
             || state.friction.len() != s.friction.len()
             || state.status.len() != s.status.len()
             || !(state.last_increment.is_empty()

@@ -21,6 +21,7 @@
 use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 use nalgebra::{Matrix3, Vector3};
 
+use crate::mech::elements::layer_contact::{LayerContactSetup, PairMatrix};
 use crate::mech::elements::triangle::{ElementMatrix, ElementVector, Material, MembraneTriangle};
 use crate::mech::model::{GapSupport, Model};
 
@@ -76,6 +77,10 @@ pub struct System {
     slots: Vec<u32>,
     /// Offset of each gap's entries in `slots`.
     gap_offsets: Vec<usize>,
+    /// Offset of each layer-contact pair's entries in `slots`.
+    pair_offsets: Vec<usize>,
+    /// The layer contacts' slave nodes and candidate triangles (their pairs' blocks).
+    pub layer_contacts: LayerContactSetup,
     /// Whether only the lower triangle is stored.
     lower_only: bool,
     /// Threads of an assembly (at least 1).
@@ -187,6 +192,16 @@ impl System {
             offset += block.len() * block.len();
             push_block(&block);
         }
+        let layer_contacts = LayerContactSetup::new(model);
+        let mut pair_offsets = Vec::with_capacity(layer_contacts.blocks.len());
+        for (v, tri) in &layer_contacts.blocks {
+            pair_offsets.push(offset);
+            offset += 144;
+            let mut block = [0; 12];
+            block[..3].copy_from_slice(&[3 * v, 3 * v + 1, 3 * v + 2]);
+            block[3..].copy_from_slice(&node_dofs(tri));
+            push_block(&block);
+        }
         // Keep every diagonal entry so that a DOF whose stiffness vanishes stays in the pattern.
         for i in 0..free_count {
             pairs.push(Pair::new(i, i));
@@ -218,6 +233,8 @@ impl System {
             symbolic,
             slots,
             gap_offsets,
+            pair_offsets,
+            layer_contacts,
             lower_only,
             threads: 1,
             parts: vec![],
@@ -347,6 +364,18 @@ impl System {
     pub fn add_element_matrix(&self, e: usize, k: &ElementMatrix, values: &mut [f64]) {
         let slots = &self.slots[81 * e..81 * (e + 1)];
         for (s, kij) in slots.iter().zip(k.iter()) {
+            if *s != NO_SLOT {
+                values[*s as usize] += kij;
+            }
+        }
+    }
+
+    /// Adds a layer-contact pair's 12×12 matrix (slave node, then the triangle's nodes;
+    /// column-major) into `values` through the slots of block `b`
+    /// ([`LayerContactSetup::blocks`]), dropping what [`System::add_element_matrix`] drops.
+    pub fn add_pair_matrix(&self, b: usize, k: &PairMatrix, values: &mut [f64]) {
+        let o = self.pair_offsets[b];
+        for (s, kij) in self.slots[o..o + 144].iter().zip(k.iter()) {
             if *s != NO_SLOT {
                 values[*s as usize] += kij;
             }

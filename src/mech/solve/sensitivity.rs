@@ -415,15 +415,18 @@ impl Analysis {
             displacement: u,
             plastic_slip: from.plastic_slip.clone(),
             contacts: from.contacts.clone(),
+            layer_contacts: from.layer_contacts.clone(),
             boundary: motion.translation.clone(),
             angles: motion.angles.clone(),
             loads: levels.clone(),
             friction: from.friction.clone(),
             ..self.state.clone()
         };
-        // The committed histories differ in what the results report only for curved contacts
-        // (their anchors) and a plastic film: elsewhere one evaluation serves both.
-        let commit = !trial.contacts.is_empty() || !trial.plastic.is_empty();
+        // The committed histories differ in what the results report only for curved and layer
+        // contacts (their anchors) and a plastic film: elsewhere one evaluation serves both.
+        let commit = !trial.contacts.is_empty()
+            || !trial.layer_contacts.is_empty()
+            || !trial.plastic.is_empty();
         let mut internal = None;
         if commit {
             self.assemble_at(&trial.displacement, &trial.loads, None);

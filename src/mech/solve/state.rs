@@ -43,6 +43,10 @@ pub struct AnalysisState {
     /// increment converges (empty for the elastic film).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub plastic: Vec<PlasticHistory>,
+    /// History of each layer-contact slave node
+    /// ([`crate::mech::elements::layer_contact`]): anchor, triangle, status, slip.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub layer_contacts: Vec<crate::mech::elements::layer_contact::LayerContactHistory>,
     /// The gas of each chamber ([`crate::mech::solve::contributions::ChamberState`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<crate::mech::solve::contributions::ChamberState>,
@@ -50,11 +54,12 @@ pub struct AnalysisState {
 
 impl AnalysisState {
     /// Whether a path-dependent history differs from `start`'s: a gap's slip, a curved-support
-    /// contact's (anchor, angle, status) or an element's plastic history.
+    /// contact's (anchor, angle, status), a layer contact's or an element's plastic history.
     pub fn history_changed_from(&self, start: &AnalysisState) -> bool {
         self.plastic_slip != start.plastic_slip
             || self.contacts != start.contacts
             || self.plastic != start.plastic
+            || self.layer_contacts != start.layer_contacts
     }
 
     /// Whether every number of the state is finite.
@@ -85,6 +90,11 @@ impl AnalysisState {
             .all(|v| v.is_finite())
             && self.contacts.iter().all(|c| {
                 [c.anchor[0], c.anchor[1], c.angle, c.origin, c.friction]
+                    .iter()
+                    .all(|v| v.is_finite())
+            })
+            && self.layer_contacts.iter().all(|c| {
+                [c.anchor[0], c.anchor[1], c.slip]
                     .iter()
                     .all(|v| v.is_finite())
             })

@@ -122,6 +122,7 @@ impl ArchEdge {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            layer_contacts: vec![],
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",

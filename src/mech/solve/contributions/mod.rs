@@ -19,8 +19,9 @@
 //! a trial copy in `add` and writes it in `commit`; the loop stays as it is.
 //!
 //! The order of [`Contributions::all_mut`] is the order of the floating-point sums into the
-//! residual and the matrix: triangles, gaps, loads, cables, curved contacts, and last the
-//! viscous stabilization (off unless a step needs it; it sizes itself from the others' matrix).
+//! residual and the matrix: triangles, gaps, loads, cables, curved contacts, layer contacts,
+//! chambers, and last the viscous stabilization (off unless a step needs it; it sizes itself
+//! from the others' matrix).
 //!
 //! | file | what |
 //! |---|---|
@@ -28,11 +29,13 @@
 //! | `gaps` | the friction gaps: trial laws and slip history, Ju–Rowlands latching |
 //! | `loads` | external loads and edge cables |
 //! | `curved` | node-to-surface contacts on curved supports |
+//! | `layers` | film-to-film contacts between layers (node to triangle, friction) |
 //! | `stabilization` | the viscous stabilization of a step whose equilibrium is not unique |
 
 mod chambers;
 mod curved;
 mod gaps;
+mod layers;
 mod loads;
 mod stabilization;
 mod triangles;
@@ -40,6 +43,7 @@ mod triangles;
 pub use chambers::{ChamberResult, ChamberState, Chambers};
 pub use curved::CurvedContacts;
 pub use gaps::Gaps;
+pub use layers::LayerContacts;
 pub use stabilization::ViscousStabilization;
 pub use triangles::Triangles;
 
@@ -127,6 +131,8 @@ pub struct Contributions {
     pub cables: Cables,
     /// Node-to-surface contacts on curved supports.
     pub curved: CurvedContacts,
+    /// Film-to-film contacts between layers.
+    pub layers: LayerContacts,
     /// Gas chambers.
     pub chambers: Chambers,
     /// The viscous stabilization of the current step (off unless a step turns it on).
@@ -143,32 +149,35 @@ impl Contributions {
             loads: Loads::new(model, system),
             cables: Cables::new(model),
             curved: CurvedContacts::new(model),
+            layers: LayerContacts::new(model, system),
             chambers: Chambers::new(model),
             stabilization: ViscousStabilization::new(diagonal, mass),
         }
     }
 
     /// All of them, in assembly order (the order of the floating-point sums).
-    pub fn all_mut(&mut self) -> [&mut dyn Contribution; 7] {
+    pub fn all_mut(&mut self) -> [&mut dyn Contribution; 8] {
         [
             &mut self.triangles,
             &mut self.gaps,
             &mut self.loads,
             &mut self.cables,
             &mut self.curved,
+            &mut self.layers,
             &mut self.chambers,
             &mut self.stabilization,
         ]
     }
 
     /// All of them, in assembly order.
-    pub fn all(&self) -> [&dyn Contribution; 7] {
+    pub fn all(&self) -> [&dyn Contribution; 8] {
         [
             &self.triangles,
             &self.gaps,
             &self.loads,
             &self.cables,
             &self.curved,
+            &self.layers,
             &self.chambers,
             &self.stabilization,
         ]
