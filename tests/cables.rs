@@ -81,6 +81,7 @@ fn strip(cables: bool, n0: f64) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        frame_axis: None,
     }
 }
 

@@ -36,7 +36,7 @@
 
 mod common;
 
-use common::film_model;
+use common::{analysis_stress_error, film_model};
 use membrane_contact::mech::elements::material::{Material, Wrinkling};
 use membrane_contact::mech::elements::triangle::MembraneTriangle;
 use membrane_contact::mech::formfinding::contact::{ContactSettings, find_shape_with_contact};
@@ -282,23 +282,6 @@ fn step_matrix_is_the_derivative_of_the_element_force_under_the_prestress_alone(
         }
     }
     assert!(worst < 1e-7 * scale, "{worst} vs {scale}");
-}
-
-/// Largest `|σ − σ0|/|σ0|` over the elements after the project's analysis of `found` under its
-/// prestress alone (no load, boundary held).
-fn analysis_stress_error(found: Model) -> f64 {
-    let target = found.material.prestress;
-    let size = target.iter().fold(0.0f64, |m, s| m.max(s.abs()));
-    let mut analysis = Analysis::new(found, SolverSettings::default()).unwrap();
-    let targets = vec![[0.0; 3]; analysis.model().groups.len()];
-    analysis.step_to(&targets, 1).unwrap();
-    let elements = analysis.results().elements;
-    let error = |e: &[f64; 3]| (0..3).map(|i| (e[i] - target[i]).abs()).fold(0.0, f64::max);
-    elements
-        .iter()
-        .map(|e| error(&e.stress))
-        .fold(0.0, f64::max)
-        / size
 }
 
 #[test]

@@ -71,6 +71,7 @@ fn strip(nx: usize) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        frame_axis: None,
         name: "Strip".into(),
         description: String::new(),
         nodes,

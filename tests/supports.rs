@@ -82,6 +82,7 @@ fn strip() -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        frame_axis: None,
     }
 }
 

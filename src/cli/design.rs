@@ -25,6 +25,8 @@ pub struct FormFindArgs<'a> {
     pub file: &'a Path,
     pub out: Option<&'a PathBuf>,
     pub prestress: Option<[f64; 3]>,
+    /// The warp direction: the model's `frame_axis` for the target and the found model.
+    pub warp: Option<[f64; 3]>,
     pub force_density_start: bool,
     pub settings: UpdateSettings,
     /// Against the curved supports (frictionless), with these settings.
@@ -51,7 +53,13 @@ pub fn write_text(out: Option<&PathBuf>, text: &str) -> Result<(), String> {
 
 /// `membrane-contact form-find FILE`: the found shape as a model file, a summary on stderr.
 pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
-    let model = read_model(a.file)?;
+    let mut model = read_model(a.file)?;
+    if let Some(warp) = a.warp {
+        model.frame_axis = Some(warp);
+        model
+            .validate()
+            .map_err(|e| format!("{}: --warp: {e}", a.file.display()))?;
+    }
     let prestress = a.prestress.unwrap_or(model.material.prestress);
     if !model.gaps.is_empty() || (a.on_supports.is_none() && !model.curved_supports.is_empty()) {
         eprintln!(

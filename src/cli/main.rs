@@ -954,6 +954,7 @@ fn main() -> ExitCode {
             file,
             out,
             prestress,
+            warp,
             force_density_start,
             tolerance,
             max_steps,
@@ -964,6 +965,7 @@ fn main() -> ExitCode {
             file,
             out: out.as_ref(),
             prestress: *prestress,
+            warp: *warp,
             force_density_start: *force_density_start,
             on_supports: on_supports.then_some(
                 membrane_contact::mech::formfinding::contact::ContactSettings {

@@ -408,6 +408,7 @@ impl ParallelArch {
             curved_supports,
             chambers: vec![],
             layers: vec![],
+            frame_axis: None,
             name: MODEL_NAME.into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

@@ -26,6 +26,7 @@ pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) 
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        frame_axis: None,
     }
 }
 
@@ -193,4 +194,25 @@ pub fn worst_fd_mismatch(
         }
     }
     worst
+}
+
+/// Largest `|σ − σ0|/|σ0|` over the elements after the project's analysis of `found` under its
+/// prestress alone (no load, boundary held).
+pub fn analysis_stress_error(found: Model) -> f64 {
+    let target = found.material.prestress;
+    let size = target.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    let mut analysis = membrane_contact::mech::Analysis::new(
+        found,
+        membrane_contact::mech::SolverSettings::default(),
+    )
+    .unwrap();
+    let targets = vec![[0.0; 3]; analysis.model().groups.len()];
+    analysis.step_to(&targets, 1).unwrap();
+    let elements = analysis.results().elements;
+    let error = |e: &[f64; 3]| (0..3).map(|i| (e[i] - target[i]).abs()).fold(0.0, f64::max);
+    elements
+        .iter()
+        .map(|e| error(&e.stress))
+        .fold(0.0, f64::max)
+        / size
 }

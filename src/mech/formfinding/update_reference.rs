@@ -21,7 +21,7 @@
 //! which lets the stress deviate from the target, is left).
 
 use super::{FormFindingError, held_dofs, solve_held};
-use crate::mech::elements::triangle::MembraneTriangle;
+use crate::mech::elements::triangle::{AXIS_NORMAL_COSINE, MembraneTriangle};
 use crate::mech::model::Model;
 use nalgebra::{Matrix2, Vector3};
 
@@ -65,9 +65,10 @@ pub fn reference_stiffness(
     let t = model.material.thickness;
     let mut triplets = Vec::with_capacity(9 * model.triangles.len());
     for (e, tri) in model.triangles.iter().enumerate() {
-        let x = tri.map(|v| Vector3::from(nodes[v]));
-        let element = MembraneTriangle::new(x)
+        let element = model
+            .element_on(e, nodes)
             .map_err(|_| FormFindingError::DegenerateElement { element: e })?;
+        check_frame(model, &element, e)?;
         let g = element.shape_gradients();
         let volume = t * element.area();
         for k in 0..3 {
@@ -90,6 +91,24 @@ pub fn reference_stiffness(
         }
     }
     Ok(triplets)
+}
+
+/// Refuses triangle `e` of the current shape when the model's `frame_axis` lies within 5.7° of
+/// its normal (its e1, and so the target's warp, would not follow the axis there).
+fn check_frame(
+    model: &Model,
+    element: &MembraneTriangle,
+    e: usize,
+) -> Result<(), FormFindingError> {
+    let Some(axis) = model.frame_axis else {
+        return Ok(());
+    };
+    let (e1, e2) = element.local_axes();
+    let cosine = e1.cross(&e2).dot(&Vector3::from(axis).normalize()).abs();
+    if cosine >= AXIS_NORMAL_COSINE {
+        return Err(FormFindingError::FrameAxisNormal { element: e });
+    }
+    Ok(())
 }
 
 /// Largest out-of-balance force `|r_k(X)|` of the free DOFs, `r = K X` ([`reference_stiffness`]).

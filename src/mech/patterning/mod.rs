@@ -98,7 +98,8 @@ impl Strip {
         MembraneTriangle::new(flat).map_err(|_| format!("cut triangle {t} has no area"))
     }
 
-    /// The strip's triangles in its own numbering, on the 3-D positions `x`.
+    /// The strip's triangles in its own numbering, on the 3-D positions `x` (frames along the
+    /// model's `frame_axis`, in which its prestress is given).
     pub fn elements(&self, model: &Model, x: &[[f64; 3]]) -> Result<Vec<StripTriangle>, String> {
         let index: std::collections::HashMap<usize, usize> = self
             .nodes
@@ -110,7 +111,8 @@ impl Strip {
             .iter()
             .map(|&t| {
                 let tri = model.triangles[t];
-                let element = MembraneTriangle::new(tri.map(|v| Vector3::from(x[v])))
+                let element = model
+                    .element_on(t, x)
                     .map_err(|_| format!("triangle {t} has no area"))?;
                 Ok(StripTriangle {
                     local: tri.map(|v| index[&v]),

@@ -122,6 +122,7 @@ impl ArchEdge {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            frame_axis: None,
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",

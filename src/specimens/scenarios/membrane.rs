@@ -116,6 +116,7 @@ impl CircularMembrane {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            frame_axis: None,
         })
     }
 

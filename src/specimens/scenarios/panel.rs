@@ -144,6 +144,7 @@ impl ArchPanel {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            frame_axis: None,
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",

@@ -113,6 +113,7 @@ impl CylinderStrip {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            frame_axis: None,
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,
