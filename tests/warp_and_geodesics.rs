@@ -32,7 +32,7 @@
 
 mod common;
 
-use common::{analysis_stress_error, film_model, flat_grid};
+use common::{analysis_stress_error, film_model, flat_grid, surface_grid};
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::model::{BoundaryGroup, Model};
@@ -173,4 +173,162 @@ fn form_find_with_a_warp_through_the_cli_writes_the_frame_axis_and_finds_the_sad
             && message.contains("triangle 0"),
         "{message}"
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Geodesic seams.
+//
+// SOURCES: Polthier & Schmies, "Straightest geodesics on polyhedral surfaces" (1998): inside a
+// triangle straight, across an edge unfolded, through a vertex of total angle Θ with Θ/2 on
+// each side.
+//
+// CLOSED FORMS: on a cylinder (developable) the geodesics perpendicular to the hoop through a
+// hoop geodesic are the generators, and the arc length along the (polygonal) hoop from the
+// start generator is the seam spacing; a strip between generators is a developable strip that
+// flattens with no strain to `L × w`. On a sphere the strips are doubly curved: they report a
+// strain, smaller for narrower strips.
+//
+// MESHES: half cylinder `r = 1 m`, axis along y, 2 m long: 24 cells around × 8 along; a
+// sphere patch `r = 1 m`, polar angle 30°–150°, 60° of azimuth, 12 × 12 cells. Start line: the
+// generator (meridian) at azimuth 0, a boundary line.
+
+use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
+use membrane_contact::mech::patterning::geodesic::{GeodesicSeams, geodesic_seams};
+
+fn half_cylinder() -> Model {
+    surface_grid(24, 8, |u, v| {
+        let phi = std::f64::consts::PI * u;
+        [phi.cos(), 2.0 * v, phi.sin()]
+    })
+}
+
+/// The start line: the column `i = 0` of a `nu × nv` grid.
+fn first_column(nu: usize, nv: usize) -> Vec<usize> {
+    (0..=nv).map(|j| j * (nu + 1)).collect()
+}
+
+/// The hoop chord of the half cylinder's 24 cells.
+fn chord() -> f64 {
+    2.0 * (std::f64::consts::PI / 48.0).sin()
+}
+
+/// The point of the polygonal hoop (24 chords from azimuth 0) at arc length `s`, as an azimuth.
+fn hoop_azimuth(s: f64) -> f64 {
+    let step = std::f64::consts::PI / 24.0;
+    let (k, f) = ((s / chord()).floor(), (s / chord()).fract());
+    let (a, b) = (k * step, (k + 1.0) * step);
+    let p = [
+        a.cos() * (1.0 - f) + b.cos() * f,
+        a.sin() * (1.0 - f) + b.sin() * f,
+    ];
+    p[1].atan2(p[0])
+}
+
+/// Largest azimuth deviation of each seam from `hoop_azimuth(k w)`, and each seam's y range.
+fn seam_errors(seams: &GeodesicSeams, width: f64) -> (f64, Vec<[f64; 2]>) {
+    let mut worst: f64 = 0.0;
+    let mut spans = vec![];
+    for (k, seam) in seams.seams.iter().enumerate() {
+        let expected = hoop_azimuth((k + 1) as f64 * width);
+        for g in seam {
+            worst = worst.max((g.point[2].atan2(g.point[0]) - expected).abs());
+        }
+        let ys = seam.iter().map(|g| g.point[1]);
+        spans.push([
+            ys.clone().fold(f64::MAX, f64::min),
+            ys.fold(f64::MIN, f64::max),
+        ]);
+    }
+    (worst, spans)
+}
+
+#[test]
+fn geodesic_seams_on_a_cylinder_are_generators_spaced_by_the_width_along_the_hoop() {
+    let model = half_cylinder();
+    for cells in [4.0, 2.5] {
+        let width = cells * chord();
+        let seams = geodesic_seams(&model, &first_column(24, 8), width).unwrap();
+        let (worst, spans) = seam_errors(&seams, width);
+        eprintln!(
+            "cylinder, width {cells} chords: {} seams, largest azimuth error {worst:.2e} rad, y spans {spans:?}",
+            seams.seams.len()
+        );
+        assert_eq!(seams.seams.len(), (24.0 / cells - 1e-9).floor() as usize);
+        assert!(worst < 1e-9, "{worst}");
+        for span in spans {
+            assert!(
+                span[0].abs() < 1e-9 && (span[1] - 2.0).abs() < 1e-9,
+                "{span:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn strips_between_geodesic_seams_of_a_cylinder_flatten_to_length_by_width_with_no_strain() {
+    let model = half_cylinder();
+    let width = 4.0 * chord();
+    let seams = geodesic_seams(&model, &first_column(24, 8), width).unwrap();
+    assert_eq!(seams.strips.len(), 6);
+    let cut = cut_pattern(&model, seams.strips, Compensation::Uniform([0.0; 2])).unwrap();
+    for (k, strip) in cut.iter().enumerate() {
+        eprintln!(
+            "strip {k}: {} triangles, size {:?}, max strain {:.2e}",
+            strip.strip.triangles.len(),
+            strip.size,
+            strip.distortion.max_strain
+        );
+        assert_eq!(strip.strip.triangles.len(), 64);
+        assert!(strip.distortion.max_strain < 1e-9, "{:?}", strip.distortion);
+        assert!((strip.size[0] - 2.0).abs() < 1e-9, "{:?}", strip.size);
+        assert!((strip.size[1] - width).abs() < 1e-9, "{:?}", strip.size);
+    }
+}
+
+fn sphere_patch() -> Model {
+    surface_grid(12, 12, |u, v| {
+        let (theta, phi) = ((30.0 + 120.0 * v).to_radians(), (60.0 * u).to_radians());
+        [
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ]
+    })
+}
+
+/// The largest strain of the strips geodesic seams `cells` equator chords apart cut.
+fn sphere_strip_strains(cells: f64) -> Vec<f64> {
+    let model = sphere_patch();
+    let width = cells * 2.0 * 2.5f64.to_radians().sin();
+    let seams = geodesic_seams(&model, &first_column(12, 12), width).unwrap();
+    let cut = cut_pattern(&model, seams.strips, Compensation::Uniform([0.0; 2])).unwrap();
+    cut.iter().map(|c| c.distortion.max_strain).collect()
+}
+
+#[test]
+fn strips_between_geodesic_seams_of_a_sphere_report_a_strain_that_narrower_strips_lower() {
+    let (wide, narrow) = (sphere_strip_strains(4.0), sphere_strip_strains(2.0));
+    eprintln!("sphere: strains of 4-cell strips {wide:.4?}, of 2-cell strips {narrow:.4?}");
+    assert_eq!((wide.len(), narrow.len()), (3, 6));
+    assert!(
+        wide.iter()
+            .chain(&narrow)
+            .all(|&s| s > 1e-4 && s.is_finite())
+    );
+    let largest = |v: &[f64]| v.iter().fold(0.0f64, |m, &s| m.max(s));
+    assert!(largest(&narrow) < 0.5 * largest(&wide));
+}
+
+#[test]
+fn a_start_line_off_the_boundary_or_not_along_edges_is_refused_naming_it() {
+    let model = half_cylinder();
+    let column = |i: usize| (0..=8).map(|j| j * 25 + i).collect::<Vec<_>>();
+    let err = geodesic_seams(&model, &column(3), 0.5).unwrap_err();
+    assert!(err.contains("not on the film's boundary"), "{err}");
+    let err = geodesic_seams(&model, &[0, 2], 0.5).unwrap_err();
+    assert!(err.contains("nodes 0 and 2"), "{err}");
+    let err = geodesic_seams(&model, &[0, 9999], 0.5).unwrap_err();
+    assert!(err.contains("node 9999"), "{err}");
+    let err = geodesic_seams(&model, &column(0), -1.0).unwrap_err();
+    assert!(err.contains("width -1"), "{err}");
 }

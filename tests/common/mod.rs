@@ -216,3 +216,23 @@ pub fn analysis_stress_error(found: Model) -> f64 {
         .fold(0.0, f64::max)
         / size
 }
+
+/// A grid of `nu × nv` cells on `point(u, v)`, `u, v ∈ [0, 1]`, as a film model (uniform
+/// diagonals); node `(i, j)` is `j (nu + 1) + i`.
+pub fn surface_grid(nu: usize, nv: usize, point: impl Fn(f64, f64) -> [f64; 3]) -> Model {
+    let id = |i: usize, j: usize| j * (nu + 1) + i;
+    let mut nodes = vec![];
+    for j in 0..=nv {
+        for i in 0..=nu {
+            nodes.push(point(i as f64 / nu as f64, j as f64 / nv as f64));
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..nv {
+        for i in 0..nu {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    film_model("Strip", nodes, triangles)
+}

@@ -5,6 +5,7 @@
 //! | file | what |
 //! |---|---|
 //! | [`seams`] | strips from seam planes or seam node lines |
+//! | [`geodesic`] | geodesic seams at a strip width (Polthier & Schmies 1998) and their strips |
 //! | [`cut`] | the whole pattern: every strip flattened, measured and compensated |
 //! | [`flatten`] | least-squares conformal map of a strip (Lévy et al. 2002, eq. 4) |
 //! | [`relax`] | least-squares strain relaxation (Gauss–Newton), flat or in space |
@@ -25,6 +26,7 @@ pub mod distortion;
 pub mod element_compensation;
 pub mod erection;
 pub mod flatten;
+pub mod geodesic;
 pub mod outline;
 pub mod reference;
 pub mod relax;
