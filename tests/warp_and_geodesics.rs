@@ -332,3 +332,51 @@ fn a_start_line_off_the_boundary_or_not_along_edges_is_refused_naming_it() {
     let err = geodesic_seams(&model, &column(0), -1.0).unwrap_err();
     assert!(err.contains("width -1"), "{err}");
 }
+
+#[test]
+fn pattern_with_geodesic_seams_through_the_cli_cuts_the_cylinder_into_strips_of_the_width() {
+    let file = std::env::temp_dir().join(format!("geodesic-cylinder-{}.json", std::process::id()));
+    let mut model = half_cylinder();
+    let rim = (0..model.nodes.len())
+        .filter(|&k| [0, 24].contains(&(k % 25)) || [0, 8].contains(&(k / 25)));
+    model.groups = vec![BoundaryGroup {
+        name: "rim".into(),
+        nodes: rim.collect(),
+        target: [0.0; 3],
+        components: None,
+        hinge: None,
+    }];
+    std::fs::write(&file, model.to_json()).unwrap();
+    let line: Vec<String> = first_column(24, 8).iter().map(|v| v.to_string()).collect();
+    let run = |width: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+            .arg("pattern")
+            .arg(&file)
+            .args(["--geodesic-from", &line.join(","), "--strip-width", width])
+            .args(["--compensation", "0"])
+            .output()
+            .unwrap()
+    };
+    let output = run(&format!("{}", 4.0 * chord()));
+    let (stdout, stderr) = (
+        String::from_utf8(output.stdout).unwrap(),
+        String::from_utf8(output.stderr).unwrap(),
+    );
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("geodesic seams: 5 seams"), "{stderr}");
+    assert_eq!(stdout.lines().count(), 6, "{stdout}");
+    assert!(
+        stdout
+            .lines()
+            .all(|l| l.contains("64 triangles") && l.contains("2.0000 × 0.5232 m")),
+        "{stdout}"
+    );
+    let refused = run("0");
+    let message = String::from_utf8(refused.stderr).unwrap();
+    assert!(
+        !refused.status.success()
+            && message.contains("--geodesic-from: geodesic seams: strip width 0"),
+        "{message}"
+    );
+    std::fs::remove_file(&file).ok();
+}

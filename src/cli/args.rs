@@ -114,6 +114,13 @@ pub enum Command {
         /// A seam along a line of mesh nodes; repeat for more seams.
         #[arg(long, value_name = "N1,N2,…")]
         seam_nodes: Vec<String>,
+        /// Geodesic seams from this line of boundary nodes: straightest geodesics (Polthier &
+        /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it.
+        #[arg(long, value_name = "N1,N2,…", requires = "strip_width")]
+        geodesic_from: Option<String>,
+        /// The width (m, along the surface) between the geodesic seams of --geodesic-from.
+        #[arg(long, value_name = "W", requires = "geodesic_from")]
+        strip_width: Option<f64>,
         /// `prestress` (the strain of the model's prestress, D⁻¹σ, along and across each strip) or
         /// the compensation in percent, `C` or `CX,CY` (along, across).
         #[arg(long, value_name = "prestress|C[,C]", default_value = "prestress")]
