@@ -185,15 +185,17 @@ fn form_find_with_a_warp_through_the_cli_writes_the_frame_axis_and_finds_the_sad
 // CLOSED FORMS: on a cylinder (developable) the geodesics perpendicular to the hoop through a
 // hoop geodesic are the generators, and the arc length along the (polygonal) hoop from the
 // start generator is the seam spacing; a strip between generators is a developable strip that
-// flattens with no strain to `L × w`. On a sphere the strips are doubly curved: they report a
-// strain, smaller for narrower strips.
+// flattens with no strain to `L × w`. On a sphere the seams are the meridians (within mesh
+// accuracy) and the strips are doubly curved: they report a strain, smaller for narrower strips.
 //
 // MESHES: half cylinder `r = 1 m`, axis along y, 2 m long: 24 cells around × 8 along; a
 // sphere patch `r = 1 m`, polar angle 30°–150°, 60° of azimuth, 12 × 12 cells. Start line: the
 // generator (meridian) at azimuth 0, a boundary line.
 
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
-use membrane_contact::mech::patterning::geodesic::{GeodesicSeams, geodesic_seams};
+use membrane_contact::mech::patterning::geodesic::{
+    GeodesicPoint, GeodesicSeams, Surface, geodesic_seams,
+};
 
 fn half_cylinder() -> Model {
     surface_grid(24, 8, |u, v| {
@@ -286,7 +288,12 @@ fn strips_between_geodesic_seams_of_a_cylinder_flatten_to_length_by_width_with_n
 }
 
 fn sphere_patch() -> Model {
-    surface_grid(12, 12, |u, v| {
+    sphere_patch_of(12)
+}
+
+/// The sphere patch in `n × n` cells.
+fn sphere_patch_of(n: usize) -> Model {
+    surface_grid(n, n, |u, v| {
         let (theta, phi) = ((30.0 + 120.0 * v).to_radians(), (60.0 * u).to_radians());
         [
             theta.sin() * phi.cos(),
@@ -379,4 +386,59 @@ fn pattern_with_geodesic_seams_through_the_cli_cuts_the_cylinder_into_strips_of_
         "{message}"
     );
     std::fs::remove_file(&file).ok();
+}
+
+/// The largest azimuth deviation (rad) of the 20°-apart geodesic seams of the sphere patch in
+/// `n × n` cells from the meridian through each seam's middle point.
+fn sphere_seam_deviation(n: usize) -> f64 {
+    let model = sphere_patch_of(n);
+    let seams = geodesic_seams(&model, &first_column(n, n), 20f64.to_radians()).unwrap();
+    assert_eq!(seams.seams.len(), 2);
+    let azimuth = |p: [f64; 3]| p[1].atan2(p[0]);
+    let deviation = |seam: &Vec<GeodesicPoint>| {
+        let meridian = azimuth(seam[seam.len() / 2].point);
+        let off = seam.iter().map(|g| (azimuth(g.point) - meridian).abs());
+        off.fold(0.0f64, f64::max)
+    };
+    seams.seams.iter().map(deviation).fold(0.0, f64::max)
+}
+
+#[test]
+fn geodesic_seams_on_a_sphere_approach_its_meridians_as_the_mesh_is_refined() {
+    let deviations = [12, 24, 48].map(sphere_seam_deviation);
+    eprintln!("sphere seams off their meridians (12, 24, 48 cells): {deviations:?} rad");
+    assert!(deviations[0] < 0.2 * 5f64.to_radians(), "{deviations:?}");
+    assert!(deviations[1] < 0.5 * deviations[0] && deviations[2] < 0.5 * deviations[1]);
+}
+
+#[test]
+fn a_straightest_geodesic_through_a_cone_apex_leaves_half_the_total_angle_on_each_side() {
+    // A hexagonal cone, apex height 1 over a unit hexagon: each of the six wedges has the apex
+    // angle α < 60°, so Θ = 6α < 2π. From the middle of wedge 0's base towards the apex, Θ/2 on
+    // each side (Polthier & Schmies, Def. 4) puts the exit at the middle of wedge 3's base,
+    // opposite; a straight continuation (π) would not.
+    let mut nodes = vec![[0.0, 0.0, 1.0]];
+    nodes.extend((0..6).map(|k| {
+        let a = (60.0 * k as f64).to_radians();
+        [a.cos(), a.sin(), 0.0]
+    }));
+    let triangles = (1..=6).map(|k| [0, k, k % 6 + 1]).collect();
+    let model = film_model("Cone", nodes, triangles);
+    let mid = |a: usize, b: usize| -> [f64; 3] {
+        std::array::from_fn(|c| 0.5 * (model.nodes[a][c] + model.nodes[b][c]))
+    };
+    let (start, opposite) = (mid(1, 2), mid(4, 5));
+    let d: [f64; 3] = std::array::from_fn(|c| model.nodes[0][c] - start[c]);
+    let surface = Surface::new(&model);
+    let path = surface.trace(0, start, d, f64::INFINITY);
+    let end = path.last().unwrap().point;
+    let miss = (0..3)
+        .map(|c| (end[c] - opposite[c]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    eprintln!(
+        "cone: {} points, exit {end:?}, opposite {opposite:?}, miss {miss:.2e} m",
+        path.len()
+    );
+    assert!(miss < 1e-12, "{miss}");
 }

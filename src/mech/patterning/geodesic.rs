@@ -307,9 +307,14 @@ fn start_of(surface: &Surface<'_>, line: &[usize]) -> Result<(usize, [f64; 3], [
     }
     let e = surface.x(b) - surface.x(a);
     let p = surface.x(a) + e * ((half - lengths[i]) / e.norm());
+    // At a node inside the line, the line's tangent there is the chord of its two neighbours.
+    let tangent = match (half - lengths[i] < 1e-9 * e.norm(), i.checked_sub(1)) {
+        (true, Some(before)) => surface.x(b) - surface.x(line[before]),
+        _ => e,
+    };
     let into = across(
         surface.x(surface.third(triangles[0], a, b)) - surface.x(a),
-        e.normalize(),
+        tangent.normalize(),
     );
     Ok((triangles[0], p.into(), into.into()))
 }
