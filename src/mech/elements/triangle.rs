@@ -1,8 +1,9 @@
 //! Constant-strain membrane triangle, total Lagrangian (paper §2.1, eqs. 2.2–2.7).
 //!
 //! Three nodes, nine DOF `u = [u1 v1 w1 u2 v2 w2 u3 v3 w3]` in global axes. The element's
-//! local in-plane frame `(e1, e2)` is fixed at the initial configuration (e1 = global X projected
-//! on the element plane, or global Y when X is normal to it), so a uniform anisotropic prestress
+//! local in-plane frame `(e1, e2)` is fixed at the initial configuration (e1 = the model's
+//! `frame_axis` projected on the element plane, [`MembraneTriangle::new_along`]; without one,
+//! global X projected, or global Y when X is normal to it), so a uniform anisotropic prestress
 //! stays uniform across a mesh.
 //!
 //! | paper (Zienkiewicz / Tabarrok–Qin notation) | here |

@@ -8,8 +8,8 @@
 //! is linear in the new positions `x`, `K_kl = Σ_e t A_e (∇N_kᵀ S ∇N_l) I₃` (the initial-stress
 //! block of the membrane tangent, paper eq. 2.7), and the solution becomes the next reference,
 //! `X_{k+1} = x`. At the fixed point `x = X`, so `F = F0` and the Cauchy stress is `S`: the film
-//! carries exactly the target prestress, in the element frame the solver uses (e1 ∥ global X
-//! projected). Cables add `N/L` on their segments (`N` their `prestress_force`). The
+//! carries exactly the target prestress, in the element frame the solver uses (e1 ∥ the model's
+//! `frame_axis` projected, global X without one: an orthotropic target's warp). Cables add `N/L` on their segments (`N` their `prestress_force`). The
 //! out-of-balance of the target stress on the current shape, `r(X_k)`, measures convergence.
 //! For an isotropic `S = σ I` the step is the cotangent-Laplacian step of Pinkall & Polthier
 //! (1993), which converges to a discrete minimal surface.
@@ -17,8 +17,10 @@
 //! The updates converge fast across the film and slowly along it (the mesh's tangential modes,
 //! which an isotropic stress hardly resists): the default tolerance, `1e-4` of `t |S| L̄`, leaves
 //! the analysis of the found shape within about that fraction of the target stress. An
-//! orthotropic `S` has an exact equilibrium shape only where the surface allows it (`λ > 0`,
-//! which lets the stress deviate from the target, is left).
+//! orthotropic `S` has an exact equilibrium shape only where the surface allows it: the
+//! tangential out-of-balance is `(σ1 − σ2)` times the geodesic curvature of the frame's lines
+//! (no surface of revolution between rings; `O(|∇z|²)` on a shallow one, where the updates
+//! stall at that level); `λ > 0`, which lets the stress deviate, is left.
 
 use super::{FormFindingError, held_dofs, solve_held};
 use crate::mech::elements::triangle::{AXIS_NORMAL_COSINE, MembraneTriangle};
