@@ -82,6 +82,7 @@ fn strip(cables: bool, n0: f64) -> Model {
         chambers: vec![],
         layers: vec![],
         layer_contacts: vec![],
+        frame_axis: None,
     }
 }
 

@@ -56,6 +56,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         chambers: vec![],
         layers: vec![],
         layer_contacts: vec![],
+        frame_axis: None,
     }
 }
 

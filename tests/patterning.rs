@@ -36,7 +36,7 @@
 
 mod common;
 
-use common::film_model;
+use common::{analysis_stress_error, film_model, surface_grid};
 use membrane_contact::mech::elements::material::{Material, Wrinkling};
 use membrane_contact::mech::elements::triangle::MembraneTriangle;
 use membrane_contact::mech::formfinding::contact::{ContactSettings, find_shape_with_contact};
@@ -284,23 +284,6 @@ fn step_matrix_is_the_derivative_of_the_element_force_under_the_prestress_alone(
     assert!(worst < 1e-7 * scale, "{worst} vs {scale}");
 }
 
-/// Largest `|σ − σ0|/|σ0|` over the elements after the project's analysis of `found` under its
-/// prestress alone (no load, boundary held).
-fn analysis_stress_error(found: Model) -> f64 {
-    let target = found.material.prestress;
-    let size = target.iter().fold(0.0f64, |m, s| m.max(s.abs()));
-    let mut analysis = Analysis::new(found, SolverSettings::default()).unwrap();
-    let targets = vec![[0.0; 3]; analysis.model().groups.len()];
-    analysis.step_to(&targets, 1).unwrap();
-    let elements = analysis.results().elements;
-    let error = |e: &[f64; 3]| (0..3).map(|i| (e[i] - target[i]).abs()).fold(0.0, f64::max);
-    elements
-        .iter()
-        .map(|e| error(&e.stress))
-        .fold(0.0, f64::max)
-        / size
-}
-
 #[test]
 fn found_minimal_surface_keeps_its_prestress_in_the_analysis() {
     {
@@ -393,25 +376,6 @@ fn catenoid_example_form_finds_and_patterns_through_the_cli_to_its_golden_waist(
     eprintln!("example waist {waist:.6} (a = {:.6})", catenoid_a(1.0, 1.0));
     assert!((waist - 0.84668).abs() < 2e-5, "{waist}");
     assert_eq!(found.material.prestress, ISOTROPIC);
-}
-
-/// A grid of `nu × nv` cells on `point(u, v)`, `u, v ∈ [0, 1]`, as a film model.
-fn surface_grid(nu: usize, nv: usize, point: impl Fn(f64, f64) -> [f64; 3]) -> Model {
-    let id = |i: usize, j: usize| j * (nu + 1) + i;
-    let mut nodes = vec![];
-    for j in 0..=nv {
-        for i in 0..=nu {
-            nodes.push(point(i as f64 / nu as f64, j as f64 / nv as f64));
-        }
-    }
-    let mut triangles = vec![];
-    for j in 0..nv {
-        for i in 0..nu {
-            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    film_model("Strip", nodes, triangles)
 }
 
 fn quarter_cylinder() -> Model {

@@ -72,6 +72,7 @@ fn strip(nx: usize) -> Model {
         chambers: vec![],
         layers: vec![],
         layer_contacts: vec![],
+        frame_axis: None,
         name: "Strip".into(),
         description: String::new(),
         nodes,

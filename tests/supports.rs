@@ -83,6 +83,7 @@ fn strip() -> Model {
         chambers: vec![],
         layers: vec![],
         layer_contacts: vec![],
+        frame_axis: None,
     }
 }
 

@@ -47,12 +47,14 @@ def _model_file(model: dict | str | Path, folder: str) -> str:
 
 def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None, tolerance: float | None = None,
               max_steps: int | None = None, force_density_start: bool = False, on_supports: bool = False,
-              stress_tolerance: float | None = None) -> dict:
+              stress_tolerance: float | None = None, warp: Sequence[float] | None = None) -> dict:
     """The found model: the geometry in which the film carries ``prestress`` (MPa, ``(sx, sy)`` or
     ``(sx, sy, txy)`` in each element's frame; default the model's) with its boundary held, and
     that prestress as its material's (``membrane-contact form-find``). ``on_supports=True``: against
     the model's curved supports, frictionless (``--on-supports``; ``stress_tolerance`` the largest
-    ``|σ − σ*|/|σ*|`` of a step accepted, default 1e-3); start from a geometry near them."""
+    ``|σ − σ*|/|σ*|`` of a step accepted, default 1e-3); start from a geometry near them.
+    ``warp=(ax, ay, az)``: each element's frame follows that direction (``--warp``), so
+    ``prestress=(warp, fill)`` is an orthotropic target; the found model has it as ``frame_axis``."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "found.json"
         args = ["form-find", _model_file(model, tmp), "--out", str(out)]
@@ -68,6 +70,8 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
             args.append("--on-supports")
         if stress_tolerance is not None:
             args += ["--stress-tolerance", repr(float(stress_tolerance))]
+        if warp is not None:
+            args += ["--warp", ",".join(repr(float(a)) for a in warp)]
         _run(args)
         return json.loads(out.read_text())
 
@@ -76,7 +80,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             seam_nodes: Sequence[Sequence[int]] = (), compensation: str | float | Sequence[float] = "prestress",
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
             erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
-            rail_path: Sequence[float] | None = None) -> dict[str, Any]:
+            rail_path: Sequence[float] | None = None, geodesic_from: Sequence[int] | None = None,
+            strip_width: float | None = None) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
     ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
     ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
@@ -91,6 +96,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     their places and pull them down and out (``--rail-path``).
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
+    ``geodesic_from`` (a line of boundary nodes) and ``strip_width`` (m): geodesic seams that far
+    apart along the surface (``--geodesic-from``, ``--strip-width``);
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
     ``svg`` / ``erection_model``: files to write the outlines and the erection model to."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -105,6 +112,9 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             args += ["--seam-plane", ",".join(repr(float(v)) for v in p)]
         for line in seam_nodes:
             args += ["--seam-nodes", ",".join(str(int(v)) for v in line)]
+        if geodesic_from is not None:
+            args += ["--geodesic-from", ",".join(str(int(v)) for v in geodesic_from),
+                     "--strip-width", repr(float(strip_width))]
         if by_element:
             args.append("--by-element")
         if rail_path is not None:

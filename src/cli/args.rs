@@ -71,10 +71,16 @@ pub enum Command {
         /// The model file to write (default: standard output).
         #[arg(short, long, value_name = "FILE")]
         out: Option<PathBuf>,
-        /// Target prestress `SX,SY[,TXY]` in MPa in each element's frame (e1 along global X
-        /// projected); default: the model's `material.prestress`.
+        /// Target prestress `SX,SY[,TXY]` in MPa in each element's frame (e1 along the model's
+        /// `frame_axis`, or --warp, projected; global X without either); default: the model's
+        /// `material.prestress`.
         #[arg(long, value_name = "SX,SY[,TXY]", value_parser = parse_prestress, allow_negative_numbers = true)]
         prestress: Option<[f64; 3]>,
+        /// The warp direction `AX,AY,AZ`: each element's e1 is it projected on the element, so
+        /// `--prestress SW,SF` is an orthotropic target (warp SW, fill SF); written to the found
+        /// model as its `frame_axis`.
+        #[arg(long, value_name = "AX,AY,AZ", value_parser = parse_direction, allow_negative_numbers = true)]
+        warp: Option<[f64; 3]>,
         /// Start from the force density shape (Schek 1974) instead of the model's geometry.
         #[arg(long)]
         force_density_start: bool,
@@ -108,6 +114,13 @@ pub enum Command {
         /// A seam along a line of mesh nodes; repeat for more seams.
         #[arg(long, value_name = "N1,N2,…")]
         seam_nodes: Vec<String>,
+        /// Geodesic seams from this line of boundary nodes: straightest geodesics (Polthier &
+        /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it.
+        #[arg(long, value_name = "N1,N2,…", requires = "strip_width")]
+        geodesic_from: Option<String>,
+        /// The width (m, along the surface) between the geodesic seams of --geodesic-from.
+        #[arg(long, value_name = "W", requires = "geodesic_from")]
+        strip_width: Option<f64>,
         /// `prestress` (the strain of the model's prestress, D⁻¹σ, along and across each strip) or
         /// the compensation in percent, `C` or `CX,CY` (along, across).
         #[arg(long, value_name = "prestress|C[,C]", default_value = "prestress")]
@@ -323,14 +336,23 @@ fn parse_prestress(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
-/// `PX,PY,PZ,NX,NY,NZ` → a plane's point and normal.
-fn parse_plane(s: &str) -> Result<[f64; 6], String> {
+/// `N` comma-separated numbers, or `expected` as the error.
+fn parse_numbers<const N: usize>(s: &str, expected: &str) -> Result<[f64; N], String> {
     let v: Vec<f64> = s
         .split(',')
         .map(|p| p.trim().parse::<f64>().map_err(|e| format!("{p:?}: {e}")))
         .collect::<Result<_, _>>()?;
-    v.try_into()
-        .map_err(|_| "six numbers: PX,PY,PZ,NX,NY,NZ".to_string())
+    v.try_into().map_err(|_| expected.to_string())
+}
+
+/// `AX,AY,AZ` → a direction (its length is not checked here: the model's validation does).
+fn parse_direction(s: &str) -> Result<[f64; 3], String> {
+    parse_numbers(s, "three numbers: AX,AY,AZ")
+}
+
+/// `PX,PY,PZ,NX,NY,NZ` → a plane's point and normal.
+fn parse_plane(s: &str) -> Result<[f64; 6], String> {
+    parse_numbers(s, "six numbers: PX,PY,PZ,NX,NY,NZ")
 }
 
 fn parse_pair(s: &str) -> Result<[f64; 2], String> {

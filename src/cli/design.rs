@@ -14,6 +14,7 @@ use membrane_contact::mech::patterning::element_compensation::{
     ElementSettings, away_from_rails, compensate_elements, erect_along, rail_start_offsets,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
+use membrane_contact::mech::patterning::geodesic::geodesic_seams;
 use membrane_contact::mech::patterning::outline::{OutlineLabel, dxf, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::seams::{
@@ -25,6 +26,8 @@ pub struct FormFindArgs<'a> {
     pub file: &'a Path,
     pub out: Option<&'a PathBuf>,
     pub prestress: Option<[f64; 3]>,
+    /// The warp direction: the model's `frame_axis` for the target and the found model.
+    pub warp: Option<[f64; 3]>,
     pub force_density_start: bool,
     pub settings: UpdateSettings,
     /// Against the curved supports (frictionless), with these settings.
@@ -51,7 +54,13 @@ pub fn write_text(out: Option<&PathBuf>, text: &str) -> Result<(), String> {
 
 /// `membrane-contact form-find FILE`: the found shape as a model file, a summary on stderr.
 pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
-    let model = read_model(a.file)?;
+    let mut model = read_model(a.file)?;
+    if let Some(warp) = a.warp {
+        model.frame_axis = Some(warp);
+        model
+            .validate()
+            .map_err(|e| format!("{}: --warp: {e}", a.file.display()))?;
+    }
     let prestress = a.prestress.unwrap_or(model.material.prestress);
     if !model.gaps.is_empty() || (a.on_supports.is_none() && !model.curved_supports.is_empty()) {
         eprintln!(
@@ -106,6 +115,8 @@ pub struct PatternArgs<'a> {
     pub file: &'a Path,
     pub seam_planes: &'a [[f64; 6]],
     pub seam_nodes: &'a [String],
+    /// Geodesic seams: the start line's nodes and the strip width (m).
+    pub geodesic: Option<(&'a str, f64)>,
     pub compensation: &'a str,
     pub svg: Option<&'a PathBuf>,
     pub dxf: Option<&'a PathBuf>,
@@ -153,33 +164,57 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
     let lines: Vec<Vec<usize>> = a
         .seam_nodes
         .iter()
-        .map(|l| {
-            l.split(',')
-                .map(|n| match n.trim().parse::<usize>() {
-                    Ok(v) if v < model.nodes.len() => Ok(v),
-                    _ => Err(format!("--seam-nodes: {n:?} is not a node of the model")),
-                })
-                .collect()
-        })
+        .map(|l| node_line(model, l, "--seam-nodes"))
         .collect::<Result<_, _>>()?;
-    let by_lines = strips_by_node_lines(model, &lines);
-    let by_planes = strips_by_planes(model, &planes);
-    // A strip is a set of triangles on the same side of every plane and connected across
-    // non-seam edges.
-    let mut strips: Vec<Vec<usize>> = Vec::new();
-    for p in &by_planes {
-        for l in &by_lines {
-            let both: Vec<usize> = p
-                .iter()
-                .copied()
-                .filter(|t| l.binary_search(t).is_ok())
-                .collect();
-            if !both.is_empty() {
-                strips.push(both);
+    let mut partitions = vec![
+        strips_by_planes(model, &planes),
+        strips_by_node_lines(model, &lines),
+    ];
+    if let Some((line, width)) = a.geodesic {
+        let line = node_line(model, line, "--geodesic-from")?;
+        let seams =
+            geodesic_seams(model, &line, width).map_err(|e| format!("--geodesic-from: {e}"))?;
+        let lengths: Vec<String> = (seams.seams.iter())
+            .map(|s| format!("{:.4}", s.last().map_or(0.0, |g| g.length)))
+            .collect();
+        eprintln!(
+            "geodesic seams: {} seams {width} m apart along a transverse geodesic of {:.4} m, lengths {} m",
+            seams.seams.len(),
+            seams.transverse.last().map_or(0.0, |g| g.length),
+            lengths.join(", ")
+        );
+        partitions.push(seams.strips);
+    }
+    // A strip is a set of triangles in the same part of every partition (the same side of
+    // every plane, connected across non-seam edges, between the same geodesic seams).
+    let mut strips: Vec<Vec<usize>> = partitions.remove(0);
+    for partition in &partitions {
+        let mut next = Vec::new();
+        for p in &strips {
+            for l in partition {
+                let both: Vec<usize> = p
+                    .iter()
+                    .copied()
+                    .filter(|t| l.binary_search(t).is_ok())
+                    .collect();
+                if !both.is_empty() {
+                    next.push(both);
+                }
             }
         }
+        strips = next;
     }
     Ok(strips)
+}
+
+/// The nodes `N1,N2,…` of `text`, each a node of `model` (`option` names the option in errors).
+fn node_line(model: &Model, text: &str, option: &str) -> Result<Vec<usize>, String> {
+    text.split(',')
+        .map(|n| match n.trim().parse::<usize>() {
+            Ok(v) if v < model.nodes.len() => Ok(v),
+            _ => Err(format!("{option}: {n:?} is not a node of the model")),
+        })
+        .collect()
 }
 
 /// The erection iterations, one line each on stdout; the last erection's compensation and the

@@ -984,6 +984,7 @@ fn main() -> ExitCode {
             file,
             out,
             prestress,
+            warp,
             force_density_start,
             tolerance,
             max_steps,
@@ -994,6 +995,7 @@ fn main() -> ExitCode {
             file,
             out: out.as_ref(),
             prestress: *prestress,
+            warp: *warp,
             force_density_start: *force_density_start,
             on_supports: on_supports.then_some(
                 membrane_contact::mech::formfinding::contact::ContactSettings {
@@ -1012,6 +1014,8 @@ fn main() -> ExitCode {
             file,
             seam_plane,
             seam_nodes,
+            geodesic_from,
+            strip_width,
             compensation,
             svg,
             dxf,
@@ -1026,6 +1030,7 @@ fn main() -> ExitCode {
             file,
             seam_planes: seam_plane,
             seam_nodes,
+            geodesic: geodesic_from.as_deref().zip(*strip_width),
             compensation,
             svg: svg.as_ref(),
             dxf: dxf.as_ref(),

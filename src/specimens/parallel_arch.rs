@@ -409,6 +409,7 @@ impl ParallelArch {
             chambers: vec![],
             layers: vec![],
             layer_contacts: vec![],
+            frame_axis: None,
             name: MODEL_NAME.into(),
             description: format!(
                 "1/4 model of the parallel steel arch specimen, arch height {:.0} mm, refinement {}",

@@ -27,6 +27,7 @@ pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) 
         chambers: vec![],
         layers: vec![],
         layer_contacts: vec![],
+        frame_axis: None,
     }
 }
 
@@ -194,4 +195,45 @@ pub fn worst_fd_mismatch(
         }
     }
     worst
+}
+
+/// Largest `|σ − σ0|/|σ0|` over the elements after the project's analysis of `found` under its
+/// prestress alone (no load, boundary held).
+pub fn analysis_stress_error(found: Model) -> f64 {
+    let target = found.material.prestress;
+    let size = target.iter().fold(0.0f64, |m, s| m.max(s.abs()));
+    let mut analysis = membrane_contact::mech::Analysis::new(
+        found,
+        membrane_contact::mech::SolverSettings::default(),
+    )
+    .unwrap();
+    let targets = vec![[0.0; 3]; analysis.model().groups.len()];
+    analysis.step_to(&targets, 1).unwrap();
+    let elements = analysis.results().elements;
+    let error = |e: &[f64; 3]| (0..3).map(|i| (e[i] - target[i]).abs()).fold(0.0, f64::max);
+    elements
+        .iter()
+        .map(|e| error(&e.stress))
+        .fold(0.0, f64::max)
+        / size
+}
+
+/// A grid of `nu × nv` cells on `point(u, v)`, `u, v ∈ [0, 1]`, as a film model (uniform
+/// diagonals); node `(i, j)` is `j (nu + 1) + i`.
+pub fn surface_grid(nu: usize, nv: usize, point: impl Fn(f64, f64) -> [f64; 3]) -> Model {
+    let id = |i: usize, j: usize| j * (nu + 1) + i;
+    let mut nodes = vec![];
+    for j in 0..=nv {
+        for i in 0..=nu {
+            nodes.push(point(i as f64 / nu as f64, j as f64 / nv as f64));
+        }
+    }
+    let mut triangles = vec![];
+    for j in 0..nv {
+        for i in 0..nu {
+            triangles.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    film_model("Strip", nodes, triangles)
 }

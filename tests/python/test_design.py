@@ -48,6 +48,20 @@ def test_pattern_cuts_the_found_catenoid_into_four_equal_strips_with_their_disto
     assert [s["compensation"] for s in uniform["strips"]] == [[0.005, 0.005]] * 2
 
 
+SADDLE = Path(__file__).resolve().parents[2] / "examples" / "orthotropic_saddle.json"
+
+
+def test_a_warp_target_and_geodesic_seams_pass_through_to_the_program():
+    found = form_find(SADDLE, prestress=(3, 1), warp=(0.8660254, 0.5, 0))
+    assert found["frame_axis"] == [0.8660254, 0.5, 0.0]
+    report = pattern(found, geodesic_from=[17 * j for j in range(17)], strip_width=0.5)
+    # Three seams 0.5 m apart across the 2 m square: four strips about 2 m × 0.5 m.
+    assert len(report["strips"]) == 4
+    for strip in report["strips"]:
+        assert strip["size"][0] == pytest.approx(2.0, abs=1e-3)
+        assert strip["size"][1] == pytest.approx(0.5, abs=1e-3)
+
+
 def test_a_model_the_program_refuses_raises_design_error_naming_the_item():
     model = json.loads(CATENOID.read_text())
     model["material"]["thickness"] = -1.0

@@ -78,7 +78,8 @@ pub struct Material {
     pub poisson_ratio: f64,
     /// Film thickness `t` (m).
     pub thickness: f64,
-    /// Initial stress `σ0 = [σx, σy, τxy]` (Pa) in each element's local frame (e1 ∥ global X).
+    /// Initial stress `σ0 = [σx, σy, τxy]` (Pa) in each element's local frame (e1 ∥ the model's
+    /// `frame_axis`, or global X, projected).
     #[serde(default)]
     pub prestress: [f64; 3],
     /// Density `ρ` (kg/m³) for self-weight (ETFE ≈ 1750); 0 (the default): weightless film.

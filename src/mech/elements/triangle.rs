@@ -1,8 +1,9 @@
 //! Constant-strain membrane triangle, total Lagrangian (paper §2.1, eqs. 2.2–2.7).
 //!
 //! Three nodes, nine DOF `u = [u1 v1 w1 u2 v2 w2 u3 v3 w3]` in global axes. The element's
-//! local in-plane frame `(e1, e2)` is fixed at the initial configuration (e1 = global X projected
-//! on the element plane, or global Y when X is normal to it), so a uniform anisotropic prestress
+//! local in-plane frame `(e1, e2)` is fixed at the initial configuration (e1 = the model's
+//! `frame_axis` projected on the element plane, [`MembraneTriangle::new_along`]; without one,
+//! global X projected, or global Y when X is normal to it), so a uniform anisotropic prestress
 //! stays uniform across a mesh.
 //!
 //! | paper (Zienkiewicz / Tabarrok–Qin notation) | here |
@@ -92,9 +93,22 @@ pub struct MembraneTriangle {
     layer_thickness: Option<f64>,
 }
 
+/// Largest `|e3 · axis|` at which a model's `frame_axis` still sets a triangle's e1 (5.7° from
+/// the normal): validation refuses a triangle closer to it.
+pub const AXIS_NORMAL_COSINE: f64 = 0.995;
+
 impl MembraneTriangle {
-    /// Builds the element from its three initial node positions.
+    /// Builds the element from its three initial node positions (e1 = global X projected).
     pub fn new(x: [Vector3<f64>; 3]) -> Result<Self, DegenerateTriangle> {
+        Self::new_along(x, None)
+    }
+
+    /// Builds the element with e1 = `axis` projected on its plane (`None`, or an axis within
+    /// 5.7° of the normal: global X projected, or Y when X is within 26° of the normal).
+    pub fn new_along(
+        x: [Vector3<f64>; 3],
+        axis: Option<[f64; 3]>,
+    ) -> Result<Self, DegenerateTriangle> {
         let (a, b) = (x[1] - x[0], x[2] - x[0]);
         let normal = a.cross(&b);
         let doubled_area = normal.norm();
@@ -103,10 +117,10 @@ impl MembraneTriangle {
             return Err(DegenerateTriangle { doubled_area });
         }
         let e3 = normal / doubled_area;
-        let reference = if e3.x.abs() < 0.9 {
-            Vector3::x()
-        } else {
-            Vector3::y()
+        let reference = match axis.map(|a| Vector3::from(a).normalize()) {
+            Some(a) if e3.dot(&a).abs() < AXIS_NORMAL_COSINE => a,
+            _ if e3.x.abs() < 0.9 => Vector3::x(),
+            _ => Vector3::y(),
         };
         let e1 = (reference - e3 * e3.dot(&reference)).normalize();
         let e2 = e3.cross(&e1);

@@ -31,6 +31,11 @@ pub enum FormFindingError {
         /// The triangle.
         element: usize,
     },
+    /// The model's `frame_axis` (the warp) lies within 5.7° of a triangle's normal.
+    FrameAxisNormal {
+        /// The triangle.
+        element: usize,
+    },
     /// The linear system of a step cannot be solved (a prestress that is not positive
     /// definite, a node held by nothing).
     Singular {
@@ -57,6 +62,10 @@ impl std::fmt::Display for FormFindingError {
                     "form finding: triangle {element} has collapsed (no area)"
                 )
             }
+            Self::FrameAxisNormal { element } => write!(
+                f,
+                "form finding: the frame axis (warp) is within 5.7° of triangle {element}'s normal: the target's directions are not defined there"
+            ),
             Self::Singular { coordinate, reason } => write!(
                 f,
                 "form finding: the {} system cannot be solved: {reason}",

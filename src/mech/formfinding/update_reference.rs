@@ -8,8 +8,8 @@
 //! is linear in the new positions `x`, `K_kl = Σ_e t A_e (∇N_kᵀ S ∇N_l) I₃` (the initial-stress
 //! block of the membrane tangent, paper eq. 2.7), and the solution becomes the next reference,
 //! `X_{k+1} = x`. At the fixed point `x = X`, so `F = F0` and the Cauchy stress is `S`: the film
-//! carries exactly the target prestress, in the element frame the solver uses (e1 ∥ global X
-//! projected). Cables add `N/L` on their segments (`N` their `prestress_force`). The
+//! carries exactly the target prestress, in the element frame the solver uses (e1 ∥ the model's
+//! `frame_axis` projected, global X without one: an orthotropic target's warp). Cables add `N/L` on their segments (`N` their `prestress_force`). The
 //! out-of-balance of the target stress on the current shape, `r(X_k)`, measures convergence.
 //! For an isotropic `S = σ I` the step is the cotangent-Laplacian step of Pinkall & Polthier
 //! (1993), which converges to a discrete minimal surface.
@@ -17,11 +17,13 @@
 //! The updates converge fast across the film and slowly along it (the mesh's tangential modes,
 //! which an isotropic stress hardly resists): the default tolerance, `1e-4` of `t |S| L̄`, leaves
 //! the analysis of the found shape within about that fraction of the target stress. An
-//! orthotropic `S` has an exact equilibrium shape only where the surface allows it (`λ > 0`,
-//! which lets the stress deviate from the target, is left).
+//! orthotropic `S` has an exact equilibrium shape only where the surface allows it: the
+//! tangential out-of-balance is `(σ1 − σ2)` times the geodesic curvature of the frame's lines
+//! (no surface of revolution between rings; `O(|∇z|²)` on a shallow one, where the updates
+//! stall at that level); `λ > 0`, which lets the stress deviate, is left.
 
 use super::{FormFindingError, held_dofs, solve_held};
-use crate::mech::elements::triangle::MembraneTriangle;
+use crate::mech::elements::triangle::{AXIS_NORMAL_COSINE, MembraneTriangle};
 use crate::mech::model::Model;
 use nalgebra::{Matrix2, Vector3};
 
@@ -65,9 +67,10 @@ pub fn reference_stiffness(
     let t = model.material.thickness;
     let mut triplets = Vec::with_capacity(9 * model.triangles.len());
     for (e, tri) in model.triangles.iter().enumerate() {
-        let x = tri.map(|v| Vector3::from(nodes[v]));
-        let element = MembraneTriangle::new(x)
+        let element = model
+            .element_on(e, nodes)
             .map_err(|_| FormFindingError::DegenerateElement { element: e })?;
+        check_frame(model, &element, e)?;
         let g = element.shape_gradients();
         let volume = t * element.area();
         for k in 0..3 {
@@ -90,6 +93,24 @@ pub fn reference_stiffness(
         }
     }
     Ok(triplets)
+}
+
+/// Refuses triangle `e` of the current shape when the model's `frame_axis` lies within 5.7° of
+/// its normal (its e1, and so the target's warp, would not follow the axis there).
+fn check_frame(
+    model: &Model,
+    element: &MembraneTriangle,
+    e: usize,
+) -> Result<(), FormFindingError> {
+    let Some(axis) = model.frame_axis else {
+        return Ok(());
+    };
+    let (e1, e2) = element.local_axes();
+    let cosine = e1.cross(&e2).dot(&Vector3::from(axis).normalize()).abs();
+    if cosine >= AXIS_NORMAL_COSINE {
+        return Err(FormFindingError::FrameAxisNormal { element: e });
+    }
+    Ok(())
 }
 
 /// Largest out-of-balance force `|r_k(X)|` of the free DOFs, `r = K X` ([`reference_stiffness`]).

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::mech::elements::curved_contact::CurvedSupport;
 use crate::mech::elements::gap::{FrictionLaw, GapFrame, GapLaw};
-use crate::mech::elements::triangle::Material;
+use crate::mech::elements::triangle::{DegenerateTriangle, Material, MembraneTriangle};
 
 /// A global axis, used for supports and symmetry planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -491,6 +491,10 @@ pub struct Model {
     /// ([`crate::mech::elements::layer_contact`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub layer_contacts: Vec<crate::mech::elements::layer_contact::LayerContactSpec>,
+    /// The global direction whose projection on each triangle is its frame's e1, the axis the
+    /// prestress, strains and stresses are given along (a warp direction); none: global X.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame_axis: Option<[f64; 3]>,
 }
 
 /// A set of film triangles with a thickness of its own (the material's elasticity, prestress
@@ -582,6 +586,8 @@ pub enum ModelError {
     NotFinite { item: String },
     /// A triangle with (near) zero area or repeated nodes.
     DegenerateTriangle { triangle: usize, nodes: [usize; 3] },
+    /// A `frame_axis` that is not a direction, or lies (nearly) normal to a triangle.
+    FrameAxis { message: String },
     /// A material constant out of range.
     Material { message: String },
     /// A gap constant out of range.
@@ -635,6 +641,7 @@ impl fmt::Display for ModelError {
                 )
             }
             Self::Material { message } => write!(f, "material: {message}"),
+            Self::FrameAxis { message } => write!(f, "frame_axis: {message}"),
             Self::Gap { gap, message } => write!(f, "gap '{gap}': {message}"),
             Self::Name { item, message } => write!(f, "{item}: {message}"),
             Self::Conflict { node, message } => write!(f, "node {node}: {message}"),
@@ -771,6 +778,16 @@ impl Model {
             }
         }
         sets
+    }
+
+    /// Triangle `t` on the positions `x`, its frame along the model's [`Model::frame_axis`].
+    pub fn element_on(
+        &self,
+        t: usize,
+        x: &[[f64; 3]],
+    ) -> Result<MembraneTriangle, DegenerateTriangle> {
+        let tri = self.triangles[t];
+        MembraneTriangle::new_along(tri.map(|v| Vector3::from(x[v])), self.frame_axis)
     }
 
     /// The triangles of `selection`.

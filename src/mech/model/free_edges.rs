@@ -23,7 +23,6 @@
 use nalgebra::{Matrix2, Vector2, Vector3};
 
 use super::format::Model;
-use crate::mech::elements::triangle::MembraneTriangle;
 
 /// Smallest traction across a boundary edge, as a fraction of the prestress's largest principal
 /// value, that counts as a pull: a film prestressed in one direction only (`[σx, 0, 0]`) pulls
@@ -88,8 +87,8 @@ pub fn free_edges(model: &Model) -> Vec<Edge> {
         }
     }
     let mut free = vec![];
-    for t in model.triangles.iter().filter(|t| t.iter().all(|&v| v < n)) {
-        let Ok(element) = MembraneTriangle::new(t.map(|v| Vector3::from(model.nodes[v]))) else {
+    for (e, t) in (model.triangles.iter().enumerate()).filter(|(_, t)| t.iter().all(|&v| v < n)) {
+        let Ok(element) = model.element_on(e, &model.nodes) else {
             continue;
         };
         let (e1, e2) = element.local_axes();

@@ -55,7 +55,7 @@
 use nalgebra::{DMatrix, Matrix6, SymmetricEigen, Vector3, Vector6};
 
 use crate::mech::elements::cable::segment_force_and_tangent;
-use crate::mech::elements::triangle::{ElementVector, MembraneTriangle};
+use crate::mech::elements::triangle::ElementVector;
 use crate::mech::model::{GapSupport, Model, ModelError};
 
 /// How many node numbers a message lists before "…".
@@ -246,8 +246,8 @@ fn initial_stiffness(
         }
     };
     let zero = ElementVector::zeros();
-    for t in model.triangles.iter().filter(|t| part_of[t[0]] == i) {
-        let Ok(element) = MembraneTriangle::new(t.map(|v| Vector3::from(model.nodes[v]))) else {
+    for (e, t) in (model.triangles.iter().enumerate()).filter(|(_, t)| part_of[t[0]] == i) {
+        let Ok(element) = model.element_on(e, &model.nodes) else {
             continue; // validation refused it before this check
         };
         area += element.area();

@@ -15,9 +15,36 @@ use crate::mech::elements::curved_contact::Centreline;
 use crate::mech::elements::curved_contact::SurfaceContact;
 use crate::mech::elements::gap::FrictionLaw;
 use crate::mech::elements::temperature::{TEMPERATURE_RANGE, in_range};
-use crate::mech::elements::triangle::MembraneTriangle;
+use crate::mech::elements::triangle::{AXIS_NORMAL_COSINE, MembraneTriangle};
 
 impl Model {
+    /// The `frame_axis`, when given: a finite direction, not within 5.7° of any triangle's
+    /// normal ([`AXIS_NORMAL_COSINE`]).
+    fn check_frame_axis(&self) -> Result<(), ModelError> {
+        let Some(axis) = self.frame_axis else {
+            return Ok(());
+        };
+        let a = Vector3::from(axis);
+        if !(a.iter().all(|v| v.is_finite()) && a.norm() > 0.0) {
+            return Err(ModelError::FrameAxis {
+                message: format!("{axis:?} is not a direction (finite, not zero)"),
+            });
+        }
+        for (t, tri) in self.triangles.iter().enumerate() {
+            let x = tri.map(|v| Vector3::from(self.nodes[v]));
+            let normal = (x[1] - x[0]).cross(&(x[2] - x[0])).normalize();
+            if normal.dot(&a.normalize()).abs() >= AXIS_NORMAL_COSINE {
+                return Err(ModelError::FrameAxis {
+                    message: format!(
+                        "{axis:?} is within 5.7° of the normal of triangle {t} {tri:?}: its \
+                         projection there gives no direction"
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Checks every item; the first problem found is returned.
     pub fn validate(&self) -> Result<(), ModelError> {
         let n = self.nodes.len();
@@ -125,6 +152,7 @@ impl Model {
                 });
             }
         }
+        self.check_frame_axis()?;
         // Constrained DOFs: 0 free, 1 fixed (support or symmetry), 2 prescribed by a group.
         let mut constrained = vec![[false; 3]; n];
         let mut names = HashSet::new();

@@ -33,7 +33,7 @@ use super::reference::{erection_model, reference_geometry};
 use super::relax::{StrainTerm, relax_flat};
 use super::{StripTriangle, flat_gradient};
 use crate::mech::elements::gap::GapStatus;
-use crate::mech::elements::triangle::{ElementStress, MembraneTriangle};
+use crate::mech::elements::triangle::ElementStress;
 use crate::mech::model::Model;
 use crate::mech::{Analysis, SolverSettings};
 
@@ -208,7 +208,7 @@ pub fn metric_correction(
     stress: &ElementStress,
 ) -> Option<Matrix2<f64>> {
     let tri = found.triangles[t];
-    let on = |x: &[[f64; 3]]| MembraneTriangle::new(tri.map(|v| Vector3::from(x[v]))).ok();
+    let on = |x: &[[f64; 3]]| found.element_on(t, x).ok();
     let (found_element, reference_element) = (on(&found.nodes)?, on(reference)?);
     let g = found_element.shape_gradients();
     let f3 = (0..3).fold(Matrix3x2::zeros(), |f, k| {

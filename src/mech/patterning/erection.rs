@@ -15,7 +15,7 @@ use nalgebra::{Matrix2, Vector2, Vector3};
 use super::cut::{Compensation, CutStrip, cut_pattern};
 use super::element_compensation::erect_with_contacts;
 use super::reference::{erection_model, reference_geometry};
-use crate::mech::elements::triangle::{ElementStress, MembraneTriangle};
+use crate::mech::elements::triangle::ElementStress;
 use crate::mech::model::Model;
 
 /// One erection of the iteration.
@@ -54,7 +54,7 @@ fn correction(
     let (mut c, mut area) = ([0.0; 2], 0.0);
     for &t in &cut.strip.triangles {
         let tri = found.triangles[t];
-        let Ok(element) = MembraneTriangle::new(tri.map(|v| Vector3::from(reference[v]))) else {
+        let Ok(element) = found.element_on(t, reference) else {
             continue;
         };
         let Ok(cut_element) = cut.strip.flat_element(found, &local, t) else {

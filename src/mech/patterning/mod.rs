@@ -5,6 +5,7 @@
 //! | file | what |
 //! |---|---|
 //! | [`seams`] | strips from seam planes or seam node lines |
+//! | [`geodesic`] | geodesic seams at a strip width (Polthier & Schmies 1998) and their strips |
 //! | [`cut`] | the whole pattern: every strip flattened, measured and compensated |
 //! | [`flatten`] | least-squares conformal map of a strip (Lévy et al. 2002, eq. 4) |
 //! | [`relax`] | least-squares strain relaxation (Gauss–Newton), flat or in space |
@@ -25,6 +26,7 @@ pub mod distortion;
 pub mod element_compensation;
 pub mod erection;
 pub mod flatten;
+pub mod geodesic;
 pub mod outline;
 pub mod reference;
 pub mod relax;
@@ -98,7 +100,8 @@ impl Strip {
         MembraneTriangle::new(flat).map_err(|_| format!("cut triangle {t} has no area"))
     }
 
-    /// The strip's triangles in its own numbering, on the 3-D positions `x`.
+    /// The strip's triangles in its own numbering, on the 3-D positions `x` (frames along the
+    /// model's `frame_axis`, in which its prestress is given).
     pub fn elements(&self, model: &Model, x: &[[f64; 3]]) -> Result<Vec<StripTriangle>, String> {
         let index: std::collections::HashMap<usize, usize> = self
             .nodes
@@ -110,7 +113,8 @@ impl Strip {
             .iter()
             .map(|&t| {
                 let tri = model.triangles[t];
-                let element = MembraneTriangle::new(tri.map(|v| Vector3::from(x[v])))
+                let element = model
+                    .element_on(t, x)
                     .map_err(|_| format!("triangle {t} has no area"))?;
                 Ok(StripTriangle {
                     local: tri.map(|v| index[&v]),

@@ -36,14 +36,9 @@ pub fn strips_by_planes(model: &Model, planes: &[SeamPlane]) -> Vec<Vec<usize>> 
     strips.into_values().collect()
 }
 
-/// The triangles of each strip bounded by the seam node `lines` (consecutive nodes of a line
-/// are a seam segment) and the film's edges, strips ordered by their first triangle.
-pub fn strips_by_node_lines(model: &Model, lines: &[Vec<usize>]) -> Vec<Vec<usize>> {
+/// The triangles on each edge `[low, high]` of the film (one on the boundary, two inside).
+pub fn triangles_by_edge(model: &Model) -> HashMap<[usize; 2], Vec<usize>> {
     let key = |a: usize, b: usize| [a.min(b), a.max(b)];
-    let seams: std::collections::HashSet<[usize; 2]> = lines
-        .iter()
-        .flat_map(|l| l.windows(2).map(|w| key(w[0], w[1])))
-        .collect();
     let mut by_edge: HashMap<[usize; 2], Vec<usize>> = HashMap::new();
     for (t, tri) in model.triangles.iter().enumerate() {
         for k in 0..3 {
@@ -53,6 +48,18 @@ pub fn strips_by_node_lines(model: &Model, lines: &[Vec<usize>]) -> Vec<Vec<usiz
                 .push(t);
         }
     }
+    by_edge
+}
+
+/// The triangles of each strip bounded by the seam node `lines` (consecutive nodes of a line
+/// are a seam segment) and the film's edges, strips ordered by their first triangle.
+pub fn strips_by_node_lines(model: &Model, lines: &[Vec<usize>]) -> Vec<Vec<usize>> {
+    let key = |a: usize, b: usize| [a.min(b), a.max(b)];
+    let seams: std::collections::HashSet<[usize; 2]> = lines
+        .iter()
+        .flat_map(|l| l.windows(2).map(|w| key(w[0], w[1])))
+        .collect();
+    let by_edge = triangles_by_edge(model);
     let mut strip_of = vec![usize::MAX; model.triangles.len()];
     let mut strips = Vec::new();
     for first in 0..model.triangles.len() {

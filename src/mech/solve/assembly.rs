@@ -142,9 +142,10 @@ impl System {
             .triangles
             .iter()
             .zip(thickness)
-            .map(|(t, layer)| {
-                let x = t.map(|v| Vector3::from(model.nodes[v]));
-                MembraneTriangle::new(x)
+            .enumerate()
+            .map(|(k, (t, layer))| {
+                model
+                    .element_on(k, &model.nodes)
                     .map(|e| (*t, layer.map_or(e, |h| e.with_thickness(h))))
                     .map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
             })

@@ -123,6 +123,7 @@ impl ArchEdge {
             chambers: vec![],
             layers: vec![],
             layer_contacts: vec![],
+            frame_axis: None,
             name: "ArchEdge".into(),
             description: format!(
                 "film edge lying on an arch of rise {h} m, prestress {} Pa along it and none across",

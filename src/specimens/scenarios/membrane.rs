@@ -117,6 +117,7 @@ impl CircularMembrane {
             chambers: vec![],
             layers: vec![],
             layer_contacts: vec![],
+            frame_axis: None,
         })
     }
 

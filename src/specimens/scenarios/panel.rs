@@ -145,6 +145,7 @@ impl ArchPanel {
             chambers: vec![],
             layers: vec![],
             layer_contacts: vec![],
+            frame_axis: None,
             name: "ArchPanel".into(),
             description: format!(
                 "{} m x {} m film over two arches (rise {} m, span {} m), edge x = {} jacked about a hinge",

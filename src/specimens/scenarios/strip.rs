@@ -114,6 +114,7 @@ impl CylinderStrip {
             chambers: vec![],
             layers: vec![],
             layer_contacts: vec![],
+            frame_axis: None,
             name: "CylinderStrip".into(),
             description: format!("unstressed strip over a half cylinder of radius {r} m"),
             nodes,
