@@ -10,9 +10,10 @@
 //! a backward-Euler step `δ = 1/c` of the pseudo-dynamics `M U̇ = −R(U)/k̄`: `M` is a lumped
 //! pseudo-mass (each free DOF's node's tributary reference area over the mean, [`pseudo_mass`]),
 //! `k̄` the mean magnitude of the free diagonal of the increment's first matrix (so that `c` is
-//! dimensionless). `c` starts at 0: while full steps succeed the iteration is Newton's. A step
-//! that raises `‖R‖₂` more than [`Continuation::REJECT`]-fold, or a singular matrix, is taken
-//! back and the pseudo-time step shortened by the same factor (from [`Continuation::START`]);
+//! dimensionless). `c` starts at 0: while full steps succeed the iteration is Newton's. A
+//! correction along which the line search finds no step, or a singular matrix, shortens the
+//! pseudo-time step [`Continuation::GROW`]-fold, the first to `c = 1/GROW` (a shift of a tenth of
+//! the mean diagonal);
 //! an accepted step scales `c` by switched evolution relaxation (SER:
 //! `c_{k+1} = c_k ‖R_k‖/‖R_{k−1}‖`, at least halved), so that `c → 0` as the residual does and
 //! the last iterations are Newton's again. Where `K` has no stiffness at all (an unstressed flat
@@ -37,9 +38,7 @@ pub(crate) struct Continuation {
 }
 
 impl Continuation {
-    /// `c` after the first rejected step: the shift is a tenth of the mean diagonal.
-    pub const START: f64 = 0.1;
-    /// Factor on `c` where the line search finds no step along a correction.
+    /// Factor on `c` where the line search finds no step along a correction (from `1/GROW`).
     pub const GROW: f64 = 10.0;
     /// Largest factor on `c` after an accepted step (SER's ratio when the residual fell more).
     pub const SHRINK: f64 = 0.5;
@@ -64,9 +63,9 @@ impl Continuation {
     }
 
     /// After a correction along which the line search found no step, or a singular matrix: a
-    /// shorter pseudo-time step.
+    /// pseudo-time step [`Self::GROW`]-fold shorter, the first `c = 1/GROW`.
     pub fn reject(&mut self) {
-        self.c = (Self::GROW * self.c).max(Self::START);
+        self.c = (Self::GROW * self.c).max(1.0 / Self::GROW);
     }
 
     /// After a full step that took `‖R‖₂` from `before` to `after`: SER, `c` scaled by their
@@ -141,22 +140,23 @@ mod tests {
 
     /// Newton's iteration until a correction is rejected; then SER: a full step scales `c` by
     /// the residual's ratio, at least halving it; a rejection makes it `GROW` times larger, from
-    /// `START`.
+    /// `1/GROW`.
     #[test]
     fn ser_follows_the_residual_and_a_rejection_shortens_the_pseudo_time_step() {
+        const START: f64 = 0.1;
         let mut p = Continuation::new();
         p.accept(1.0, 5.0);
         assert_eq!(p.c, 0.0, "full steps are Newton's");
         p.reject();
-        assert_eq!(p.c, Continuation::START);
+        assert_eq!(p.c, START);
         p.accept(1.0, 0.9);
-        assert_eq!(p.c, 0.5 * Continuation::START);
+        assert_eq!(p.c, 0.5 * START);
         p.accept(1.0, 0.01);
-        assert!((p.c - 0.01 * 0.5 * Continuation::START).abs() < 1e-18);
+        assert!((p.c - 0.01 * 0.5 * START).abs() < 1e-18);
         p.reject();
-        assert_eq!(p.c, Continuation::START);
+        assert_eq!(p.c, START);
         p.reject();
-        assert_eq!(p.c, Continuation::GROW * Continuation::START);
+        assert_eq!(p.c, Continuation::GROW * START);
     }
 
     /// The shift is `c k̄ m_i` on each diagonal slot, `k̄` the mean |diagonal| of the first

@@ -258,10 +258,12 @@ impl Analysis {
             if iteration > 3 && record.residual > 1e6 * it.residuals[0].max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
             }
-            // The Ju–Rowlands matrix converges linearly by design: judged by the limit only.
+            // Stalled after `2 N*` iterations without progress (more than the controller would
+            // keep of a dissipative increment); the Ju–Rowlands matrix converges linearly by
+            // design: judged by the limit only.
             if !improved
                 && !self.converges_linearly()
-                && iteration >= it.progress.best_at + Self::STALL_PATIENCE
+                && iteration >= it.progress.best_at + 2 * Self::TARGET_ITERATIONS
             {
                 return Err(self.failure(&it, record, true));
             }
@@ -402,11 +404,11 @@ impl Analysis {
         Ok((state, residuals))
     }
 
-    /// The contacts whose status changed within the last [`Self::STALL_PATIENCE`] iterates of
+    /// The contacts whose status changed within the last `2 N*` iterates of
     /// `statuses` (one status list per iterate). Called once when an increment fails.
     fn chattering(&self, statuses: &[Vec<GapStatus>]) -> Vec<String> {
         let names = self.parts.status_names();
-        let recent = &statuses[statuses.len().saturating_sub(Self::STALL_PATIENCE)..];
+        let recent = &statuses[statuses.len().saturating_sub(2 * Self::TARGET_ITERATIONS)..];
         let Some(last) = recent.last() else {
             return Vec::new();
         };
@@ -520,8 +522,6 @@ impl Analysis {
 
     /// A residual or correction below this fraction of the best so far counts as progress.
     pub(crate) const PROGRESS: f64 = 0.9;
-    /// Iterations without progress before an increment is declared stalled and cut back.
-    pub(crate) const STALL_PATIENCE: usize = 12;
     /// Changes between stick and slip that make a contact's status a cycle ([`Hold`]).
     pub(crate) const CYCLE: usize = 3;
     /// Merits the nonmonotone line search compares against.
