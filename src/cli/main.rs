@@ -237,10 +237,15 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         if let Some(mu) = inputs.mu {
             analysis.set_friction(mu)?;
         }
+        // The path's time: the step's length moves air through the orifices.
+        let loads = LoadLevels {
+            time,
+            ..inputs.loads.clone()
+        };
         let report = match analysis.step_to_motion(
             &inputs.targets,
             &inputs.angles,
-            &inputs.loads,
+            &loads,
             o.increments as usize,
         ) {
             Ok(report) => report,
