@@ -605,14 +605,13 @@ fn an_orifice_conserves_the_air_mass_of_the_chambers_it_joins() {
     assert!(r.orifices[0].mass_flow > 0.0);
 }
 
-/// One long step (10⁶ s) through the orifice: the pressures equalise without crossing, the
-/// middle layer then carries nothing and stays flat, and the shared pressure is Boyle's for the
-/// whole air in the two outer layers' Föppl–Hencky volumes, `(p + p_a) 2 V(p) = m R T`, within
-/// 1 % (16 rings a layer).
+/// One long step (10⁶ s) through the orifice: the pressures equalise without crossing (the
+/// middle layer then carries nothing), and the shared pressure is Boyle's for the whole air in
+/// the two outer layers' Föppl–Hencky volumes, `(p + p_a) 2 V(p) = m R T`, within 1 % (16
+/// rings a layer; measured −0.33 %, both 347.810 Pa).
 #[test]
-#[ignore = "Newton stalls: the tangent lacks the orifice's coupling of the two chambers"]
 fn a_long_step_through_an_orifice_equalises_the_chambers_at_boyles_shared_pressure() {
-    let (mut analysis, mut levels) = with_orifice(8, 1e-4);
+    let (mut analysis, mut levels) = with_orifice(16, 1e-4);
     let mass: f64 = analysis.results().chambers.iter().map(|c| c.mass).sum();
     levels.time = 1e6;
     analysis

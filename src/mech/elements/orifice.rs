@@ -89,6 +89,28 @@ pub fn implicit_transfer(cda: f64, from: &OrificeEnd, to: &OrificeEnd, dt: f64) 
     0.5 * (lo + hi)
 }
 
+/// `β = ∂m/∂Δp₀` (kg/Pa) of the backward-Euler transfer `m` over `dt`: from
+/// `m = dt ṁ(Δp₀ − s m)`, `β = 1/(1/(dt ṁ') + s)` with `ṁ' = ṁ/(2Δp)` (the density's change
+/// neglected) and `s = R (T_f/V_f + T_t/V_t)`; `1/s` (one gas) once the pressures are equal, 0
+/// where `dt ≤ 0`.
+pub fn transfer_slope(from: &OrificeEnd, to: &OrificeEnd, mass: f64, dt: f64) -> f64 {
+    let s = AIR_GAS_CONSTANT * (from.temperature / from.volume + to.temperature / to.volume);
+    if !(dt > 0.0 && s.is_finite() && s > 0.0) {
+        return 0.0;
+    }
+    let dp = (from.pressure_with(-mass) - to.pressure_with(mass)).abs();
+    let rate = (mass / dt).abs();
+    // 1/(dt ṁ') = 2|Δp| / (dt |ṁ|): 0 once the pressures are equal.
+    let lag = if dp == 0.0 {
+        0.0
+    } else if rate > 0.0 {
+        2.0 * dp / (dt * rate)
+    } else {
+        return 0.0;
+    };
+    1.0 / (lag + s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

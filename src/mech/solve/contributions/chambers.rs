@@ -8,8 +8,9 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::{Contribution, Evaluation};
+use crate::mech::elements::chamber::AIR_GAS_CONSTANT;
 use crate::mech::elements::chamber::{ChamberGeometry, GasLaw, tet_gradient, tet_hessian};
-use crate::mech::elements::orifice::{OrificeEnd, implicit_transfer};
+use crate::mech::elements::orifice::{OrificeEnd, implicit_transfer, transfer_slope};
 use crate::mech::model::Model;
 use crate::mech::results::Results;
 use crate::mech::solve::assembly::{Dof, node_dofs};
@@ -93,6 +94,9 @@ pub struct Chambers {
     start_time: f64,
     /// Each orifice's mass flow (kg/s) over the increment at the last evaluation.
     flows: Vec<f64>,
+    /// Each orifice's `β = ∂m/∂Δp₀` at the last evaluation (kg/Pa): how the moved mass follows
+    /// the pressure difference the volumes make, for the tangent.
+    betas: Vec<f64>,
 }
 
 impl Chambers {
@@ -227,10 +231,12 @@ impl Chambers {
     /// a chamber) and keeps their flows. Only an orifice between two sealed chambers passes air.
     fn exchange(&mut self, dt: f64) {
         self.flows.clear();
+        self.betas.clear();
         for o in &self.orifices {
             let (a, b) = (self.last[o.from], self.last[o.to]);
             if !(a.sealed && b.sealed) {
                 self.flows.push(0.0);
+                self.betas.push(0.0);
                 continue;
             }
             let end = |k: usize, c: &ChamberState| OrificeEnd {
@@ -241,6 +247,7 @@ impl Chambers {
             };
             let (from, to) = (end(o.from, &a), end(o.to, &b));
             let m = implicit_transfer(o.cda, &from, &to, dt);
+            self.betas.push(transfer_slope(&from, &to, m, dt));
             for (k, end, mass) in [(o.from, from, -m), (o.to, to, m)] {
                 let c = &mut self.last[k];
                 c.constant = end.law.with_air(end.constant, mass, end.volume);
@@ -248,6 +255,36 @@ impl Chambers {
             }
             self.flows.push(if dt > 0.0 { m / dt } else { 0.0 });
         }
+    }
+
+    /// The rank-one terms of the chambers' `terms` (`(−dp/dV, g)` of each sealed one at a
+    /// fixed air mass) with each orifice's coupling: the moved mass `m` follows the pressure
+    /// difference, `dm = β (a_f dV_f − a_t dV_t)`, so `dp_i/dV_j` is a 2×2 block per orifice,
+    /// symmetrized and written as three non-negative rank-one terms on `g_f`, `g_t`, `g_f + g_t`.
+    fn couple(&mut self, mut terms: Vec<Option<(f64, Vec<f64>)>>) {
+        let mut extra = vec![];
+        for (o, &beta) in self.orifices.iter().zip(&self.betas) {
+            if beta <= 0.0 {
+                continue;
+            }
+            let k = |c: usize| AIR_GAS_CONSTANT * self.last[c].temperature / self.last[c].volume;
+            let (kf, kt) = (k(o.from), k(o.to));
+            let (Some((af, gf)), Some((at, gt))) = (&terms[o.from], &terms[o.to]) else {
+                continue;
+            };
+            // `a` here is −dp/dV at a fixed mass.
+            let (af, at) = (*af, *at);
+            let c = 0.5 * beta * (kf * at + kt * af);
+            let sum: Vec<f64> = gf.iter().zip(gt).map(|(x, y)| x + y).collect();
+            extra.push((c, sum));
+            terms[o.from]
+                .as_mut()
+                .map(|t| t.0 = af * (1.0 - kf * beta) - c);
+            terms[o.to]
+                .as_mut()
+                .map(|t| t.0 = at * (1.0 - kt * beta) - c);
+        }
+        self.low_rank = terms.into_iter().flatten().chain(extra).collect();
     }
 
     /// Each chamber's volume (m³) at the displacements `u`.
@@ -281,6 +318,7 @@ impl Contribution for Chambers {
         self.last = self.gas_at(at, &volumes);
         self.exchange(at.levels.time - self.start_time);
         self.low_rank.clear();
+        let mut terms = Vec::with_capacity(self.geometry.len());
         let system = at.system;
         for (k, g) in self.geometry.iter().enumerate() {
             let (gas, law) = (self.last[k], &self.laws[k]);
@@ -304,11 +342,9 @@ impl Contribution for Chambers {
                     system.add_element_matrix(e, &h, values);
                 }
             }
-            if let Some(grad) = gradient {
-                let a = -law.slope(constant, v, t);
-                self.low_rank.push((a, grad));
-            }
+            terms.push(gradient.map(|grad| (-law.slope(constant, v, t), grad)));
         }
+        self.couple(terms);
     }
 
     fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
