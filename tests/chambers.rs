@@ -635,7 +635,7 @@ fn a_long_step_through_an_orifice_equalises_the_chambers_at_boyles_shared_pressu
 }
 
 /// A short step (1 ms) moves the orifice law's `ṁ Δt` at the sealed state's pressures,
-/// `ṁ = C_d A √(2 ρ_lower Δp)`, within 0.1 %.
+/// `ṁ = C_d A √(2 ρ_lower Δp)`, within 1e-4 (measured 1e-7).
 #[test]
 fn a_short_step_through_an_orifice_passes_the_flow_law() {
     let (mut analysis, mut levels) = with_orifice(8, 1e-6);
@@ -654,8 +654,9 @@ fn a_short_step_through_an_orifice_passes_the_flow_law() {
         r.orifices[0].mass_flow,
         moved / 1e-3
     );
-    assert!((r.orifices[0].mass_flow / law - 1.0).abs() < 1e-3);
-    assert!((moved / 1e-3 / law - 1.0).abs() < 1e-3);
+    // 1e-4: the upstream density (the lower chamber's) is 5e-4 from the downstream one's.
+    assert!((r.orifices[0].mass_flow / law - 1.0).abs() < 1e-4);
+    assert!((moved / 1e-3 / law - 1.0).abs() < 1e-4);
 }
 
 /// The model file's checks name the orifice and what is wrong: an unknown chamber, the same
