@@ -740,6 +740,13 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             }
         );
     }
+    for o in &results.orifices {
+        out!(
+            "orifice {}: mass flow {:.6e} kg/s over the last step",
+            o.name,
+            o.mass_flow
+        );
+    }
     let t = results.total_reaction;
     out!(
         "total reaction (supports, symmetry planes, groups): ({:.3}, {:.3}, {:.3}) N",
