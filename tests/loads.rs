@@ -490,6 +490,7 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
         chambers: vec![],
         heating: vec![],
         air: vec![],
+        time: 0.0,
     };
     analysis
         .set_limits(SolverSettings {
