@@ -81,6 +81,7 @@ fn strip(cables: bool, n0: f64) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        orifices: vec![],
         layer_contacts: vec![],
         frame_axis: None,
     }

@@ -5,7 +5,8 @@
 use membrane_contact::mech::elements::load::LoadLevels;
 use membrane_contact::mech::elements::triangle::Material;
 use membrane_contact::mech::model::{
-    AllElements, ChamberSpec, ClosingPlane, ElementSelection, Layer, Model, PressureSet, Towards,
+    AllElements, ChamberSpec, ClosingPlane, ElementSelection, Layer, Model, OrificeSpec,
+    PressureSet, Towards,
 };
 use membrane_contact::mech::solve::assembly::{Dof, System};
 use membrane_contact::mech::solve::contributions::{Chambers, Contribution, Evaluation};
@@ -547,4 +548,140 @@ fn malformed_layers_are_refused_naming_the_layer() {
         let err = with(layers).unwrap_err();
         assert!(err.contains("layer '") && err.contains(said), "{err}");
     }
+}
+
+/// The three-layer cushion (`rings` rings a layer, 1 m radius) with an orifice `hole` of area
+/// `area` (C_d 0.6) from the lower chamber to the upper, inflated by its supplies to 300 and
+/// 400 Pa and sealed: the analysis and its load levels (time 0).
+fn with_orifice(rings: usize, area: f64) -> (Analysis, LoadLevels) {
+    let (mut model, _, _) = three_layer(1.0, rings, film(1.0e6));
+    model.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area,
+        discharge_coefficient: 0.6,
+    }];
+    model.validate().unwrap();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(f), 4)
+            .unwrap();
+    }
+    analysis.seal_chambers().unwrap();
+    (analysis, full)
+}
+
+/// Air through an orifice between two sealed chambers only moves: over steps of 2 s the sum of
+/// the chambers' air masses stays the same (1e-12 relative) while the pressures approach.
+#[test]
+fn an_orifice_conserves_the_air_mass_of_the_chambers_it_joins() {
+    let (mut analysis, mut levels) = with_orifice(8, 1e-4);
+    let total =
+        |r: &membrane_contact::mech::Results| r.chambers.iter().map(|c| c.mass).sum::<f64>();
+    let r0 = analysis.results();
+    let before = total(&r0);
+    let dp0 = r0.chambers[1].pressure - r0.chambers[0].pressure;
+    for k in 1..=3 {
+        levels.time = 2.0 * k as f64;
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+            .unwrap();
+    }
+    let r = analysis.results();
+    let dp = r.chambers[1].pressure - r.chambers[0].pressure;
+    println!(
+        "mass {before:.9e} -> {:.9e} kg, Δp {dp0:.3} -> {dp:.3} Pa, flow {:.3e} kg/s",
+        total(&r),
+        r.orifices[0].mass_flow
+    );
+    assert!((total(&r) / before - 1.0).abs() < 1e-12);
+    assert!(
+        dp > 0.0 && dp < 0.9 * dp0,
+        "the pressures approach: {dp0} -> {dp}"
+    );
+    assert!(r.orifices[0].mass_flow > 0.0);
+}
+
+/// One long step (10⁶ s) through the orifice: the pressures equalise without crossing (the
+/// middle layer then carries nothing), and the shared pressure is Boyle's for the whole air in
+/// the two outer layers' Föppl–Hencky volumes, `(p + p_a) 2 V(p) = m R T`, within 1 % (16
+/// rings a layer; measured −0.33 %, both 347.810 Pa).
+#[test]
+fn a_long_step_through_an_orifice_equalises_the_chambers_at_boyles_shared_pressure() {
+    let (mut analysis, mut levels) = with_orifice(16, 1e-4);
+    let mass: f64 = analysis.results().chambers.iter().map(|c| c.mass).sum();
+    levels.time = 1e6;
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
+    let r = analysis.results();
+    let (upper, lower) = (r.chambers[0].pressure, r.chambers[1].pressure);
+    let (pa, t) = (101_325.0, 293.15);
+    let gas = mass * 287.05 * t;
+    let material = film(1.0e6);
+    let p = bisect(1.0, 1e4, |p| {
+        (p + pa) * 2.0 * layer_volume(&material, 1.0, p).0 - gas
+    });
+    println!(
+        "upper {upper:.4} Pa, lower {lower:.4} Pa vs Boyle {p:.4} Pa ({:+.3} %)",
+        100.0 * (upper / p - 1.0)
+    );
+    assert!(lower >= upper, "no overshoot");
+    assert!(lower - upper < 1e-3, "equalised: {}", lower - upper);
+    assert!((upper / p - 1.0).abs() < 0.01);
+}
+
+/// A short step (1 ms) moves the orifice law's `ṁ Δt` at the sealed state's pressures,
+/// `ṁ = C_d A √(2 ρ_lower Δp)`, within 1e-4 (measured 1e-7).
+#[test]
+fn a_short_step_through_an_orifice_passes_the_flow_law() {
+    let (mut analysis, mut levels) = with_orifice(8, 1e-6);
+    let r0 = analysis.results();
+    let (upper, lower) = (r0.chambers[0].pressure, r0.chambers[1].pressure);
+    let rho = (lower + 101_325.0) / (287.05 * 293.15);
+    let law = 0.6 * 1e-6 * (2.0 * rho * (lower - upper)).sqrt();
+    levels.time = 1e-3;
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
+    let r = analysis.results();
+    let moved = r0.chambers[1].mass - r.chambers[1].mass;
+    println!(
+        "flow {:.6e} kg/s, moved/Δt {:.6e} kg/s vs law {law:.6e} kg/s",
+        r.orifices[0].mass_flow,
+        moved / 1e-3
+    );
+    // 1e-4: the upstream density (the lower chamber's) is 5e-4 from the downstream one's.
+    assert!((r.orifices[0].mass_flow / law - 1.0).abs() < 1e-4);
+    assert!((moved / 1e-3 / law - 1.0).abs() < 1e-4);
+}
+
+/// The model file's checks name the orifice and what is wrong: an unknown chamber, the same
+/// chamber at both ends, an area ≤ 0, a discharge coefficient outside (0, 1].
+#[test]
+fn a_malformed_orifice_is_refused_with_its_name_and_reason() {
+    let (mut base, _, _) = three_layer(1.0, 2, film(1.0e6));
+    base.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area: 1e-4,
+        discharge_coefficient: 0.6,
+    }];
+    base.validate().unwrap();
+    let refused = |edit: &dyn Fn(&mut OrificeSpec), says: &str| {
+        let mut m = base.clone();
+        edit(&mut m.orifices[0]);
+        let e = m.validate().expect_err(says).to_string();
+        assert!(e.contains("orifice 'hole'") && e.contains(says), "{e}");
+    };
+    refused(&|o| o.to = "attic".into(), "'attic' is not a chamber");
+    refused(&|o| o.to = "lower".into(), "must join two chambers");
+    refused(&|o| o.area = 0.0, "area");
+    refused(&|o| o.area = -1e-4, "area");
+    refused(&|o| o.discharge_coefficient = 0.0, "discharge_coefficient");
+    refused(&|o| o.discharge_coefficient = 1.2, "discharge_coefficient");
 }

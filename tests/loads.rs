@@ -55,6 +55,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        orifices: vec![],
         layer_contacts: vec![],
         frame_axis: None,
     }
@@ -489,6 +490,7 @@ fn a_failed_step_with_pressure_keeps_the_last_converged_state_and_load_level() {
         chambers: vec![],
         heating: vec![],
         air: vec![],
+        time: 0.0,
     };
     analysis
         .set_limits(SolverSettings {

@@ -65,6 +65,7 @@ fn patch(nx: usize, ny: usize, lx: f64, ly: f64) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        orifices: vec![],
         layer_contacts: vec![],
         frame_axis: None,
         name: "Patch".into(),

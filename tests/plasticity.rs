@@ -71,6 +71,7 @@ fn strip(nx: usize) -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        orifices: vec![],
         layer_contacts: vec![],
         frame_axis: None,
         name: "Strip".into(),

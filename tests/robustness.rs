@@ -1038,6 +1038,7 @@ fn run_staged_from(
             chambers: vec![],
             heating: vec![],
             air: vec![],
+            time: 0.0,
         };
         let steps = stage["steps"].as_u64().unwrap() as usize;
         for k in 1..=steps {

@@ -82,6 +82,7 @@ fn strip() -> Model {
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        orifices: vec![],
         layer_contacts: vec![],
         frame_axis: None,
     }

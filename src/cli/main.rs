@@ -237,10 +237,15 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         if let Some(mu) = inputs.mu {
             analysis.set_friction(mu)?;
         }
+        // The path's time: the step's length moves air through the orifices.
+        let loads = LoadLevels {
+            time,
+            ..inputs.loads.clone()
+        };
         let report = match analysis.step_to_motion(
             &inputs.targets,
             &inputs.angles,
-            &inputs.loads,
+            &loads,
             o.increments as usize,
         ) {
             Ok(report) => report,
@@ -733,6 +738,13 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             } else {
                 "held by its supply"
             }
+        );
+    }
+    for o in &results.orifices {
+        out!(
+            "orifice {}: mass flow {:.6e} kg/s over the last step",
+            o.name,
+            o.mass_flow
         );
     }
     let t = results.total_reaction;

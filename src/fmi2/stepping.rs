@@ -54,6 +54,8 @@ impl Instance {
             .ok_or_else(|| Failure::error("no analysis (not initialized)"))?;
         // Gravity is a parameter: the built model holds it, and the first step ramps it in.
         loads.gravity = built.analysis.model().loads.gravity;
+        // The step's length moves air through the orifices (issue 43).
+        loads.time = t + h;
         // Air fed into sealed chambers (`<chamber>.massFlow`, issue 43): its running total.
         let (table, values) = (&self.description.variables, &self.values);
         match super::variables::supplied_air(&built.analysis, table, values, &sealed, h) {

@@ -408,6 +408,7 @@ impl ParallelArch {
             curved_supports,
             chambers: vec![],
             layers: vec![],
+            orifices: vec![],
             layer_contacts: vec![],
             frame_axis: None,
             name: MODEL_NAME.into(),

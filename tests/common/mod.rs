@@ -26,6 +26,7 @@ pub fn film_model(name: &str, nodes: Vec<[f64; 3]>, triangles: Vec<[usize; 3]>) 
         curved_supports: vec![],
         chambers: vec![],
         layers: vec![],
+        orifices: vec![],
         layer_contacts: vec![],
         frame_axis: None,
     }

@@ -215,6 +215,7 @@ fn pressure_and_force_inputs_load_the_membrane_and_states_keep_the_load_levels()
         chambers: vec![],
         heating: vec![],
         air: vec![],
+        time: 0.0,
     };
     analysis
         .step_to_with_loads(&[[0.0; 3]], &levels, 2)
@@ -321,6 +322,7 @@ fn output_points_and_set_summaries_are_outputs_equal_to_the_core() {
         chambers: vec![],
         heating: vec![],
         air: vec![],
+        time: 0.0,
     };
     analysis
         .step_to_with_loads(&[[0.0; 3]], &levels, 2)

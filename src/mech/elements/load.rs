@@ -57,6 +57,14 @@ pub struct LoadLevels {
     /// before it was kept).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub air: Vec<f64>,
+    /// The analysis time (s) the levels belong to: the step's length is what moves air through
+    /// the orifices ([`crate::mech::model::OrificeSpec`]); 0 in a state written before it was kept.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub time: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// `a[k] + (b[k] − a[k]) · fraction` over the longer of `a` and `b`, a missing entry read as 0.
@@ -77,6 +85,7 @@ impl LoadLevels {
             chambers: vec![0.0; model.chambers.len()],
             heating: vec![0.0; model.chambers.len()],
             air: vec![0.0; model.chambers.len()],
+            time: 0.0,
         }
     }
 
@@ -89,6 +98,7 @@ impl LoadLevels {
             chambers: model.chambers.iter().map(|c| c.pressure).collect(),
             heating: model.chambers.iter().map(|c| c.heating).collect(),
             air: vec![0.0; model.chambers.len()],
+            time: 0.0,
         }
     }
 
@@ -122,6 +132,7 @@ impl LoadLevels {
                 .map(|(&a, &b)| lerp(a, b))
                 .collect(),
             air: lerp_padded(&self.air, &target.air, fraction),
+            time: lerp(self.time, target.time),
         }
     }
 
@@ -134,6 +145,7 @@ impl LoadLevels {
             chambers: self.chambers.iter().map(|p| p * factor).collect(),
             heating: self.heating.iter().map(|t| t * factor).collect(),
             air: self.air.iter().map(|m| m * factor).collect(),
+            time: self.time * factor,
         }
     }
 
@@ -146,6 +158,7 @@ impl LoadLevels {
             .chain(&self.chambers)
             .chain(&self.heating)
             .chain(&self.air)
+            .chain(std::iter::once(&self.time))
             .copied()
     }
 

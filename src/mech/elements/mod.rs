@@ -22,6 +22,7 @@ pub mod gap;
 pub mod layer_contact;
 pub mod load;
 pub mod material;
+pub mod orifice;
 pub mod plasticity;
 pub mod temperature;
 pub mod triangle;

@@ -483,6 +483,9 @@ pub struct Model {
     /// [`crate::mech::elements::chamber`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<ChamberSpec>,
+    /// Orifices between two chambers, air flowing by the orifice equation (issue 43).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub orifices: Vec<OrificeSpec>,
     /// Film layers of their own thickness (a cushion's 250/100/250 µm layers); the triangles of
     /// no layer have the material's.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -543,6 +546,23 @@ pub struct ChamberSpec {
     /// The air's temperature rise in a standard run (K; the sun on a cushion), default 0.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub heating: f64,
+}
+
+/// An opening between two chambers: air flows from the higher pressure to the lower by the
+/// orifice equation `ṁ = C_d A √(2 ρ |Δp|)` ([`crate::mech::elements::chamber::orifice_flow`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OrificeSpec {
+    /// Name (an identifier).
+    pub name: String,
+    /// The chamber whose air flows out when its pressure is the higher (`Δp = p_from − p_to`).
+    pub from: String,
+    /// The other chamber.
+    pub to: String,
+    /// The opening's area `A` (m²).
+    pub area: f64,
+    /// The discharge coefficient `C_d` in (0, 1] (about 0.6 for a sharp-edged hole).
+    pub discharge_coefficient: f64,
 }
 
 fn default_air_temperature() -> f64 {

@@ -316,6 +316,7 @@ impl Model {
         self.validate_cables(&mut names)?;
         self.validate_curved_supports(&mut names)?;
         self.validate_chambers(&mut names)?;
+        self.validate_orifices(&mut names)?;
         self.validate_layers(&mut names)?;
         self.validate_layer_contacts(&mut names)?;
         check_xml_text("model description", &self.description)?;
@@ -573,6 +574,39 @@ impl Model {
             }
             self.check_selection(&c.elements).map_err(error)?;
             ChamberGeometry::new(self, c).map_err(error)?;
+        }
+        Ok(())
+    }
+
+    /// Checks the `orifices` section (names join the namespace): two different known chambers,
+    /// a positive, finite area and a discharge coefficient in (0, 1].
+    fn validate_orifices(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        for o in &self.orifices {
+            check_name(names, "orifice", &o.name)?;
+            let error = |message: String| ModelError::Load {
+                item: format!("orifice '{}'", o.name),
+                message,
+            };
+            for end in [&o.from, &o.to] {
+                if !self.chambers.iter().any(|c| &c.name == end) {
+                    return Err(error(format!("'{end}' is not a chamber")));
+                }
+            }
+            if o.from == o.to {
+                return Err(error(format!(
+                    "from and to are both chamber '{}': it must join two chambers",
+                    o.from
+                )));
+            }
+            if !(o.area > 0.0 && o.area.is_finite()) {
+                return Err(error(format!("area = {} m² must be > 0", o.area)));
+            }
+            if !(o.discharge_coefficient > 0.0 && o.discharge_coefficient <= 1.0) {
+                return Err(error(format!(
+                    "discharge_coefficient = {} must be within (0, 1]",
+                    o.discharge_coefficient
+                )));
+            }
         }
         Ok(())
     }

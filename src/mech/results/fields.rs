@@ -53,6 +53,9 @@ pub struct Results {
     /// Pressure and volume of each gas chamber, model order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<crate::mech::solve::contributions::ChamberResult>,
+    /// Mass flow through each orifice over the last increment, model order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub orifices: Vec<crate::mech::solve::contributions::OrificeResult>,
     /// Total reaction of each named support set (N), global axes, over its fixed components.
     pub support_reactions: Vec<[f64; 3]>,
     /// Sum of all restraint forces on the film (N): supports, symmetry planes and groups (the

@@ -75,6 +75,11 @@ pub fn check_results(
             return Err(format!("air of chamber {} = {x}", c.name));
         }
     }
+    for r in &results.orifices {
+        if !r.mass_flow.is_finite() {
+            return Err(format!("mass flow of orifice {} = {}", r.name, r.mass_flow));
+        }
+    }
     for (r, c) in results.cables.iter().zip(&model.cables) {
         if !r.max_force.is_finite() {
             return Err(format!("axial force of cable {} = {}", c.name, r.max_force));

@@ -82,6 +82,7 @@ impl Analysis {
             surface_contacts: vec![],
             layer_contacts: vec![],
             chambers: vec![],
+            orifices: vec![],
             support_reactions,
             total_reaction,
             node_reactions,

@@ -104,6 +104,7 @@ impl Analysis {
             last_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
             chambers: parts.chambers.initial_states(&model),
+            orifices: vec![0.0; model.orifices.len()],
             layer_contacts: parts.layers.initial_histories(&system),
             plastic: system
                 .material

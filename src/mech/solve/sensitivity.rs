@@ -235,6 +235,7 @@ impl Analysis {
                 chambers: end.loads.chambers.clone(),
                 heating: end.loads.heating.clone(),
                 air: end.loads.air.clone(),
+                time: end.loads.time,
             };
             (motion, levels, s * seed.friction)
         };
@@ -275,6 +276,7 @@ impl Analysis {
                 chambers: vec![0.0; end.loads.chambers.len()],
                 heating: vec![0.0; end.loads.heating.len()],
                 air: vec![0.0; end.loads.air.len()],
+                time: 0.0,
             };
             self.parts
                 .loads

@@ -50,6 +50,9 @@ pub struct AnalysisState {
     /// The gas of each chamber ([`crate::mech::solve::contributions::ChamberState`]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub chambers: Vec<crate::mech::solve::contributions::ChamberState>,
+    /// The mass flow (kg/s, from → to) through each orifice over the last increment.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub orifices: Vec<f64>,
 }
 
 impl AnalysisState {

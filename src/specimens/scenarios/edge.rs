@@ -122,6 +122,7 @@ impl ArchEdge {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            orifices: vec![],
             layer_contacts: vec![],
             frame_axis: None,
             name: "ArchEdge".into(),

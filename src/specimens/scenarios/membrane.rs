@@ -116,6 +116,7 @@ impl CircularMembrane {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            orifices: vec![],
             layer_contacts: vec![],
             frame_axis: None,
         })

@@ -144,6 +144,7 @@ impl ArchPanel {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            orifices: vec![],
             layer_contacts: vec![],
             frame_axis: None,
             name: "ArchPanel".into(),

@@ -113,6 +113,7 @@ impl CylinderStrip {
             curved_supports: vec![],
             chambers: vec![],
             layers: vec![],
+            orifices: vec![],
             layer_contacts: vec![],
             frame_axis: None,
             name: "CylinderStrip".into(),

@@ -8,7 +8,9 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::{Contribution, Evaluation};
+use crate::mech::elements::chamber::AIR_GAS_CONSTANT;
 use crate::mech::elements::chamber::{ChamberGeometry, GasLaw, tet_gradient, tet_hessian};
+use crate::mech::elements::orifice::{OrificeEnd, implicit_transfer, transfer_slope};
 use crate::mech::model::Model;
 use crate::mech::results::Results;
 use crate::mech::solve::assembly::{Dof, node_dofs};
@@ -54,6 +56,24 @@ pub struct ChamberResult {
     pub mass: f64,
 }
 
+/// One orifice's result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OrificeResult {
+    /// The orifice's name.
+    pub name: String,
+    /// Mass flow (kg/s) from its `from` chamber to its `to` over the last increment.
+    pub mass_flow: f64,
+}
+
+/// An orifice between two chambers: their indices and `C_d A` (m²).
+#[derive(Clone, Debug)]
+struct Orifice {
+    name: String,
+    from: usize,
+    to: usize,
+    cda: f64,
+}
+
 /// The chambers of a model with their state at the start of the increment and at the last
 /// evaluation.
 #[derive(Clone, Debug, Default)]
@@ -69,6 +89,14 @@ pub struct Chambers {
     /// `(−dp/dV, g)` of each sealed chamber at the last evaluation with a matrix: `g` over the
     /// free equations.
     low_rank: Vec<(f64, Vec<f64>)>,
+    orifices: Vec<Orifice>,
+    /// The analysis time (s) at the increment's start.
+    start_time: f64,
+    /// Each orifice's mass flow (kg/s) over the increment at the last evaluation.
+    flows: Vec<f64>,
+    /// Each orifice's `β = ∂m/∂Δp₀` at the last evaluation (kg/Pa): how the moved mass follows
+    /// the pressure difference the volumes make, for the tangent.
+    betas: Vec<f64>,
 }
 
 impl Chambers {
@@ -90,6 +118,22 @@ impl Chambers {
                 })
                 .collect(),
             names: model.chambers.iter().map(|c| c.name.clone()).collect(),
+            orifices: model
+                .orifices
+                .iter()
+                .map(|o| {
+                    let index = |name: &str| {
+                        let k = model.chambers.iter().position(|c| c.name == name);
+                        k.expect("validated orifice")
+                    };
+                    Orifice {
+                        name: o.name.clone(),
+                        from: index(&o.from),
+                        to: index(&o.to),
+                        cda: o.discharge_coefficient * o.area,
+                    }
+                })
+                .collect(),
             reference: model.nodes.iter().map(|&p| Vector3::from(p)).collect(),
             ..Self::default()
         }
@@ -150,6 +194,99 @@ impl Chambers {
         &self.low_rank
     }
 
+    /// Each chamber's gas at the evaluation `at` with the current `volumes`, before the
+    /// orifices: the start's gas with the air supplied since, at the heated temperature.
+    fn gas_at(&self, at: &Evaluation<'_>, volumes: &[f64]) -> Vec<ChamberState> {
+        (0..self.geometry.len())
+            .map(|k| {
+                // Before any restore (a first evaluation) the air is the reference's, supplied.
+                let gas = self.start.get(k).copied().unwrap_or_default();
+                let law = &self.laws[k];
+                let t = law.temperature + at.levels.heating.get(k).copied().unwrap_or(0.0);
+                let supplied = at.levels.air.get(k).copied().unwrap_or(0.0);
+                let constant = if gas.sealed {
+                    law.with_air(gas.constant, supplied - gas.supplied, gas.volume)
+                } else {
+                    gas.constant
+                };
+                let pressure = if gas.sealed {
+                    law.pressure(constant, volumes[k], t)
+                } else {
+                    at.levels.chambers.get(k).copied().unwrap_or(0.0)
+                };
+                ChamberState {
+                    constant,
+                    pressure,
+                    volume: volumes[k],
+                    temperature: t,
+                    supplied,
+                    ..gas
+                }
+            })
+            .collect()
+    }
+
+    /// Moves the air each orifice passes over `dt` seconds between the gas of [`Self::last`]
+    /// (backward Euler, [`implicit_transfer`]; one orifice after the other where several share
+    /// a chamber) and keeps their flows. Only an orifice between two sealed chambers passes air.
+    fn exchange(&mut self, dt: f64) {
+        self.flows.clear();
+        self.betas.clear();
+        for o in &self.orifices {
+            let (a, b) = (self.last[o.from], self.last[o.to]);
+            if !(a.sealed && b.sealed) {
+                self.flows.push(0.0);
+                self.betas.push(0.0);
+                continue;
+            }
+            let end = |k: usize, c: &ChamberState| OrificeEnd {
+                law: self.laws[k],
+                constant: c.constant,
+                volume: c.volume,
+                temperature: c.temperature,
+            };
+            let (from, to) = (end(o.from, &a), end(o.to, &b));
+            let m = implicit_transfer(o.cda, &from, &to, dt);
+            self.betas.push(transfer_slope(&from, &to, m, dt));
+            for (k, end, mass) in [(o.from, from, -m), (o.to, to, m)] {
+                let c = &mut self.last[k];
+                c.constant = end.law.with_air(end.constant, mass, end.volume);
+                c.pressure = end.pressure_with(mass);
+            }
+            self.flows.push(if dt > 0.0 { m / dt } else { 0.0 });
+        }
+    }
+
+    /// The rank-one terms of the chambers' `terms` (`(−dp/dV, g)` of each sealed one at a
+    /// fixed air mass) with each orifice's coupling: the moved mass `m` follows the pressure
+    /// difference, `dm = β (a_f dV_f − a_t dV_t)`, so `dp_i/dV_j` is a 2×2 block per orifice,
+    /// symmetrized and written as three non-negative rank-one terms on `g_f`, `g_t`, `g_f + g_t`.
+    fn couple(&mut self, mut terms: Vec<Option<(f64, Vec<f64>)>>) {
+        let mut extra = vec![];
+        for (o, &beta) in self.orifices.iter().zip(&self.betas) {
+            if beta <= 0.0 {
+                continue;
+            }
+            let k = |c: usize| AIR_GAS_CONSTANT * self.last[c].temperature / self.last[c].volume;
+            let (kf, kt) = (k(o.from), k(o.to));
+            let (Some((af, gf)), Some((at, gt))) = (&terms[o.from], &terms[o.to]) else {
+                continue;
+            };
+            // `a` here is −dp/dV at a fixed mass.
+            let (af, at) = (*af, *at);
+            let c = 0.5 * beta * (kf * at + kt * af);
+            let sum: Vec<f64> = gf.iter().zip(gt).map(|(x, y)| x + y).collect();
+            extra.push((c, sum));
+            terms[o.from]
+                .as_mut()
+                .map(|t| t.0 = af * (1.0 - kf * beta) - c);
+            terms[o.to]
+                .as_mut()
+                .map(|t| t.0 = at * (1.0 - kt * beta) - c);
+        }
+        self.low_rank = terms.into_iter().flatten().chain(extra).collect();
+    }
+
     /// Each chamber's volume (m³) at the displacements `u`.
     fn volumes(&self, u: &[f64]) -> Vec<f64> {
         let x: Vec<Vector3<f64>> = self
@@ -165,10 +302,12 @@ impl Chambers {
 impl Contribution for Chambers {
     fn restore(&mut self, start: &AnalysisState) {
         self.start.clone_from(&start.chambers);
+        self.start_time = start.loads.time;
     }
 
     fn at_converged(&mut self, state: &AnalysisState) {
         self.start.clone_from(&state.chambers);
+        self.start_time = state.loads.time;
     }
 
     fn add(&mut self, at: &Evaluation<'_>, residual: &mut [f64], mut values: Option<&mut [f64]>) {
@@ -176,34 +315,14 @@ impl Contribution for Chambers {
             return;
         }
         let volumes = self.volumes(at.u);
-        self.last.clear();
+        self.last = self.gas_at(at, &volumes);
+        self.exchange(at.levels.time - self.start_time);
         self.low_rank.clear();
+        let mut terms = Vec::with_capacity(self.geometry.len());
         let system = at.system;
         for (k, g) in self.geometry.iter().enumerate() {
-            // Before any restore (a first evaluation) the air is the reference's, supplied.
-            let gas = self.start.get(k).copied().unwrap_or_default();
-            let v = volumes[k];
-            let law = &self.laws[k];
-            let t = law.temperature + at.levels.heating.get(k).copied().unwrap_or(0.0);
-            let supplied = at.levels.air.get(k).copied().unwrap_or(0.0);
-            let constant = if gas.sealed {
-                law.with_air(gas.constant, supplied - gas.supplied, gas.volume)
-            } else {
-                gas.constant
-            };
-            let p = if gas.sealed {
-                law.pressure(constant, v, t)
-            } else {
-                at.levels.chambers.get(k).copied().unwrap_or(0.0)
-            };
-            self.last.push(ChamberState {
-                constant,
-                pressure: p,
-                volume: v,
-                temperature: t,
-                supplied,
-                ..gas
-            });
+            let (gas, law) = (self.last[k], &self.laws[k]);
+            let (v, p, constant, t) = (gas.volume, gas.pressure, gas.constant, gas.temperature);
             // `g` over the free equations, for the rank-one term: only where a matrix is asked.
             let mut gradient =
                 (gas.sealed && values.is_some()).then(|| vec![0.0; system.free_count]);
@@ -223,16 +342,15 @@ impl Contribution for Chambers {
                     system.add_element_matrix(e, &h, values);
                 }
             }
-            if let Some(grad) = gradient {
-                let a = -law.slope(constant, v, t);
-                self.low_rank.push((a, grad));
-            }
+            terms.push(gradient.map(|grad| (-law.slope(constant, v, t), grad)));
         }
+        self.couple(terms);
     }
 
     fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
         if !self.geometry.is_empty() {
             state.chambers.clone_from(&self.last);
+            state.orifices.clone_from(&self.flows);
         }
     }
 
@@ -255,6 +373,15 @@ impl Contribution for Chambers {
                 sealed: c.sealed,
                 temperature: c.temperature,
                 mass: law.mass(c.pressure, c.volume, c.temperature),
+            })
+            .collect();
+        out.orifices = self
+            .orifices
+            .iter()
+            .enumerate()
+            .map(|(k, o)| OrificeResult {
+                name: o.name.clone(),
+                mass_flow: state.orifices.get(k).copied().unwrap_or(0.0),
             })
             .collect();
     }
