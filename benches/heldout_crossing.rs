@@ -830,6 +830,7 @@ fn run(path: &Path, increments: usize) -> Outcome {
             chambers: vec![],
             heating: vec![],
             air: vec![],
+            time: 0.0,
         };
         for k in 1..=stage.steps {
             let f = k as f64 / stage.steps as f64;

@@ -7,6 +7,10 @@ cd "$(dirname "$0")/.."
 echo "== cargo test (release) =="
 cargo test --release --locked
 
+# Every benchmark compiles (they are run by hand; a model field added without them went unseen)
+echo "== benchmarks compile (cargo bench --no-run) =="
+cargo bench --locked --no-run
+
 # -- robustness benchmark, quick slice (issue 23): every 10th load path of each family of the
 #    grid must converge (exit 1 below 100 %); measured 8 s on 2 cores (15 s CPU)
 echo "== robustness benchmark (--check --quick) =="

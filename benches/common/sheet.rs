@@ -66,5 +66,7 @@ pub fn sheet(n: usize) -> Model {
         chambers: vec![],
         layers: vec![],
         layer_contacts: vec![],
+        orifices: vec![],
+        frame_axis: None,
     }
 }
