@@ -215,6 +215,13 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             state.last_increment.len()
         ));
     }
+    let loads_len = loads.path().count();
+    if !(state.last_load_increment.is_empty() || state.last_load_increment.len() == loads_len) {
+        return Err(format!(
+            "the state's last load increment has {} values, the model {loads_len} load levels",
+            state.last_load_increment.len()
+        ));
+    }
     let size = model_size(model);
     let reach = MAX_DISPLACEMENT_IN_DIAGONALS * size;
     let bounded = |what: &str, values: &mut dyn Iterator<Item = f64>, limit: f64| match values

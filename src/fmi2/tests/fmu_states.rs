@@ -145,6 +145,10 @@ fn forged_states_are_refused_at_deserialization_with_a_message() {
             "last increment",
         ),
         (
+            analysis(|a| a.last_load_increment = vec![0.0; 2]),
+            "last load increment has 2 values",
+        ),
+        (
             analysis(|a| a.friction[2] = 1e6),
             "friction coefficient of gap 'G3'",
         ),

@@ -151,14 +151,21 @@ impl LoadLevels {
 
     /// Every number, in a fixed order (for finiteness checks).
     pub fn values(&self) -> impl Iterator<Item = f64> + '_ {
+        self.path()
+            .chain(self.air.iter().copied())
+            .chain(std::iter::once(self.time))
+    }
+
+    /// The levels a step's path moves proportionally, in a fixed order: pressures, forces,
+    /// gravity, chambers' supply pressures and heating (not the air supplied, whose list may be
+    /// empty, nor the time): the predictor compares successive increments' changes of them.
+    pub fn path(&self) -> impl Iterator<Item = f64> + '_ {
         self.pressure
             .iter()
             .chain(self.force.iter().flatten())
             .chain(&self.gravity)
             .chain(&self.chambers)
             .chain(&self.heating)
-            .chain(&self.air)
-            .chain(std::iter::once(&self.time))
             .copied()
     }
 

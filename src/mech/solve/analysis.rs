@@ -102,6 +102,7 @@ impl Analysis {
                 .map(|l| l.evaluate(Vector3::zeros(), Vector2::zeros()).status)
                 .collect(),
             last_increment: Vec::new(),
+            last_load_increment: Vec::new(),
             contacts: parts.curved.initial_histories(&model),
             chambers: parts.chambers.initial_states(&model),
             orifices: vec![0.0; model.orifices.len()],
@@ -218,6 +219,8 @@ impl Analysis {
             || state.status.len() != s.status.len()
             || !(state.last_increment.is_empty()
                 || state.last_increment.len() == s.displacement.len())
+            || !(state.last_load_increment.is_empty()
+                || state.last_load_increment.len() == s.loads.path().count())
             || !state.loads.fits(&self.model)
         {
             return Err("state does not match this model's sizes".into());

@@ -177,6 +177,49 @@ impl Controller {
     }
 }
 
+/// How one part of a step's path (the boundary motion, or the load levels) moves against the
+/// last converged increment: `Σ new·last`, `Σ last²`, `Σ new²`.
+#[derive(Default)]
+struct Collinear {
+    dot: f64,
+    old: f64,
+    new: f64,
+}
+
+impl Collinear {
+    /// Adds one component's change `new` in this increment and `last` in the last one.
+    fn add(&mut self, new: f64, last: f64) {
+        (self.dot, self.old, self.new) = (
+            self.dot + new * last,
+            self.old + last * last,
+            self.new + new * new,
+        );
+    }
+
+    /// None where the part stands still in both increments; Some(ratio of this increment's
+    /// change to the last's) where it keeps its direction (within 8°); Some(NaN) where it
+    /// turns, stops or starts.
+    fn ratio(&self) -> Option<f64> {
+        if self.old == 0.0 && self.new == 0.0 {
+            None
+        } else if self.old > 0.0 && self.dot > 0.99 * (self.old * self.new).sqrt() {
+            Some(self.dot / self.old)
+        } else {
+            Some(f64::NAN)
+        }
+    }
+
+    /// The ratio a path with this boundary motion and `loads` extrapolates by: the motion's
+    /// where it moves (a motion that turns or stops extrapolates nothing, whatever the loads
+    /// do: the boundary then leaves the last increment's path), the loads' where the boundary
+    /// stands still; None where neither keeps its direction.
+    fn ratio_with(&self, loads: &Self) -> Option<f64> {
+        self.ratio()
+            .or_else(|| loads.ratio())
+            .filter(|r| r.is_finite())
+    }
+}
+
 impl Analysis {
     /// Moves every boundary group to the translation `target` (m) and the hinge angle
     /// `angles` (rad, one per group: 0 for a group without a hinge), and the loads to `loads`;
@@ -354,6 +397,10 @@ impl Analysis {
             for (l, a) in state.last_increment.iter_mut().zip(&current.last_increment) {
                 *l += a;
             }
+            let loads = state.last_load_increment.iter_mut();
+            for (l, a) in loads.zip(&current.last_load_increment) {
+                *l += a;
+            }
             report.note_converged(history, force);
             *last_start = Some(std::mem::replace(current, state));
             if force <= tolerance {
@@ -424,27 +471,37 @@ impl Analysis {
     /// Largest factor between two successive increments, and on the predictor's extrapolation.
     pub(crate) const GROWTH: f64 = 2.0;
 
-    /// The first iterate of an increment from the converged `start` to `motion`: the
-    /// prescribed DOFs at their values and, when the boundary keeps moving the same way, the
-    /// free DOFs extrapolated along the last converged increment (fewer iterations, same
-    /// converged answer), then corrected by each contribution where the extrapolation leaves
-    /// its constraint (`Contribution::correct_prediction`: closed curved-support contacts
-    /// kept at their converged gap).
-    pub(super) fn predict(&self, start: &AnalysisState, motion: &GroupMotion) -> Vec<f64> {
+    /// The first iterate of an increment from the converged `start` to `motion` and `levels`:
+    /// the prescribed DOFs at their values and, where the path keeps its direction (the boundary
+    /// motion along its last converged increment's, or the boundary still and the load levels
+    /// along their last change: [`Collinear::ratio_with`]), the free DOFs extrapolated along the
+    /// last increment by the ratio of the moves (fewer iterations, same converged answer), then corrected by each contribution where the
+    /// extrapolation leaves its constraint (`Contribution::correct_prediction`: closed
+    /// curved-support contacts kept at their converged gap).
+    pub(super) fn predict(
+        &self,
+        start: &AnalysisState,
+        motion: &GroupMotion,
+        levels: &LoadLevels,
+    ) -> Vec<f64> {
         let mut u = self.unextrapolated(start, motion);
-        let (mut dot, mut old, mut new) = (0.0, 0.0, 0.0);
+        let mut moved = Collinear::default();
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { .. } = d {
-                let step = u[i] - start.displacement[i];
                 let last = start.last_increment.get(i).copied().unwrap_or(0.0);
-                (dot, old, new) = (dot + step * last, old + last * last, new + step * step);
+                moved.add(u[i] - start.displacement[i], last);
             }
         }
-        if old > 0.0 && dot > 0.99 * (old * new).sqrt() {
+        let mut loaded = Collinear::default();
+        let steps = levels.path().zip(start.loads.path());
+        for ((new, old), last) in steps.zip(&start.last_load_increment) {
+            loaded.add(new - old, *last);
+        }
+        if let Some(ratio) = moved.ratio_with(&loaded) {
             // Not beyond twice the last increment: an enlarged increment (see `step_to`) would
             // otherwise extrapolate the film far outside the range where the last one tells
             // anything (residuals of 1e11 N were measured at its first iterate).
-            let ratio = (dot / old).min(Self::GROWTH);
+            let ratio = ratio.min(Self::GROWTH);
             for (i, d) in self.system.dofs.iter().enumerate() {
                 if let Dof::Free(_) = d {
                     u[i] += ratio * start.last_increment[i];
@@ -476,6 +533,33 @@ mod tests {
     use crate::mech::solve::settings::SolverSettings;
     use crate::specimens::ParallelArch;
 
+    /// Checks that each free DOF of `once` and `twice` is `start`'s plus one and two last
+    /// increments, and of each of `unmoved` `start`'s; returns how many free DOFs moved.
+    fn free_dofs_extrapolated(
+        a: &Analysis,
+        start: &AnalysisState,
+        [once, twice]: [&[f64]; 2],
+        unmoved: &[&[f64]],
+    ) -> usize {
+        let near = |x: f64, y: f64| (x - y).abs() <= 1e-12 * (1.0 + y.abs());
+        let mut extrapolated = 0;
+        for (i, d) in a.system.dofs.iter().enumerate() {
+            let (u0, du) = (start.displacement[i], start.last_increment[i]);
+            if let Dof::Free(_) = d {
+                assert!(
+                    near(once[i], u0 + du),
+                    "DOF {i}: {} vs {}",
+                    once[i],
+                    u0 + du
+                );
+                assert!(near(twice[i], u0 + 2.0 * du), "DOF {i}");
+                unmoved.iter().for_each(|u| assert_eq!(u[i], u0, "DOF {i}"));
+                extrapolated += usize::from(du != 0.0);
+            }
+        }
+        extrapolated
+    }
+
     /// The predictor extrapolates the free DOFs along the last converged increment when the
     /// boundary keeps moving the same way (by the ratio of the moves, at most
     /// [`Analysis::PREDICTOR_LIMIT`] times), not at all when it turns back; the prescribed DOFs
@@ -493,27 +577,17 @@ mod tests {
             angles: vec![0.0; first.len()],
         };
         // Moves of 1×, −1× and 4× the last increment.
+        let levels = start.loads.clone();
         let (same, back, far) = (
-            a.predict(&start, &motion(2.0)),
-            a.predict(&start, &motion(0.0)),
-            a.predict(&start, &motion(5.0)),
+            a.predict(&start, &motion(2.0), &levels),
+            a.predict(&start, &motion(0.0), &levels),
+            a.predict(&start, &motion(5.0), &levels),
         );
-        let mut extrapolated = 0;
+        let extrapolated = free_dofs_extrapolated(&a, &start, [&same, &far], &[&back]);
         for (i, d) in a.system.dofs.iter().enumerate() {
-            let (u0, du) = (start.displacement[i], start.last_increment[i]);
+            let u0 = start.displacement[i];
             match *d {
-                Dof::Free(_) => {
-                    let near = |x: f64, y: f64| (x - y).abs() <= 1e-12 * (1.0 + y.abs());
-                    assert!(
-                        near(same[i], u0 + du),
-                        "DOF {i}: {} vs {}",
-                        same[i],
-                        u0 + du
-                    );
-                    assert!(near(far[i], u0 + 2.0 * du), "DOF {i}");
-                    assert_eq!(back[i], u0, "DOF {i}");
-                    extrapolated += usize::from(du != 0.0);
-                }
+                Dof::Free(_) => {}
                 Dof::Prescribed { group, component } => {
                     assert_eq!(same[i], 2.0 * first[group][component]);
                     assert_eq!(back[i], 0.0);
@@ -522,5 +596,72 @@ mod tests {
             }
         }
         assert!(extrapolated > 0, "the first step moved no free DOF");
+    }
+
+    /// A load path is extrapolated like a boundary motion: after two pressure steps of the
+    /// same size the third's first iterate is the last state plus the last increment (twice
+    /// it for a step twice as large), and nothing is extrapolated for a step back, a step that
+    /// changes the load by another ratio than the motion, or a motion after a load step.
+    #[test]
+    fn a_load_path_that_keeps_its_direction_is_extrapolated_by_its_ratio() {
+        let text = include_str!("../../../examples/circular_membrane.json");
+        let model = crate::mech::model::Model::from_json(text).unwrap();
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        let still = a.state().boundary.clone();
+        let initial = a.state().loads.clone();
+        let pressure = |p: f64| {
+            let mut levels = initial.clone();
+            levels.pressure[0] = p;
+            levels
+        };
+        let (one, two) = (pressure(100.0), pressure(200.0));
+        a.step_to_with_loads(&still, &one, 1).unwrap();
+        a.step_to_with_loads(&still, &two, 1).unwrap();
+        let start = a.state().clone();
+        let motion = |t: Vec<[f64; 3]>| GroupMotion {
+            angles: vec![0.0; t.len()],
+            translation: t,
+        };
+        let at = |levels: &LoadLevels| a.predict(&start, &motion(still.clone()), levels);
+        let (same, double, back) = (at(&pressure(300.0)), at(&pressure(400.0)), at(&one));
+        let moved: Vec<[f64; 3]> = still.iter().map(|t| [t[0], t[1], t[2] + 1e-3]).collect();
+        let mixed = a.predict(&start, &motion(moved), &pressure(300.0));
+        let extrapolated = free_dofs_extrapolated(&a, &start, [&same, &double], &[&back, &mixed]);
+        assert!(extrapolated > 0, "the pressure step moved no free DOF");
+    }
+
+    /// A moving boundary extrapolates by its ratio where it keeps the direction (within 8°) of
+    /// the last increment, and nothing where it turns, stops or starts; a still one by the
+    /// loads' ratio on the same terms.
+    #[test]
+    fn a_path_extrapolates_by_the_motion_else_by_the_loads_where_they_keep_their_direction() {
+        let part = |pairs: &[(f64, f64)]| {
+            let mut c = Collinear::default();
+            pairs.iter().for_each(|&(new, last)| c.add(new, last));
+            c
+        };
+        let still = part(&[(0.0, 0.0)]);
+        let along = part(&[(2.0, 1.0), (4.0, 2.0)]);
+        let along_more = part(&[(3.0, 1.0)]);
+        assert_eq!(still.ratio_with(&still), None);
+        assert_eq!(along.ratio_with(&still), Some(2.0));
+        assert_eq!(still.ratio_with(&along), Some(2.0));
+        assert_eq!(along.ratio_with(&along), Some(2.0));
+        assert_eq!(along.ratio_with(&along_more), Some(2.0), "the motion's");
+        assert_eq!(
+            along.ratio_with(&part(&[(0.0, 1.0)])),
+            Some(2.0),
+            "loads stopped"
+        );
+        assert_eq!(still.ratio_with(&along_more), Some(3.0));
+        assert_eq!(part(&[(-1.0, 1.0)]).ratio_with(&along), None, "back");
+        assert_eq!(still.ratio_with(&part(&[(-1.0, 1.0)])), None, "loads back");
+        assert_eq!(part(&[(0.0, 1.0)]).ratio_with(&still), None, "stopped");
+        assert_eq!(part(&[(1.0, 0.0)]).ratio_with(&still), None, "started");
+        assert_eq!(
+            part(&[(1.0, 1.0), (0.2, 0.0)]).ratio_with(&still),
+            None,
+            "turned 11°"
+        );
     }
 }

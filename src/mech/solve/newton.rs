@@ -227,7 +227,7 @@ impl Analysis {
         motion: &GroupMotion,
         levels: &LoadLevels,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
-        let u = self.predict(start, motion);
+        let u = self.predict(start, motion, levels);
         for c in self.parts.all_mut() {
             c.restore(start);
         }
@@ -390,6 +390,11 @@ impl Analysis {
             last_increment: u
                 .iter()
                 .zip(&start.displacement)
+                .map(|(a, b)| a - b)
+                .collect(),
+            last_load_increment: levels
+                .path()
+                .zip(start.loads.path())
                 .map(|(a, b)| a - b)
                 .collect(),
             displacement: u,

@@ -39,6 +39,11 @@ pub struct AnalysisState {
     /// predictor of the next increment when the boundary keeps moving the same way.
     #[serde(default)]
     pub last_increment: Vec<f64>,
+    /// Change of the load levels over the last converged increment ([`LoadLevels::path`]
+    /// order; empty before the first): the predictor extrapolates a load path that keeps
+    /// its direction like a boundary motion.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub last_load_increment: Vec<f64>,
     /// Plastic history of each triangle of an elasto-plastic film, committed only when an
     /// increment converges (empty for the elastic film).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -74,6 +79,7 @@ impl AnalysisState {
             .chain(&self.angles)
             .chain(&self.friction)
             .chain(&self.last_increment)
+            .chain(&self.last_load_increment)
             .chain(
                 self.plastic
                     .iter()
