@@ -115,12 +115,20 @@ pub enum Command {
         #[arg(long, value_name = "N1,N2,…")]
         seam_nodes: Vec<String>,
         /// Geodesic seams from this line of boundary nodes: straightest geodesics (Polthier &
-        /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it.
+        /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it; repeat
+        /// for more start lines. The film is split along the seams (nodes added where they
+        /// cross its triangles' edges), so the strips' outlines follow them.
         #[arg(long, value_name = "N1,N2,…", requires = "strip_width")]
-        geodesic_from: Option<String>,
-        /// The width (m, along the surface) between the geodesic seams of --geodesic-from.
-        #[arg(long, value_name = "W", requires = "geodesic_from")]
-        strip_width: Option<f64>,
+        geodesic_from: Vec<String>,
+        /// The width (m, along the surface) between the geodesic seams of --geodesic-from: one
+        /// for every start line, or one per start line in their order.
+        #[arg(
+            long,
+            value_name = "W",
+            requires = "geodesic_from",
+            allow_negative_numbers = true
+        )]
+        strip_width: Vec<f64>,
         /// `prestress` (the strain of the model's prestress, D⁻¹σ, along and across each strip) or
         /// the compensation in percent, `C` or `CX,CY` (along, across).
         #[arg(long, value_name = "prestress|C[,C]", default_value = "prestress")]

@@ -20,6 +20,7 @@ use membrane_contact::mech::patterning::reference::{erection_model, reference_ge
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
 };
+use membrane_contact::mech::patterning::split::{SplitFilm, split_along};
 
 /// What `form-find` is asked.
 pub struct FormFindArgs<'a> {
@@ -115,8 +116,9 @@ pub struct PatternArgs<'a> {
     pub file: &'a Path,
     pub seam_planes: &'a [[f64; 6]],
     pub seam_nodes: &'a [String],
-    /// Geodesic seams: the start line's nodes and the strip width (m).
-    pub geodesic: Option<(&'a str, f64)>,
+    /// Geodesic seams: the start lines' nodes and the strip widths (m; one for all, or one per
+    /// line).
+    pub geodesic: (&'a [String], &'a [f64]),
     pub compensation: &'a str,
     pub svg: Option<&'a PathBuf>,
     pub dxf: Option<&'a PathBuf>,
@@ -151,26 +153,23 @@ fn compensation(text: &str) -> Result<Compensation, String> {
     }
 }
 
-/// The strips the seams cut (planes, then node lines within them; none: the whole film).
-fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String> {
-    let planes: Vec<SeamPlane> = a
-        .seam_planes
-        .iter()
-        .map(|p| SeamPlane {
-            point: [p[0], p[1], p[2]],
-            normal: [p[3], p[4], p[5]],
-        })
-        .collect();
-    let lines: Vec<Vec<usize>> = a
-        .seam_nodes
-        .iter()
-        .map(|l| node_line(model, l, "--seam-nodes"))
-        .collect::<Result<_, _>>()?;
-    let mut partitions = vec![
-        strips_by_planes(model, &planes),
-        strips_by_node_lines(model, &lines),
-    ];
-    if let Some((line, width)) = a.geodesic {
+/// The geodesic seams from each start line of `a` (one line on stderr each), the film split
+/// along them: the split film and its strips.
+fn geodesic_split(model: &Model, a: &PatternArgs<'_>) -> Result<Option<SplitFilm>, String> {
+    let (lines, widths) = a.geodesic;
+    if lines.is_empty() {
+        return Ok(None);
+    }
+    if widths.len() != 1 && widths.len() != lines.len() {
+        return Err(format!(
+            "--strip-width: one width for every --geodesic-from, or one per start line ({} lines, {} widths)",
+            lines.len(),
+            widths.len()
+        ));
+    }
+    let mut all = Vec::new();
+    for (k, line) in lines.iter().enumerate() {
+        let width = widths[k.min(widths.len() - 1)];
         let line = node_line(model, line, "--geodesic-from")?;
         let seams =
             geodesic_seams(model, &line, width).map_err(|e| format!("--geodesic-from: {e}"))?;
@@ -183,8 +182,56 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
             seams.transverse.last().map_or(0.0, |g| g.length),
             lengths.join(", ")
         );
-        partitions.push(seams.strips);
+        all.extend(seams.seams);
     }
+    let split = split_along(model, &all).map_err(|e| format!("--geodesic-from: {e}"))?;
+    eprintln!(
+        "split along the seams: {} nodes and {} triangles added",
+        split.model.nodes.len() - model.nodes.len(),
+        split.model.triangles.len() - model.triangles.len()
+    );
+    Ok(Some(split))
+}
+
+/// The strips the seams cut (planes, then node lines within them, then geodesic seams; none:
+/// the whole film), on the film split along the geodesic seams (the model returned).
+fn strips(model: Model, a: &PatternArgs<'_>) -> Result<(Model, Vec<Vec<usize>>), String> {
+    let planes: Vec<SeamPlane> = a
+        .seam_planes
+        .iter()
+        .map(|p| SeamPlane {
+            point: [p[0], p[1], p[2]],
+            normal: [p[3], p[4], p[5]],
+        })
+        .collect();
+    let lines: Vec<Vec<usize>> = a
+        .seam_nodes
+        .iter()
+        .map(|l| node_line(&model, l, "--seam-nodes"))
+        .collect::<Result<_, _>>()?;
+    let mut partitions = vec![
+        strips_by_planes(&model, &planes),
+        strips_by_node_lines(&model, &lines),
+    ];
+    let model = match geodesic_split(&model, a)? {
+        None => model,
+        Some(split) => {
+            // The planes' and node lines' strips hold the pieces of their triangles.
+            for partition in &mut partitions {
+                let mut part = vec![usize::MAX; model.triangles.len()];
+                for (k, strip) in partition.iter().enumerate() {
+                    strip.iter().for_each(|&t| part[t] = k);
+                }
+                let mut pieces = vec![Vec::new(); partition.len()];
+                for (t, &p) in split.parent.iter().enumerate() {
+                    pieces[part[p]].push(t);
+                }
+                *partition = pieces;
+            }
+            partitions.push(split.strips.clone());
+            split.model
+        }
+    };
     // A strip is a set of triangles in the same part of every partition (the same side of
     // every plane, connected across non-seam edges, between the same geodesic seams).
     let mut strips: Vec<Vec<usize>> = partitions.remove(0);
@@ -204,7 +251,7 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
         }
         strips = next;
     }
-    Ok(strips)
+    Ok((model, strips))
 }
 
 /// The nodes `N1,N2,…` of `text`, each a node of `model` (`option` names the option in errors).
@@ -331,9 +378,8 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     if a.by_element && a.erect.0 == 0 {
         return Err("--by-element corrects by erections: give --erect N (N ≥ 1)".into());
     }
-    let model = read_model(a.file)?;
     let started = Instant::now();
-    let strips = strips(&model, &a)?;
+    let (model, strips) = strips(read_model(a.file)?, &a)?;
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
     let path = a

@@ -1042,7 +1042,7 @@ fn main() -> ExitCode {
             file,
             seam_planes: seam_plane,
             seam_nodes,
-            geodesic: geodesic_from.as_deref().zip(*strip_width),
+            geodesic: (geodesic_from.as_slice(), strip_width.as_slice()),
             compensation,
             svg: svg.as_ref(),
             dxf: dxf.as_ref(),
