@@ -76,12 +76,18 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
         return json.loads(out.read_text())
 
 
+def _nested(values: Sequence[Any]) -> bool:
+    """Whether ``values`` is a list of lists (several lines or waypoints), not one."""
+    return len(values) > 0 and not isinstance(values[0], (int, float))
+
+
 def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (),
             seam_nodes: Sequence[Sequence[int]] = (), compensation: str | float | Sequence[float] = "prestress",
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
             erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
-            rail_path: Sequence[float] | None = None, geodesic_from: Sequence[int] | None = None,
-            strip_width: float | None = None) -> dict[str, Any]:
+            rail_path: Sequence[float] | Sequence[Sequence[float]] | None = None,
+            geodesic_from: Sequence[int] | Sequence[Sequence[int]] | None = None,
+            strip_width: float | Sequence[float] | None = None) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
     ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
     ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
@@ -93,11 +99,14 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     ``stalled`` (triangles above the tolerance whose error did not halve) and ``held_by_friction``
     (those of them that friction holds on a support: their stress does not follow their cut).
     ``rail_path=(up, in)`` (m): the erections start with the rails that far above and inward of
-    their places and pull them down and out (``--rail-path``).
+    their places and pull them down and out (``--rail-path``); a list of such pairs is a winding
+    path, the rails going through each in turn, e.g. ``[(0.10, 0.03), (0.0, 0.03)]``: down, then
+    out.
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
-    ``geodesic_from`` (a line of boundary nodes) and ``strip_width`` (m): geodesic seams that far
-    apart along the surface (``--geodesic-from``, ``--strip-width``);
+    ``geodesic_from`` (a line of boundary nodes, or a list of lines) and ``strip_width`` (m, one
+    for all lines or one per line): geodesic seams that far apart along the surface, the film split
+    along them (``--geodesic-from``, ``--strip-width``);
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
     ``svg`` / ``erection_model``: files to write the outlines and the erection model to."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -113,12 +122,17 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
         for line in seam_nodes:
             args += ["--seam-nodes", ",".join(str(int(v)) for v in line)]
         if geodesic_from is not None:
-            args += ["--geodesic-from", ",".join(str(int(v)) for v in geodesic_from),
-                     "--strip-width", repr(float(strip_width))]
+            lines = geodesic_from if _nested(geodesic_from) else [geodesic_from]
+            for line in lines:
+                args += ["--geodesic-from", ",".join(str(int(v)) for v in line)]
+            widths = [strip_width] if isinstance(strip_width, (int, float)) else list(strip_width)
+            for w in widths:
+                args += ["--strip-width", repr(float(w))]
         if by_element:
             args.append("--by-element")
         if rail_path is not None:
-            args += ["--rail-path", ",".join(repr(float(v)) for v in rail_path)]
+            for waypoint in (rail_path if _nested(rail_path) else [rail_path]):
+                args += ["--rail-path", ",".join(repr(float(v)) for v in waypoint)]
         if svg is not None:
             args += ["--svg", str(svg)]
         if erection_model is not None:

@@ -158,9 +158,11 @@ pub enum Command {
         /// The erection path of a roof: the rails (the model's boundary groups) start UP m above
         /// and IN m inward (horizontally, towards the film) of their places, the film laid on
         /// its supports, and are pulled down and out to them; without it the cut is laid at
-        /// its fitted reference and the rails drawn straight to their places.
+        /// its fitted reference and the rails drawn straight to their places. Repeat for a
+        /// winding path: the rails go through each waypoint in turn, then to their places
+        /// (`--rail-path 0.10,0.03 --rail-path 0,0.03`: down, then out).
         #[arg(long, value_name = "UP,IN", value_parser = parse_pair, allow_negative_numbers = true)]
-        rail_path: Option<[f64; 2]>,
+        rail_path: Vec<[f64; 2]>,
         /// Increments of each erection.
         #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         erect_increments: u32,

@@ -11,7 +11,7 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementSettings, away_from_rails, compensate_elements, erect_along, rail_start_offsets,
+    ElementSettings, away_from_rails, compensate_elements, erect_through, rail_waypoints,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::geodesic::geodesic_seams;
@@ -127,8 +127,8 @@ pub struct PatternArgs<'a> {
     pub erect: (usize, f64, usize),
     /// Correct each triangle's reference metric, not each strip's compensation.
     pub by_element: bool,
-    /// The rails' start offsets `[up, in]` (m) of the erection path.
-    pub rail_path: Option<[f64; 2]>,
+    /// The rails' offsets `[up, in]` (m) at each waypoint of the erection path.
+    pub rail_path: &'a [[f64; 2]],
     /// Where to write the report as JSON.
     pub report: Option<&'a PathBuf>,
 }
@@ -269,10 +269,10 @@ fn node_line(model: &Model, text: &str, option: &str) -> Result<Vec<usize>, Stri
 fn compensate_with_erections(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    (start, path): (Compensation, &[(usize, [f64; 3])]),
+    (start, path): (Compensation, &[Vec<(usize, [f64; 3])>]),
     (iterations, tolerance, increments): (usize, f64, usize),
 ) -> Result<(Compensation, Vec<serde_json::Value>), String> {
-    let mut erect = |m: Model| erect_along(m, increments, path).map(|e| e.elements);
+    let mut erect = |m: Model| erect_through(m, increments, path).map(|e| e.elements);
     let history =
         compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
     for (k, h) in history.iter().enumerate() {
@@ -310,7 +310,7 @@ fn compensate_with_erections(
 fn compensate_by_elements(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    (start, path): (Compensation, &[(usize, [f64; 3])]),
+    (start, path): (Compensation, &[Vec<(usize, [f64; 3])>]),
     (iterations, tolerance, increments): (usize, f64, usize),
 ) -> Result<(Vec<CutStrip>, serde_json::Value), String> {
     let settings = ElementSettings {
@@ -318,7 +318,7 @@ fn compensate_by_elements(
         tolerance,
         counted: away_from_rails(model),
     };
-    let mut erect = |m: Model| erect_along(m, increments, path);
+    let mut erect = |m: Model| erect_through(m, increments, path);
     let outcome = compensate_elements(model, strips, start, &settings, &mut erect)?;
     for (k, h) in outcome.history.iter().enumerate() {
         println!(
@@ -382,10 +382,7 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let (model, strips) = strips(read_model(a.file)?, &a)?;
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
-    let path = a
-        .rail_path
-        .map(|[up, inward]| rail_start_offsets(&model, up, inward))
-        .unwrap_or_default();
+    let path = rail_waypoints(&model, a.rail_path);
     let cut = if a.erect.0 > 0 && a.by_element {
         let (cut, r) = compensate_by_elements(&model, strips, (compensation, &path), a.erect)?;
         report = r;

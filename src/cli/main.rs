@@ -1049,7 +1049,7 @@ fn main() -> ExitCode {
             erection_model: erection_model.as_ref(),
             erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
             by_element: *by_element,
-            rail_path: *rail_path,
+            rail_path: rail_path.as_slice(),
             report: report.as_ref(),
         }),
         Command::ExportSpecimen {
