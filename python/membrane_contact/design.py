@@ -6,7 +6,9 @@ finding and patterning").
   strategy, Bletzinger & Ramm 1999), returned as a model (dict);
 * :func:`pattern` — the strips cut along seams, flattened and compensated, with their sizes and
   distortions, and, with ``erect=N``, the compensation corrected by erections with the analysis
-  (each strip's, or with ``by_element=True`` each triangle's).
+  (each strip's, or with ``by_element=True`` each triangle's);
+* :func:`pattern_variants` — several patterns and compensations (rail paths, friction-aware or
+  uniform, …) at once on the study machinery's Dask cluster, one variant per worker.
 
 Both take a model as a dict or a file path; a model the program refuses raises
 :class:`DesignError` with the program's message, which names the bad item.
@@ -139,3 +141,34 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             args += ["--erection-model", str(erection_model)]
         _run(args)
         return json.loads(report.read_text())
+
+
+def _pattern_variant(model_text: str, options: dict) -> dict:
+    """One variant of :func:`pattern_variants` on a worker: its report, or its ``error``."""
+    try:
+        return pattern(json.loads(model_text), **options)
+    except DesignError as e:
+        return {"error": str(e)}
+
+
+def pattern_variants(model: dict | str | Path, variants: Sequence[dict], client: Any = None, *,
+                     scheduler: str | None = None, workers: int | None = None) -> list[dict]:
+    """Runs the cutting pattern and its compensation by erection of each of ``variants`` (keyword
+    arguments of :func:`pattern`: another rail path, friction-aware or uniform compensation, more
+    erections, …) on the study machinery's Dask cluster (:func:`membrane_contact.cluster.cluster`:
+    ``client``, else one to ``scheduler``, else a ``LocalCluster`` of ``workers`` single-threaded
+    processes), one variant per task, every erection of its iterations inside it. Returns the
+    reports in the order of ``variants``; a variant the program refuses gives ``{"error":
+    message}`` and the others go on (as a study's refused case). The workers run the same
+    ``membrane-contact`` program as :func:`pattern` (``$MEMBRANE_CONTACT_CLI``, the wheel's, or the
+    checkout's build)."""
+    if not isinstance(model, dict):
+        model = json.loads(Path(model).read_text())
+    text = json.dumps(model)
+    if client is None:
+        from .cluster import cluster
+
+        with cluster(scheduler, workers) as client:
+            return pattern_variants(model, variants, client)
+    futures = [client.submit(_pattern_variant, text, dict(v), pure=False) for v in variants]
+    return client.gather(futures)

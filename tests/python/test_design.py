@@ -133,3 +133,23 @@ def test_design_iterations_figure_drum_rows_match_its_csv_golden_number():
     golden = [r for r in (root / "docs" / "figures" / "design_iterations.csv").read_text().splitlines()
               if r.startswith("\"drum, mu = 0.3") or r.startswith("drum, mu = 0.3")][0]
     assert float(golden.split(",")[-1]) == pytest.approx(0.178791, abs=1e-5)
+
+
+def test_pattern_variants_on_the_study_cluster_give_each_variants_own_report():
+    """Two compensation variants of the drum (μ = 0.3), the rails straight down and out and the
+    winding path (down, then out), and one the program refuses, run on a local Dask cluster of two
+    workers: each report is the one :func:`pattern` gives alone, the paths differ (friction), and
+    the refused variant carries the program's message while the others go on."""
+    pytest.importorskip("distributed")
+    from membrane_contact.design import pattern_variants
+
+    straight = dict(erect=1, by_element=True, rail_path=(0.10, 0.03))
+    winding = dict(erect=1, by_element=True, rail_path=[(0.10, 0.03), (0.0, 0.03)])
+    refused = dict(erect=0, by_element=True)
+    reports = pattern_variants(DRUM, [straight, winding, refused], workers=2)
+    assert "--erect" in reports[2]["error"]
+    for options, report in zip((straight, winding), reports):
+        alone = pattern(DRUM, **options)
+        assert report["erections"] == alone["erections"]
+    first = [r["erections"][0]["max_error"] for r in reports[:2]]
+    assert abs(first[0] - first[1]) > 1e-3, first
