@@ -20,7 +20,7 @@ use membrane_contact::mech::patterning::reference::{erection_model, reference_ge
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
 };
-use membrane_contact::mech::patterning::split::{SplitFilm, split_along};
+use membrane_contact::mech::patterning::split::{SNAP, SplitFilm, split_along};
 
 /// What `form-find` is asked.
 pub struct FormFindArgs<'a> {
@@ -184,7 +184,7 @@ fn geodesic_split(model: &Model, a: &PatternArgs<'_>) -> Result<Option<SplitFilm
         );
         all.extend(seams.seams);
     }
-    let split = split_along(model, &all).map_err(|e| format!("--geodesic-from: {e}"))?;
+    let split = split_along(model, &all, SNAP).map_err(|e| format!("--geodesic-from: {e}"))?;
     eprintln!(
         "split along the seams: {} nodes and {} triangles added",
         split.model.nodes.len() - model.nodes.len(),

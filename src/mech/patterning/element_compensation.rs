@@ -227,7 +227,8 @@ pub fn refit_strips(
             })
             .collect::<Result<Vec<_>, _>>()?;
         relax_flat(&mut c.strip.flat, &terms, 100).map_err(|e| format!("strip {k}: {e}"))?;
-        align(&mut c.strip.flat);
+        let local: Vec<[usize; 3]> = elements.iter().map(|e| e.local).collect();
+        align(&mut c.strip.flat, &local);
         let b = bounds(&c.strip.flat);
         c.size = [b[2] - b[0], b[3] - b[1]];
         c.compensation = [0, 1].map(|a| uncut[k][a] / c.size[a] - 1.0);

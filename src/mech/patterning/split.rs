@@ -36,6 +36,11 @@ type V3 = Vector3<f64>;
 /// Relative distance (to the triangle's longest edge) below which two points are one node.
 const SAME_POINT: f64 = 1e-9;
 
+/// A seam that crosses an edge within this fraction of its length from an end goes through that
+/// end instead: no sliver piece (a seam along a mesh line of a curved film crosses its edges
+/// within 1e-5 to 1e-3 of their ends), the outline off the seam by at most this much of the edge.
+pub const SNAP: f64 = 0.02;
+
 /// The film split along its seams.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SplitFilm {
@@ -98,11 +103,13 @@ struct Builder<'a> {
     x: Vec<V3>,
     origin: Vec<Origin>,
     on_edge: HashMap<[usize; 2], Vec<(f64, usize)>>,
+    snap: f64,
 }
 
 impl<'a> Builder<'a> {
-    fn new(model: &'a Model) -> Self {
+    fn new(model: &'a Model, snap: f64) -> Self {
         Self {
+            snap,
             model,
             x: model.nodes.iter().map(|&p| V3::from(p)).collect(),
             origin: Vec::new(),
@@ -158,6 +165,11 @@ impl<'a> Builder<'a> {
             ));
         }
         let [a, b] = edge(k);
+        // Within SNAP of an end, the seam goes through that end (decided on the edge alone, so
+        // both triangles of the edge decide alike).
+        if lambda < self.snap || lambda > 1.0 - self.snap {
+            return Ok(if lambda < 0.5 { a } else { b });
+        }
         if let Some(&(_, v)) = self.on_edge.get(&[a, b]).and_then(|nodes| {
             let length = (self.x[b] - self.x[a]).norm();
             nodes
@@ -291,10 +303,16 @@ impl<'a> Builder<'a> {
 
 /// Splits `model`'s film along the `seams` (points on its triangles' edges, each point's
 /// `triangle` the one the segment leaving it crosses, as [`super::geodesic`] traces them) and
-/// returns the split film, its seam edges and the strips between them.
-pub fn split_along(model: &Model, seams: &[Vec<GeodesicPoint>]) -> Result<SplitFilm, String> {
+/// returns the split film, its seam edges and the strips between them. A crossing within `snap`
+/// of an edge's length from its end goes through that end ([`SNAP`]; 0: every crossing is a
+/// node, the outlines exactly on the seams).
+pub fn split_along(
+    model: &Model,
+    seams: &[Vec<GeodesicPoint>],
+    snap: f64,
+) -> Result<SplitFilm, String> {
     let chords = chords(seams);
-    let mut b = Builder::new(model);
+    let mut b = Builder::new(model, snap);
     let mut by_triangle: Vec<Vec<[usize; 2]>> = vec![Vec::new(); model.triangles.len()];
     for c in &chords {
         let ends = [
