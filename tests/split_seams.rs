@@ -274,10 +274,35 @@ fn seams_from_two_start_lines_cross_and_split_the_film_into_the_strips_of_both_f
         .args(["--compensation", "0"])
         .output()
         .unwrap();
-    std::fs::remove_file(&file).ok();
     let stderr = String::from_utf8(output.stderr).unwrap();
     assert!(output.status.success(), "{stderr}");
     assert!(stderr.contains("geodesic seams: 4 seams"), "{stderr}");
     let stdout = String::from_utf8(output.stdout).unwrap();
     assert_eq!(stdout.lines().count(), 14, "{stdout}");
+    // Three widths for two lines are refused.
+    let refused = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .arg("pattern")
+        .arg(&file)
+        .args([
+            "--geodesic-from",
+            &list(&bottom),
+            "--geodesic-from",
+            &list(&column),
+        ])
+        .args([
+            "--strip-width",
+            "0.3",
+            "--strip-width",
+            "0.7",
+            "--strip-width",
+            "0.5",
+        ])
+        .output()
+        .unwrap();
+    let message = String::from_utf8(refused.stderr).unwrap();
+    assert!(
+        !refused.status.success() && message.contains("2 lines, 3 widths"),
+        "{message}"
+    );
+    std::fs::remove_file(&file).ok();
 }
