@@ -22,7 +22,8 @@
 //! then out) erects the drum film to the straight path's stresses without friction (the end
 //! state of an elastic film on a frictionless support does not depend on the path) and to other
 //! stresses with μ = 0.3; the element-wise compensation along it reaches 5 % away from the rails
-//! or names every triangle it leaves above and those friction holds, through the CLI as well.
+//! or names every triangle it leaves above and those friction holds, through the CLI as well,
+//! which writes each erection's model as it erects it.
 //!
 //! MESHES (erection): a flat 2 m × 1 m film, 8 × 4 cells, rim held; a film over a drum
 //! (cylinder `r = 0.5 m` along y, a curved support), ±60° of arc (12 cells) and 0.5 m tangents
@@ -1221,40 +1222,40 @@ fn a_winding_rail_path_matters_only_with_friction_and_the_compensation_along_it_
     );
     // The CLI's repeated --rail-path is the same path.
     let path = format!("{}/examples/drum.json", env!("CARGO_MANIFEST_DIR"));
-    let report = std::env::temp_dir().join(format!("winding-{}.json", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("winding-{}", std::process::id()));
+    let (report, best) = (dir.join("report.json"), dir.join("best.json"));
+    let erect = ["--erect", "3", "--by-element", "--erect-tolerance", "5"];
+    let rails = ["--rail-path", "0.10,0.03", "--rail-path", "0,0.03"];
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
-        .args([
-            "pattern",
-            &path,
-            "--erect",
-            "3",
-            "--by-element",
-            "--erect-tolerance",
-            "5",
-        ])
-        .args([
-            "--rail-path",
-            "0.10,0.03",
-            "--rail-path",
-            "0,0.03",
-            "--report",
-        ])
+        .args(["pattern", &path])
+        .args(erect)
+        .args(rails)
+        .arg("--report")
         .arg(&report)
+        .arg("--erection-models")
+        .arg(dir.join("models"))
+        .arg("--erection-model")
+        .arg(&best)
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    std::fs::remove_file(&report).ok();
     let first = json["erections"][0]["max_error"].as_f64().unwrap();
-    assert!(
-        (first - outcome.history[0].max_error.0).abs() < 1e-9,
-        "{first}"
-    );
+    let library = outcome.history[0].max_error.0;
+    assert!((first - library).abs() < 1e-9, "{first}");
     let stalled: Vec<usize> = serde_json::from_value(json["stalled"].clone()).unwrap();
     assert_eq!(stalled, outcome.stalled);
+    // --erection-models wrote each erection's model as it was erected; the one of the smallest
+    // largest error is the kept cut's, which --erection-model writes.
+    let read = |f: &std::path::Path| Model::from_json(&std::fs::read_to_string(f).unwrap());
+    let erections = json["erections"].as_array().unwrap();
+    let models = std::fs::read_dir(dir.join("models")).unwrap().count();
+    assert_eq!(models, erections.len());
+    let error = |k: usize| erections[k]["max_error"].as_f64().unwrap();
+    let kept = (0..models).min_by(|&i, &j| error(i).total_cmp(&error(j)));
+    let kept_model = read(&dir.join(format!("models/erection-{}.json", kept.unwrap())));
+    assert!(kept_model.unwrap() == read(&best).unwrap());
+    std::fs::remove_dir_all(&dir).ok();
 }

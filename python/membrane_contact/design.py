@@ -89,7 +89,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
             rail_path: Sequence[float] | Sequence[Sequence[float]] | None = None,
             geodesic_from: Sequence[int] | Sequence[Sequence[int]] | None = None,
-            strip_width: float | Sequence[float] | None = None) -> dict[str, Any]:
+            strip_width: float | Sequence[float] | None = None,
+            erection_models: str | Path | None = None) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
     ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
     ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
@@ -110,7 +111,10 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     for all lines or one per line): geodesic seams that far apart along the surface, the film split
     along them (``--geodesic-from``, ``--strip-width``);
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
-    ``svg`` / ``erection_model``: files to write the outlines and the erection model to."""
+    ``svg`` / ``erection_model``: files to write the outlines and the erection model to;
+    ``erection_models``: a folder to write every erection's model to as it is erected
+    (``erection-K.json``: models a :class:`membrane_contact.study.Study` can run, packed by
+    ``fmu-pack``)."""
     with tempfile.TemporaryDirectory() as tmp:
         report = Path(tmp) / "report.json"
         if not isinstance(compensation, str):
@@ -139,6 +143,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             args += ["--svg", str(svg)]
         if erection_model is not None:
             args += ["--erection-model", str(erection_model)]
+        if erection_models is not None:
+            args += ["--erection-models", str(erection_models)]
         _run(args)
         return json.loads(report.read_text())
 

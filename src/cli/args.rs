@@ -170,6 +170,11 @@ pub enum Command {
         /// cut strips), no prestress, each held node driven back to its place by its own group.
         #[arg(long, value_name = "FILE")]
         erection_model: Option<PathBuf>,
+        /// With --erect: write the model of every erection the compensation makes to this
+        /// folder (`erection-K.json`, K = 0, 1, …), before it is erected: models a study (or
+        /// `membrane-contact model`, or `fmu-pack`) can run on their own.
+        #[arg(long, value_name = "DIR")]
+        erection_models: Option<PathBuf>,
         /// Write what the strip lines and erection lines say as JSON (for scripts: the Python
         /// package's `membrane_contact.design.pattern` reads it).
         #[arg(long, value_name = "FILE")]

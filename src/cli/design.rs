@@ -11,7 +11,8 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementSettings, away_from_rails, compensate_elements, erect_through, rail_waypoints,
+    ElementSettings, ErectContacts, away_from_rails, compensate_elements, erect_through,
+    rail_waypoints,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::geodesic::geodesic_seams;
@@ -129,6 +130,8 @@ pub struct PatternArgs<'a> {
     pub by_element: bool,
     /// The rails' offsets `[up, in]` (m) at each waypoint of the erection path.
     pub rail_path: &'a [[f64; 2]],
+    /// A folder to write each erection's model to (`erection-K.json`), as the loop erects it.
+    pub erection_models: Option<&'a PathBuf>,
     /// Where to write the report as JSON.
     pub report: Option<&'a PathBuf>,
 }
@@ -269,10 +272,11 @@ fn node_line(model: &Model, text: &str, option: &str) -> Result<Vec<usize>, Stri
 fn compensate_with_erections(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    (start, path): (Compensation, &[Vec<(usize, [f64; 3])>]),
-    (iterations, tolerance, increments): (usize, f64, usize),
+    start: Compensation,
+    (iterations, tolerance): (usize, f64),
+    erect: &mut ErectContacts<'_>,
 ) -> Result<(Compensation, Vec<serde_json::Value>), String> {
-    let mut erect = |m: Model| erect_through(m, increments, path).map(|e| e.elements);
+    let mut erect = |m: Model| erect(m).map(|e| e.elements);
     let history =
         compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
     for (k, h) in history.iter().enumerate() {
@@ -310,16 +314,16 @@ fn compensate_with_erections(
 fn compensate_by_elements(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    (start, path): (Compensation, &[Vec<(usize, [f64; 3])>]),
-    (iterations, tolerance, increments): (usize, f64, usize),
+    start: Compensation,
+    (iterations, tolerance): (usize, f64),
+    erect: &mut ErectContacts<'_>,
 ) -> Result<(Vec<CutStrip>, serde_json::Value), String> {
     let settings = ElementSettings {
         iterations,
         tolerance,
         counted: away_from_rails(model),
     };
-    let mut erect = |m: Model| erect_through(m, increments, path);
-    let outcome = compensate_elements(model, strips, start, &settings, &mut erect)?;
+    let outcome = compensate_elements(model, strips, start, &settings, erect)?;
     for (k, h) in outcome.history.iter().enumerate() {
         println!(
             "erection {k}: prestress error away from the rails mean {:.3} %, max {:.3} % (triangle {}), {} triangles yielded",
@@ -383,15 +387,40 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
     let path = rail_waypoints(&model, a.rail_path);
-    let cut = if a.erect.0 > 0 && a.by_element {
-        let (cut, r) = compensate_by_elements(&model, strips, (compensation, &path), a.erect)?;
+    let (iterations, tolerance, increments) = a.erect;
+    let mut count = 0;
+    // Each erection's model is written first (`--erection-models DIR`), then erected.
+    let mut erect = |m: Model| {
+        if let Some(dir) = a.erection_models {
+            let file = dir.join(format!("erection-{count}.json"));
+            write_text(Some(&file), &(m.to_json() + "\n"))?;
+        }
+        count += 1;
+        erect_through(m, increments, &path)
+    };
+    if let Some(dir) = a.erection_models {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    let cut = if iterations > 0 && a.by_element {
+        let (cut, r) = compensate_by_elements(
+            &model,
+            strips,
+            compensation,
+            (iterations, tolerance),
+            &mut erect,
+        )?;
         report = r;
         cut
     } else {
-        if a.erect.0 > 0 {
+        if iterations > 0 {
             let erections;
-            (compensation, erections) =
-                compensate_with_erections(&model, strips.clone(), (compensation, &path), a.erect)?;
+            (compensation, erections) = compensate_with_erections(
+                &model,
+                strips.clone(),
+                compensation,
+                (iterations, tolerance),
+                &mut erect,
+            )?;
             report["erections"] = erections.into();
         }
         cut_pattern(&model, strips, compensation)?

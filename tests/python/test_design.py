@@ -153,3 +153,14 @@ def test_pattern_variants_on_the_study_cluster_give_each_variants_own_report():
         assert report["erections"] == alone["erections"]
     first = [r["erections"][0]["max_error"] for r in reports[:2]]
     assert abs(first[0] - first[1]) > 1e-3, first
+
+
+def test_each_erection_model_of_the_compensation_is_written_for_a_study(tmp_path):
+    """``erection_models``: one model per erection of the loop, as it was erected, each a model
+    the program accepts (``membrane-contact check``) and so one a study can pack and run."""
+    report = pattern(DRUM, erect=2, by_element=True, erection_models=tmp_path)
+    files = sorted(tmp_path.glob("erection-*.json"))
+    assert [f.name for f in files] == [f"erection-{k}.json" for k in range(len(report["erections"]))]
+    from membrane_contact.design import _run
+    for f in files:
+        _run(["check", str(f)])
