@@ -18,7 +18,12 @@
 //! Element-wise compensation: a strip refitted to a uniform target metric `diag(a², b²)` takes
 //! the lengths `2a × b` exactly; the fixed point on the reference metrics brings an uncompensated
 //! cut over a frictionless drum within 0.5 % in one correction; with μ = 0.3 it stalls and names
-//! the crown's elements as held by friction.
+//! the crown's elements as held by friction. A winding rail path (up 0.10 m and in 0.03 m, down,
+//! then out) erects the drum film to the straight path's stresses without friction (the end
+//! state of an elastic film on a frictionless support does not depend on the path) and to other
+//! stresses with μ = 0.3; the element-wise compensation along it reaches 5 % away from the rails
+//! or names every triangle it leaves above and those friction holds, through the CLI as well,
+//! which writes each erection's model as it erects it.
 //!
 //! MESHES (erection): a flat 2 m × 1 m film, 8 × 4 cells, rim held; a film over a drum
 //! (cylinder `r = 0.5 m` along y, a curved support), ±60° of arc (12 cells) and 0.5 m tangents
@@ -50,7 +55,8 @@ use membrane_contact::mech::patterning::Strip;
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
     ElementCompensation, ElementSettings, Erected, away_from_rails, compensate_elements,
-    erect_along, erect_with_contacts, rail_start_offsets, refit_strips,
+    erect_along, erect_through, erect_with_contacts, rail_start_offsets, rail_waypoints,
+    refit_strips,
 };
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
@@ -1141,4 +1147,115 @@ fn element_wise_iteration_stops_when_the_largest_error_grows_and_keeps_the_best_
     assert!(h[1].max_error.0 > h[0].max_error.0);
     let first = cut_pattern(&model, halves(&model), start).unwrap();
     assert_eq!(outcome.cut, first);
+}
+
+/// The largest difference between two erections' stresses, relative to the target prestress.
+fn stress_apart(a: &Erected, b: &Erected) -> f64 {
+    (a.elements.iter().zip(&b.elements))
+        .flat_map(|(p, q)| (0..3).map(move |i| (p.stress[i] - q.stress[i]).abs()))
+        .fold(0.0, f64::max)
+        / ISOTROPIC[0]
+}
+
+/// The bay path as waypoints: up 0.10 m and in 0.03 m, then down, then out.
+const DOWN_THEN_OUT: [[f64; 2]; 2] = [[0.10, 0.03], [0.0, 0.03]];
+
+#[test]
+fn a_winding_rail_path_matters_only_with_friction_and_the_compensation_along_it_reaches_the_target_or_names_what_friction_holds()
+ {
+    let mut apart = [0.0; 2];
+    for (k, mu) in [0.0, 0.3].into_iter().enumerate() {
+        let model = film_over_drum(mu);
+        let cut = cut_pattern(&model, whole(&model), Compensation::Prestress).unwrap();
+        let erection = erection_model(&model, reference_geometry(&model, &cut).unwrap());
+        let straight = erect_along(
+            erection.clone(),
+            10,
+            &rail_start_offsets(&model, 0.10, 0.03),
+        );
+        let winding = erect_through(erection, 10, &rail_waypoints(&model, &DOWN_THEN_OUT));
+        apart[k] = stress_apart(&straight.unwrap(), &winding.unwrap());
+    }
+    eprintln!(
+        "drum, winding against straight path: stresses apart by {:.2e} of the target without friction, {:.3} with μ = 0.3",
+        apart[0], apart[1]
+    );
+    assert!(apart[0] < 1e-6 && apart[1] > 0.01, "{apart:?}");
+    // The element-wise compensation along the winding path, μ = 0.3, tolerance 5 %.
+    let model = film_over_drum(0.3);
+    let settings = ElementSettings {
+        iterations: 3,
+        tolerance: 0.05,
+        counted: away_from_rails(&model),
+    };
+    let path = rail_waypoints(&model, &DOWN_THEN_OUT);
+    let mut erect = |m: Model| erect_through(m, 10, &path);
+    let start = Compensation::Prestress;
+    let outcome = compensate_elements(&model, whole(&model), start, &settings, &mut erect).unwrap();
+    let last = outcome.history.last().unwrap();
+    let above: Vec<usize> = (0..model.triangles.len())
+        .filter(|&t| settings.counted[t] && last.element_errors[t] > settings.tolerance)
+        .collect();
+    for (k, h) in outcome.history.iter().enumerate() {
+        eprintln!(
+            "winding path, μ = 0.3: erection {k}: mean {:.2} %, max {:.2} % (triangle {}), {} yielded",
+            100.0 * h.mean_error,
+            100.0 * h.max_error.0,
+            h.max_error.1,
+            h.yielded
+        );
+    }
+    eprintln!(
+        "above 5 %: {above:?}; stalled {:?}; held by friction {:?}",
+        outcome.stalled, outcome.held_by_friction
+    );
+    // Reached, or every triangle left above the tolerance is named, and friction is why.
+    if !above.is_empty() {
+        assert_eq!(above, outcome.stalled);
+        assert!(outcome.held_by_friction.contains(&last.max_error.1));
+    }
+    assert!(
+        outcome
+            .held_by_friction
+            .iter()
+            .all(|t| outcome.stalled.contains(t))
+    );
+    // The CLI's repeated --rail-path is the same path.
+    let path = format!("{}/examples/drum.json", env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("winding-{}", std::process::id()));
+    let (report, best) = (dir.join("report.json"), dir.join("best.json"));
+    let erect = ["--erect", "3", "--by-element", "--erect-tolerance", "5"];
+    let rails = ["--rail-path", "0.10,0.03", "--rail-path", "0,0.03"];
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["pattern", &path])
+        .args(erect)
+        .args(rails)
+        .arg("--report")
+        .arg(&report)
+        .arg("--erection-models")
+        .arg(dir.join("models"))
+        .arg("--erection-model")
+        .arg(&best)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let first = json["erections"][0]["max_error"].as_f64().unwrap();
+    let library = outcome.history[0].max_error.0;
+    assert!((first - library).abs() < 1e-9, "{first}");
+    let stalled: Vec<usize> = serde_json::from_value(json["stalled"].clone()).unwrap();
+    assert_eq!(stalled, outcome.stalled);
+    // --erection-models wrote each erection's model as it was erected; the one of the smallest
+    // largest error is the kept cut's, which --erection-model writes.
+    let read = |f: &std::path::Path| Model::from_json(&std::fs::read_to_string(f).unwrap());
+    let erections = json["erections"].as_array().unwrap();
+    let models = std::fs::read_dir(dir.join("models")).unwrap().count();
+    assert_eq!(models, erections.len());
+    let error = |k: usize| erections[k]["max_error"].as_f64().unwrap();
+    let kept = (0..models).min_by(|&i, &j| error(i).total_cmp(&error(j)));
+    let kept_model = read(&dir.join(format!("models/erection-{}.json", kept.unwrap())));
+    assert!(kept_model.unwrap() == read(&best).unwrap());
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -6,7 +6,9 @@ finding and patterning").
   strategy, Bletzinger & Ramm 1999), returned as a model (dict);
 * :func:`pattern` — the strips cut along seams, flattened and compensated, with their sizes and
   distortions, and, with ``erect=N``, the compensation corrected by erections with the analysis
-  (each strip's, or with ``by_element=True`` each triangle's).
+  (each strip's, or with ``by_element=True`` each triangle's);
+* :func:`pattern_variants` — several patterns and compensations (rail paths, friction-aware or
+  uniform, …) at once on the study machinery's Dask cluster, one variant per worker.
 
 Both take a model as a dict or a file path; a model the program refuses raises
 :class:`DesignError` with the program's message, which names the bad item.
@@ -76,12 +78,19 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
         return json.loads(out.read_text())
 
 
+def _nested(values: Sequence[Any]) -> bool:
+    """Whether ``values`` is a list of lists (several lines or waypoints), not one."""
+    return len(values) > 0 and not isinstance(values[0], (int, float))
+
+
 def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (),
             seam_nodes: Sequence[Sequence[int]] = (), compensation: str | float | Sequence[float] = "prestress",
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
             erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
-            rail_path: Sequence[float] | None = None, geodesic_from: Sequence[int] | None = None,
-            strip_width: float | None = None) -> dict[str, Any]:
+            rail_path: Sequence[float] | Sequence[Sequence[float]] | None = None,
+            geodesic_from: Sequence[int] | Sequence[Sequence[int]] | None = None,
+            strip_width: float | Sequence[float] | None = None,
+            erection_models: str | Path | None = None) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
     ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
     ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
@@ -93,13 +102,19 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     ``stalled`` (triangles above the tolerance whose error did not halve) and ``held_by_friction``
     (those of them that friction holds on a support: their stress does not follow their cut).
     ``rail_path=(up, in)`` (m): the erections start with the rails that far above and inward of
-    their places and pull them down and out (``--rail-path``).
+    their places and pull them down and out (``--rail-path``); a list of such pairs is a winding
+    path, the rails going through each in turn, e.g. ``[(0.10, 0.03), (0.0, 0.03)]``: down, then
+    out.
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
-    ``geodesic_from`` (a line of boundary nodes) and ``strip_width`` (m): geodesic seams that far
-    apart along the surface (``--geodesic-from``, ``--strip-width``);
+    ``geodesic_from`` (a line of boundary nodes, or a list of lines) and ``strip_width`` (m, one
+    for all lines or one per line): geodesic seams that far apart along the surface, the film split
+    along them (``--geodesic-from``, ``--strip-width``);
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
-    ``svg`` / ``erection_model``: files to write the outlines and the erection model to."""
+    ``svg`` / ``erection_model``: files to write the outlines and the erection model to;
+    ``erection_models``: a folder to write every erection's model to as it is erected
+    (``erection-K.json``: models a :class:`membrane_contact.study.Study` can run, packed by
+    ``fmu-pack``)."""
     with tempfile.TemporaryDirectory() as tmp:
         report = Path(tmp) / "report.json"
         if not isinstance(compensation, str):
@@ -113,15 +128,53 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
         for line in seam_nodes:
             args += ["--seam-nodes", ",".join(str(int(v)) for v in line)]
         if geodesic_from is not None:
-            args += ["--geodesic-from", ",".join(str(int(v)) for v in geodesic_from),
-                     "--strip-width", repr(float(strip_width))]
+            lines = geodesic_from if _nested(geodesic_from) else [geodesic_from]
+            for line in lines:
+                args += ["--geodesic-from", ",".join(str(int(v)) for v in line)]
+            widths = [strip_width] if isinstance(strip_width, (int, float)) else list(strip_width)
+            for w in widths:
+                args += ["--strip-width", repr(float(w))]
         if by_element:
             args.append("--by-element")
         if rail_path is not None:
-            args += ["--rail-path", ",".join(repr(float(v)) for v in rail_path)]
+            for waypoint in (rail_path if _nested(rail_path) else [rail_path]):
+                args += ["--rail-path", ",".join(repr(float(v)) for v in waypoint)]
         if svg is not None:
             args += ["--svg", str(svg)]
         if erection_model is not None:
             args += ["--erection-model", str(erection_model)]
+        if erection_models is not None:
+            args += ["--erection-models", str(erection_models)]
         _run(args)
         return json.loads(report.read_text())
+
+
+def _pattern_variant(model_text: str, options: dict) -> dict:
+    """One variant of :func:`pattern_variants` on a worker: its report, or its ``error``."""
+    try:
+        return pattern(json.loads(model_text), **options)
+    except DesignError as e:
+        return {"error": str(e)}
+
+
+def pattern_variants(model: dict | str | Path, variants: Sequence[dict], client: Any = None, *,
+                     scheduler: str | None = None, workers: int | None = None) -> list[dict]:
+    """Runs the cutting pattern and its compensation by erection of each of ``variants`` (keyword
+    arguments of :func:`pattern`: another rail path, friction-aware or uniform compensation, more
+    erections, …) on the study machinery's Dask cluster (:func:`membrane_contact.cluster.cluster`:
+    ``client``, else one to ``scheduler``, else a ``LocalCluster`` of ``workers`` single-threaded
+    processes), one variant per task, every erection of its iterations inside it. Returns the
+    reports in the order of ``variants``; a variant the program refuses gives ``{"error":
+    message}`` and the others go on (as a study's refused case). The workers run the same
+    ``membrane-contact`` program as :func:`pattern` (``$MEMBRANE_CONTACT_CLI``, the wheel's, or the
+    checkout's build)."""
+    if not isinstance(model, dict):
+        model = json.loads(Path(model).read_text())
+    text = json.dumps(model)
+    if client is None:
+        from .cluster import cluster
+
+        with cluster(scheduler, workers) as client:
+            return pattern_variants(model, variants, client)
+    futures = [client.submit(_pattern_variant, text, dict(v), pure=False) for v in variants]
+    return client.gather(futures)

@@ -115,12 +115,20 @@ pub enum Command {
         #[arg(long, value_name = "N1,N2,…")]
         seam_nodes: Vec<String>,
         /// Geodesic seams from this line of boundary nodes: straightest geodesics (Polthier &
-        /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it.
+        /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it; repeat
+        /// for more start lines. The film is split along the seams (nodes added where they
+        /// cross its triangles' edges), so the strips' outlines follow them.
         #[arg(long, value_name = "N1,N2,…", requires = "strip_width")]
-        geodesic_from: Option<String>,
-        /// The width (m, along the surface) between the geodesic seams of --geodesic-from.
-        #[arg(long, value_name = "W", requires = "geodesic_from")]
-        strip_width: Option<f64>,
+        geodesic_from: Vec<String>,
+        /// The width (m, along the surface) between the geodesic seams of --geodesic-from: one
+        /// for every start line, or one per start line in their order.
+        #[arg(
+            long,
+            value_name = "W",
+            requires = "geodesic_from",
+            allow_negative_numbers = true
+        )]
+        strip_width: Vec<f64>,
         /// `prestress` (the strain of the model's prestress, D⁻¹σ, along and across each strip) or
         /// the compensation in percent, `C` or `CX,CY` (along, across).
         #[arg(long, value_name = "prestress|C[,C]", default_value = "prestress")]
@@ -150,9 +158,11 @@ pub enum Command {
         /// The erection path of a roof: the rails (the model's boundary groups) start UP m above
         /// and IN m inward (horizontally, towards the film) of their places, the film laid on
         /// its supports, and are pulled down and out to them; without it the cut is laid at
-        /// its fitted reference and the rails drawn straight to their places.
+        /// its fitted reference and the rails drawn straight to their places. Repeat for a
+        /// winding path: the rails go through each waypoint in turn, then to their places
+        /// (`--rail-path 0.10,0.03 --rail-path 0,0.03`: down, then out).
         #[arg(long, value_name = "UP,IN", value_parser = parse_pair, allow_negative_numbers = true)]
-        rail_path: Option<[f64; 2]>,
+        rail_path: Vec<[f64; 2]>,
         /// Increments of each erection.
         #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         erect_increments: u32,
@@ -160,6 +170,11 @@ pub enum Command {
         /// cut strips), no prestress, each held node driven back to its place by its own group.
         #[arg(long, value_name = "FILE")]
         erection_model: Option<PathBuf>,
+        /// With --erect: write the model of every erection the compensation makes to this
+        /// folder (`erection-K.json`, K = 0, 1, …), before it is erected: models a study (or
+        /// `membrane-contact model`, or `fmu-pack`) can run on their own.
+        #[arg(long, value_name = "DIR")]
+        erection_models: Option<PathBuf>,
         /// Write what the strip lines and erection lines say as JSON (for scripts: the Python
         /// package's `membrane_contact.design.pattern` reads it).
         #[arg(long, value_name = "FILE")]

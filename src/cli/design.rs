@@ -11,7 +11,8 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementSettings, away_from_rails, compensate_elements, erect_along, rail_start_offsets,
+    ElementSettings, ErectContacts, away_from_rails, compensate_elements, erect_through,
+    rail_waypoints,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::geodesic::geodesic_seams;
@@ -20,6 +21,7 @@ use membrane_contact::mech::patterning::reference::{erection_model, reference_ge
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
 };
+use membrane_contact::mech::patterning::split::{SNAP, SplitFilm, split_along};
 
 /// What `form-find` is asked.
 pub struct FormFindArgs<'a> {
@@ -115,8 +117,9 @@ pub struct PatternArgs<'a> {
     pub file: &'a Path,
     pub seam_planes: &'a [[f64; 6]],
     pub seam_nodes: &'a [String],
-    /// Geodesic seams: the start line's nodes and the strip width (m).
-    pub geodesic: Option<(&'a str, f64)>,
+    /// Geodesic seams: the start lines' nodes and the strip widths (m; one for all, or one per
+    /// line).
+    pub geodesic: (&'a [String], &'a [f64]),
     pub compensation: &'a str,
     pub svg: Option<&'a PathBuf>,
     pub dxf: Option<&'a PathBuf>,
@@ -125,8 +128,10 @@ pub struct PatternArgs<'a> {
     pub erect: (usize, f64, usize),
     /// Correct each triangle's reference metric, not each strip's compensation.
     pub by_element: bool,
-    /// The rails' start offsets `[up, in]` (m) of the erection path.
-    pub rail_path: Option<[f64; 2]>,
+    /// The rails' offsets `[up, in]` (m) at each waypoint of the erection path.
+    pub rail_path: &'a [[f64; 2]],
+    /// A folder to write each erection's model to (`erection-K.json`), as the loop erects it.
+    pub erection_models: Option<&'a PathBuf>,
     /// Where to write the report as JSON.
     pub report: Option<&'a PathBuf>,
 }
@@ -151,26 +156,23 @@ fn compensation(text: &str) -> Result<Compensation, String> {
     }
 }
 
-/// The strips the seams cut (planes, then node lines within them; none: the whole film).
-fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String> {
-    let planes: Vec<SeamPlane> = a
-        .seam_planes
-        .iter()
-        .map(|p| SeamPlane {
-            point: [p[0], p[1], p[2]],
-            normal: [p[3], p[4], p[5]],
-        })
-        .collect();
-    let lines: Vec<Vec<usize>> = a
-        .seam_nodes
-        .iter()
-        .map(|l| node_line(model, l, "--seam-nodes"))
-        .collect::<Result<_, _>>()?;
-    let mut partitions = vec![
-        strips_by_planes(model, &planes),
-        strips_by_node_lines(model, &lines),
-    ];
-    if let Some((line, width)) = a.geodesic {
+/// The geodesic seams from each start line of `a` (one line on stderr each), the film split
+/// along them: the split film and its strips.
+fn geodesic_split(model: &Model, a: &PatternArgs<'_>) -> Result<Option<SplitFilm>, String> {
+    let (lines, widths) = a.geodesic;
+    if lines.is_empty() {
+        return Ok(None);
+    }
+    if widths.len() != 1 && widths.len() != lines.len() {
+        return Err(format!(
+            "--strip-width: one width for every --geodesic-from, or one per start line ({} lines, {} widths)",
+            lines.len(),
+            widths.len()
+        ));
+    }
+    let mut all = Vec::new();
+    for (k, line) in lines.iter().enumerate() {
+        let width = widths[k.min(widths.len() - 1)];
         let line = node_line(model, line, "--geodesic-from")?;
         let seams =
             geodesic_seams(model, &line, width).map_err(|e| format!("--geodesic-from: {e}"))?;
@@ -183,8 +185,56 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
             seams.transverse.last().map_or(0.0, |g| g.length),
             lengths.join(", ")
         );
-        partitions.push(seams.strips);
+        all.extend(seams.seams);
     }
+    let split = split_along(model, &all, SNAP).map_err(|e| format!("--geodesic-from: {e}"))?;
+    eprintln!(
+        "split along the seams: {} nodes and {} triangles added",
+        split.model.nodes.len() - model.nodes.len(),
+        split.model.triangles.len() - model.triangles.len()
+    );
+    Ok(Some(split))
+}
+
+/// The strips the seams cut (planes, then node lines within them, then geodesic seams; none:
+/// the whole film), on the film split along the geodesic seams (the model returned).
+fn strips(model: Model, a: &PatternArgs<'_>) -> Result<(Model, Vec<Vec<usize>>), String> {
+    let planes: Vec<SeamPlane> = a
+        .seam_planes
+        .iter()
+        .map(|p| SeamPlane {
+            point: [p[0], p[1], p[2]],
+            normal: [p[3], p[4], p[5]],
+        })
+        .collect();
+    let lines: Vec<Vec<usize>> = a
+        .seam_nodes
+        .iter()
+        .map(|l| node_line(&model, l, "--seam-nodes"))
+        .collect::<Result<_, _>>()?;
+    let mut partitions = vec![
+        strips_by_planes(&model, &planes),
+        strips_by_node_lines(&model, &lines),
+    ];
+    let model = match geodesic_split(&model, a)? {
+        None => model,
+        Some(split) => {
+            // The planes' and node lines' strips hold the pieces of their triangles.
+            for partition in &mut partitions {
+                let mut part = vec![usize::MAX; model.triangles.len()];
+                for (k, strip) in partition.iter().enumerate() {
+                    strip.iter().for_each(|&t| part[t] = k);
+                }
+                let mut pieces = vec![Vec::new(); partition.len()];
+                for (t, &p) in split.parent.iter().enumerate() {
+                    pieces[part[p]].push(t);
+                }
+                *partition = pieces;
+            }
+            partitions.push(split.strips.clone());
+            split.model
+        }
+    };
     // A strip is a set of triangles in the same part of every partition (the same side of
     // every plane, connected across non-seam edges, between the same geodesic seams).
     let mut strips: Vec<Vec<usize>> = partitions.remove(0);
@@ -204,7 +254,7 @@ fn strips(model: &Model, a: &PatternArgs<'_>) -> Result<Vec<Vec<usize>>, String>
         }
         strips = next;
     }
-    Ok(strips)
+    Ok((model, strips))
 }
 
 /// The nodes `N1,N2,…` of `text`, each a node of `model` (`option` names the option in errors).
@@ -222,10 +272,11 @@ fn node_line(model: &Model, text: &str, option: &str) -> Result<Vec<usize>, Stri
 fn compensate_with_erections(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    (start, path): (Compensation, &[(usize, [f64; 3])]),
-    (iterations, tolerance, increments): (usize, f64, usize),
+    start: Compensation,
+    (iterations, tolerance): (usize, f64),
+    erect: &mut ErectContacts<'_>,
 ) -> Result<(Compensation, Vec<serde_json::Value>), String> {
-    let mut erect = |m: Model| erect_along(m, increments, path).map(|e| e.elements);
+    let mut erect = |m: Model| erect(m).map(|e| e.elements);
     let history =
         compensate_by_erection(model, strips, start, (iterations, tolerance), &mut erect)?;
     for (k, h) in history.iter().enumerate() {
@@ -263,16 +314,16 @@ fn compensate_with_erections(
 fn compensate_by_elements(
     model: &Model,
     strips: Vec<Vec<usize>>,
-    (start, path): (Compensation, &[(usize, [f64; 3])]),
-    (iterations, tolerance, increments): (usize, f64, usize),
+    start: Compensation,
+    (iterations, tolerance): (usize, f64),
+    erect: &mut ErectContacts<'_>,
 ) -> Result<(Vec<CutStrip>, serde_json::Value), String> {
     let settings = ElementSettings {
         iterations,
         tolerance,
         counted: away_from_rails(model),
     };
-    let mut erect = |m: Model| erect_along(m, increments, path);
-    let outcome = compensate_elements(model, strips, start, &settings, &mut erect)?;
+    let outcome = compensate_elements(model, strips, start, &settings, erect)?;
     for (k, h) in outcome.history.iter().enumerate() {
         println!(
             "erection {k}: prestress error away from the rails mean {:.3} %, max {:.3} % (triangle {}), {} triangles yielded",
@@ -331,24 +382,45 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     if a.by_element && a.erect.0 == 0 {
         return Err("--by-element corrects by erections: give --erect N (N ≥ 1)".into());
     }
-    let model = read_model(a.file)?;
     let started = Instant::now();
-    let strips = strips(&model, &a)?;
+    let (model, strips) = strips(read_model(a.file)?, &a)?;
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
-    let path = a
-        .rail_path
-        .map(|[up, inward]| rail_start_offsets(&model, up, inward))
-        .unwrap_or_default();
-    let cut = if a.erect.0 > 0 && a.by_element {
-        let (cut, r) = compensate_by_elements(&model, strips, (compensation, &path), a.erect)?;
+    let path = rail_waypoints(&model, a.rail_path);
+    let (iterations, tolerance, increments) = a.erect;
+    let mut count = 0;
+    // Each erection's model is written first (`--erection-models DIR`), then erected.
+    let mut erect = |m: Model| {
+        if let Some(dir) = a.erection_models {
+            let file = dir.join(format!("erection-{count}.json"));
+            write_text(Some(&file), &(m.to_json() + "\n"))?;
+        }
+        count += 1;
+        erect_through(m, increments, &path)
+    };
+    if let Some(dir) = a.erection_models {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    let cut = if iterations > 0 && a.by_element {
+        let (cut, r) = compensate_by_elements(
+            &model,
+            strips,
+            compensation,
+            (iterations, tolerance),
+            &mut erect,
+        )?;
         report = r;
         cut
     } else {
-        if a.erect.0 > 0 {
+        if iterations > 0 {
             let erections;
-            (compensation, erections) =
-                compensate_with_erections(&model, strips.clone(), (compensation, &path), a.erect)?;
+            (compensation, erections) = compensate_with_erections(
+                &model,
+                strips.clone(),
+                compensation,
+                (iterations, tolerance),
+                &mut erect,
+            )?;
             report["erections"] = erections.into();
         }
         cut_pattern(&model, strips, compensation)?

@@ -133,3 +133,34 @@ def test_design_iterations_figure_drum_rows_match_its_csv_golden_number():
     golden = [r for r in (root / "docs" / "figures" / "design_iterations.csv").read_text().splitlines()
               if r.startswith("\"drum, mu = 0.3") or r.startswith("drum, mu = 0.3")][0]
     assert float(golden.split(",")[-1]) == pytest.approx(0.178791, abs=1e-5)
+
+
+def test_pattern_variants_on_the_study_cluster_give_each_variants_own_report():
+    """Two compensation variants of the drum (μ = 0.3), the rails straight down and out and the
+    winding path (down, then out), and one the program refuses, run on a local Dask cluster of two
+    workers: each report is the one :func:`pattern` gives alone, the paths differ (friction), and
+    the refused variant carries the program's message while the others go on."""
+    pytest.importorskip("distributed")
+    from membrane_contact.design import pattern_variants
+
+    straight = dict(erect=1, by_element=True, rail_path=(0.10, 0.03))
+    winding = dict(erect=1, by_element=True, rail_path=[(0.10, 0.03), (0.0, 0.03)])
+    refused = dict(erect=0, by_element=True)
+    reports = pattern_variants(DRUM, [straight, winding, refused], workers=2)
+    assert "--erect" in reports[2]["error"]
+    for options, report in zip((straight, winding), reports):
+        alone = pattern(DRUM, **options)
+        assert report["erections"] == alone["erections"]
+    first = [r["erections"][0]["max_error"] for r in reports[:2]]
+    assert abs(first[0] - first[1]) > 1e-3, first
+
+
+def test_each_erection_model_of_the_compensation_is_written_for_a_study(tmp_path):
+    """``erection_models``: one model per erection of the loop, as it was erected, each a model
+    the program accepts (``membrane-contact check``) and so one a study can pack and run."""
+    report = pattern(DRUM, erect=2, by_element=True, erection_models=tmp_path)
+    files = sorted(tmp_path.glob("erection-*.json"))
+    assert [f.name for f in files] == [f"erection-{k}.json" for k in range(len(report["erections"]))]
+    from membrane_contact.design import _run
+    for f in files:
+        _run(["check", str(f)])

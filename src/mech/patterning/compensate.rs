@@ -10,20 +10,31 @@ use nalgebra::{Matrix2, Vector2};
 use super::{StripTriangle, flat_gradient};
 use crate::mech::elements::material::Material;
 
-/// Turns the flat strip about its centroid so that its long principal axis is `x`.
-pub fn align(flat: &mut [[f64; 2]]) {
-    let n = flat.len() as f64;
-    let c = flat
-        .iter()
-        .fold([0.0; 2], |c, p| [c[0] + p[0] / n, c[1] + p[1] / n]);
-    let m = flat.iter().fold(Matrix2::zeros(), |m, p| {
-        let d = Vector2::new(p[0] - c[0], p[1] - c[1]);
-        m + d * d.transpose()
-    });
+/// Turns the flat strip about its centroid so that its long principal axis is `x`: the
+/// centroid and the principal axes of its area (the flat `triangles`, local node indices), so
+/// that they are the strip's shape's whatever its mesh (a strip split along a seam has more
+/// nodes on that side).
+pub fn align(flat: &mut [[f64; 2]], triangles: &[[usize; 3]]) {
+    // ∫ x dA and ∫ x xᵀ dA of each triangle: A (a + b + c)/3 and A/12 (Σ v vᵀ + s sᵀ), s = a + b + c.
+    let (mut area, mut first, mut second) = (0.0, Vector2::zeros(), Matrix2::zeros());
+    for t in triangles {
+        let [a, b, c] = t.map(|k| Vector2::from(flat[k]));
+        let d = 0.5 * ((b - a).perp(&(c - a))).abs();
+        let s = a + b + c;
+        area += d;
+        first += s * (d / 3.0);
+        second += (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose())
+            * (d / 12.0);
+    }
+    if area <= 0.0 {
+        return;
+    }
+    let c = first / area;
+    let m = second / area - c * c.transpose();
     let angle = 0.5 * (2.0 * m[(0, 1)]).atan2(m[(0, 0)] - m[(1, 1)]);
     let (s, co) = angle.sin_cos();
     for p in flat.iter_mut() {
-        let (x, y) = (p[0] - c[0], p[1] - c[1]);
+        let (x, y) = (p[0] - c.x, p[1] - c.y);
         *p = [co * x + s * y, -s * x + co * y];
     }
 }

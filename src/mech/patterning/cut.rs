@@ -52,7 +52,8 @@ pub fn cut_pattern(
                 .map_err(|e| format!("strip {k}: flattening: {e}"))?;
             relax_strains(&mut strip, &elements, 100)
                 .map_err(|e| format!("strip {k}: relaxation: {e}"))?;
-            align(&mut strip.flat);
+            let local: Vec<[usize; 3]> = elements.iter().map(|e| e.local).collect();
+            align(&mut strip.flat, &local);
             let measured = distortion(&elements, &strip.flat);
             let c = match &compensation {
                 Compensation::Uniform(c) => *c,

@@ -84,6 +84,15 @@ pub fn rail_start_offsets(found: &Model, up: f64, inward: f64) -> Vec<(usize, [f
     offsets
 }
 
+/// The waypoints of a winding erection path: for each `[up, inward]` of `path` the rails'
+/// offsets there ([`rail_start_offsets`]); the rails pass through them in turn and end at their
+/// places (the bay: `[[0.10, 0.03], [0.0, 0.03]]`, down, then out).
+pub fn rail_waypoints(found: &Model, path: &[[f64; 2]]) -> Vec<Vec<(usize, [f64; 3])>> {
+    path.iter()
+        .map(|&[up, inward]| rail_start_offsets(found, up, inward))
+        .collect()
+}
+
 /// Erects `model` (an [`super::reference::erection_model`], one group `node<k>` per held node)
 /// in two stages: first each node `k` of `start` to its target plus its offset (the rails lifted
 /// and drawn in: the film laid on the supports slack), then every group to its target (the rails
@@ -93,27 +102,54 @@ pub fn erect_along(
     increments: usize,
     start: &[(usize, [f64; 3])],
 ) -> Result<Erected, String> {
+    let waypoints = if start.is_empty() {
+        vec![]
+    } else {
+        vec![start.to_vec()]
+    };
+    erect_through(model, increments, &waypoints)
+}
+
+/// Erects `model` along a winding path: each node `k` of the first waypoint goes to its target
+/// plus its offset there, then on through every further waypoint's offsets, straight from one
+/// to the next, and last every group to its target; `increments` per leg. Friction makes the
+/// erected state depend on the legs (a node that sticks on one leg keeps its place into the
+/// next); without it only the end counts.
+pub fn erect_through(
+    model: Model,
+    increments: usize,
+    waypoints: &[Vec<(usize, [f64; 3])>],
+) -> Result<Erected, String> {
     let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
-    let mut first = targets.clone();
-    for &(v, offset) in start {
-        let name = format!("node{v}");
-        let Some(g) = model.groups.iter().position(|g| g.name == name) else {
-            return Err(format!(
-                "erection path: node {v} has no group {name} in the erection model"
-            ));
-        };
-        (0..3).for_each(|c| first[g][c] += offset[c]);
+    let mut legs = Vec::new();
+    for offsets in waypoints.iter().filter(|w| !w.is_empty()) {
+        let mut leg = targets.clone();
+        for &(v, offset) in offsets {
+            let name = format!("node{v}");
+            let Some(g) = model.groups.iter().position(|g| g.name == name) else {
+                return Err(format!(
+                    "erection path: node {v} has no group {name} in the erection model"
+                ));
+            };
+            (0..3).for_each(|c| leg[g][c] += offset[c]);
+        }
+        legs.push(leg);
     }
     let mut analysis = Analysis::new(model, SolverSettings::default())
         .map_err(|e| format!("erection model: {e}"))?;
-    if !start.is_empty() {
+    for (k, leg) in legs.iter().enumerate() {
         analysis
-            .step_to(&first, increments)
-            .map_err(|e| format!("erection, rails to their start: {e}"))?;
+            .step_to(leg, increments)
+            .map_err(|e| format!("erection, rails to waypoint {}: {e}", k + 1))?;
     }
     analysis
         .step_to(&targets, increments)
         .map_err(|e| format!("erection: {e}"))?;
+    Ok(erected(&mut analysis))
+}
+
+/// The stresses of an erected `analysis` and the nodes friction holds on a support.
+fn erected(analysis: &mut Analysis) -> Erected {
     let results = analysis.results();
     let model = analysis.model();
     let held = |status: GapStatus, friction: f64| {
@@ -127,10 +163,10 @@ pub fn erect_along(
     for (g, r) in model.gaps.iter().zip(&results.gaps) {
         frictional[g.film_node] |= held(r.status, r.friction_force);
     }
-    Ok(Erected {
+    Erected {
         elements: results.elements,
         frictional,
-    })
+    }
 }
 
 /// The stress-free shape of metric `m` (in the frame of the 3-D triangle `t`) as a strain term:
@@ -191,7 +227,8 @@ pub fn refit_strips(
             })
             .collect::<Result<Vec<_>, _>>()?;
         relax_flat(&mut c.strip.flat, &terms, 100).map_err(|e| format!("strip {k}: {e}"))?;
-        align(&mut c.strip.flat);
+        let local: Vec<[usize; 3]> = elements.iter().map(|e| e.local).collect();
+        align(&mut c.strip.flat, &local);
         let b = bounds(&c.strip.flat);
         c.size = [b[2] - b[0], b[3] - b[1]];
         c.compensation = [0, 1].map(|a| uncut[k][a] / c.size[a] - 1.0);

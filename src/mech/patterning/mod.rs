@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`seams`] | strips from seam planes or seam node lines |
 //! | [`geodesic`] | geodesic seams at a strip width (Polthier & Schmies 1998) and their strips |
+//! | [`split`] | the film split along seams that cross its triangles: new nodes on the edges crossed |
 //! | [`cut`] | the whole pattern: every strip flattened, measured and compensated |
 //! | [`flatten`] | least-squares conformal map of a strip (Lévy et al. 2002, eq. 4) |
 //! | [`relax`] | least-squares strain relaxation (Gauss–Newton), flat or in space |
@@ -31,6 +32,7 @@ pub mod outline;
 pub mod reference;
 pub mod relax;
 pub mod seams;
+pub mod split;
 
 use nalgebra::{Matrix2, Vector2, Vector3};
 

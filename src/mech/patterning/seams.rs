@@ -59,6 +59,17 @@ pub fn strips_by_node_lines(model: &Model, lines: &[Vec<usize>]) -> Vec<Vec<usiz
         .iter()
         .flat_map(|l| l.windows(2).map(|w| key(w[0], w[1])))
         .collect();
+    strips_by_edges(model, &seams)
+}
+
+/// The triangles of each strip bounded by the seam `edges` (`[low, high]` node pairs) and the
+/// film's edges: the triangles connected across every other edge, strips ordered by their
+/// first triangle.
+pub fn strips_by_edges(
+    model: &Model,
+    seams: &std::collections::HashSet<[usize; 2]>,
+) -> Vec<Vec<usize>> {
+    let key = |a: usize, b: usize| [a.min(b), a.max(b)];
     let by_edge = triangles_by_edge(model);
     let mut strip_of = vec![usize::MAX; model.triangles.len()];
     let mut strips = Vec::new();
