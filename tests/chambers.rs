@@ -785,3 +785,74 @@ fn orifice_tangent_between_two_chambers_matches_finite_differences() {
         "worst {worst_of_all:e} of the largest entry"
     );
 }
+
+/// The model of `examples/two_chamber_orifice.json`: the three-layer cushion (1 m radius, 4
+/// rings a layer, 200 µm films with 1 MPa prestress) whose chambers are supplied at 300 Pa
+/// (`upper`) and 400 Pa (`lower`), joined by the orifice `hole` (1 cm², C_d 0.6) from `lower`
+/// to `upper`, with the three crowns as output points.
+fn two_chamber_orifice() -> Model {
+    use membrane_contact::mech::model::OutputPoint;
+    let (mut model, first, disc_nodes) = three_layer(1.0, 4, film(1.0e6));
+    model.name = "TwoChamberOrifice".into();
+    model.description = "Three-layer ETFE cushion, 2 m diameter: two chambers supplied at 300 and \
+                         400 Pa, joined by a 1 cm² orifice (examples/two_chamber_orifice.json)"
+        .into();
+    model.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area: 1e-4,
+        discharge_coefficient: 0.6,
+    }];
+    model.outputs.points = [
+        ("crownTop", 0),
+        ("crownMiddle", first),
+        ("crownBottom", disc_nodes),
+    ]
+    .map(|(name, node)| OutputPoint {
+        name: name.into(),
+        node,
+    })
+    .to_vec();
+    model.validate().unwrap();
+    model
+}
+
+/// `examples/two_chamber_orifice.json`, inflated by its supplies in three steps and sealed, then
+/// left for one step of 2 s: the orifice passes air from the lower chamber to the upper at the
+/// golden flow 9.1404e-4 kg/s (the pressures 300 → 301.83 Pa and 400 → 397.82 Pa), the air's
+/// total mass kept and the moved mass the flow times the step.
+#[test]
+fn two_chamber_orifice_example_passes_its_golden_flow_in_the_first_two_seconds() {
+    let model = two_chamber_orifice();
+    assert_example_file("two_chamber_orifice.json", &model);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let mut levels = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels.scaled(f), 4)
+            .unwrap();
+    }
+    analysis.seal_chambers().unwrap();
+    let before = analysis.results();
+    levels.time = 2.0;
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
+    let r = analysis.results();
+    let mass = |r: &membrane_contact::mech::Results| r.chambers.iter().map(|c| c.mass).sum::<f64>();
+    println!(
+        "flow {:.6e} kg/s, upper {:.4} Pa, lower {:.4} Pa, volumes {:.6e} {:.6e} m³",
+        r.orifices[0].mass_flow,
+        r.chambers[0].pressure,
+        r.chambers[1].pressure,
+        before.chambers[0].volume,
+        before.chambers[1].volume
+    );
+    assert!((mass(&r) / mass(&before) - 1.0).abs() < 1e-12);
+    assert!((r.orifices[0].moved - 2.0 * r.orifices[0].mass_flow).abs() < 1e-15);
+    // Golden (release build, 2026-11-29): 9.140445e-4 kg/s; 301.8267 and 397.8178 Pa.
+    assert!((r.orifices[0].mass_flow / 9.140445e-4 - 1.0).abs() < 1e-6);
+    assert!((r.chambers[0].pressure - 301.8267).abs() < 1e-3);
+    assert!((r.chambers[1].pressure - 397.8178).abs() < 1e-3);
+}

@@ -63,6 +63,9 @@ pub struct OrificeResult {
     pub name: String,
     /// Mass flow (kg/s) from its `from` chamber to its `to` over the last increment.
     pub mass_flow: f64,
+    /// Air (kg) passed from `from` to `to` since the analysis started.
+    #[serde(default)]
+    pub moved: f64,
 }
 
 /// The chambers' pneumatic stiffness `G A Gᵀ`, added to the Newton matrix by the
@@ -104,6 +107,8 @@ pub struct Chambers {
     start_time: f64,
     /// Each orifice's mass flow (kg/s) over the increment at the last evaluation.
     flows: Vec<f64>,
+    /// Each orifice's moved air (kg) over the increment at the last evaluation.
+    moved: Vec<f64>,
     /// `∂p_i/∂V_j` of the chambers at the last evaluation (Pa/m³), the orifices' transfers
     /// included: zero rows for supplied chambers.
     slopes: DMatrix<f64>,
@@ -261,10 +266,12 @@ impl Chambers {
         let n = self.last.len();
         let mut dc = DMatrix::<f64>::zeros(n, n);
         self.flows.clear();
+        self.moved.clear();
         for o in &self.orifices {
             let (from, to) = (self.end(o.from), self.end(o.to));
             if from.held.is_some() && to.held.is_some() {
                 self.flows.push(0.0);
+                self.moved.push(0.0);
                 continue;
             }
             let m = implicit_transfer(o.cda, &from, &to, dt);
@@ -305,6 +312,7 @@ impl Chambers {
                 c.pressure = end.pressure_with(sign * m);
             }
             self.flows.push(if dt > 0.0 { m / dt } else { 0.0 });
+            self.moved.push(m);
         }
         self.slopes = DMatrix::from_fn(n, n, |i, j| {
             let (c, law) = (&self.last[i], &self.laws[i]);
@@ -387,10 +395,13 @@ impl Contribution for Chambers {
         };
     }
 
-    fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
+    fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {
         if !self.geometry.is_empty() {
             state.chambers.clone_from(&self.last);
             state.orifices.clone_from(&self.flows);
+            state.orifice_moved = (0..self.moved.len())
+                .map(|k| start.orifice_moved.get(k).copied().unwrap_or(0.0) + self.moved[k])
+                .collect();
         }
     }
 
@@ -422,6 +433,7 @@ impl Contribution for Chambers {
             .map(|(k, o)| OrificeResult {
                 name: o.name.clone(),
                 mass_flow: state.orifices.get(k).copied().unwrap_or(0.0),
+                moved: state.orifice_moved.get(k).copied().unwrap_or(0.0),
             })
             .collect();
     }
