@@ -856,3 +856,79 @@ fn two_chamber_orifice_example_passes_its_golden_flow_in_the_first_two_seconds()
     assert!((r.chambers[0].pressure - 301.8267).abs() < 1e-3);
     assert!((r.chambers[1].pressure - 397.8178).abs() < 1e-3);
 }
+
+/// [`with_orifice`]'s cushion with only the lower chamber sealed: the upper one stays on its
+/// supply at 300 Pa.
+fn beside_a_supply(rings: usize, area: f64) -> (Analysis, LoadLevels) {
+    let (model, _, _) = three_layer(1.0, rings, film(1.0e6));
+    let mut model = model;
+    model.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area,
+        discharge_coefficient: 0.6,
+    }];
+    model.validate().unwrap();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(f), 4)
+            .unwrap();
+    }
+    analysis.set_chambers_sealed(&[false, true]).unwrap();
+    (analysis, full)
+}
+
+/// An orifice beside a supplied chamber passes air (issue 43): the supply holds its pressure
+/// and the sealed neighbour empties or fills through the orifice. A short step (1 ms, 1 mm²)
+/// moves the orifice law's `ṁ = C_d A √(2 ρ Δp)` at the sealed state's pressures (within 1e-4),
+/// the air leaving the sealed chamber; a long step (10⁶ s) ends with the neighbour at the
+/// supply's pressure (1e-6 Pa), without crossing it. The supply raised to 500 Pa over a step of
+/// 10⁹ s fills it back up to 500 Pa, the flow reversed (negative) and the moved air the
+/// neighbour's gain. (Over 10⁶ s the neighbour lags the rising supply by 8e-4 Pa: the flow
+/// that keeps up with the supply's ramp needs that difference through 1 mm².)
+#[test]
+fn an_orifice_beside_a_supplied_chamber_fills_or_empties_it_to_the_supplys_pressure() {
+    let (mut analysis, mut levels) = beside_a_supply(8, 1e-6);
+    let r0 = analysis.results();
+    let (upper, lower) = (r0.chambers[0].pressure, r0.chambers[1].pressure);
+    assert_eq!((upper, lower), (300.0, 400.0));
+    let rho = (lower + 101_325.0) / (287.05 * 293.15);
+    let law = 0.6 * 1e-6 * (2.0 * rho * (lower - upper)).sqrt();
+    levels.time = 1e-3;
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
+    let r = analysis.results();
+    let lost = (r0.chambers[1].mass - r.chambers[1].mass) / 1e-3;
+    println!(
+        "short step: flow {:.6e} kg/s, lower loses {lost:.6e} kg/s, law {law:.6e} kg/s",
+        r.orifices[0].mass_flow
+    );
+    assert!((r.orifices[0].mass_flow / law - 1.0).abs() < 1e-4);
+    assert!((lost / law - 1.0).abs() < 1e-4);
+    assert_eq!(r.chambers[0].pressure, 300.0, "the supply holds it");
+    for (supply, time) in [(300.0, 1e6), (500.0, 1e9)] {
+        let before = analysis.results();
+        levels.chambers[0] = supply;
+        levels.time = time;
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+            .unwrap();
+        let r = analysis.results();
+        let (p, moved) = (
+            r.chambers[1].pressure,
+            r.orifices[0].moved - before.orifices[0].moved,
+        );
+        let gained = r.chambers[1].mass - before.chambers[1].mass;
+        println!(
+            "supply {supply} Pa: sealed chamber at {p:.9} Pa, moved {moved:.6e} kg, gained {gained:.6e} kg"
+        );
+        assert!((p - supply).abs() < 1e-6, "{p} vs {supply}");
+        assert!((gained + moved).abs() < 1e-12 * r.chambers[1].mass);
+        assert_eq!(r.chambers[0].pressure, supply);
+        assert!(moved.signum() == (before.chambers[1].pressure - supply).signum());
+    }
+}
