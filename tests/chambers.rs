@@ -63,8 +63,8 @@ fn cushion(a: f64, rings: usize, material: Material, pressure: f64) -> Model {
     m
 }
 
-/// The chambers' free residual and full free–free tangent (sparse part plus each rank-one
-/// term `a g gᵀ`) at `u`.
+/// The chambers' free residual and full free–free tangent (sparse part plus the pneumatic
+/// stiffness `G A Gᵀ`) at `u`.
 fn chamber_tangent(
     chambers: &mut Chambers,
     system: &System,
@@ -82,10 +82,11 @@ fn chamber_tangent(
     };
     chambers.add(&at, &mut residual, Some(&mut values));
     let mut k = dense(system, &values);
-    for (a, g) in chambers.low_rank() {
-        let g = nalgebra::DVector::from_column_slice(g);
-        k += &g * g.transpose() * *a;
-    }
+    let low_rank = chambers.low_rank();
+    let g = DMatrix::from_fn(system.free_count, low_rank.columns.len(), |i, j| {
+        low_rank.columns[j][i]
+    });
+    k += &g * &low_rank.matrix * g.transpose();
     let mut free = vec![0.0; system.free_count];
     for (i, d) in system.dofs.iter().enumerate() {
         if let Dof::Free(eq) = d {
@@ -134,7 +135,7 @@ fn chamber_tangent_with_the_pneumatic_stiffness_matches_finite_differences() {
             }
             chambers.restore(&state);
             let (_, k) = chamber_tangent(&mut chambers, &system, &levels, &u);
-            assert_eq!(chambers.low_rank().len(), usize::from(sealed));
+            assert_eq!(chambers.low_rank().columns.len(), usize::from(sealed));
             let worst = worst_fd_mismatch(&system, &u, 1e-7, &k, |v| {
                 chamber_tangent(&mut chambers, &system, &levels, v).0
             });
@@ -684,4 +685,250 @@ fn a_malformed_orifice_is_refused_with_its_name_and_reason() {
     refused(&|o| o.area = -1e-4, "area");
     refused(&|o| o.discharge_coefficient = 0.0, "discharge_coefficient");
     refused(&|o| o.discharge_coefficient = 1.2, "discharge_coefficient");
+}
+
+/// The three-layer cushion of 3 rings a layer with the orifice `hole` (C_d A = 0.6 · 1e-4 m²)
+/// from the lower chamber to the upper, both chambers of polytropic exponent `kappa`, and a
+/// displaced shape: the top layer risen, the middle a little, the bottom sagged, rippled.
+fn orifice_model(kappa: f64) -> (Model, Vec<f64>) {
+    let (mut model, first, disc_nodes) = three_layer(1.0, 3, film(1.0e6));
+    for c in &mut model.chambers {
+        c.kappa = kappa;
+    }
+    model.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area: 1e-4,
+        discharge_coefficient: 0.6,
+    }];
+    model.validate().unwrap();
+    let mut u = vec![0.0; model.dof_count()];
+    for (v, x) in model.nodes.iter().enumerate() {
+        let shape = (1.0 - x[0] * x[0] - x[1] * x[1]).max(0.0);
+        let rise = match v {
+            _ if v >= first => 0.01,
+            _ if v >= disc_nodes => -0.05,
+            _ => 0.05,
+        };
+        u[3 * v] = 1e-3 * (v as f64 * 0.7).sin() * shape;
+        u[3 * v + 1] = 1e-3 * (v as f64 * 1.3).cos() * shape;
+        u[3 * v + 2] = rise * shape * (1.0 + 0.1 * (v as f64).sin());
+    }
+    (model, u)
+}
+
+/// The chambers' tangent with an orifice (the air it moves over the step follows the volumes
+/// through the backward-Euler orifice equation, coupling the two chambers' pressures) matches
+/// central differences of their residual: isothermal and adiabatic air, the flow either way,
+/// over a short step (the flow law decides), a middle one and a long one (the pressures
+/// equalise), and with the upstream chamber held by its supply. Fails with the coupling left
+/// out, with it symmetrized, or with the upstream density's change neglected.
+#[test]
+fn orifice_tangent_between_two_chambers_matches_finite_differences() {
+    use membrane_contact::mech::elements::chamber::ChamberGeometry;
+    let mut worst_of_all: f64 = 0.0;
+    for kappa in [1.0, 1.4] {
+        let (model, u) = orifice_model(kappa);
+        let system = System::new(&model, false).unwrap();
+        let mut chambers = Chambers::new(&model);
+        let analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+        let x: Vec<nalgebra::Vector3<f64>> = model
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(v, p)| {
+                nalgebra::Vector3::new(p[0] + u[3 * v], p[1] + u[3 * v + 1], p[2] + u[3 * v + 2])
+            })
+            .collect();
+        let volume = |k: usize| {
+            ChamberGeometry::new(&model, &model.chambers[k])
+                .unwrap()
+                .volume(&x)
+        };
+        for (upper, lower, held) in [
+            (300.0, 700.0, false),
+            (700.0, 300.0, false),
+            (300.0, 700.0, true),
+        ] {
+            for dt in [1e-3, 0.3, 1e3] {
+                let mut state = analysis.state().clone();
+                for (k, p) in [(0, upper), (1, lower)] {
+                    let c = &mut state.chambers[k];
+                    c.sealed = !(held && p == lower);
+                    c.constant = if c.sealed {
+                        (p + 101_325.0) * volume(k).powf(kappa)
+                    } else {
+                        0.0
+                    };
+                    c.volume = volume(k);
+                }
+                chambers.restore(&state);
+                let mut levels = LoadLevels::of_model(&model);
+                levels.chambers[1] = lower;
+                levels.time = dt;
+                let (_, k) = chamber_tangent(&mut chambers, &system, &levels, &u);
+                let worst = worst_fd_mismatch(&system, &u, 1e-7, &k, |v| {
+                    chamber_tangent(&mut chambers, &system, &levels, v).0
+                });
+                println!(
+                    "κ {kappa}, upper {upper} Pa, lower {lower} Pa (held {held}), Δt {dt} s: worst {:.3e} of {:.3e}",
+                    worst / k.amax(),
+                    k.amax()
+                );
+                worst_of_all = worst_of_all.max(worst / k.amax());
+            }
+        }
+    }
+    assert!(
+        worst_of_all < 1e-6,
+        "worst {worst_of_all:e} of the largest entry"
+    );
+}
+
+/// The model of `examples/two_chamber_orifice.json`: the three-layer cushion (1 m radius, 4
+/// rings a layer, 200 µm films with 1 MPa prestress) whose chambers are supplied at 300 Pa
+/// (`upper`) and 400 Pa (`lower`), joined by the orifice `hole` (1 cm², C_d 0.6) from `lower`
+/// to `upper`, with the three crowns as output points.
+fn two_chamber_orifice() -> Model {
+    use membrane_contact::mech::model::OutputPoint;
+    let (mut model, first, disc_nodes) = three_layer(1.0, 4, film(1.0e6));
+    model.name = "TwoChamberOrifice".into();
+    model.description = "Three-layer ETFE cushion, 2 m diameter: two chambers supplied at 300 and \
+                         400 Pa, joined by a 1 cm² orifice (examples/two_chamber_orifice.json)"
+        .into();
+    model.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area: 1e-4,
+        discharge_coefficient: 0.6,
+    }];
+    model.outputs.points = [
+        ("crownTop", 0),
+        ("crownMiddle", first),
+        ("crownBottom", disc_nodes),
+    ]
+    .map(|(name, node)| OutputPoint {
+        name: name.into(),
+        node,
+    })
+    .to_vec();
+    model.validate().unwrap();
+    model
+}
+
+/// `examples/two_chamber_orifice.json`, inflated by its supplies in three steps and sealed, then
+/// left for one step of 2 s: the orifice passes air from the lower chamber to the upper at the
+/// golden flow 9.1404e-4 kg/s (the pressures 300 → 301.83 Pa and 400 → 397.82 Pa), the air's
+/// total mass kept and the moved mass the flow times the step.
+#[test]
+fn two_chamber_orifice_example_passes_its_golden_flow_in_the_first_two_seconds() {
+    let model = two_chamber_orifice();
+    assert_example_file("two_chamber_orifice.json", &model);
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let mut levels = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels.scaled(f), 4)
+            .unwrap();
+    }
+    analysis.seal_chambers().unwrap();
+    let before = analysis.results();
+    levels.time = 2.0;
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
+    let r = analysis.results();
+    let mass = |r: &membrane_contact::mech::Results| r.chambers.iter().map(|c| c.mass).sum::<f64>();
+    println!(
+        "flow {:.6e} kg/s, upper {:.4} Pa, lower {:.4} Pa, volumes {:.6e} {:.6e} m³",
+        r.orifices[0].mass_flow,
+        r.chambers[0].pressure,
+        r.chambers[1].pressure,
+        before.chambers[0].volume,
+        before.chambers[1].volume
+    );
+    assert!((mass(&r) / mass(&before) - 1.0).abs() < 1e-12);
+    assert!((r.orifices[0].moved - 2.0 * r.orifices[0].mass_flow).abs() < 1e-15);
+    // Golden (release build, 2026-11-29): 9.140445e-4 kg/s; 301.8267 and 397.8178 Pa.
+    assert!((r.orifices[0].mass_flow / 9.140445e-4 - 1.0).abs() < 1e-6);
+    assert!((r.chambers[0].pressure - 301.8267).abs() < 1e-3);
+    assert!((r.chambers[1].pressure - 397.8178).abs() < 1e-3);
+}
+
+/// [`with_orifice`]'s cushion with only the lower chamber sealed: the upper one stays on its
+/// supply at 300 Pa.
+fn beside_a_supply(rings: usize, area: f64) -> (Analysis, LoadLevels) {
+    let (model, _, _) = three_layer(1.0, rings, film(1.0e6));
+    let mut model = model;
+    model.orifices = vec![OrificeSpec {
+        name: "hole".into(),
+        from: "lower".into(),
+        to: "upper".into(),
+        area,
+        discharge_coefficient: 0.6,
+    }];
+    model.validate().unwrap();
+    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+    let full = LoadLevels::of_model(&model);
+    for f in [0.25, 0.5, 1.0] {
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &full.scaled(f), 4)
+            .unwrap();
+    }
+    analysis.set_chambers_sealed(&[false, true]).unwrap();
+    (analysis, full)
+}
+
+/// An orifice beside a supplied chamber passes air (issue 43): the supply holds its pressure
+/// and the sealed neighbour empties or fills through the orifice. A short step (1 ms, 1 mm²)
+/// moves the orifice law's `ṁ = C_d A √(2 ρ Δp)` at the sealed state's pressures (within 1e-4),
+/// the air leaving the sealed chamber; a long step (10⁶ s) ends with the neighbour at the
+/// supply's pressure (1e-6 Pa), without crossing it. The supply raised to 500 Pa over a step of
+/// 10⁹ s fills it back up to 500 Pa, the flow reversed (negative) and the moved air the
+/// neighbour's gain. (Over 10⁶ s the neighbour lags the rising supply by 8e-4 Pa: the flow
+/// that keeps up with the supply's ramp needs that difference through 1 mm².)
+#[test]
+fn an_orifice_beside_a_supplied_chamber_fills_or_empties_it_to_the_supplys_pressure() {
+    let (mut analysis, mut levels) = beside_a_supply(8, 1e-6);
+    let r0 = analysis.results();
+    let (upper, lower) = (r0.chambers[0].pressure, r0.chambers[1].pressure);
+    assert_eq!((upper, lower), (300.0, 400.0));
+    let rho = (lower + 101_325.0) / (287.05 * 293.15);
+    let law = 0.6 * 1e-6 * (2.0 * rho * (lower - upper)).sqrt();
+    levels.time = 1e-3;
+    analysis
+        .step_to_with_loads(&[[0.0; 3]], &levels, 1)
+        .unwrap();
+    let r = analysis.results();
+    let lost = (r0.chambers[1].mass - r.chambers[1].mass) / 1e-3;
+    println!(
+        "short step: flow {:.6e} kg/s, lower loses {lost:.6e} kg/s, law {law:.6e} kg/s",
+        r.orifices[0].mass_flow
+    );
+    assert!((r.orifices[0].mass_flow / law - 1.0).abs() < 1e-4);
+    assert!((lost / law - 1.0).abs() < 1e-4);
+    assert_eq!(r.chambers[0].pressure, 300.0, "the supply holds it");
+    for (supply, time) in [(300.0, 1e6), (500.0, 1e9)] {
+        let before = analysis.results();
+        levels.chambers[0] = supply;
+        levels.time = time;
+        analysis
+            .step_to_with_loads(&[[0.0; 3]], &levels, 4)
+            .unwrap();
+        let r = analysis.results();
+        let (p, moved) = (
+            r.chambers[1].pressure,
+            r.orifices[0].moved - before.orifices[0].moved,
+        );
+        let gained = r.chambers[1].mass - before.chambers[1].mass;
+        println!(
+            "supply {supply} Pa: sealed chamber at {p:.9} Pa, moved {moved:.6e} kg, gained {gained:.6e} kg"
+        );
+        assert!((p - supply).abs() < 1e-6, "{p} vs {supply}");
+        assert!((gained + moved).abs() < 1e-12 * r.chambers[1].mass);
+        assert_eq!(r.chambers[0].pressure, supply);
+        assert!(moved.signum() == (before.chambers[1].pressure - supply).signum());
+    }
 }

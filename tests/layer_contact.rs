@@ -372,3 +372,151 @@ fn frictional_discs_stick_and_both_iteration_matrices_reach_the_same_state() {
         assert!((rises[0][k] - rises[1][k]).abs() < 1e-8 * one, "{rises:?}");
     }
 }
+
+/// A two-layer cushion (issue 43): two identical clamped discs (4 rings, radius 1 m, the
+/// specimens' film) on one rim circle, each held by a group of its own (`rimTop`, `rimBottom`:
+/// the extrusion's two clamping lines, so that each layer's reaction is known), the air between
+/// them held at `air` Pa by the supply (two chambers closed by the frame's plane z = 0, one per
+/// layer: together the air between the layers), the top layer's nodes in frictionless contact
+/// with the bottom layer, and snow (pressure set `snow`, towards −z) on the top layer. Returns
+/// the model and the bottom layer's centre node.
+fn snowed_cushion(air: f64) -> (Model, usize) {
+    use membrane_contact::mech::model::{ChamberSpec, ClosingPlane, ElementSelection};
+    let disc = disc(1.0, 0.0);
+    let mut model = disc.model().unwrap();
+    let (n, first) = (model.nodes.len(), model.triangles.len());
+    for v in 0..n {
+        model.nodes.push(model.nodes[v]);
+    }
+    let bottom: Vec<[usize; 3]> = model.triangles.iter().map(|t| t.map(|v| v + n)).collect();
+    model.triangles.extend(bottom);
+    model.groups[0].name = "rimTop".into();
+    let mut rim_bottom = model.groups[0].clone();
+    rim_bottom.name = "rimBottom".into();
+    rim_bottom.nodes = rim_bottom.nodes.iter().map(|v| v + n).collect();
+    model.groups.push(rim_bottom);
+    let top = ElementSelection::List((0..first).collect());
+    let chamber = |name: &str, elements: ElementSelection, z: f64| ChamberSpec {
+        name: name.into(),
+        elements,
+        closed_by_plane: Some(ClosingPlane {
+            point: [0.0; 3],
+            normal: [0.0, 0.0, z],
+        }),
+        pressure: air,
+        sealed: false,
+        kappa: 1.0,
+        atmosphere: 101_325.0,
+        temperature: 293.15,
+        heating: 0.0,
+    };
+    model.chambers = vec![
+        chamber("airTop", top.clone(), 1.0),
+        chamber(
+            "airBottom",
+            ElementSelection::List((first..2 * first).collect()),
+            -1.0,
+        ),
+    ];
+    model.loads.pressures[0].name = "snow".into();
+    model.loads.pressures[0].elements = top;
+    model.loads.pressures[0].towards = Some(Towards::Direction([0.0, 0.0, -1.0]));
+    model.layer_contacts.push(LayerContactSpec {
+        name: "Touch".into(),
+        slave: LayerSurface::Triangles((0..first).collect()),
+        master: LayerSurface::Triangles((first..2 * first).collect()),
+        // Both layers' triangles face +z; the top one lands on the bottom from above.
+        side: Side::Front,
+        both_ways: false,
+        normal_stiffness: 1e6,
+        tangential_stiffness: 1e5,
+        friction: 0.0,
+        friction_law: Default::default(),
+        search_distance: 0.3,
+    });
+    model.validate().unwrap();
+    (model, n)
+}
+
+/// Snow inverts the top layer of a two-layer cushion onto the bottom one, and then the two
+/// carry it together ([`snowed_cushion`], the air held at 300 Pa by the supply): the top layer
+/// goes down, through its rim's plane (inverted at 400 Pa of snow, its centre 42 mm below the
+/// rim while the bottom's is 63 mm), and lands on the bottom layer once the snow exceeds twice
+/// the air's pressure (600 Pa: the top then mirrors the bottom). Before that the contact carries
+/// nothing; at 1 200 Pa its normal force is positive (720.7 N), the bottom layer's rim reaction
+/// has risen from `p A` = 310.6 N by it (within 1 %), the bottom layer's centre has gone down
+/// with the top (to 80.9 mm), and at every snow level
+/// the two rims' vertical reactions add up to the snow's resultant `S A` (`A` the rim polygon's
+/// area: a follower pressure on a film held at its rim), to 1e-6.
+#[test]
+fn an_inverted_top_layer_lands_on_the_bottom_layer_and_they_share_the_snow() {
+    use membrane_contact::mech::elements::layer_contact::Totals;
+    let air = 300.0;
+    let (model, bottom_centre) = snowed_cushion(air);
+    let area: f64 = (0..model.triangles.len() / 2)
+        .map(|e| {
+            let [a, b, c] = model.triangles[e].map(|v| nalgebra::Vector3::from(model.nodes[v]));
+            0.5 * (b - a).cross(&(c - a)).norm()
+        })
+        .sum();
+    let mut analysis = Analysis::new(model.clone(), settings()).unwrap();
+    let mut levels = LoadLevels::zero(&model);
+    let held = [[0.0; 3]; 2];
+    for f in [0.25, 0.5, 1.0] {
+        levels.chambers = vec![f * air; 2];
+        analysis.step_to_with_loads(&held, &levels, 4).unwrap();
+    }
+    let mut seen = vec![];
+    for snow in [200.0, 400.0, 600.0, 800.0, 1000.0, 1200.0] {
+        levels.pressure[0] = snow;
+        analysis.step_to_with_loads(&held, &levels, 4).unwrap();
+        let r = analysis.results();
+        let (top, bottom) = (r.reactions[0][2], r.reactions[1][2]);
+        let touch = Totals::of(&r, 0);
+        let (wt, wb) = (
+            analysis.node_displacement(0).z,
+            analysis.node_displacement(bottom_centre).z,
+        );
+        println!(
+            "snow {snow} Pa: top Rz {top:.3} N, bottom Rz {bottom:.3} N, sum/(S A) {:.9}, contact {:.3} N on {} nodes, centres {wt:.5} / {wb:.5} m",
+            (top + bottom) / (snow * area),
+            touch.normal_force,
+            touch.closed
+        );
+        assert!(
+            ((top + bottom) / (snow * area) - 1.0).abs() < 1e-6,
+            "equilibrium at {snow} Pa"
+        );
+        seen.push((snow, bottom, touch.normal_force, wt, wb));
+    }
+    let (bulging, before, after) = (seen[0], seen[1], seen[5]);
+    assert!(bulging.3 > 0.0, "the top layer still bulges up at 200 Pa");
+    // Inverted (through the rim's plane) but not yet on the bottom layer: the coincident rim
+    // nodes touch with a force of round-off only.
+    assert!(
+        before.3 < 0.0 && before.3 > before.4 + 0.01,
+        "inverted, above the bottom"
+    );
+    assert!(
+        before.2.abs() < 1e-6,
+        "no contact at 400 Pa of snow: {}",
+        before.2
+    );
+    assert!(after.2 > 0.0, "the contact carries load at 1200 Pa");
+    assert!(
+        after.3 < 0.0 && (after.3 - after.4).abs() < 1e-3,
+        "the top layer lies on the bottom one"
+    );
+    // The bottom layer's reaction rises by what the contact brings (its normals tilt a little
+    // off vertical: measured 718.6 N for 720.7 N).
+    let rise = after.1 - before.1;
+    assert!(
+        (rise / after.2 - 1.0).abs() < 0.01,
+        "bottom reaction rose {rise} N for {} N",
+        after.2
+    );
+    assert!(
+        after.4 < before.4,
+        "the bottom layer went down with the top"
+    );
+}

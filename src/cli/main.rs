@@ -742,7 +742,7 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     }
     for o in &results.orifices {
         out!(
-            "orifice {}: mass flow {:.6e} kg/s over the last step",
+            "orifice {}: mass flow {:.6e} kg/s over the last increment",
             o.name,
             o.mass_flow
         );

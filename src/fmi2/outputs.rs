@@ -156,6 +156,7 @@ pub(super) fn state_result(binding: &Binding, results: &Results) -> Option<f64> 
         Binding::ChamberMass(k) => results.chambers[k].mass,
         Binding::LayerNormalForce(k) => totals(results, k).0,
         Binding::LayerMaxSlip(k) => totals(results, k).1,
+        Binding::OrificeMassFlow(k) => results.orifices[k].mass_flow,
         _ => return None,
     })
 }
@@ -192,5 +193,6 @@ pub(super) fn is_state_result(binding: &Binding) -> bool {
             | Binding::ChamberMass(_)
             | Binding::LayerNormalForce(_)
             | Binding::LayerMaxSlip(_)
+            | Binding::OrificeMassFlow(_)
     )
 }

@@ -233,6 +233,9 @@ pub enum Binding {
     LayerNormalForce(usize),
     /// Largest slip between the layers of a layer contact.
     LayerMaxSlip(usize),
+    /// Mass flow through an orifice over the last step (kg/s, positive from its `from` chamber
+    /// to its `to`).
+    OrificeMassFlow(usize),
     SurfaceStatus(usize),
     /// Displacement of an output point along axis 0, 1, 2.
     PointDisplacement {

@@ -22,6 +22,17 @@ use crate::mech::{
     Analysis, AnalysisState, LoadLevels, SettingNames, StepError, StepReport, check_results,
 };
 
+/// Each orifice's mass flow in the checked results of a step of `h` seconds made its average
+/// over the step, `(moved − moved₀)/h` (`moved`: the air it has passed since the start, `moved₀`
+/// before the step), not the last increment's.
+fn step_average_flows(built: &mut Built, moved: &[f64], h: f64) {
+    if let Some(results) = built.checked.as_mut() {
+        for (k, o) in results.orifices.iter_mut().enumerate() {
+            o.mass_flow = (o.moved - moved.get(k).copied().unwrap_or(0.0)) / h;
+        }
+    }
+}
+
 /// The FMU parameters that a refused step's advice names.
 const SETTING_NAMES: SettingNames = SettingNames {
     max_iterations: "solver.maxIterations",
@@ -67,8 +78,12 @@ impl Instance {
         }
         // μ and the chambers' valves change the state before the step; a refused step goes back.
         let before = change_state_for_step(&mut built.analysis, mu, &sealed)?;
+        let moved = built.analysis.state().orifice_moved.clone();
         match checked_step(built, &targets, &angles, &loads, &self.logger) {
-            Ok(report) => self.step_converged(t + h, &report),
+            Ok(report) => {
+                step_average_flows(built, &moved, h);
+                self.step_converged(t + h, &report)
+            }
             Err(e) => {
                 if let Some(before) = before {
                     built.analysis.set_state(before).map_err(Failure::error)?;

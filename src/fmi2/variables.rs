@@ -47,6 +47,7 @@
 //! | `reactions.Rx/.Ry/.Rz` | Real | output | N | sum of all restraint forces (supports, symmetry, groups) |
 //! | `<cable>.maxForce` | Real | output | N | largest axial force of a tension-only cable |
 //! | `<support>.node<v>.slip/.normalForce/.frictionForce/.status` | Real, Integer | output | m, N | node-to-surface contact on a curved support: arc length slid along it, forces, status |
+//! | `<orifice>.massFlow` | Real | output | kg/s | air through an orifice averaged over the last step (moved mass / step), positive from its `from` chamber to its `to` |
 //! | `<point>.ux/.uy/.uz` | Real | output | m | displacement of a named output point |
 //! | `<set>.maxPrincipalStress/.minPrincipalStress/.maxEquivalentStress/.maxStrain/.compressedArea` | Real | output | Pa, 1, m2 | field summary of a named element set |
 //! | `<set>.maxPlasticStrain` | Real | output | 1 | elasto-plastic film only: largest equivalent plastic strain of a named element set |
@@ -256,7 +257,8 @@ pub fn supplied_air(
     Ok(air)
 }
 
-/// Each chamber's outputs: the air's pressure, volume, temperature and mass.
+/// Each chamber's outputs (the air's pressure, volume, temperature and mass), then each
+/// orifice's mass flow.
 fn chamber_outputs(table: &mut TableBuilder, model: &Model) {
     for (k, c) in model.chambers.iter().enumerate() {
         table.output(
@@ -282,6 +284,18 @@ fn chamber_outputs(table: &mut TableBuilder, model: &Model) {
             "kg",
             &format!("mass of the air in chamber '{}' (ideal gas)", c.name),
             Binding::ChamberMass(k),
+        );
+    }
+    for (k, o) in model.orifices.iter().enumerate() {
+        table.output(
+            &format!("{}.massFlow", o.name),
+            "kg/s",
+            &format!(
+                "mass flow through orifice '{}' averaged over the last step, positive from \
+                 chamber '{}' to '{}'",
+                o.name, o.from, o.to
+            ),
+            Binding::OrificeMassFlow(k),
         );
     }
 }

@@ -458,3 +458,77 @@ fn forged_curved_support_contact_states_are_refused_by_the_contacts_law() {
     }
     assert_eq!(deserialize_status(&fmu, &bytes).0, 0, "{:?}", log.take());
 }
+
+/// Issue 43: `run(fmu, from, to)` steps a fresh `fmu` up to step `k`; a state taken there, the
+/// steps `k..n` run on, the state set back (in place, then serialized and read back) and the
+/// same steps run again give every output bit for bit as the first time.
+fn assert_mid_run_round_trip(
+    fmu: &Fmu,
+    (k, n): (usize, usize),
+    run: &dyn Fn(&Fmu, usize, usize) -> Vec<(Vec<f64>, Vec<i32>)>,
+) -> Vec<(Vec<f64>, Vec<i32>)> {
+    run(fmu, 0, k);
+    let mut state: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(unsafe { fmi2_get_fmu_state(fmu.c, &mut state) }, 0);
+    let at_save = fmu.all_values();
+    let first = run(fmu, k, n);
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, state) }, 0);
+    assert_eq!(fmu.all_values(), at_save);
+    assert_eq!(run(fmu, k, n), first, "set back in place");
+    let bytes = serialized(fmu, state);
+    let mut restored: Fmi2FmuState = std::ptr::null_mut();
+    assert_eq!(
+        unsafe { fmi2_de_serialize_fmu_state(fmu.c, bytes.as_ptr(), bytes.len(), &mut restored) },
+        0
+    );
+    assert_eq!(unsafe { fmi2_set_fmu_state(fmu.c, restored) }, 0);
+    assert_eq!(run(fmu, k, n), first, "serialized and read back");
+    for mut s in [state, restored] {
+        assert_eq!(unsafe { fmi2_free_fmu_state(fmu.c, &mut s) }, 0);
+    }
+    first
+}
+
+/// Issue 43: a state taken mid-run while the top layer of `examples/two_layers_touching.json`
+/// lies on the bottom one (snow ramped over 6 steps, state after the third, the contact's
+/// normal force positive there) repeats the next three steps bit for bit (the layer contact's
+/// anchors, statuses and slip travel with the state).
+#[test]
+fn a_state_with_a_layer_contact_round_trips_mid_run_bit_for_bit() {
+    let model =
+        crate::mech::Model::from_json(include_str!("../../../examples/two_layers_touching.json"))
+            .unwrap();
+    let (u, log) = (
+        Unpacked::new("layer state", Source::Model(model)),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[("Snow.pressure", 0.0)], &[]);
+    let run = |fmu: &Fmu, from: usize, to: usize| {
+        fmu.steps((from, to), (0.0, 1.0), &|f, n| {
+            assert_eq!(f.set_real("Snow.pressure", 400.0 * (n + 1) as f64 / 6.0), 0);
+            if n == 3 {
+                assert!(f.real("Touch.normalForce") > 0.0, "in contact at the state");
+            }
+        })
+    };
+    let first = assert_mid_run_round_trip(&fmu, (3, 6), &run);
+    assert_eq!(first.len(), 3);
+    assert!(fmu.real("Touch.normalForce") > 0.0);
+}
+
+/// Issue 43: a state taken mid-run while the orifice of `examples/two_chamber_orifice.json`
+/// passes air between its sealed chambers (inflated, sealed, one step of 0.5 s) repeats the
+/// next three steps bit for bit: the enclosed air, the moved mass and `hole.massFlow`.
+#[test]
+fn a_state_with_an_orifice_round_trips_mid_run_bit_for_bit() {
+    let (u, log) = (
+        Unpacked::two_chamber_orifice("orifice state"),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    fmu.inflate_and_seal_two_chambers();
+    let run = |fmu: &Fmu, from: usize, to: usize| fmu.steps((from, to), (3.0, 0.5), &|_, _| {});
+    let first = assert_mid_run_round_trip(&fmu, (1, 4), &run);
+    assert_eq!(first.len(), 3);
+    assert!(fmu.real("hole.massFlow") > 0.0, "the air flows");
+}

@@ -164,6 +164,16 @@ impl Unpacked {
         Self::new(tag, Source::ParallelArch(ParallelArch::default()))
     }
 
+    /// `examples/two_chamber_orifice.json`: a three-layer cushion whose two chambers, supplied
+    /// at 300 and 400 Pa, are joined by the orifice `hole` from `lower` to `upper` (issue 43).
+    fn two_chamber_orifice(tag: &str) -> Self {
+        let text = include_str!("../../../examples/two_chamber_orifice.json");
+        Self::new(
+            tag,
+            Source::Model(crate::mech::Model::from_json(text).unwrap()),
+        )
+    }
+
     pub(super) fn vr(&self, name: &str) -> u32 {
         self.variables
             .iter()
@@ -324,6 +334,37 @@ impl<'a> Fmu<'a> {
             }
         }
         (reals, ints)
+    }
+
+    /// [`Unpacked::two_chamber_orifice`]'s cushion inflated by its supplies in three steps of
+    /// 1 s (to 300 and 400 Pa) and both valves closed: the air is enclosed as the next step,
+    /// from t = 3, starts, and from then on the orifice passes air from `lower` to `upper`.
+    fn inflate_and_seal_two_chambers(&self) {
+        for (k, f) in [0.25, 0.5, 1.0].into_iter().enumerate() {
+            assert_eq!(self.set_real("upper.supplyPressure", 300.0 * f), 0);
+            assert_eq!(self.set_real("lower.supplyPressure", 400.0 * f), 0);
+            assert_eq!(self.step(k as f64, 1.0), 0, "{:?}", self.log.take());
+        }
+        assert_eq!(self.set_boolean("upper.sealed", true), 0);
+        assert_eq!(self.set_boolean("lower.sealed", true), 0);
+    }
+
+    /// Steps `from..to` of `h` seconds from `t0` (step `n` from `t0 + n h`), `set(self, n)`
+    /// setting the inputs before each: every Real and Integer variable after each step.
+    fn steps(
+        &self,
+        (from, to): (usize, usize),
+        (t0, h): (f64, f64),
+        set: &dyn Fn(&Self, usize),
+    ) -> Vec<(Vec<f64>, Vec<i32>)> {
+        (from..to)
+            .map(|n| {
+                set(self, n);
+                let t = t0 + n as f64 * h;
+                assert_eq!(self.step(t, h), 0, "step {n}: {:?}", self.log.take());
+                self.all_values()
+            })
+            .collect()
     }
 
     /// Steps `frame.dz` linearly to `fraction` of the target in `n` steps of the ramp over [0, 1].

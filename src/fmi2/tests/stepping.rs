@@ -486,3 +486,44 @@ fn a_sealed_chamber_fed_by_mass_flow_holds_the_integrated_mass_at_the_gas_laws_p
     assert_eq!(fmu.step(time, h), 0, "{:?}", log.take());
     assert!((fmu.real("air.mass") - (before.0 - flow * h)).abs() <= 1e-12 * before.0);
 }
+
+/// Issue 43: `<orifice>.massFlow` is the air the orifice passed over the last step divided by
+/// the step (kg/s, positive from its `from` chamber to its `to`), with two increments a step
+/// (so not the last increment's flow). `examples/two_chamber_orifice.json` inflated by its
+/// supplies and sealed, then four steps of 0.5 s: `hole.massFlow` is the upper chamber's gain
+/// of air over the step / 0.5 s and the lower one's loss, to 1e-9, positive (lower → upper: the
+/// lower chamber's pressure is higher) and falling as the pressures approach. While both
+/// chambers are supplied it is 0.
+#[test]
+fn orifice_mass_flow_is_the_air_moved_over_the_step_divided_by_the_step() {
+    let (u, log) = (
+        Unpacked::two_chamber_orifice("orifice flow"),
+        Log::default(),
+    );
+    let fmu = Fmu::initialized(&u, &log, &[], &[("solver.incrementsPerStep", 2)]);
+    fmu.inflate_and_seal_two_chambers();
+    assert_eq!(fmu.real("hole.massFlow"), 0.0, "two supplies pass nothing");
+    let h = 0.5;
+    let mut last = f64::INFINITY;
+    for n in 0..4 {
+        let (upper, lower) = (fmu.real("upper.mass"), fmu.real("lower.mass"));
+        assert_eq!(fmu.step(3.0 + n as f64 * h, h), 0, "{:?}", log.take());
+        let flow = fmu.real("hole.massFlow");
+        let gained = (fmu.real("upper.mass") - upper) / h;
+        let lost = (lower - fmu.real("lower.mass")) / h;
+        println!(
+            "step {n}: massFlow {flow:.9e} kg/s, upper gains {gained:.9e}, lower loses {lost:.9e}"
+        );
+        assert!(
+            (flow - gained).abs() <= 1e-9 * flow,
+            "step {n}: {flow} vs {gained}"
+        );
+        assert!(
+            (flow - lost).abs() <= 1e-9 * flow,
+            "step {n}: {flow} vs {lost}"
+        );
+        assert!(flow > 0.0 && flow < last, "step {n}: {flow} after {last}");
+        last = flow;
+    }
+    assert!(fmu.real("lower.pressure") > fmu.real("upper.pressure"));
+}

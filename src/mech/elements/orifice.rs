@@ -25,13 +25,28 @@ pub struct OrificeEnd {
     pub volume: f64,
     /// The air's temperature (K).
     pub temperature: f64,
+    /// `Some(p)`: a supply holds the gauge pressure `p` (Pa) whatever air passes (the chamber
+    /// is not sealed; its `constant` is unused).
+    pub held: Option<f64>,
 }
 
 impl OrificeEnd {
     /// The gauge pressure (Pa) with `mass` kg of air added (negative: let out).
     pub fn pressure_with(&self, mass: f64) -> f64 {
+        if let Some(p) = self.held {
+            return p;
+        }
         let c = self.law.with_air(self.constant, mass, self.volume);
         self.law.pressure(c, self.volume, self.temperature)
+    }
+
+    /// `∂p/∂m = R T/V` (Pa/kg): how the pressure rises with air added (0 where a supply holds
+    /// it).
+    pub fn mass_stiffness(&self) -> f64 {
+        match self.held {
+            Some(_) => 0.0,
+            None => AIR_GAS_CONSTANT * self.temperature / self.volume,
+        }
     }
 
     /// The air's density (kg/m³) at gauge pressure `p` (ideal gas).
@@ -59,12 +74,14 @@ fn flow_after(cda: f64, from: &OrificeEnd, to: &OrificeEnd, mass: f64) -> f64 {
 
 /// The air mass (kg) that flows from `from` to `to` over `dt` seconds by backward Euler: the
 /// root of `m − dt ṁ(m)` between 0 and the equalising mass (0 where `dt ≤ 0` or a volume is
-/// not positive).
+/// not positive). Between two supplies, whose pressures no air changes, it is `dt ṁ`.
 pub fn implicit_transfer(cda: f64, from: &OrificeEnd, to: &OrificeEnd, dt: f64) -> f64 {
-    let stiffness =
-        AIR_GAS_CONSTANT * (from.temperature / from.volume + to.temperature / to.volume);
+    let stiffness = from.mass_stiffness() + to.mass_stiffness();
     if !(dt > 0.0 && from.volume > 0.0 && to.volume > 0.0 && stiffness.is_finite()) {
         return 0.0;
+    }
+    if stiffness == 0.0 {
+        return dt * flow_after(cda, from, to, 0.0);
     }
     let equal = (from.pressure_with(0.0) - to.pressure_with(0.0)) / stiffness;
     if !equal.is_finite() || equal == 0.0 {
@@ -89,26 +106,38 @@ pub fn implicit_transfer(cda: f64, from: &OrificeEnd, to: &OrificeEnd, dt: f64) 
     0.5 * (lo + hi)
 }
 
-/// `β = ∂m/∂Δp₀` (kg/Pa) of the backward-Euler transfer `m` over `dt`: from
-/// `m = dt ṁ(Δp₀ − s m)`, `β = 1/(1/(dt ṁ') + s)` with `ṁ' = ṁ/(2Δp)` (the density's change
-/// neglected) and `s = R (T_f/V_f + T_t/V_t)`; `1/s` (one gas) once the pressures are equal, 0
-/// where `dt ≤ 0`.
-pub fn transfer_slope(from: &OrificeEnd, to: &OrificeEnd, mass: f64, dt: f64) -> f64 {
-    let s = AIR_GAS_CONSTANT * (from.temperature / from.volume + to.temperature / to.volume);
-    if !(dt > 0.0 && s.is_finite() && s > 0.0) {
-        return 0.0;
+/// How the backward-Euler transfer `m` over `dt` follows its ends' pressures: `(∂m/∂P_f,
+/// ∂m/∂P_t)` with `P_f`, `P_t` the pressures after the transfer at a fixed `m` (what the
+/// volumes and the air already moved make). Differentiating `m = dt ṁ(Δp, ρ)` with
+/// `dΔp = dP_f − dP_t − s dm`, `s = k_f + k_t` ([`OrificeEnd::mass_stiffness`]),
+/// `dt ∂ṁ/∂Δp = m/(2Δp) = 1/r` and `dt ∂ṁ/∂ρ dρ = δ dP_up`, `δ = m/(2(P_up + p_a))` of the
+/// upstream end (its density's change; the upstream pressure itself moves by `∓k dm`):
+/// `dm (r + s + r (δ_f k_f − δ_t k_t)) = (1 + r δ_f) dP_f − (1 − r δ_t) dP_t`, `δ` nonzero
+/// at the upstream end only. `r = 0` once the pressures are equal (the flow law is infinitely
+/// steep there): `dm = (dP_f − dP_t)/s`. Nothing where `dt ≤ 0` or no air moved against a
+/// pressure difference.
+pub fn transfer_sensitivity(from: &OrificeEnd, to: &OrificeEnd, mass: f64, dt: f64) -> (f64, f64) {
+    let (kf, kt) = (from.mass_stiffness(), to.mass_stiffness());
+    let (pf, pt) = (from.pressure_with(-mass), to.pressure_with(mass));
+    let dp = pf - pt;
+    if !(dt > 0.0 && (kf + kt).is_finite()) || (mass == 0.0 && dp != 0.0) {
+        return (0.0, 0.0);
     }
-    let dp = (from.pressure_with(-mass) - to.pressure_with(mass)).abs();
-    let rate = (mass / dt).abs();
-    // 1/(dt ṁ') = 2|Δp| / (dt |ṁ|): 0 once the pressures are equal.
-    let lag = if dp == 0.0 {
+    let r = if mass == 0.0 {
         0.0
-    } else if rate > 0.0 {
-        2.0 * dp / (dt * rate)
     } else {
-        return 0.0;
+        (2.0 * dp / mass).max(0.0)
     };
-    1.0 / (lag + s)
+    let (df, dt_) = if pf >= pt {
+        (mass / (2.0 * (pf + from.law.atmosphere)), 0.0)
+    } else {
+        (0.0, mass / (2.0 * (pt + to.law.atmosphere)))
+    };
+    let denominator = r + kf + kt + r * (df * kf - dt_ * kt);
+    if !(denominator > 0.0) {
+        return (0.0, 0.0);
+    }
+    ((1.0 + r * df) / denominator, -(1.0 - r * dt_) / denominator)
 }
 
 #[cfg(test)]
@@ -126,6 +155,7 @@ mod tests {
             constant: law.constant(pressure, volume, 293.15),
             volume,
             temperature: 293.15,
+            held: None,
         }
     }
 

@@ -106,6 +106,7 @@ impl Analysis {
             contacts: parts.curved.initial_histories(&model),
             chambers: parts.chambers.initial_states(&model),
             orifices: vec![0.0; model.orifices.len()],
+            orifice_moved: vec![0.0; model.orifices.len()],
             layer_contacts: parts.layers.initial_histories(&system),
             plastic: system
                 .material

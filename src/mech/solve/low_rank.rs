@@ -1,8 +1,11 @@
 //! The chambers' pneumatic stiffness in the Newton correction (issue 43): the matrix is the
-//! sparse `S` plus one rank-one term `a g gᵀ` per sealed chamber (`contributions/chambers.rs`),
-//! solved by the Sherman–Morrison–Woodbury identity from `S`'s held factor (Golub & Van Loan,
-//! *Matrix Computations*, §2.1.4): `x = y − Z (A⁻¹ + Gᵀ Z)⁻¹ Gᵀ y` with `y = S⁻¹ b`,
-//! `Z = S⁻¹ G`, `A = diag(a)`. No dense row enters the sparse factorization.
+//! sparse `S` plus `G A Gᵀ`, `G` the columns `g = ∂V/∂u` of the sealed chambers and
+//! `A = −∂p/∂V` between them (`contributions/chambers.rs`: diagonal, one rank-one term per
+//! chamber, unless an orifice couples two, unsymmetrically), solved by the
+//! Sherman–Morrison–Woodbury identity from `S`'s held factor (Golub & Van Loan, *Matrix
+//! Computations*, §2.1.4) in the form that needs no `A⁻¹`:
+//! `x = y − Z A (I + Gᵀ Z A)⁻¹ Gᵀ y` with `y = S⁻¹ b`, `Z = S⁻¹ G`. No dense row enters the
+//! sparse factorization.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -17,34 +20,28 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 impl Analysis {
     /// Turns `rhs = S⁻¹ b` (the sparse matrix of the last assembly, factorized) into the
-    /// solution with the chambers' rank-one terms added; nothing without a sealed chamber.
+    /// solution with the chambers' `G A Gᵀ` added; nothing without a sealed chamber.
     pub(crate) fn add_low_rank(&mut self, rhs: &mut [f64]) -> Result<(), FactorizationError> {
-        let terms: Vec<(f64, Vec<f64>)> = self
-            .parts
-            .chambers
-            .low_rank()
-            .iter()
-            .filter(|(a, _)| *a > 0.0)
-            .cloned()
-            .collect();
-        if terms.is_empty() {
+        let terms = self.parts.chambers.low_rank().clone();
+        let (columns, a) = (&terms.columns, &terms.matrix);
+        let m = columns.len();
+        if m == 0 || a.iter().all(|&x| x == 0.0) {
             return Ok(());
         }
-        let m = terms.len();
         let matrix = self.system.matrix(&self.work.values);
         let mut z = Vec::with_capacity(m);
-        for (_, g) in &terms {
+        for g in columns {
             let mut column = g.clone();
             self.linear.solve_held(matrix, &mut column)?;
             z.push(column);
         }
-        let small = DMatrix::from_fn(m, m, |i, j| {
-            dot(&terms[i].1, &z[j]) + if i == j { 1.0 / terms[i].0 } else { 0.0 }
-        });
-        let gy = DVector::from_fn(m, |i, _| dot(&terms[i].1, rhs));
-        let w = small.lu().solve(&gy).ok_or_else(|| {
+        let gz = DMatrix::from_fn(m, m, |i, j| dot(&columns[i], &z[j]));
+        let small = DMatrix::identity(m, m) + gz * a;
+        let gy = DVector::from_fn(m, |i, _| dot(&columns[i], rhs));
+        let t = small.lu().solve(&gy).ok_or_else(|| {
             FactorizationError("the chambers' pneumatic stiffness made the matrix singular".into())
         })?;
+        let w = a * t;
         for (j, column) in z.iter().enumerate() {
             for (r, zj) in rhs.iter_mut().zip(column) {
                 *r -= w[j] * zj;

@@ -58,6 +58,11 @@ pub struct AnalysisState {
     /// The mass flow (kg/s, from → to) through each orifice over the last increment.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub orifices: Vec<f64>,
+    /// The air mass (kg, from → to) each orifice has passed since the analysis started: a
+    /// step's average flow is its change over the step (empty in a state written before it was
+    /// kept: read as zeros).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub orifice_moved: Vec<f64>,
 }
 
 impl AnalysisState {

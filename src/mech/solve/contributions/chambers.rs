@@ -4,13 +4,13 @@
 //! term, which the Newton correction adds by the Sherman–Morrison–Woodbury identity
 //! (`solve/low_rank.rs`), never as a dense row.
 
-use nalgebra::Vector3;
+use nalgebra::{DMatrix, Vector3};
 use serde::{Deserialize, Serialize};
 
 use super::{Contribution, Evaluation};
 use crate::mech::elements::chamber::AIR_GAS_CONSTANT;
 use crate::mech::elements::chamber::{ChamberGeometry, GasLaw, tet_gradient, tet_hessian};
-use crate::mech::elements::orifice::{OrificeEnd, implicit_transfer, transfer_slope};
+use crate::mech::elements::orifice::{OrificeEnd, implicit_transfer, transfer_sensitivity};
 use crate::mech::model::Model;
 use crate::mech::results::Results;
 use crate::mech::solve::assembly::{Dof, node_dofs};
@@ -63,6 +63,20 @@ pub struct OrificeResult {
     pub name: String,
     /// Mass flow (kg/s) from its `from` chamber to its `to` over the last increment.
     pub mass_flow: f64,
+    /// Air (kg) passed from `from` to `to` since the analysis started.
+    #[serde(default)]
+    pub moved: f64,
+}
+
+/// The chambers' pneumatic stiffness `G A Gᵀ`, added to the Newton matrix by the
+/// Sherman–Morrison–Woodbury identity (`solve/low_rank.rs`), never as dense rows.
+#[derive(Clone, Debug, Default)]
+pub struct LowRank {
+    /// `g = ∂V/∂u` of each sealed chamber over the free equations: the columns of `G`.
+    pub columns: Vec<Vec<f64>>,
+    /// `A_ij = −∂p_i/∂V_j` between those chambers: diagonal (`−dp/dV` at a fixed air mass)
+    /// without orifices; an orifice couples its two chambers, not symmetrically.
+    pub matrix: DMatrix<f64>,
 }
 
 /// An orifice between two chambers: their indices and `C_d A` (m²).
@@ -86,17 +100,18 @@ pub struct Chambers {
     start: Vec<ChamberState>,
     /// Pressure and volume at the last evaluation.
     last: Vec<ChamberState>,
-    /// `(−dp/dV, g)` of each sealed chamber at the last evaluation with a matrix: `g` over the
-    /// free equations.
-    low_rank: Vec<(f64, Vec<f64>)>,
+    /// The pneumatic stiffness at the last evaluation with a matrix.
+    low_rank: LowRank,
     orifices: Vec<Orifice>,
     /// The analysis time (s) at the increment's start.
     start_time: f64,
     /// Each orifice's mass flow (kg/s) over the increment at the last evaluation.
     flows: Vec<f64>,
-    /// Each orifice's `β = ∂m/∂Δp₀` at the last evaluation (kg/Pa): how the moved mass follows
-    /// the pressure difference the volumes make, for the tangent.
-    betas: Vec<f64>,
+    /// Each orifice's moved air (kg) over the increment at the last evaluation.
+    moved: Vec<f64>,
+    /// `∂p_i/∂V_j` of the chambers at the last evaluation (Pa/m³), the orifices' transfers
+    /// included: zero rows for supplied chambers.
+    slopes: DMatrix<f64>,
 }
 
 impl Chambers {
@@ -189,8 +204,8 @@ impl Chambers {
         self.start.iter().any(|c| c.sealed)
     }
 
-    /// The rank-one terms `(a, g)` of the last evaluation with a matrix (`a g gᵀ` to add to it).
-    pub fn low_rank(&self) -> &[(f64, Vec<f64>)] {
+    /// The pneumatic stiffness `G A Gᵀ` of the last evaluation with a matrix (to add to it).
+    pub fn low_rank(&self) -> &LowRank {
         &self.low_rank
     }
 
@@ -226,65 +241,92 @@ impl Chambers {
             .collect()
     }
 
-    /// Moves the air each orifice passes over `dt` seconds between the gas of [`Self::last`]
-    /// (backward Euler, [`implicit_transfer`]; one orifice after the other where several share
-    /// a chamber) and keeps their flows. Only an orifice between two sealed chambers passes air.
-    fn exchange(&mut self, dt: f64) {
-        self.flows.clear();
-        self.betas.clear();
-        for o in &self.orifices {
-            let (a, b) = (self.last[o.from], self.last[o.to]);
-            if !(a.sealed && b.sealed) {
-                self.flows.push(0.0);
-                self.betas.push(0.0);
-                continue;
-            }
-            let end = |k: usize, c: &ChamberState| OrificeEnd {
-                law: self.laws[k],
-                constant: c.constant,
-                volume: c.volume,
-                temperature: c.temperature,
-            };
-            let (from, to) = (end(o.from, &a), end(o.to, &b));
-            let m = implicit_transfer(o.cda, &from, &to, dt);
-            self.betas.push(transfer_slope(&from, &to, m, dt));
-            for (k, end, mass) in [(o.from, from, -m), (o.to, to, m)] {
-                let c = &mut self.last[k];
-                c.constant = end.law.with_air(end.constant, mass, end.volume);
-                c.pressure = end.pressure_with(mass);
-            }
-            self.flows.push(if dt > 0.0 { m / dt } else { 0.0 });
+    /// Chamber `k`'s end of an orifice in [`Self::last`]'s gas.
+    fn end(&self, k: usize) -> OrificeEnd {
+        let c = &self.last[k];
+        OrificeEnd {
+            law: self.laws[k],
+            constant: c.constant,
+            volume: c.volume,
+            temperature: c.temperature,
+            held: (!c.sealed).then_some(c.pressure),
         }
     }
 
-    /// The rank-one terms of the chambers' `terms` (`(−dp/dV, g)` of each sealed one at a
-    /// fixed air mass) with each orifice's coupling: the moved mass `m` follows the pressure
-    /// difference, `dm = β (a_f dV_f − a_t dV_t)`, so `dp_i/dV_j` is a 2×2 block per orifice,
-    /// symmetrized and written as three non-negative rank-one terms on `g_f`, `g_t`, `g_f + g_t`.
-    fn couple(&mut self, mut terms: Vec<Option<(f64, Vec<f64>)>>) {
-        let mut extra = vec![];
-        for (o, &beta) in self.orifices.iter().zip(&self.betas) {
-            if beta <= 0.0 {
+    /// Moves the air each orifice passes over `dt` seconds between the gas of [`Self::last`]
+    /// (backward Euler, [`implicit_transfer`]; one orifice after the other where several share
+    /// a chamber), keeps their flows and `∂p_i/∂V_j` ([`Self::slopes`]). A supplied chamber
+    /// keeps its pressure (its supply makes good what passes); two supplies pass nothing.
+    ///
+    /// The slopes follow each chamber's constant `C_i` through the transfers, `dC_i/dV_j`:
+    /// with `m` kg added, `C' = C + m R T₀ V^{κ−1}` and `p = C' (T/T₀)/V^κ − p_a`, so at a fixed
+    /// `m` `dp = p_C (dC + m R T₀ (κ−1) V^{κ−2} dV) + (∂p/∂V)_{C'} dV`, `p_C = (T/T₀)/V^κ`, and
+    /// `dm` follows those by [`transfer_sensitivity`].
+    fn exchange(&mut self, dt: f64) {
+        let n = self.last.len();
+        let mut dc = DMatrix::<f64>::zeros(n, n);
+        self.flows.clear();
+        self.moved.clear();
+        for o in &self.orifices {
+            let (from, to) = (self.end(o.from), self.end(o.to));
+            if from.held.is_some() && to.held.is_some() {
+                self.flows.push(0.0);
+                self.moved.push(0.0);
                 continue;
             }
-            let k = |c: usize| AIR_GAS_CONSTANT * self.last[c].temperature / self.last[c].volume;
-            let (kf, kt) = (k(o.from), k(o.to));
-            let (Some((af, gf)), Some((at, gt))) = (&terms[o.from], &terms[o.to]) else {
-                continue;
+            let m = implicit_transfer(o.cda, &from, &to, dt);
+            let (sf, st) = transfer_sensitivity(&from, &to, m, dt);
+            // `dC'` at a fixed moved mass (with `−m` at `from`, `m` at `to`) and `dp` from it.
+            let fixed = |k: usize, end: &OrificeEnd, dc: &DMatrix<f64>, mass: f64| {
+                let (law, v) = (&end.law, end.volume);
+                let mut row = dc.row(k).clone_owned();
+                row[k] += mass
+                    * AIR_GAS_CONSTANT
+                    * law.temperature
+                    * (law.kappa - 1.0)
+                    * v.powf(law.kappa - 2.0);
+                let c = law.with_air(end.constant, mass, v);
+                let p_c = (end.temperature / law.temperature) / v.powf(law.kappa);
+                let mut dp = &row * p_c;
+                dp[k] += law.slope(c, v, end.temperature);
+                (row, dp)
             };
-            // `a` here is −dp/dV at a fixed mass.
-            let (af, at) = (*af, *at);
-            let c = 0.5 * beta * (kf * at + kt * af);
-            let sum: Vec<f64> = gf.iter().zip(gt).map(|(x, y)| x + y).collect();
-            extra.push((c, sum));
-            terms[o.from]
-                .as_mut()
-                .map(|t| t.0 = af * (1.0 - kf * beta) - c);
-            terms[o.to]
-                .as_mut()
-                .map(|t| t.0 = at * (1.0 - kt * beta) - c);
+            let (row_f, dp_f) = fixed(o.from, &from, &dc, -m);
+            let (row_t, dp_t) = fixed(o.to, &to, &dc, m);
+            let dm = if from.held.is_some() {
+                dp_t * st
+            } else if to.held.is_some() {
+                dp_f * sf
+            } else {
+                dp_f * sf + dp_t * st
+            };
+            for (k, end, row, sign) in [(o.from, from, row_f, -1.0), (o.to, to, row_t, 1.0)] {
+                if end.held.is_some() {
+                    continue;
+                }
+                let law = &end.law;
+                let per_kg = AIR_GAS_CONSTANT * law.temperature * end.volume.powf(law.kappa - 1.0);
+                dc.set_row(k, &(row + &dm * (sign * per_kg)));
+                let c = &mut self.last[k];
+                c.constant = law.with_air(end.constant, sign * m, end.volume);
+                c.pressure = end.pressure_with(sign * m);
+            }
+            self.flows.push(if dt > 0.0 { m / dt } else { 0.0 });
+            self.moved.push(m);
         }
-        self.low_rank = terms.into_iter().flatten().chain(extra).collect();
+        self.slopes = DMatrix::from_fn(n, n, |i, j| {
+            let (c, law) = (&self.last[i], &self.laws[i]);
+            if !c.sealed {
+                return 0.0;
+            }
+            let p_c = (c.temperature / law.temperature) / c.volume.powf(law.kappa);
+            let own = if i == j {
+                law.slope(c.constant, c.volume, c.temperature)
+            } else {
+                0.0
+            };
+            p_c * dc[(i, j)] + own
+        });
     }
 
     /// Each chamber's volume (m³) at the displacements `u`.
@@ -317,12 +359,10 @@ impl Contribution for Chambers {
         let volumes = self.volumes(at.u);
         self.last = self.gas_at(at, &volumes);
         self.exchange(at.levels.time - self.start_time);
-        self.low_rank.clear();
-        let mut terms = Vec::with_capacity(self.geometry.len());
+        let mut columns = Vec::with_capacity(self.geometry.len());
         let system = at.system;
         for (k, g) in self.geometry.iter().enumerate() {
-            let (gas, law) = (self.last[k], &self.laws[k]);
-            let (v, p, constant, t) = (gas.volume, gas.pressure, gas.constant, gas.temperature);
+            let (gas, p) = (self.last[k], self.last[k].pressure);
             // `g` over the free equations, for the rank-one term: only where a matrix is asked.
             let mut gradient =
                 (gas.sealed && values.is_some()).then(|| vec![0.0; system.free_count]);
@@ -342,15 +382,26 @@ impl Contribution for Chambers {
                     system.add_element_matrix(e, &h, values);
                 }
             }
-            terms.push(gradient.map(|grad| (-law.slope(constant, v, t), grad)));
+            columns.push(gradient);
         }
-        self.couple(terms);
+        let sealed: Vec<usize> = (0..columns.len())
+            .filter(|&k| columns[k].is_some())
+            .collect();
+        self.low_rank = LowRank {
+            matrix: DMatrix::from_fn(sealed.len(), sealed.len(), |i, j| {
+                -self.slopes[(sealed[i], sealed[j])]
+            }),
+            columns: columns.into_iter().flatten().collect(),
+        };
     }
 
-    fn commit(&self, _start: &AnalysisState, state: &mut AnalysisState) {
+    fn commit(&self, start: &AnalysisState, state: &mut AnalysisState) {
         if !self.geometry.is_empty() {
             state.chambers.clone_from(&self.last);
             state.orifices.clone_from(&self.flows);
+            state.orifice_moved = (0..self.moved.len())
+                .map(|k| start.orifice_moved.get(k).copied().unwrap_or(0.0) + self.moved[k])
+                .collect();
         }
     }
 
@@ -382,6 +433,7 @@ impl Contribution for Chambers {
             .map(|(k, o)| OrificeResult {
                 name: o.name.clone(),
                 mass_flow: state.orifices.get(k).copied().unwrap_or(0.0),
+                moved: state.orifice_moved.get(k).copied().unwrap_or(0.0),
             })
             .collect();
     }

@@ -40,7 +40,7 @@ mod loads;
 mod stabilization;
 mod triangles;
 
-pub use chambers::{ChamberResult, ChamberState, Chambers, OrificeResult};
+pub use chambers::{ChamberResult, ChamberState, Chambers, LowRank, OrificeResult};
 pub use curved::CurvedContacts;
 pub use gaps::Gaps;
 pub use layers::LayerContacts;
