@@ -60,6 +60,8 @@ def test_fmi3_archives_pass_fmpy_validate_with_the_library_in_the_fmi3_folder(sp
 
 ARRAYS = ["film.nodeCount", "film.gapCount", "film.displacement", "film.reaction", "film.gapSlipX",
           "film.gapSlipY", "film.gapNormalForce", "film.gapStatus", "film.lineReaction"]
+# The specimen's one reaction line, its frame (issue 45: per-line arrays).
+LINES = ["frame.linePoints", "frame.lineReaction", "frame.linePosition", "frame.lineArc"]
 
 
 def test_fmi3_keeps_the_fmi2_variables_value_references_and_token_and_adds_the_arrays(fmu_path, specimen3):
@@ -71,8 +73,11 @@ def test_fmi3_keeps_the_fmi2_variables_value_references_and_token_and_adds_the_a
     n = len(d2.modelVariables)
     assert rows(d2, types.get) == rows(d3, str)[:n]
     extra = d3.modelVariables[n:]
-    assert [v.name for v in extra] == ARRAYS
-    assert [v.valueReference for v in extra] == list(range(n, n + len(ARRAYS)))
+    assert [v.name for v in extra] == ARRAYS + LINES
+    assert [v.valueReference for v in extra[:len(ARRAYS)]] == list(range(n, n + len(ARRAYS)))
+    # The frame's line arrays follow the references reserved for the 13 film fields (the
+    # contact arrays among them are absent: the specimen has no curved supports).
+    assert [v.valueReference for v in extra[len(ARRAYS):]] == list(range(n + 13, n + 17))
 
 
 @pytest.mark.parametrize("which", ["specimen", "user model"])
