@@ -100,7 +100,8 @@ impl Instance {
 
 impl Instance {
     /// `fmi3GetAdjointDerivative` in one solve (`Analysis::adjoint_response`): `out = Jᵀ v`,
-    /// when every unknown is a group's reaction or an output point's displacement, every known
+    /// when every unknown is a reaction (a group's, a support set's, the total) or an output
+    /// point's displacement, every known
     /// an input, and the held tangent symmetric (no contact slides, no follower pressure acts).
     /// None otherwise: the caller takes J's columns, which also name what is refused.
     pub(crate) fn adjoint_in_one_solve(
@@ -119,6 +120,8 @@ impl Instance {
             }
             match variables[r as usize].binding {
                 Binding::Reaction { group, axis } => weights.reactions[group][axis] += x,
+                Binding::SupportReaction { set, axis } => weights.supports[set][axis] += x,
+                Binding::TotalReaction(axis) => weights.total[axis] += x,
                 Binding::PointDisplacement { point, axis } => weights.points[point][axis] += x,
                 _ => return None,
             }

@@ -503,7 +503,8 @@ fn fmi3_derivatives_on_curved_supports_match_one_sided_differences_and_are_trans
 
 /// The one-solve adjoint through `fmi3GetAdjointDerivative` (issue 45 item 1), the specimen on
 /// gaps under the isotropic law, at the end of the step checked: at μ = 9.9 (every closed gap
-/// sticks: a symmetric tangent) `Jᵀ v` of the frame's reactions over the six inputs is **one**
+/// sticks: a symmetric tangent) `Jᵀ v` of the frame's reactions and the total reaction (the
+/// symmetry supports' too) over the six inputs is **one**
 /// solve with the held tangent; at μ = 0.2 (G1, G2 slip) it is J's columns, a solve per input.
 /// Both equal `vᵀ` times the columns of `fmi3GetDirectionalDerivative` (unit seeds): to 1e-6 of
 /// the largest for the one solve (a contraction of residuals against differences of results),
@@ -524,9 +525,9 @@ fn fmi3_adjoint_of_reactions_is_one_solve_at_a_symmetric_tangent() {
         let fmu = lowered(&case, &u, &log);
         assert_eq!(fmu.set("frame.dz", -0.06), 0);
         assert!(fmu.step(11.0, 1.0) <= 1, "{:?}", log.take());
-        let unknowns = ["frame.Rx", "frame.Ry", "frame.Rz"];
+        let unknowns = ["frame.Rx", "frame.Ry", "frame.Rz", "reactions.Rz"];
         let knowns: Vec<&str> = SEEDS.iter().map(|s| s.0).collect();
-        let v = [0.3, -0.7, 1.1];
+        let v = [0.3, -0.7, 1.1, -0.4];
         let before = fmu.tangent_solves();
         let (status, jtv) = fmu.adjoint(&unknowns, &knowns, &v);
         assert!(status <= 1, "{status}: {:?}", log.take());

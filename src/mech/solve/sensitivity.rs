@@ -59,16 +59,16 @@
 //!
 //! **One-solve adjoint** ([`Analysis::adjoint_response`], issue 45): `vᵀ J` over any number of
 //! inputs for outputs whose gradient with respect to the displacements is known without
-//! differences: a group's reaction (the sum of its residual rows, `∂R/∂u_f = K_pf`) and an
-//! output point's displacement (a unit row). With `y` those outputs and `g` the residual,
+//! differences: a reaction (a group's, a support set's, the total: a sum of the residual's
+//! restrained rows r, `∂R/∂u_f = K_rf`) and an output point's displacement (a unit row). With `y` those outputs and `g` the residual,
 //! `vᵀ dy/dq = vᵀ ∂y/∂q − λᵀ ∂g_f/∂q`, `K_ffᵀ λ = (∂y/∂u_f)ᵀ v`: one solve for λ, then per
 //! input the residual's derivative above (two residual assemblies for a group's motion, the
 //! loads' residual for a load, the contacts' for μ) contracted with λ and with the reactions'
 //! weights. The factor held is that of `K`, so the solve is `Kᵀ`'s only for a symmetric tangent:
 //! the adjoint checks the held values (`|K_ij − K_ji| ≤ 1e-10 max |K|`) and refuses a follower
 //! pressure that acts (its load stiffness is unsymmetric); a sliding contact makes the tangent
-//! unsymmetric and is refused so. `(K_pf)ᵀ v` is then `K_fp v`: the residual's derivative along
-//! the groups moved by the reactions' weights, the translation seed's own right-hand side. The
+//! unsymmetric and is refused so. `(K_rf)ᵀ v` is then `K_fr v`: the residual's derivative along
+//! the restrained DOFs moved by the reactions' weights (a central difference, free DOFs held). The
 //! values agree with J's columns to the differences' accuracy (1e-6 in the test), not to the
 //! last bit: the columns are a difference of results along each response, the adjoint a
 //! contraction of residuals.
@@ -136,12 +136,17 @@ impl Seed {
 
 /// The weights `v` of the outputs a one-solve adjoint ([`Analysis::adjoint_response`])
 /// contracts: the outputs whose gradient with respect to the displacements the analysis has
-/// without differences (a group's reaction: its rows of the residual; a point's displacement).
+/// without differences (a reaction: a sum of the residual's restrained rows; a point's
+/// displacement: a unit row).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct OutputWeights {
     /// Per group: the weight of its reaction along x, y, z (prescribed components; others
     /// ignored).
     pub reactions: Vec<[f64; 3]>,
+    /// Per named support set: the weight of its reaction along x, y, z (fixed components).
+    pub supports: Vec<[f64; 3]>,
+    /// The weight of the total reaction (every restraint) along x, y, z.
+    pub total: [f64; 3],
     /// Per output point: the weight of its displacement along x, y, z.
     pub points: Vec<[f64; 3]>,
 }
@@ -151,6 +156,8 @@ impl OutputWeights {
     pub fn zero(analysis: &Analysis) -> Self {
         OutputWeights {
             reactions: vec![[0.0; 3]; analysis.state().boundary.len()],
+            supports: vec![[0.0; 3]; analysis.model().support_sets().len()],
+            total: [0.0; 3],
             points: vec![[0.0; 3]; analysis.model().outputs.points.len()],
         }
     }
@@ -376,6 +383,7 @@ impl Analysis {
         let zero = Seed::zero(self);
         let (start, end) = self.derivative_states(&zero)?;
         if weights.reactions.len() != end.boundary.len()
+            || weights.supports.len() != self.model.support_sets().len()
             || weights.points.len() != self.model.outputs.points.len()
         {
             return Err("the weights do not fit the model's groups and output points".into());
@@ -395,16 +403,14 @@ impl Analysis {
         {
             return Err("a contact slides: the tangent is not symmetric".into());
         }
-        // w = Cᵀ v over the free DOFs: a reaction's row of C is K_pf, whose transpose is K_fp
-        // for a symmetric tangent, so its part is the residual's derivative along the groups
-        // moved by the reactions' weights (a translation seed); a point's is its free DOFs.
+        // w = Cᵀ v over the free DOFs: a reaction's row of C is K_rf (r: its restrained DOFs),
+        // whose transpose is K_fr for a symmetric tangent, so its part is the residual's
+        // derivative along the restrained DOFs moved by the reactions' weights; a point's is
+        // its free DOFs.
+        let restrained = self.restrained_weights(weights);
         let mut w = vec![0.0; self.system.free_count];
-        let moved_by_reactions = Seed {
-            translation: weights.reactions.clone(),
-            ..zero
-        };
-        if let Some(largest) = self.seed_scale(&end, &moved_by_reactions)? {
-            let (_, dg) = self.seed_residual(&start, &end, &moved_by_reactions, 1e-6 / largest);
+        if restrained.iter().any(|&x| x != 0.0) {
+            let dg = self.restrained_residual(&start, &end, &restrained);
             for (i, d) in self.system.dofs.iter().enumerate() {
                 if let Dof::Free(f) = *d {
                     w[f] = dg[i];
@@ -427,7 +433,7 @@ impl Analysis {
         }
         let values = seeds
             .iter()
-            .map(|seed| self.adjoint_entry((&start, &end), weights, &lambda, seed))
+            .map(|seed| self.adjoint_entry((&start, &end), (weights, &restrained), &lambda, seed))
             .collect();
         self.state = end;
         values
@@ -439,7 +445,7 @@ impl Analysis {
     fn adjoint_entry(
         &mut self,
         (start, end): (&AnalysisState, &AnalysisState),
-        weights: &OutputWeights,
+        (weights, restrained): (&OutputWeights, &[f64]),
         lambda: &[f64],
         seed: &Seed,
     ) -> Result<f64, String> {
@@ -452,10 +458,7 @@ impl Analysis {
         for (i, d) in self.system.dofs.iter().enumerate() {
             match *d {
                 Dof::Free(f) => value -= lambda[f] * dg[i],
-                Dof::Prescribed { group, component } => {
-                    value += weights.reactions[group][component] * dg[i]
-                }
-                _ => {}
+                _ => value += restrained[i] * dg[i],
             }
         }
         for (point, weight) in self.model.outputs.points.iter().zip(&weights.points) {
@@ -464,6 +467,62 @@ impl Analysis {
             }
         }
         Ok(value)
+    }
+
+    /// The reactions' weights on every DOF (0 at free ones): a reaction is the sum of the
+    /// residual's rows it gathers (`Analysis::results`), so its weight goes to each of them.
+    fn restrained_weights(&self, weights: &OutputWeights) -> Vec<f64> {
+        let mut on = vec![0.0; self.system.dofs.len()];
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Prescribed { group, component } = *d {
+                on[i] += weights.reactions[group][component];
+            }
+            if !matches!(d, Dof::Free(_)) {
+                on[i] += weights.total[i % 3];
+            }
+        }
+        let sets = self.model.support_sets();
+        for s in &self.model.supports {
+            let Some(set) = s
+                .name
+                .as_ref()
+                .and_then(|n| sets.iter().position(|m| m == n))
+            else {
+                continue;
+            };
+            for a in &s.fixed {
+                on[3 * s.node + a.index()] += weights.supports[set][a.index()];
+            }
+        }
+        on
+    }
+
+    /// The central difference of the residual of every DOF along the restrained DOFs moved by
+    /// `restrained` (free DOFs, group motion and loads held): `K_·r · restrained`, with a step
+    /// that moves the largest by 1e-6 of the model's size.
+    fn restrained_residual(
+        &mut self,
+        start: &AnalysisState,
+        end: &AnalysisState,
+        restrained: &[f64],
+    ) -> Vec<f64> {
+        let largest = restrained.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let eps = 1e-6 * self.length_scale / largest;
+        let held = || {
+            let motion = GroupMotion {
+                translation: end.boundary.clone(),
+                angles: end.angles.clone(),
+            };
+            (motion, end.loads.clone(), 0.0)
+        };
+        let (_, plus) =
+            self.results_from(start, along(&end.displacement, restrained, eps), &held());
+        let (_, minus) =
+            self.results_from(start, along(&end.displacement, restrained, -eps), &held());
+        plus.iter()
+            .zip(&minus)
+            .map(|(p, m)| (p - m) / (2.0 * eps))
+            .collect()
     }
 
     /// Ok when the held tangent is symmetric to rounding (`|K_ij − K_ji| ≤ 1e-10 max |K|`),
@@ -801,9 +860,10 @@ mod tests {
     /// group's three translations and μ) costs one solve with the held tangent, and equals
     /// `vᵀ` times J's columns (one linear response per input) to their differences' accuracy.
     /// MODEL: the specimen's frame lowered by 5 mm per step with μ = 0.2, then two steps with
-    /// μ = 9.9 (the closed gaps stick: a symmetric tangent; as in `src/fmi3/tests`), two output points: a free film node and a frame node
-    /// (whose displacement is the input's own). Weights: pseudo-random on every group's
-    /// reactions and both points.
+    /// μ = 9.9 (the closed gaps stick: a symmetric tangent; as in `src/fmi3/tests`), two output
+    /// points: a free film node and a frame node (whose displacement is the input's own).
+    /// Weights: pseudo-random on every group's reactions, the total reaction (the symmetry
+    /// supports' too) and both points.
     #[test]
     fn an_adjoint_over_many_inputs_is_one_solve_and_the_columns_transpose() {
         let spec = ParallelArch::default();
@@ -842,7 +902,11 @@ mod tests {
             x = (x * 997.0 + 0.13).fract();
             2.0 * x - 1.0
         };
-        for w in weights.reactions.iter_mut().chain(&mut weights.points) {
+        for w in (weights.reactions.iter_mut())
+            .chain(&mut weights.supports)
+            .chain(&mut weights.points)
+            .chain([&mut weights.total])
+        {
             *w = [next(), next(), next()];
         }
         let mut seeds = vec![mu(&a)];
@@ -877,6 +941,14 @@ mod tests {
                     v += w[c] * r.derivative(|x| x.points[p][c]);
                 }
             }
+            for (set, w) in weights.supports.iter().enumerate() {
+                for c in 0..3 {
+                    v += w[c] * r.derivative(|x| x.support_reactions[set][c]);
+                }
+            }
+            for c in 0..3 {
+                v += weights.total[c] * r.derivative(|x| x.total_reaction[c]);
+            }
             largest = largest.max(v.abs());
             columns.push(v);
         }
@@ -902,6 +974,58 @@ mod tests {
             let mut w = weights.clone();
             w.reactions[0][2] = 1.0;
             assert!(b.adjoint_response(&w, &[dz(&b)]).is_err());
+        }
+    }
+
+    /// The one-solve adjoint of a support set's and a hinged group's reactions (issue 45).
+    /// MODEL: `examples/hinged_panel.json` (the hinged group `rail`, the support set `frame`, no
+    /// contacts: a symmetric tangent), `rail.dz` to −5 mm and `rail.angle` to 0.01 rad in one
+    /// step. TEST GOAL: `vᵀ J` of the rail's, the frame's and the total reactions over the rail's
+    /// translations and angle is one solve, and `vᵀ` times J's columns to 1e-6.
+    #[test]
+    fn an_adjoint_of_support_set_and_hinged_group_reactions_is_one_solve() {
+        let model = Model::from_json(include_str!("../../../examples/hinged_panel.json")).unwrap();
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        let loads = a.state().loads.clone();
+        a.step_to_motion(&[[0.0, 0.0, -0.005]], &[0.01], &loads, 2)
+            .unwrap();
+        let mut weights = OutputWeights::zero(&a);
+        assert_eq!(weights.supports.len(), 1);
+        weights.reactions[0] = [0.4, -0.9, 1.3];
+        weights.supports[0] = [-0.6, 0.8, 0.5];
+        weights.total = [0.2, 0.3, -0.7];
+        let mut seeds = vec![];
+        for c in 0..3 {
+            let mut s = Seed::zero(&a);
+            s.translation[0][c] = 1.0;
+            seeds.push(s);
+        }
+        let mut s = Seed::zero(&a);
+        s.angles[0] = 1.0;
+        seeds.push(s);
+        let before = a.tangent_solves();
+        let adjoint = a.adjoint_response(&weights, &seeds).unwrap();
+        assert_eq!(a.tangent_solves(), before + 1);
+        let columns: Vec<f64> = seeds
+            .iter()
+            .map(|s| {
+                let r = a.linear_response(s).unwrap();
+                (0..3)
+                    .map(|c| {
+                        weights.supports[0][c] * r.derivative(|x| x.support_reactions[0][c])
+                            + weights.total[c] * r.derivative(|x| x.total_reaction[c])
+                            + weights.reactions[0][c] * r.derivative(|x| x.reactions[0][c])
+                    })
+                    .sum()
+            })
+            .collect();
+        let largest = columns.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        assert!(largest > 0.0);
+        for (adj, col) in adjoint.iter().zip(&columns) {
+            assert!(
+                (adj - col).abs() <= 1e-6 * largest,
+                "{adjoint:?} vs {columns:?}"
+            );
         }
     }
 
