@@ -87,12 +87,7 @@ impl Instance {
         }
         out.iter_mut().zip(values).for_each(|(o, v)| *o = v);
         match path_dependent(built.step_increments, &response.points[1]) {
-            Some(what) => Err(Failure::warning(format!(
-                "derivatives of the last of the step's {} increments, the earlier ones held: {what}, \
-                 whose response depends on the path, so the step repeated with other inputs \
-                 differs from them (set solver.incrementsPerStep = 1 for the step's own)",
-                built.step_increments
-            ))),
+            Some(what) => Err(path_warning(built.step_increments, &what)),
             None => Ok(()),
         }
     }
@@ -144,11 +139,7 @@ impl Instance {
         }
         let results = built.analysis.results();
         Some(match path_dependent(built.step_increments, &results) {
-            Some(what) => Err(Failure::warning(format!(
-                "derivatives of the last of the step's {} increments, the earlier ones held: \
-                 {what}, whose response depends on the path",
-                built.step_increments
-            ))),
+            Some(what) => Err(path_warning(built.step_increments, &what)),
             None => Ok(()),
         })
     }
@@ -162,6 +153,16 @@ impl Instance {
             .as_ref()
             .map_or(0, |b| b.analysis.tangent_solves())
     }
+}
+
+/// The warning of derivatives that are the last of a step's `increments` when `what` makes
+/// the step's own differ ([`path_dependent`]).
+fn path_warning(increments: usize, what: &str) -> Failure {
+    Failure::warning(format!(
+        "derivatives of the last of the step's {increments} increments, the earlier ones held: \
+         {what}, whose response depends on the path, so the step repeated with other inputs \
+         differs from them (set solver.incrementsPerStep = 1 for the step's own)"
+    ))
 }
 
 /// Adds `d` along the input bound to `binding` to `seed`; false if it is not an input.
