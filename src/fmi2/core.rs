@@ -2,7 +2,8 @@
 //! (`fmi_glue::export_fmi2!` in `exports.rs`, `fmi_glue::export_fmi3!` in `src/fmi3`) call.
 //! Each method forwards to the instance's own, so both versions drive the same code; the FMI 3.0 directional
 //! derivative is made of the 2.0 one's columns (one per known, [`Columns`]), so that the
-//! adjoint is its exact transpose.
+//! adjoint is its exact transpose; an adjoint of reactions and point displacements at a
+//! symmetric tangent is one solve instead (`Instance::adjoint_in_one_solve`).
 
 use std::path::Path;
 
@@ -196,6 +197,23 @@ impl Core for Instance {
         out: &mut [f64],
     ) -> Outcome {
         Instance::directional_derivative(self, unknowns, knowns, seed, out)
+    }
+
+    /// One solve with the held factor (`Instance::adjoint_in_one_solve`) where the unknowns
+    /// are reactions and point displacements and the tangent is symmetric; else J's columns,
+    /// the directional derivative's exact transpose.
+    fn adjoint_derivative(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        seed: &[f64],
+        out: &mut [f64],
+    ) -> Outcome {
+        if let Some(outcome) = self.adjoint_in_one_solve(unknowns, knowns, seed, out) {
+            return outcome;
+        }
+        let columns = Columns::of(self, unknowns, knowns, Instance::directional_derivative)?;
+        columns.apply((unknowns, seed), knowns, true, out)
     }
 
     fn directional_derivative(

@@ -10,7 +10,7 @@
 use super::instance::Instance;
 use super::phase::{Failure, Outcome};
 use super::scalar_variable::{Binding, Causality, VarType};
-use crate::mech::{GapStatus, Results, Seed};
+use crate::mech::{GapStatus, OutputWeights, Results, Seed};
 
 impl Instance {
     /// `dv_unknown[i] = Σ_j ∂unknown_i/∂known_j · dv_known[j]`; refuses, naming it, an unknown
@@ -59,18 +59,11 @@ impl Instance {
                 )));
             }
             let d = if scale > 0.0 { d / scale } else { d };
-            match v.binding {
-                Binding::GroupDisplacement { group, axis } => s.translation[group][axis] += d,
-                Binding::GroupAngle(g) => s.angles[g] += d,
-                Binding::Pressure(k) => s.pressure[k] += d,
-                Binding::NodalForce { set, axis } => s.force[set][axis] += d,
-                Binding::Friction => s.friction += d,
-                _ => {
-                    return Err(Failure::error(format!(
-                        "known {} (value reference {r}) is not an input",
-                        v.name
-                    )));
-                }
+            if !add_to_seed(&mut s, &v.binding, d) {
+                return Err(Failure::error(format!(
+                    "known {} (value reference {r}) is not an input",
+                    v.name
+                )));
             }
         }
         let response = built
@@ -94,15 +87,95 @@ impl Instance {
         }
         out.iter_mut().zip(values).for_each(|(o, v)| *o = v);
         match path_dependent(built.step_increments, &response.points[1]) {
-            Some(what) => Err(Failure::warning(format!(
-                "derivatives of the last of the step's {} increments, the earlier ones held: {what}, \
-                 whose response depends on the path, so the step repeated with other inputs \
-                 differs from them (set solver.incrementsPerStep = 1 for the step's own)",
-                built.step_increments
-            ))),
+            Some(what) => Err(path_warning(built.step_increments, &what)),
             None => Ok(()),
         }
     }
+}
+
+impl Instance {
+    /// `fmi3GetAdjointDerivative` in one solve (`Analysis::adjoint_response`): `out = Jᵀ v`,
+    /// when every unknown is a reaction (a group's, a support set's, the total) or an output
+    /// point's displacement, every known
+    /// an input, and the held tangent symmetric (no contact slides, no follower pressure acts).
+    /// None otherwise: the caller takes J's columns, which also name what is refused.
+    pub(crate) fn adjoint_in_one_solve(
+        &mut self,
+        unknowns: &[u32],
+        knowns: &[u32],
+        v: &[f64],
+        out: &mut [f64],
+    ) -> Option<Outcome> {
+        let variables = &self.description.variables;
+        let built = self.analysis.as_mut()?;
+        let mut weights = OutputWeights::zero(&built.analysis);
+        for (&r, &x) in unknowns.iter().zip(v) {
+            if !x.is_finite() || variables.get(r as usize)?.causality != Causality::Output {
+                return None;
+            }
+            match variables[r as usize].binding {
+                Binding::Reaction { group, axis } => weights.reactions[group][axis] += x,
+                Binding::SupportReaction { set, axis } => weights.supports[set][axis] += x,
+                Binding::TotalReaction(axis) => weights.total[axis] += x,
+                Binding::PointDisplacement { point, axis } => weights.points[point][axis] += x,
+                _ => return None,
+            }
+        }
+        let mut seeds = Vec::with_capacity(knowns.len());
+        for &r in knowns {
+            let mut s = Seed::zero(&built.analysis);
+            add_to_seed(&mut s, &variables.get(r as usize)?.binding, 1.0).then_some(())?;
+            seeds.push(s);
+        }
+        let values = built.analysis.adjoint_response(&weights, &seeds).ok()?;
+        if let Some((&r, _)) = knowns.iter().zip(&values).find(|(_, x)| !x.is_finite()) {
+            return Some(Err(Failure::error(format!(
+                "the derivative at value reference {r} overflows for this seed: scale the seed down"
+            ))));
+        }
+        out.copy_from_slice(&values);
+        if built.step_increments <= 1 {
+            return Some(Ok(()));
+        }
+        let results = built.analysis.results();
+        Some(match path_dependent(built.step_increments, &results) {
+            Some(what) => Err(path_warning(built.step_increments, &what)),
+            None => Ok(()),
+        })
+    }
+}
+
+#[cfg(test)]
+impl Instance {
+    /// Solves with the held tangent since the analysis was built (0 without one).
+    pub(crate) fn tangent_solves(&self) -> usize {
+        self.analysis
+            .as_ref()
+            .map_or(0, |b| b.analysis.tangent_solves())
+    }
+}
+
+/// The warning of derivatives that are the last of a step's `increments` when `what` makes
+/// the step's own differ ([`path_dependent`]).
+fn path_warning(increments: usize, what: &str) -> Failure {
+    Failure::warning(format!(
+        "derivatives of the last of the step's {increments} increments, the earlier ones held: \
+         {what}, whose response depends on the path, so the step repeated with other inputs \
+         differs from them (set solver.incrementsPerStep = 1 for the step's own)"
+    ))
+}
+
+/// Adds `d` along the input bound to `binding` to `seed`; false if it is not an input.
+fn add_to_seed(seed: &mut Seed, binding: &Binding, d: f64) -> bool {
+    match *binding {
+        Binding::GroupDisplacement { group, axis } => seed.translation[group][axis] += d,
+        Binding::GroupAngle(g) => seed.angles[g] += d,
+        Binding::Pressure(k) => seed.pressure[k] += d,
+        Binding::NodalForce { set, axis } => seed.force[set][axis] += d,
+        Binding::Friction => seed.friction += d,
+        _ => return false,
+    }
+    true
 }
 
 /// What makes the derivatives of the last of a step's `increments` differ from the step's own

@@ -17,6 +17,7 @@
 //! again from the FMU's resources and compares GUIDs, so a binary and an XML that disagree on the
 //! interface refuse to run together.
 
+use crate::mech::results::lines::{ReactionLine, reaction_lines};
 use std::io;
 
 use quick_xml::Writer;
@@ -46,6 +47,9 @@ pub struct Description {
     pub variables: Vec<Variable>,
     /// The model at the start values of the parameters.
     pub model: Model,
+    /// Its reaction lines (groups, then support sets; `mech::results::lines`): the FMI 3.0
+    /// interface's per-line arrays, worked out once.
+    pub reaction_lines: Vec<ReactionLine>,
 }
 
 /// Renders the description of an FMU of `source`.
@@ -98,6 +102,7 @@ pub fn describe(source: &Source) -> Result<Description, String> {
         guid,
         xml,
         variables: table,
+        reaction_lines: reaction_lines(&model).0,
         model,
     })
 }

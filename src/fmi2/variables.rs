@@ -5,10 +5,11 @@
 //! `description.rs`) are built from it, when the FMU is packed and again when it is instantiated.
 //! What one variable is (type, causality, value, binding): `scalar_variable.rs`.
 //!
-//! Why this file is above 800 lines: it is the table, one list in the order of the XML (the
-//! [`variables`] function, one `push` per variable family, about 500 lines), with the names it
-//! reserves and the inputs it gives a step. Cut in parts it would no longer read as the one list
-//! of the FMU's interface that it is.
+//! Why this file is above 800 lines: it is the table, one list in the order of the XML: the
+//! [`variables`] function calls one function per family of variables (the inputs of each kind,
+//! the parameters, the outputs of each element kind) in that order, and those follow it in the
+//! same order; with them the names the table reserves and the inputs it gives a step. A new
+//! family is one function and one call at its place in the list.
 //!
 //! Value references are the positions in the table (0-based), unique over all types; the
 //! ModelStructure `index` of a variable is its value reference + 1.
@@ -351,16 +352,43 @@ pub fn step_inputs(
     inputs
 }
 
-/// The variable table of an FMU of `model`. Order: `time`, inputs, parameters, outputs.
+/// The variable table of an FMU of `model`. Order: `time`, inputs, parameters, outputs; one
+/// function per family of variables, called in the order of the XML.
 pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
     let mut table = TableBuilder::default();
-    let solver = SolverSettings::default();
+    time_and_friction(&mut table, model);
+    group_inputs(&mut table, model);
+    pressure_inputs(&mut table, model);
+    chamber_inputs(&mut table, model);
+    force_inputs(&mut table, model);
+    specimen_parameters(&mut table, kind);
+    film_parameters(&mut table, model);
+    gap_parameters(&mut table, model);
+    solver_parameters(&mut table);
+    gap_outputs(&mut table, model);
+    group_outputs(&mut table, model);
+    reaction_outputs(&mut table, model);
+    curved_support_outputs(&mut table, model);
+    cable_outputs(&mut table, model);
+    chamber_outputs(&mut table, model);
+    layer_contact_outputs(&mut table, model);
+    point_outputs(&mut table, model);
+    element_set_outputs(&mut table, model);
+    solver_outputs(&mut table);
+    film_outputs(&mut table, model);
+    stabilization_outputs(&mut table);
+    table.0
+}
+
+/// The axes of the components `x`, `y`, `z`.
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// `time` and, with gaps or curved supports, the `mu` input.
+fn time_and_friction(table: &mut TableBuilder, model: &Model) {
     let mu = model.gaps.first().map_or_else(
         || model.curved_supports.first().map_or(0.0, |s| s.friction),
         |g| g.friction,
     );
-    let axes = ["x", "y", "z"];
-
     table.push(
         "time",
         VarType::Real,
@@ -381,9 +409,13 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::Friction,
         );
     }
+}
+
+/// Each boundary group's displacement inputs (prescribed components) and hinge angle.
+fn group_inputs(table: &mut TableBuilder, model: &Model) {
     for (group, g) in model.groups.iter().enumerate() {
         let prescribed = g.prescribes();
-        for (axis, a) in axes.iter().enumerate().filter(|(c, _)| prescribed[*c]) {
+        for (axis, a) in AXES.iter().enumerate().filter(|(c, _)| prescribed[*c]) {
             table.input(
                 &format!("{}.d{a}", g.name),
                 0.0,
@@ -408,6 +440,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
+}
+
+/// Each pressure set's pressure input.
+fn pressure_inputs(table: &mut TableBuilder, model: &Model) {
     for (set, p) in model.loads.pressures.iter().enumerate() {
         table.input(
             &format!("{}.pressure", p.name),
@@ -433,7 +469,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::Pressure(set),
         );
     }
-    chamber_inputs(&mut table, model);
+}
+
+/// Each force set's force inputs.
+fn force_inputs(table: &mut TableBuilder, model: &Model) {
     for (set, f) in model.loads.forces.iter().enumerate() {
         for (axis, a) in ["Fx", "Fy", "Fz"].iter().enumerate() {
             table.input(
@@ -442,13 +481,16 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 "N",
                 &format!(
                     "force on each node of force set '{}' along {}, reached at the end of a step",
-                    f.name, axes[axis]
+                    f.name, AXES[axis]
                 ),
                 Binding::NodalForce { set, axis },
             );
         }
     }
+}
 
+/// The specimen's `archHeight` (none for a user model).
+fn specimen_parameters(table: &mut TableBuilder, kind: Kind) {
     if let Kind::ParallelArch { arch_height } = kind {
         table.parameter(
             "archHeight",
@@ -458,6 +500,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::ArchHeight,
         );
     }
+}
+
+/// The film's material parameters and gravity.
+fn film_parameters(table: &mut TableBuilder, model: &Model) {
     let m = &model.material;
     let film: [(&str, f64, &str, &str, Binding); 6] = [
         (
@@ -534,7 +580,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          and scaled by ETFE's published relation (docs/mechanics.md, Temperature)",
         Binding::Temperature,
     );
-    for (axis, a) in axes.iter().enumerate() {
+    for (axis, a) in AXES.iter().enumerate() {
         table.parameter(
             &format!("gravity.{a}"),
             Value::Real(model.loads.gravity[axis]),
@@ -545,6 +591,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::Gravity(axis),
         );
     }
+}
+
+/// Each gap's penalty stiffnesses and the friction law of every contact.
+fn gap_parameters(table: &mut TableBuilder, model: &Model) {
     for (i, g) in model.gaps.iter().enumerate() {
         table.parameter(
             &format!("{}.kn", g.name),
@@ -573,6 +623,11 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          (the paper's: slides along the gap's local x, or along the support, only); empty: each keeps the model file's",
         Binding::FrictionLaw,
     );
+}
+
+/// The Newton settings and the VTK output's.
+fn solver_parameters(table: &mut TableBuilder) {
+    let solver = SolverSettings::default();
     let solver_parameters: [(&str, Value, Option<&'static str>, &str, Binding); 8] = [
         (
             "displacementTolerance",
@@ -653,7 +708,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "encoding of the VTK files: binary (raw appended data, about half the size) or ascii",
         Binding::VtkFormat,
     );
+}
 
+/// Each gap's results and status.
+fn gap_outputs(table: &mut TableBuilder, model: &Model) {
     for (i, g) in model.gaps.iter().enumerate() {
         let n = &g.name;
         table.output(
@@ -701,6 +759,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::GapStatus(i),
         );
     }
+}
+
+/// Each boundary group's reactions (prescribed components) and hinge moment.
+fn group_outputs(table: &mut TableBuilder, model: &Model) {
     for (group, g) in model.groups.iter().enumerate() {
         let prescribed = g.prescribes();
         for (axis, a) in ["Rx", "Ry", "Rz"]
@@ -713,7 +775,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 "N",
                 &format!(
                     "total reaction force of boundary group '{}' along {}",
-                    g.name, axes[axis]
+                    g.name, AXES[axis]
                 ),
                 Binding::Reaction { group, axis },
             );
@@ -730,6 +792,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
+}
+
+/// Each support set's reactions and the total reaction.
+fn reaction_outputs(table: &mut TableBuilder, model: &Model) {
     for (set, name) in model.support_sets().iter().enumerate() {
         for (axis, a) in ["Rx", "Ry", "Rz"].iter().enumerate() {
             table.output(
@@ -737,7 +803,7 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 "N",
                 &format!(
                     "total reaction of support set '{name}' along {} (its fixed components)",
-                    axes[axis]
+                    AXES[axis]
                 ),
                 Binding::SupportReaction { set, axis },
             );
@@ -749,11 +815,15 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             "N",
             &format!(
                 "sum of all restraint forces on the film along {} (supports, symmetry planes, groups; not the gaps)",
-                axes[axis]
+                AXES[axis]
             ),
             Binding::TotalReaction(axis),
         );
     }
+}
+
+/// Each curved-support contact's results and status.
+fn curved_support_outputs(table: &mut TableBuilder, model: &Model) {
     let mut contact = 0;
     for s in &model.curved_supports {
         for &v in &s.nodes {
@@ -805,6 +875,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             contact += 1;
         }
     }
+}
+
+/// Each cable's largest force.
+fn cable_outputs(table: &mut TableBuilder, model: &Model) {
     for (cable, c) in model.cables.iter().enumerate() {
         table.output(
             &format!("{}.maxForce", c.name),
@@ -813,7 +887,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::CableForce(cable),
         );
     }
-    chamber_outputs(&mut table, model);
+}
+
+/// Each layer contact's total normal force and largest slip.
+fn layer_contact_outputs(table: &mut TableBuilder, model: &Model) {
     for (k, c) in model.layer_contacts.iter().enumerate() {
         table.output(
             &format!("{}.normalForce", c.name),
@@ -831,6 +908,10 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             Binding::LayerMaxSlip(k),
         );
     }
+}
+
+/// Each output point's displacement.
+fn point_outputs(table: &mut TableBuilder, model: &Model) {
     for (point, p) in model.outputs.points.iter().enumerate() {
         for (axis, a) in ["ux", "uy", "uz"].iter().enumerate() {
             table.output(
@@ -838,12 +919,16 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
                 "m",
                 &format!(
                     "displacement of output point '{}' (node {}) along {}",
-                    p.name, p.node, axes[axis]
+                    p.name, p.node, AXES[axis]
                 ),
                 Binding::PointDisplacement { point, axis },
             );
         }
     }
+}
+
+/// Each element set's field summary.
+fn element_set_outputs(table: &mut TableBuilder, model: &Model) {
     for (set, e) in model.outputs.element_sets.iter().enumerate() {
         for (quantity, suffix, unit, what) in SummaryQuantity::ALL {
             table.output(
@@ -854,25 +939,16 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
-    let integer_output = |table: &mut TableBuilder, name: &str, description: &str, binding| {
-        table.push(
-            name,
-            VarType::Integer,
-            Causality::Output,
-            None,
-            None,
-            description,
-            binding,
-        )
-    };
-    integer_output(
-        &mut table,
+}
+
+/// The last step's Newton statistics and stabilization energy.
+fn solver_outputs(table: &mut TableBuilder) {
+    table.integer_output(
         "solver.iterations",
         "Newton iterations of the last step (all increments)",
         Binding::Iterations,
     );
-    integer_output(
-        &mut table,
+    table.integer_output(
         "solver.cutbacks",
         "increments halved in the last step",
         Binding::Cutbacks,
@@ -896,27 +972,28 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
         "solver.stabilizationEnergy over the film's elastic strain energy; above 2e-4 the step warns",
         Binding::StabilizationRatio,
     );
+}
+
+/// The film's stress and element-state outputs, the elasto-plastic film's last.
+fn film_outputs(table: &mut TableBuilder, model: &Model) {
     table.output(
         "film.maxEquivalentStress",
         "Pa",
         "largest von Mises stress of the film elements",
         Binding::MaxEquivalentStress,
     );
-    integer_output(
-        &mut table,
+    table.integer_output(
         "film.wrinkledElements",
         "number of wrinkled film elements (uniaxial tension; 0 without wrinkling)",
         Binding::WrinkledElements,
     );
-    integer_output(
-        &mut table,
+    table.integer_output(
         "film.slackElements",
         "number of slack film elements (no stress; 0 without wrinkling)",
         Binding::SlackElements,
     );
     if model.material.plasticity.is_some() {
-        integer_output(
-            &mut table,
+        table.integer_output(
             "film.yieldedElements",
             "number of film elements with a positive equivalent plastic strain",
             Binding::YieldedElements,
@@ -939,8 +1016,11 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
             );
         }
     }
-    integer_output(
-        &mut table,
+}
+
+/// The last step's stabilized increments and dissipation ratio.
+fn stabilization_outputs(table: &mut TableBuilder) {
+    table.integer_output(
         "solver.stabilizedIncrements",
         "increments of the last step solved with the viscous stabilization (solver.stabilization)",
         Binding::StabilizedIncrements,
@@ -952,7 +1032,6 @@ pub fn variables(model: &Model, kind: Kind) -> Vec<Variable> {
          ALLSD/ALLIE); above 0.05 the step warns, above 1 the warning says the state is the damping's",
         Binding::DissipationRatio,
     );
-    table.0
 }
 
 fn saturating_i32(v: usize) -> i32 {
@@ -1025,6 +1104,18 @@ impl TableBuilder {
             Causality::Parameter,
             Some(start),
             unit,
+            description,
+            binding,
+        );
+    }
+
+    fn integer_output(&mut self, name: &str, description: &str, binding: Binding) {
+        self.push(
+            name,
+            VarType::Integer,
+            Causality::Output,
+            None,
+            None,
             description,
             binding,
         );

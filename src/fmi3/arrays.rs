@@ -17,13 +17,20 @@
 //! | `film.contactSlip` | Float64 output, m | contactCount | contacts `contact_slip` |
 //! | `film.contactNormalForce` | Float64 output, N | contactCount | contacts `contact_normal_force` |
 //! | `film.contactStatus` | Int32 output | contactCount | contacts `contact_status` |
+//! | `<line>.linePoints` | UInt64 structural parameter | | nodes of the reaction line of a group or support set |
+//! | `<line>.lineReaction` | Float64 output, N/m | linePoints × 3 | film `line_reaction` at the line's nodes, in order along it (the line's own share where lines meet) |
+//! | `<line>.linePosition` | Float64 output, m | linePoints × 3 | the film file's points at the line's nodes |
+//! | `<line>.lineArc` | Float64 output, m | linePoints | arc length from the line's first node (reference geometry; lines that are one chain of edges only) |
 //!
 //! Their value references follow the FMI 2.0 table's last one, so the scalars keep theirs, and
 //! each field has its own whether the model has it or not (a model without gaps has no gap
-//! arrays and no `film.gapCount`, one without curved supports no contact arrays).
+//! arrays and no `film.gapCount`, one without curved supports no contact arrays). The lines'
+//! (`mech::results::lines`: groups, then support sets, each joined by film edges) follow, four
+//! references per line, the arc's reserved where a line is no chain.
 
 use crate::fmi2::description::Description;
-use crate::mech::results::vtk::line_reaction_field;
+use crate::mech::results::lines::{ReactionLine, reaction_lines};
+use crate::mech::results::vtk::{deformed, line_reaction_field_of};
 use crate::mech::{Model, Results};
 
 /// One array (or structural parameter) of the 3.0 interface.
@@ -42,7 +49,18 @@ pub enum Field {
     ContactSlip,
     ContactNormalForce,
     ContactStatus,
+    /// The nodes of reaction line k (a structural parameter).
+    RailPoints(usize),
+    /// Reaction per unit length at each node of line k.
+    RailReaction(usize),
+    /// Position of each node of line k.
+    RailPosition(usize),
+    /// Arc length of each node of line k.
+    RailArc(usize),
 }
+
+/// References per reaction line: points, reaction, position, arc.
+const PER_LINE: u32 = 4;
 
 /// Name, FMI 3.0 type, unit, description of each field, in value-reference order (a new field
 /// goes at the end: the value references of the others stay).
@@ -73,29 +91,48 @@ pub struct State {
     pub results: Results,
     /// `line_reaction` of the VTK film file.
     pub line_reaction: Vec<f64>,
+    /// The reaction lines of the model.
+    pub lines: Vec<ReactionLine>,
+    /// The film file's points (three per node).
+    pub points: Vec<f64>,
 }
 
 impl State {
     /// The state of `model` at `displacement` with `results`.
     pub fn new(model: &Model, displacement: Vec<f64>, results: Results) -> Self {
-        let line_reaction = line_reaction_field(model, &results);
+        let lines = reaction_lines(model).0;
         let nodes = model.nodes.len();
+        let line_reaction = line_reaction_field_of(nodes, &lines, &results);
+        let points = deformed(model, &displacement);
         Self {
             nodes,
             displacement,
             results,
             line_reaction,
+            lines,
+            points,
         }
     }
 }
 
+/// A reaction line as the arrays size it: name, what it is (`group`, `support set`), nodes,
+/// whether it is one chain of edges (has an arc length).
+#[derive(Clone, Debug)]
+struct Line {
+    name: String,
+    label: &'static str,
+    points: usize,
+    chain: bool,
+}
+
 /// The arrays of one FMU: where their value references start, and the sizes.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Arrays {
     base: u32,
     nodes: usize,
     gaps: usize,
     contacts: usize,
+    lines: Vec<Line>,
 }
 
 impl Arrays {
@@ -107,14 +144,36 @@ impl Arrays {
             nodes: d.model.nodes.len(),
             gaps: d.model.gaps.len(),
             contacts: d.model.curved_supports.iter().map(|s| s.nodes.len()).sum(),
+            lines: d
+                .reaction_lines
+                .iter()
+                .map(|l| Line {
+                    name: l.name.clone(),
+                    label: l.kind.label(),
+                    points: l.nodes.len(),
+                    chain: l.position.is_some(),
+                })
+                .collect(),
         }
     }
 
     /// The fields this FMU has, with their value references.
     pub fn fields(&self) -> impl Iterator<Item = (u32, Field)> + '_ {
-        (FIELDS.iter().zip(self.base..))
+        let fixed = (FIELDS.iter().zip(self.base..))
             .filter(|((f, ..), _)| self.count(f.sized_by()) != Some(0))
-            .map(|((f, ..), vr)| (vr, *f))
+            .map(|((f, ..), vr)| (vr, *f));
+        let first = self.base + FIELDS.len() as u32;
+        let lines = self.lines.iter().enumerate().flat_map(move |(k, l)| {
+            let vr = first + PER_LINE * k as u32;
+            let fields = [
+                Field::RailPoints(k),
+                Field::RailReaction(k),
+                Field::RailPosition(k),
+                Field::RailArc(k),
+            ];
+            (vr..).zip(fields).take(if l.chain { 4 } else { 3 })
+        });
+        fixed.chain(lines)
     }
 
     /// The field of value reference `vr`, if it is one of the arrays.
@@ -128,7 +187,58 @@ impl Arrays {
             Field::NodeCount => Some(self.nodes as u64),
             Field::GapCount => Some(self.gaps as u64),
             Field::ContactCount => Some(self.contacts as u64),
+            Field::RailPoints(k) => Some(self.lines[k].points as u64),
             _ => None,
+        }
+    }
+
+    /// Name, FMI 3.0 type, unit and description of `field`.
+    fn about(&self, field: Field) -> (String, &'static str, &'static str, String) {
+        let line = |k: usize| &self.lines[k];
+        let of = |k: usize| format!("{} '{}'", line(k).label, line(k).name);
+        match field {
+            Field::RailPoints(k) => (
+                format!("{}.linePoints", line(k).name),
+                "UInt64",
+                "",
+                format!(
+                    "number of nodes on the reaction line of {}: the rows of its lineReaction and \
+                     linePosition",
+                    of(k)
+                ),
+            ),
+            Field::RailReaction(k) => (
+                format!("{}.lineReaction", line(k).name),
+                "Float64",
+                "N/m",
+                format!(
+                    "reaction per unit length at each node along {} in order along the line (x, \
+                     y, z): the VTK film field 'line_reaction' there, its own share where lines meet",
+                    of(k)
+                ),
+            ),
+            Field::RailPosition(k) => (
+                format!("{}.linePosition", line(k).name),
+                "Float64",
+                "m",
+                format!(
+                    "position of each node along {} (x, y, z, deformed): the VTK film file's points",
+                    of(k)
+                ),
+            ),
+            Field::RailArc(k) => (
+                format!("{}.lineArc", line(k).name),
+                "Float64",
+                "m",
+                format!(
+                    "arc length of each node along {} from its first node (reference geometry)",
+                    of(k)
+                ),
+            ),
+            f => {
+                let (_, name, kind, unit, description) = FIELDS[f.fixed_index()];
+                (name.into(), kind, unit, description.into())
+            }
         }
     }
 
@@ -137,7 +247,7 @@ impl Arrays {
         let vr_of = |f: Field| self.fields().find(|(_, g)| *g == f).map(|(r, _)| r);
         let mut xml = String::new();
         for (vr, field) in self.fields() {
-            let (_, name, kind, unit, description) = FIELDS[field as usize];
+            let (name, kind, unit, description) = self.about(field);
             let head = format!(
                 "    <{kind} name=\"{name}\" valueReference=\"{vr}\" description=\"{description}\""
             );
@@ -153,8 +263,11 @@ impl Arrays {
                 u => format!(" unit=\"{u}\""),
             };
             let size = vr_of(field.sized_by()).expect("an array comes with its size");
-            let columns = match field.sized_by() {
-                Field::NodeCount => "\n      <Dimension start=\"3\"/>",
+            let columns = match field {
+                Field::RailReaction(_) | Field::RailPosition(_) => {
+                    "\n      <Dimension start=\"3\"/>"
+                }
+                _ if field.sized_by() == Field::NodeCount => "\n      <Dimension start=\"3\"/>",
                 _ => "",
             };
             let variability = if kind == "Int32" {
@@ -172,7 +285,7 @@ impl Arrays {
 
     /// The units of the fields this FMU has.
     pub fn units(&self) -> Vec<&'static str> {
-        let units = self.fields().map(|(_, f)| FIELDS[f as usize].3);
+        let units = self.fields().map(|(_, f)| self.about(f).2);
         units.filter(|u| !u.is_empty()).collect()
     }
 
@@ -191,7 +304,16 @@ impl Field {
             NodeCount | Displacement | Reaction | LineReaction => NodeCount,
             GapCount | GapSlipX | GapSlipY | GapNormalForce | GapStatus => GapCount,
             ContactCount | ContactSlip | ContactNormalForce | ContactStatus => ContactCount,
+            RailPoints(k) | RailReaction(k) | RailPosition(k) | RailArc(k) => RailPoints(k),
         }
+    }
+
+    /// The row of a field of the film in `FIELDS`.
+    fn fixed_index(self) -> usize {
+        FIELDS
+            .iter()
+            .position(|f| f.0 == self)
+            .expect("a field of the film")
     }
 
     /// The values of a Float64 field at a converged state, as the VTK writer takes them.
@@ -209,6 +331,14 @@ impl Field {
             Field::GapNormalForce => gaps.iter().map(|g| g.normal_force).collect(),
             Field::ContactSlip => contacts.iter().map(|c| c.slip).collect(),
             Field::ContactNormalForce => contacts.iter().map(|c| c.normal_force).collect(),
+            Field::RailReaction(k) => {
+                let reactions = state.lines.get(k)?.reactions(r);
+                reactions.iter().flat_map(|q| q.per_length).collect()
+            }
+            Field::RailPosition(k) => (state.lines.get(k)?.nodes.iter())
+                .flat_map(|&v| state.points[3 * v..3 * v + 3].to_vec())
+                .collect(),
+            Field::RailArc(k) => state.lines.get(k)?.position.clone()?,
             _ => return None,
         })
     }

@@ -14,8 +14,10 @@
 //! step returns `fmi3Discard` and keeps the last converged state, as in 2.0), FMU states and
 //! their serialization, `fmi3GetDirectionalDerivative` and `fmi3GetAdjointDerivative`, both made
 //! of J's columns (`fmi_glue::core::Columns`: the adjoint is the directional derivative's exact
-//! transpose, at one held solve per known; `docs/fmu.md` says why not one transpose solve), a
-//! terminal per boundary group ([`terminals`]). Checked against steps in `tests/derivatives.rs`.
+//! transpose, at one held solve per known), but for an adjoint of reactions and point
+//! displacements at a symmetric tangent, which is one solve (`Instance::adjoint_in_one_solve`;
+//! `docs/fmu.md` says when and why not for the other outputs), a terminal per boundary group
+//! ([`terminals`]). Checked against steps in `tests/derivatives.rs`.
 
 pub mod arrays;
 pub mod description;

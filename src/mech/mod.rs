@@ -26,5 +26,6 @@ pub use model::{Model, ModelError};
 pub use results::Results;
 pub use results::finite::check_results;
 pub use solve::{
-    Analysis, AnalysisState, Response, Seed, SettingNames, SolverSettings, StepError, StepReport,
+    Analysis, AnalysisState, OutputWeights, Response, Seed, SettingNames, SolverSettings,
+    StepError, StepReport,
 };

@@ -60,6 +60,8 @@ def test_fmi3_archives_pass_fmpy_validate_with_the_library_in_the_fmi3_folder(sp
 
 ARRAYS = ["film.nodeCount", "film.gapCount", "film.displacement", "film.reaction", "film.gapSlipX",
           "film.gapSlipY", "film.gapNormalForce", "film.gapStatus", "film.lineReaction"]
+# The specimen's one reaction line, its frame (issue 45: per-line arrays).
+LINES = ["frame.linePoints", "frame.lineReaction", "frame.linePosition", "frame.lineArc"]
 
 
 def test_fmi3_keeps_the_fmi2_variables_value_references_and_token_and_adds_the_arrays(fmu_path, specimen3):
@@ -71,8 +73,11 @@ def test_fmi3_keeps_the_fmi2_variables_value_references_and_token_and_adds_the_a
     n = len(d2.modelVariables)
     assert rows(d2, types.get) == rows(d3, str)[:n]
     extra = d3.modelVariables[n:]
-    assert [v.name for v in extra] == ARRAYS
-    assert [v.valueReference for v in extra] == list(range(n, n + len(ARRAYS)))
+    assert [v.name for v in extra] == ARRAYS + LINES
+    assert [v.valueReference for v in extra[:len(ARRAYS)]] == list(range(n, n + len(ARRAYS)))
+    # The frame's line arrays follow the references reserved for the 13 film fields (the
+    # contact arrays among them are absent: the specimen has no curved supports).
+    assert [v.valueReference for v in extra[len(ARRAYS):]] == list(range(n + 13, n + 17))
 
 
 @pytest.mark.parametrize("which", ["specimen", "user model"])
@@ -218,12 +223,20 @@ def test_fmi3_arrays_equal_the_vtk_fields_bit_for_bit(specimen3, tmp_path):
     # An array and a scalar in one call: their values one after the other.
     both = f.fmu.getFloat64([f.vr["frame.Rz"], f.vr["film.gapSlipX"]], 1 + gaps)
     assert both[1:] == list(gap["film.gapSlipX"]) and both[0] == f.fmu.getFloat64([f.vr["frame.Rz"]])[0]
+    # The frame's reaction line (issue 45): its nodes in order along it, found by their points.
+    (points,) = f.fmu.getUInt64([f.vr["frame.linePoints"]])
+    line_q = np.array(f.fmu.getFloat64([f.vr["frame.lineReaction"]], 3 * points)).reshape(points, 3)
+    line_x = np.array(f.fmu.getFloat64([f.vr["frame.linePosition"]], 3 * points)).reshape(points, 3)
     f.close()
     film = meshio.read(tmp_path / "ParallelArch_film_0003.vtu")
     lines = meshio.read(tmp_path / "ParallelArch_gaps_0003.vtu")
     assert np.array_equal(u, film.point_data["displacement"]) and np.abs(u).max() > 0
     assert np.array_equal(r, film.point_data["reaction"]) and np.abs(r).max() > 0
     assert np.array_equal(q, film.point_data["line_reaction"]) and np.abs(q).max() > 0
+    # The frame is the specimen's one line: its values are the field's at its nodes, bit for bit.
+    at = [int(np.flatnonzero((film.points == x).all(axis=1))[0]) for x in line_x]
+    assert len(set(at)) == points > 1
+    assert np.array_equal(line_q, film.point_data["line_reaction"][at]) and np.abs(line_q).max() > 0
     for name, field in [("film.gapSlipX", "gap_slip_x"), ("film.gapSlipY", "gap_slip_y"),
                         ("film.gapNormalForce", "gap_normal_force")]:
         assert np.array_equal(gap[name], lines.cell_data[field][0]), name

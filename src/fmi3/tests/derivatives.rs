@@ -500,3 +500,53 @@ fn fmi3_derivatives_on_curved_supports_match_one_sided_differences_and_are_trans
         "no switch met"
     );
 }
+
+/// The one-solve adjoint through `fmi3GetAdjointDerivative` (issue 45 item 1), the specimen on
+/// gaps under the isotropic law, at the end of the step checked: at μ = 9.9 (every closed gap
+/// sticks: a symmetric tangent) `Jᵀ v` of the frame's reactions and the total reaction (the
+/// symmetry supports' too) over the six inputs is **one**
+/// solve with the held tangent; at μ = 0.2 (G1, G2 slip) it is J's columns, a solve per input.
+/// Both equal `vᵀ` times the columns of `fmi3GetDirectionalDerivative` (unit seeds): to 1e-6 of
+/// the largest for the one solve (a contraction of residuals against differences of results),
+/// exactly for the columns.
+#[test]
+fn fmi3_adjoint_of_reactions_is_one_solve_at_a_symmetric_tangent() {
+    for (mu, solves, tolerance) in [(9.9, 1, 1e-6), (0.2, SEEDS.len(), 0.0)] {
+        let case = Case {
+            law: FrictionLaw::Isotropic,
+            contact: SpecimenContact::Gaps,
+            mu,
+            all_stick: mu > 1.0,
+            tolerance,
+        };
+        let model = every_input_specimen(case.law, case.contact);
+        let u = Unpacked::new(&format!("one solve {mu}"), Source::Model(model));
+        let log = Log::default();
+        let fmu = lowered(&case, &u, &log);
+        assert_eq!(fmu.set("frame.dz", -0.06), 0);
+        assert!(fmu.step(11.0, 1.0) <= 1, "{:?}", log.take());
+        let unknowns = ["frame.Rx", "frame.Ry", "frame.Rz", "reactions.Rz"];
+        let knowns: Vec<&str> = SEEDS.iter().map(|s| s.0).collect();
+        let v = [0.3, -0.7, 1.1, -0.4];
+        let before = fmu.tangent_solves();
+        let (status, jtv) = fmu.adjoint(&unknowns, &knowns, &v);
+        assert!(status <= 1, "{status}: {:?}", log.take());
+        assert_eq!(fmu.tangent_solves() - before, solves, "μ = {mu}");
+        let columns: Vec<f64> = knowns
+            .iter()
+            .map(|k| {
+                let (status, column) = fmu.directional(&unknowns, &[k], &[1.0]);
+                assert!(status <= 1, "{status}: {:?}", log.take());
+                column.iter().zip(&v).map(|(c, v)| c * v).sum()
+            })
+            .collect();
+        let largest = columns.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        assert!(largest > 0.0);
+        let worst = jtv
+            .iter()
+            .zip(&columns)
+            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest));
+        eprintln!("μ = {mu}: adjoint vs columns {worst:e} of the largest, {solves} solves");
+        assert!(worst <= case.tolerance, "μ = {mu}: {jtv:?} vs {columns:?}");
+    }
+}

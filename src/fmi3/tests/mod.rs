@@ -8,6 +8,7 @@
 //! returned, and pointers to live locals or slices holding the announced number of elements.
 
 mod derivatives;
+mod lines;
 
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 use std::path::PathBuf;
@@ -105,6 +106,16 @@ impl<'a> Fmu3<'a> {
         floats: &[(&str, f64)],
         ints: &[(&str, i32)],
     ) -> Self {
+        Self::initialized_with(u, log, (floats, ints), &[])
+    }
+
+    /// [`Fmu3::initialized`] with String parameters too.
+    fn initialized_with(
+        u: &'a Unpacked,
+        log: &'a Log,
+        (floats, ints): (&[(&str, f64)], &[(&str, i32)]),
+        strings: &[(&str, &str)],
+    ) -> Self {
         let c = unsafe {
             instantiate_co_simulation(
                 c"film".as_ptr(),
@@ -129,6 +140,11 @@ impl<'a> Fmu3<'a> {
         );
         for &(n, v) in floats {
             assert_eq!(fmu.set(n, v), 0, "{n}: {:?}", log.take());
+        }
+        for &(n, v) in strings {
+            let v = CString::new(v).unwrap();
+            let status = unsafe { set_string(c, &u.vr(n), 1, &v.as_ptr(), 1) };
+            assert_eq!(status, 0, "{n}: {:?}", log.take());
         }
         for &(n, v) in ints {
             let status = unsafe { set_int32(c, &u.vr(n), 1, &v, 1) };
@@ -187,6 +203,14 @@ impl<'a> Fmu3<'a> {
 
     fn free(&self, mut s: *mut c_void) {
         assert_eq!(unsafe { free_fmu_state(self.c, &mut s) }, 0);
+    }
+
+    /// Solves with the held tangent so far (`Analysis::tangent_solves`).
+    fn tangent_solves(&self) -> usize {
+        // SAFETY: `c` is the glue's `Box<Instance>` (`fmi_glue::fmi2::instantiate_with`:
+        // `Box::into_raw`), freed only in `Drop`; nothing else uses it during this read.
+        let instance = unsafe { &*self.c.cast::<crate::fmi2::instance::Instance>() };
+        instance.tangent_solves()
     }
 
     /// `fmi3GetDirectionalDerivative`: status and `J seed` (a seed per known).

@@ -311,8 +311,18 @@ pub fn film_grid(
 /// Reaction per unit length of each node (N/m, three per node): its line reaction along the
 /// boundary groups and support sets it belongs to ([`crate::mech::results::lines`]), summed; 0 elsewhere.
 pub fn line_reaction_field(model: &Model, results: &Results) -> Vec<f64> {
-    let mut field = vec![0.0; 3 * model.nodes.len()];
-    for line in crate::mech::results::lines::reaction_lines(model).0 {
+    let lines = crate::mech::results::lines::reaction_lines(model).0;
+    line_reaction_field_of(model.nodes.len(), &lines, results)
+}
+
+/// [`line_reaction_field`] of a model of `nodes` nodes whose reaction lines are `lines`.
+pub fn line_reaction_field_of(
+    nodes: usize,
+    lines: &[crate::mech::results::lines::ReactionLine],
+    results: &Results,
+) -> Vec<f64> {
+    let mut field = vec![0.0; 3 * nodes];
+    for line in lines {
         for r in line.reactions(results) {
             for (c, q) in r.per_length.iter().enumerate() {
                 field[3 * r.node + c] += q;
@@ -386,8 +396,8 @@ pub fn principal_strain(strain: [f64; 3]) -> [f64; 2] {
     [centre + radius, centre - radius]
 }
 
-/// Deformed node positions, three per node.
-fn deformed(model: &Model, displacement: &[f64]) -> Vec<f64> {
+/// The film's node positions `x + u` (three per node), the film file's points.
+pub fn deformed(model: &Model, displacement: &[f64]) -> Vec<f64> {
     model
         .nodes
         .iter()

@@ -42,6 +42,8 @@ pub struct Analysis {
     pub(in crate::mech) increment_start: Option<AnalysisState>,
     /// The factorized tangent of the derivatives, held between seeds (`sensitivity`).
     pub(in crate::mech) held_tangent: Option<Box<HeldTangent>>,
+    /// Solves with the held tangent so far (`Analysis::tangent_solves`).
+    pub(in crate::mech) tangent_solves: usize,
 
     /// Bounding-box diagonal `L` of the model (m): the length scale of the tolerances and of
     /// the input check.
@@ -134,6 +136,7 @@ impl Analysis {
             work,
             increment_start: None,
             held_tangent: None,
+            tangent_solves: 0,
             length_scale,
             force_floor,
             observer: IncrementObserver::default(),

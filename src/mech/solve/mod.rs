@@ -41,6 +41,6 @@ pub use report::{
     Attempt, DISSIPATION_BOUND, IncrementFailure, IterationRecord, STABILIZATION_BOUND,
     SettingNames, SetupError, StepError, StepReport,
 };
-pub use sensitivity::{Response, Seed};
+pub use sensitivity::{OutputWeights, Response, Seed};
 pub use settings::{DEFAULT_INCREMENTS_PER_STEP, MAX_THREADS, SolverSettings};
 pub use state::AnalysisState;

@@ -56,8 +56,24 @@
 //!   converged point, kept;
 //! * after [`Analysis::set_state`] (an FMU state restored) and before the next step, the start
 //!   is the restored state itself: the linear response of the next increment.
+//!
+//! **One-solve adjoint** ([`Analysis::adjoint_response`], issue 45): `vᵀ J` over any number of
+//! inputs for outputs whose gradient with respect to the displacements is known without
+//! differences: a reaction (a group's, a support set's, the total: a sum of the residual's
+//! restrained rows r, `∂R/∂u_f = K_rf`) and an output point's displacement (a unit row). With `y` those outputs and `g` the residual,
+//! `vᵀ dy/dq = vᵀ ∂y/∂q − λᵀ ∂g_f/∂q`, `K_ffᵀ λ = (∂y/∂u_f)ᵀ v`: one solve for λ, then per
+//! input the residual's derivative above (two residual assemblies for a group's motion, the
+//! loads' residual for a load, the contacts' for μ) contracted with λ and with the reactions'
+//! weights. The factor held is that of `K`, so the solve is `Kᵀ`'s only for a symmetric tangent:
+//! the adjoint checks the held values (`|K_ij − K_ji| ≤ 1e-10 max |K|`) and refuses a follower
+//! pressure that acts (its load stiffness is unsymmetric); a sliding contact makes the tangent
+//! unsymmetric and is refused so. `(K_rf)ᵀ v` is then `K_fr v`: the residual's derivative along
+//! the restrained DOFs moved by the reactions' weights (a central difference, free DOFs held). The
+//! values agree with J's columns to the differences' accuracy (1e-6 in the test), not to the
+//! last bit: the columns are a difference of results along each response, the adjoint a
+//! contraction of residuals.
 
-use crate::mech::elements::gap::IterationMatrix;
+use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::{ExternalLoad, LoadLevels};
 use crate::mech::results::Results;
 use crate::mech::solve::analysis::Analysis;
@@ -118,6 +134,35 @@ impl Seed {
     }
 }
 
+/// The weights `v` of the outputs a one-solve adjoint ([`Analysis::adjoint_response`])
+/// contracts: the outputs whose gradient with respect to the displacements the analysis has
+/// without differences (a reaction: a sum of the residual's restrained rows; a point's
+/// displacement: a unit row).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OutputWeights {
+    /// Per group: the weight of its reaction along x, y, z (prescribed components; others
+    /// ignored).
+    pub reactions: Vec<[f64; 3]>,
+    /// Per named support set: the weight of its reaction along x, y, z (fixed components).
+    pub supports: Vec<[f64; 3]>,
+    /// The weight of the total reaction (every restraint) along x, y, z.
+    pub total: [f64; 3],
+    /// Per output point: the weight of its displacement along x, y, z.
+    pub points: Vec<[f64; 3]>,
+}
+
+impl OutputWeights {
+    /// No weight, for `analysis`'s model.
+    pub fn zero(analysis: &Analysis) -> Self {
+        OutputWeights {
+            reactions: vec![[0.0; 3]; analysis.state().boundary.len()],
+            supports: vec![[0.0; 3]; analysis.model().support_sets().len()],
+            total: [0.0; 3],
+            points: vec![[0.0; 3]; analysis.model().outputs.points.len()],
+        }
+    }
+}
+
 /// The results at the converged state moved by `−2ε, −ε, ε, 2ε` along its linear response
 /// to a seed: the derivative of any result is their fourth-order central difference.
 #[derive(Clone, Debug)]
@@ -140,6 +185,41 @@ impl Analysis {
     /// The linear response of the converged state to `seed` (module doc). Errors: a seed of
     /// the wrong size, the Ju–Rowlands matrix (not the tangent), a singular tangent.
     pub fn linear_response(&mut self, seed: &Seed) -> Result<Response, String> {
+        let (start, end) = self.derivative_states(seed)?;
+        let Some(largest) = self.seed_scale(&end, seed)? else {
+            let r = self.results();
+            return Ok(Response {
+                points: [r.clone(), r.clone(), r.clone(), r],
+                epsilon: 1.0,
+            });
+        };
+        // ε: a relative change of 1e-6 of the largest seeded quantity.
+        let eps = 1e-6 / largest;
+        let (mut du, dg) = self.seed_residual(&start, &end, seed, eps);
+        let mut rhs = vec![0.0; self.system.free_count];
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Free(f) = *d {
+                rhs[f] = -dg[i];
+            }
+        }
+        if !rhs.is_empty() {
+            self.solve_with_tangent(&start, &end, &mut rhs)
+                .map_err(|e| format!("the tangent at the converged state: {}", e.0))?;
+        }
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Free(f) = *d {
+                du[i] = rhs[f];
+            }
+        }
+        let (points, epsilon) = self.response_points(&start, &end, seed, (eps, largest), &du);
+        self.state = end;
+        Ok(Response { points, epsilon })
+    }
+
+    /// The increment's start and the converged state a seed's derivatives are taken at, once
+    /// the analysis and the seed allow them (the consistent tangent, no gas chambers, a seed of
+    /// the model's sizes).
+    fn derivative_states(&self, seed: &Seed) -> Result<(AnalysisState, AnalysisState), String> {
         if self.settings.iteration_matrix != IterationMatrix::Consistent {
             return Err(
                 "derivatives need the consistent tangent (solver.useJuRowlands = false)".into(),
@@ -161,7 +241,12 @@ impl Analysis {
             return Err("the seed does not fit the model's groups and load sets".into());
         }
         let start = self.increment_start.clone().unwrap_or_else(|| end.clone());
-        // ε: a relative change of 1e-6 of the largest seeded quantity.
+        Ok((start, end))
+    }
+
+    /// The largest seeded quantity, each relative to its input's value (at least its floor);
+    /// None for a zero seed.
+    fn seed_scale(&self, end: &AnalysisState, seed: &Seed) -> Result<Option<f64>, String> {
         let relative = |d: f64, x: f64, floor: f64| d.abs() / x.abs().max(floor);
         let l = self.length_scale;
         let mut largest = relative(
@@ -192,55 +277,20 @@ impl Analysis {
         if !largest.is_finite() {
             return Err("the seed holds values that are not finite".into());
         }
-        if largest == 0.0 {
-            let r = self.results();
-            return Ok(Response {
-                points: [r.clone(), r.clone(), r.clone(), r],
-                epsilon: 1.0,
-            });
-        }
-        let eps = 1e-6 / largest;
-        let moved = |sign: f64| -> Moved {
-            let s = sign * eps;
-            let motion = GroupMotion {
-                translation: end
-                    .boundary
-                    .iter()
-                    .zip(&seed.translation)
-                    .map(|(b, t)| std::array::from_fn(|c| b[c] + s * t[c]))
-                    .collect(),
-                angles: end
-                    .angles
-                    .iter()
-                    .zip(&seed.angles)
-                    .map(|(a, d)| a + s * d)
-                    .collect(),
-            };
-            let levels = LoadLevels {
-                pressure: end
-                    .loads
-                    .pressure
-                    .iter()
-                    .zip(&seed.pressure)
-                    .map(|(p, d)| p + s * d)
-                    .collect(),
-                force: end
-                    .loads
-                    .force
-                    .iter()
-                    .zip(&seed.force)
-                    .map(|(f, d)| std::array::from_fn(|c| f[c] + s * d[c]))
-                    .collect(),
-                gravity: end.loads.gravity,
-                chambers: end.loads.chambers.clone(),
-                heating: end.loads.heating.clone(),
-                air: end.loads.air.clone(),
-                time: end.loads.time,
-            };
-            (motion, levels, s * seed.friction)
-        };
-        // Prescribed values along the seed.
-        let (plus, minus) = (moved(1.0), moved(-1.0));
+        Ok((largest != 0.0).then_some(largest))
+    }
+
+    /// The prescribed DOFs' motion along `seed` (0 at free DOFs) and `∂g/∂(p, λ, μ) · seed`
+    /// over every DOF, free DOFs held, by kind of input (module doc), differences of step
+    /// `eps`.
+    fn seed_residual(
+        &mut self,
+        start: &AnalysisState,
+        end: &AnalysisState,
+        seed: &Seed,
+        eps: f64,
+    ) -> (Vec<f64>, Vec<f64>) {
+        let (plus, minus) = (moved(end, seed, eps), moved(end, seed, -eps));
         let mut du = vec![0.0; end.displacement.len()];
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Prescribed { group, component } = *d {
@@ -249,18 +299,14 @@ impl Analysis {
                     / (2.0 * eps);
             }
         }
-        let along = |u: &[f64], d: &[f64], s: f64| -> Vec<f64> {
-            u.iter().zip(d).map(|(a, b)| a + s * b).collect()
-        };
-        // ∂g/∂(p, λ, μ) · seed over every DOF, free DOFs held: by kind of input.
         let mut dg = vec![0.0; end.displacement.len()];
         if du.iter().any(|&d| d != 0.0) {
             // Group motion: central difference of the whole residual (module doc: why).
             let held = |m: Moved| (m.0, end.loads.clone(), 0.0);
             let (_, g_plus) =
-                self.results_from(&start, along(&end.displacement, &du, eps), &held(plus));
+                self.results_from(start, along(&end.displacement, &du, eps), &held(plus));
             let (_, g_minus) =
-                self.results_from(&start, along(&end.displacement, &du, -eps), &held(minus));
+                self.results_from(start, along(&end.displacement, &du, -eps), &held(minus));
             for ((d, p), m) in dg.iter_mut().zip(&g_plus).zip(&g_minus) {
                 *d += (p - m) / (2.0 * eps);
             }
@@ -283,23 +329,20 @@ impl Analysis {
                 .add_to(&self.system, &levels, &end.displacement, &mut dg, None);
         }
         if seed.friction != 0.0 {
-            self.add_friction_derivative(&start, &end, eps * seed.friction, &mut dg, 1.0 / eps);
+            self.add_friction_derivative(start, end, eps * seed.friction, &mut dg, 1.0 / eps);
         }
-        let mut rhs = vec![0.0; self.system.free_count];
-        for (i, d) in self.system.dofs.iter().enumerate() {
-            if let Dof::Free(f) = *d {
-                rhs[f] = -dg[i];
-            }
-        }
-        if !rhs.is_empty() {
-            self.solve_with_tangent(&start, &end, &mut rhs)
-                .map_err(|e| format!("the tangent at the converged state: {}", e.0))?;
-        }
-        for (i, d) in self.system.dofs.iter().enumerate() {
-            if let Dof::Free(f) = *d {
-                du[i] = rhs[f];
-            }
-        }
+        (du, dg)
+    }
+
+    /// The results at `−2h, −h, h, 2h` along the response `du` (every DOF) to `seed`, and `h`.
+    fn response_points(
+        &mut self,
+        start: &AnalysisState,
+        end: &AnalysisState,
+        seed: &Seed,
+        (eps, largest): (f64, f64),
+        du: &[f64],
+    ) -> ([Results; 4], f64) {
         // The outputs move along (du, seed) by a step of their own, at least ε: with ε alone, a
         // response that is small against the displacements themselves (the normal
         // displacement of a gap under a μ seed: 1e-14 m against 0.1 m) is lost to the
@@ -310,20 +353,207 @@ impl Analysis {
         // turns over the slip) below 1e-6 at that step.
         let du_max = du.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         let eps_out = if du_max > 0.0 {
-            (OUTPUT_STEP * l / du_max).min(1e-3 / largest).max(eps)
+            (OUTPUT_STEP * self.length_scale / du_max)
+                .min(1e-3 / largest)
+                .max(eps)
         } else {
             eps
         };
         let points = [-2.0, -1.0, 1.0, 2.0].map(|k: f64| {
-            let at = moved(k * eps_out / eps);
-            self.results_from(&start, along(&end.displacement, &du, k * eps_out), &at)
+            // The inputs' step as the seed's sign times ε, rounded as before the split.
+            let at = moved(end, seed, (k * eps_out / eps) * eps);
+            self.results_from(start, along(&end.displacement, du, k * eps_out), &at)
                 .0
         });
+        (points, eps_out)
+    }
+
+    /// `Jᵀ v` over `seeds` (one value per seed: `vᵀ J seed`), `v` the weights of the group
+    /// reactions and output points' displacements, J the derivatives
+    /// [`Analysis::linear_response`] gives, at the cost of **one** solve with the held
+    /// tangent (module doc, "One-solve adjoint"). Errors: those of
+    /// [`Analysis::linear_response`], weights of the wrong size, and a tangent that is not
+    /// symmetric (a contact slides, a follower pressure acts): there `Kᵀ` is not the factor
+    /// held and the caller takes J's columns instead.
+    pub fn adjoint_response(
+        &mut self,
+        weights: &OutputWeights,
+        seeds: &[Seed],
+    ) -> Result<Vec<f64>, String> {
+        let zero = Seed::zero(self);
+        let (start, end) = self.derivative_states(&zero)?;
+        if weights.reactions.len() != end.boundary.len()
+            || weights.supports.len() != self.model.support_sets().len()
+            || weights.points.len() != self.model.outputs.points.len()
+        {
+            return Err("the weights do not fit the model's groups and output points".into());
+        }
+        if let Some(p) = end.loads.pressure.iter().find(|p| **p != 0.0) {
+            return Err(format!(
+                "a follower pressure acts ({p} Pa): its load stiffness is not symmetric"
+            ));
+        }
+        // A sliding contact makes the tangent unsymmetric: refused before the solve (the held
+        // values are checked after it all the same).
+        let results = self.results();
+        let slides = |s: GapStatus| s == GapStatus::Slip;
+        if results.gaps.iter().any(|g| slides(g.status))
+            || results.surface_contacts.iter().any(|c| slides(c.status))
+            || results.layer_contacts.iter().any(|c| slides(c.status))
+        {
+            return Err("a contact slides: the tangent is not symmetric".into());
+        }
+        // w = Cᵀ v over the free DOFs: a reaction's row of C is K_rf (r: its restrained DOFs),
+        // whose transpose is K_fr for a symmetric tangent, so its part is the residual's
+        // derivative along the restrained DOFs moved by the reactions' weights; a point's is
+        // its free DOFs.
+        let restrained = self.restrained_weights(weights);
+        let mut w = vec![0.0; self.system.free_count];
+        if restrained.iter().any(|&x| x != 0.0) {
+            let dg = self.restrained_residual(&start, &end, &restrained);
+            for (i, d) in self.system.dofs.iter().enumerate() {
+                if let Dof::Free(f) = *d {
+                    w[f] = dg[i];
+                }
+            }
+        }
+        for (point, weight) in self.model.outputs.points.iter().zip(&weights.points) {
+            for (c, x) in weight.iter().enumerate() {
+                if let Dof::Free(f) = self.system.dofs[3 * point.node + c] {
+                    w[f] += x;
+                }
+            }
+        }
+        // λ = K⁻ᵀ w: the one solve, with the factor of K = Kᵀ.
+        let mut lambda = w;
+        if lambda.iter().any(|&x| x != 0.0) {
+            self.solve_with_tangent(&start, &end, &mut lambda)
+                .map_err(|e| format!("the tangent at the converged state: {}", e.0))?;
+            self.held_tangent_symmetric()?;
+        }
+        let values = seeds
+            .iter()
+            .map(|seed| self.adjoint_entry((&start, &end), (weights, &restrained), &lambda, seed))
+            .collect();
         self.state = end;
-        Ok(Response {
-            points,
-            epsilon: eps_out,
-        })
+        values
+    }
+
+    /// `vᵀ J seed = vᵀ (∂y/∂q seed) − λᵀ ∂g_f/∂q seed`: the outputs' direct dependence on the
+    /// inputs (a reaction's residual rows, a prescribed point's motion) less the free
+    /// residual's derivative contracted with the adjoint `λ`.
+    fn adjoint_entry(
+        &mut self,
+        (start, end): (&AnalysisState, &AnalysisState),
+        (weights, restrained): (&OutputWeights, &[f64]),
+        lambda: &[f64],
+        seed: &Seed,
+    ) -> Result<f64, String> {
+        self.derivative_states(seed)?;
+        let Some(largest) = self.seed_scale(end, seed)? else {
+            return Ok(0.0);
+        };
+        let (du, dg) = self.seed_residual(start, end, seed, 1e-6 / largest);
+        let mut value = 0.0;
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            match *d {
+                Dof::Free(f) => value -= lambda[f] * dg[i],
+                _ => value += restrained[i] * dg[i],
+            }
+        }
+        for (point, weight) in self.model.outputs.points.iter().zip(&weights.points) {
+            for (c, x) in weight.iter().enumerate() {
+                value += x * du[3 * point.node + c];
+            }
+        }
+        Ok(value)
+    }
+
+    /// The reactions' weights on every DOF (0 at free ones): a reaction is the sum of the
+    /// residual's rows it gathers (`Analysis::results`), so its weight goes to each of them.
+    fn restrained_weights(&self, weights: &OutputWeights) -> Vec<f64> {
+        let mut on = vec![0.0; self.system.dofs.len()];
+        for (i, d) in self.system.dofs.iter().enumerate() {
+            if let Dof::Prescribed { group, component } = *d {
+                on[i] += weights.reactions[group][component];
+            }
+            if !matches!(d, Dof::Free(_)) {
+                on[i] += weights.total[i % 3];
+            }
+        }
+        let sets = self.model.support_sets();
+        for s in &self.model.supports {
+            let Some(set) = s
+                .name
+                .as_ref()
+                .and_then(|n| sets.iter().position(|m| m == n))
+            else {
+                continue;
+            };
+            for a in &s.fixed {
+                on[3 * s.node + a.index()] += weights.supports[set][a.index()];
+            }
+        }
+        on
+    }
+
+    /// The central difference of the residual of every DOF along the restrained DOFs moved by
+    /// `restrained` (free DOFs, group motion and loads held): `K_·r · restrained`, with a step
+    /// that moves the largest by 1e-6 of the model's size.
+    fn restrained_residual(
+        &mut self,
+        start: &AnalysisState,
+        end: &AnalysisState,
+        restrained: &[f64],
+    ) -> Vec<f64> {
+        let largest = restrained.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let eps = 1e-6 * self.length_scale / largest;
+        let held = || {
+            let motion = GroupMotion {
+                translation: end.boundary.clone(),
+                angles: end.angles.clone(),
+            };
+            (motion, end.loads.clone(), 0.0)
+        };
+        let (_, plus) =
+            self.results_from(start, along(&end.displacement, restrained, eps), &held());
+        let (_, minus) =
+            self.results_from(start, along(&end.displacement, restrained, -eps), &held());
+        plus.iter()
+            .zip(&minus)
+            .map(|(p, m)| (p - m) / (2.0 * eps))
+            .collect()
+    }
+
+    /// Ok when the held tangent is symmetric to rounding (`|K_ij − K_ji| ≤ 1e-10 max |K|`),
+    /// so that its factor solves with `Kᵀ` too; else the error names the largest asymmetry.
+    fn held_tangent_symmetric(&self) -> Result<(), String> {
+        let Some(held) = self.held_tangent.as_deref() else {
+            return Err("no tangent held".into());
+        };
+        let m = self.system.matrix(&held.values);
+        let largest = held.values.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let mut worst = 0.0_f64;
+        for j in 0..m.ncols() {
+            for (&i, &v) in m.row_idx_of_col_raw(j).iter().zip(m.val_of_col(j)) {
+                let t = m.get(j, i).copied().unwrap_or(0.0);
+                worst = worst.max((v - t).abs());
+            }
+        }
+        if worst <= 1e-10 * largest {
+            Ok(())
+        } else {
+            Err(format!(
+                "the tangent is not symmetric (|K_ij − K_ji| up to {worst:e} of {largest:e}: a \
+                 contact slides): its transpose is not the factor held"
+            ))
+        }
+    }
+
+    /// Solves with the consistent tangent at the converged state since the analysis was built
+    /// (the derivatives' solves: the one of an adjoint, one per seed of a linear response).
+    pub fn tangent_solves(&self) -> usize {
+        self.tangent_solves
     }
 
     /// Adds `scale · (g(μ + δ) − g(μ − δ))/2` to `dg`: the central difference of the residual
@@ -367,6 +597,7 @@ impl Analysis {
         end: &AnalysisState,
         rhs: &mut [f64],
     ) -> Result<(), FactorizationError> {
+        self.tangent_solves += 1;
         if let Some(held) = self.held_tangent.as_deref_mut()
             && held.factor != 0
             && held.factor == self.linear.factor_id()
@@ -443,6 +674,51 @@ impl Analysis {
         let internal = internal.unwrap_or_else(|| self.work.internal.clone());
         (results, internal)
     }
+}
+
+/// The end values of a step's inputs moved by `s` along `seed`.
+fn moved(end: &AnalysisState, seed: &Seed, s: f64) -> Moved {
+    let motion = GroupMotion {
+        translation: end
+            .boundary
+            .iter()
+            .zip(&seed.translation)
+            .map(|(b, t)| std::array::from_fn(|c| b[c] + s * t[c]))
+            .collect(),
+        angles: end
+            .angles
+            .iter()
+            .zip(&seed.angles)
+            .map(|(a, d)| a + s * d)
+            .collect(),
+    };
+    let levels = LoadLevels {
+        pressure: end
+            .loads
+            .pressure
+            .iter()
+            .zip(&seed.pressure)
+            .map(|(p, d)| p + s * d)
+            .collect(),
+        force: end
+            .loads
+            .force
+            .iter()
+            .zip(&seed.force)
+            .map(|(f, d)| std::array::from_fn(|c| f[c] + s * d[c]))
+            .collect(),
+        gravity: end.loads.gravity,
+        chambers: end.loads.chambers.clone(),
+        heating: end.loads.heating.clone(),
+        air: end.loads.air.clone(),
+        time: end.loads.time,
+    };
+    (motion, levels, s * seed.friction)
+}
+
+/// `u + s d`.
+fn along(u: &[f64], d: &[f64], s: f64) -> Vec<f64> {
+    u.iter().zip(d).map(|(a, b)| a + s * b).collect()
 }
 
 /// `start` with the friction coefficients of `end` (gaps and curved-support contacts, each its
@@ -578,6 +854,179 @@ mod tests {
         let raised = a.linear_response(&mu(&a)).unwrap();
         assert_eq!(raised.points, c.linear_response(&mu(&c)).unwrap().points);
         assert_ne!(derivatives(&raised), derivatives(&restored));
+    }
+
+    /// The one-solve adjoint (issue 45 item 1). TEST GOAL: `vᵀ J` over many inputs (every
+    /// group's three translations and μ) costs one solve with the held tangent, and equals
+    /// `vᵀ` times J's columns (one linear response per input) to their differences' accuracy.
+    /// MODEL: the specimen's frame lowered by 5 mm per step with μ = 0.2, then two steps with
+    /// μ = 9.9 (the closed gaps stick: a symmetric tangent; as in `src/fmi3/tests`), two output
+    /// points: a free film node and a frame node (whose displacement is the input's own).
+    /// Weights: pseudo-random on every group's reactions, the total reaction (the symmetry
+    /// supports' too) and both points.
+    #[test]
+    fn an_adjoint_over_many_inputs_is_one_solve_and_the_columns_transpose() {
+        let spec = ParallelArch::default();
+        let mut model = spec.model().unwrap();
+        let frame_node = (0..model.nodes.len())
+            .find(|&n| model.groups.iter().any(|g| g.nodes.contains(&n)))
+            .unwrap();
+        let free_node = (0..model.nodes.len())
+            .find(|&n| {
+                model.groups.iter().all(|g| !g.nodes.contains(&n))
+                    && model.supports.iter().all(|s| s.node != n)
+            })
+            .unwrap();
+        for (name, node) in [("free", free_node), ("edge", frame_node)] {
+            let name = name.to_string();
+            model
+                .outputs
+                .points
+                .push(crate::mech::model::OutputPoint { name, node });
+        }
+        let targets: Vec<_> = (1..=12)
+            .map(|k| spec.boundary_targets(&model, k as f64 / 30.0))
+            .collect();
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        a.set_friction(0.2).unwrap();
+        for (k, t) in targets.iter().enumerate() {
+            if k == 10 {
+                a.set_friction(9.9).unwrap();
+            }
+            a.step_to(t, 1).unwrap();
+        }
+        assert!(a.results().gaps.iter().all(|g| g.status != GapStatus::Slip));
+        let mut weights = OutputWeights::zero(&a);
+        let mut x = 0.37_f64;
+        let mut next = || {
+            x = (x * 997.0 + 0.13).fract();
+            2.0 * x - 1.0
+        };
+        for w in (weights.reactions.iter_mut())
+            .chain(&mut weights.supports)
+            .chain(&mut weights.points)
+            .chain([&mut weights.total])
+        {
+            *w = [next(), next(), next()];
+        }
+        let mut seeds = vec![mu(&a)];
+        for g in 0..weights.reactions.len() {
+            for c in 0..3 {
+                let mut s = Seed::zero(&a);
+                s.translation[g][c] = 1.0;
+                seeds.push(s);
+            }
+        }
+        let before = a.tangent_solves();
+        let adjoint = a.adjoint_response(&weights, &seeds).unwrap();
+        assert_eq!(a.tangent_solves(), before + 1, "{} inputs", seeds.len());
+        let prescribed = |a: &Analysis, g: usize, c: usize| {
+            a.system
+                .dofs
+                .iter()
+                .any(|d| matches!(*d, Dof::Prescribed { group, component } if (group, component) == (g, c)))
+        };
+        let mut largest = 0.0_f64;
+        let mut columns = vec![];
+        for s in &seeds {
+            let r = a.linear_response(s).unwrap();
+            let mut v = 0.0;
+            for (g, w) in weights.reactions.iter().enumerate() {
+                for c in (0..3).filter(|&c| prescribed(&a, g, c)) {
+                    v += w[c] * r.derivative(|x| x.reactions[g][c]);
+                }
+            }
+            for (p, w) in weights.points.iter().enumerate() {
+                for c in 0..3 {
+                    v += w[c] * r.derivative(|x| x.points[p][c]);
+                }
+            }
+            for (set, w) in weights.supports.iter().enumerate() {
+                for c in 0..3 {
+                    v += w[c] * r.derivative(|x| x.support_reactions[set][c]);
+                }
+            }
+            for c in 0..3 {
+                v += weights.total[c] * r.derivative(|x| x.total_reaction[c]);
+            }
+            largest = largest.max(v.abs());
+            columns.push(v);
+        }
+        assert!(largest > 0.0);
+        let worst = adjoint
+            .iter()
+            .zip(&columns)
+            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest));
+        eprintln!(
+            "{} inputs: adjoint vs columns {worst:e} of the largest",
+            seeds.len()
+        );
+        for (k, (adj, col)) in adjoint.iter().zip(&columns).enumerate() {
+            assert!(
+                (adj - col).abs() <= 1e-6 * largest,
+                "input {k}: adjoint {adj} vs columns {col} (largest {largest})"
+            );
+        }
+        // A slipping contact: not the factor's transpose, refused (the FMU takes the columns).
+        let (mut b, _) = lowered(3);
+        if b.results().gaps.iter().any(|g| g.status == GapStatus::Slip) {
+            let weights = OutputWeights::zero(&b);
+            let mut w = weights.clone();
+            w.reactions[0][2] = 1.0;
+            assert!(b.adjoint_response(&w, &[dz(&b)]).is_err());
+        }
+    }
+
+    /// The one-solve adjoint of a support set's and a hinged group's reactions (issue 45).
+    /// MODEL: `examples/hinged_panel.json` (the hinged group `rail`, the support set `frame`, no
+    /// contacts: a symmetric tangent), `rail.dz` to −5 mm and `rail.angle` to 0.01 rad in one
+    /// step. TEST GOAL: `vᵀ J` of the rail's, the frame's and the total reactions over the rail's
+    /// translations and angle is one solve, and `vᵀ` times J's columns to 1e-6.
+    #[test]
+    fn an_adjoint_of_support_set_and_hinged_group_reactions_is_one_solve() {
+        let model = Model::from_json(include_str!("../../../examples/hinged_panel.json")).unwrap();
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        let loads = a.state().loads.clone();
+        a.step_to_motion(&[[0.0, 0.0, -0.005]], &[0.01], &loads, 2)
+            .unwrap();
+        let mut weights = OutputWeights::zero(&a);
+        assert_eq!(weights.supports.len(), 1);
+        weights.reactions[0] = [0.4, -0.9, 1.3];
+        weights.supports[0] = [-0.6, 0.8, 0.5];
+        weights.total = [0.2, 0.3, -0.7];
+        let mut seeds = vec![];
+        for c in 0..3 {
+            let mut s = Seed::zero(&a);
+            s.translation[0][c] = 1.0;
+            seeds.push(s);
+        }
+        let mut s = Seed::zero(&a);
+        s.angles[0] = 1.0;
+        seeds.push(s);
+        let before = a.tangent_solves();
+        let adjoint = a.adjoint_response(&weights, &seeds).unwrap();
+        assert_eq!(a.tangent_solves(), before + 1);
+        let columns: Vec<f64> = seeds
+            .iter()
+            .map(|s| {
+                let r = a.linear_response(s).unwrap();
+                (0..3)
+                    .map(|c| {
+                        weights.supports[0][c] * r.derivative(|x| x.support_reactions[0][c])
+                            + weights.total[c] * r.derivative(|x| x.total_reaction[c])
+                            + weights.reactions[0][c] * r.derivative(|x| x.reactions[0][c])
+                    })
+                    .sum()
+            })
+            .collect();
+        let largest = columns.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+        assert!(largest > 0.0);
+        for (adj, col) in adjoint.iter().zip(&columns) {
+            assert!(
+                (adj - col).abs() <= 1e-6 * largest,
+                "{adjoint:?} vs {columns:?}"
+            );
+        }
     }
 
     /// The exact right-hand side of a pressure seed (the loads' residual at the seed's levels)
