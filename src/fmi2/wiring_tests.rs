@@ -804,11 +804,15 @@ fn every_parameter_and_input_of_a_yielding_circular_membrane_reaches_the_solver(
     ] {
         assert!(u.variables.iter().any(|v| v.name == name), "{name} missing");
     }
+    // `film.wrinkling` is seen here although the converged film is nowhere compressed: a step's
+    // second increment starts from the extrapolated iterate of the load path, on whose way to
+    // equilibrium the tension field acts, so the outputs differ within the equilibrium
+    // tolerance (above `SEEN`).
     check_every_variable(
         "plastic",
         Source::Model(model),
         &[("solver.incrementsPerStep", Value::Integer(2))],
-        &[NOTHING_SLIDES, NEVER_WRINKLES, NO_CONTACT_MATRIX],
+        &[NOTHING_SLIDES, NO_CONTACT_MATRIX],
     );
 }
 
