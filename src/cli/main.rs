@@ -166,13 +166,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
     }
-    let mut csv = CsvFiles::create(o, analysis.model().material.plasticity.is_some())?;
-    let mut outputs = report::Outputs::create(
-        analysis.model(),
-        o.line_reactions.as_deref(),
-        o.report.as_deref(),
-    )?;
-    let (mut vtk_steps, mut vtk_written) = start_vtk(o, &mut analysis)?;
+    let mut writers = StepWriters::create(o, &mut analysis)?;
     let mut progress = Progress::new(
         !o.quiet && std::io::stderr().is_terminal(),
         path.steps.len(),
@@ -216,23 +210,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
             }
         };
         tally.record(step, &report);
-        let results =
-            (csv.any() || o.vtk.is_some() || outputs.wants_results()).then(|| analysis.results());
-        if let (Some(dir), Some(results)) = (&o.vtk, &results) {
-            vtk_steps.push((time, step));
-            write_vtk(
-                dir,
-                &analysis,
-                results,
-                &vtk_steps,
-                o.vtk_format,
-                &mut vtk_written,
-            )?;
-        }
-        if let Some(results) = &results {
-            csv.write_step(step, time, analysis.model(), results)?;
-            outputs.step(step, time, inputs, &report, &analysis, results)?;
-        }
+        let results = writers.write(o, (step, time), inputs, &report, &mut analysis)?;
         last_contacts = contact_step_warnings(&mut analysis, results.as_ref());
         for w in &last_contacts {
             eprintln!("warning: step {step}: {w}");
@@ -245,7 +223,9 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     membrane_contact::mech::check_results(analysis.model(), &results, None)
         .map_err(|e| format!("the results are not finite ({e}): refused"))?;
     report(height_mm, &analysis, &results);
-    outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
+    writers
+        .outputs
+        .finish(&analysis, &results, elapsed.as_secs_f64())?;
     for w in membrane_contact::mech::results::warnings::result_warnings(analysis.model(), &results)
     {
         if !last_contacts.contains(&w) {
@@ -254,15 +234,81 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     }
     tally.print(count, elapsed, &analysis);
     if o.vtk.is_some() {
+        writers.print_vtk(o);
+    }
+    Ok(())
+}
+
+/// Where the converged steps' results go besides the summary: the CSV files, the line
+/// reactions and report, the VTK states.
+struct StepWriters {
+    csv: CsvFiles,
+    outputs: report::Outputs,
+    /// The (time, step) of each VTK state written.
+    vtk_steps: Vec<(f64, usize)>,
+    vtk_written: VtkWritten,
+}
+
+impl StepWriters {
+    /// Opens the CSV files and the outputs, and with `--vtk` writes state 0000.
+    fn create(o: &RunArgs, analysis: &mut Analysis) -> Result<Self, String> {
+        let csv = CsvFiles::create(o, analysis.model().material.plasticity.is_some())?;
+        let outputs = report::Outputs::create(
+            analysis.model(),
+            o.line_reactions.as_deref(),
+            o.report.as_deref(),
+        )?;
+        let (vtk_steps, vtk_written) = start_vtk(o, analysis)?;
+        Ok(Self {
+            csv,
+            outputs,
+            vtk_steps,
+            vtk_written,
+        })
+    }
+
+    /// Writes a converged step's results (its number and time) where they are wanted;
+    /// returns them, or `None` where nothing wants them.
+    fn write(
+        &mut self,
+        o: &RunArgs,
+        (step, time): (usize, f64),
+        inputs: &StepInputs,
+        report: &StepReport,
+        analysis: &mut Analysis,
+    ) -> Result<Option<Results>, String> {
+        let results = (self.csv.any() || o.vtk.is_some() || self.outputs.wants_results())
+            .then(|| analysis.results());
+        if let (Some(dir), Some(results)) = (&o.vtk, &results) {
+            self.vtk_steps.push((time, step));
+            write_vtk(
+                dir,
+                analysis,
+                results,
+                &self.vtk_steps,
+                o.vtk_format,
+                &mut self.vtk_written,
+            )?;
+        }
+        if let Some(results) = &results {
+            self.csv.write_step(step, time, analysis.model(), results)?;
+            self.outputs
+                .step(step, time, inputs, report, analysis, results)?;
+        }
+        Ok(results)
+    }
+
+    /// Prints what the VTK files took.
+    fn print_vtk(&self, o: &RunArgs) {
+        let written = &self.vtk_written;
         out!(
             "VTK ({}): {} .vtu files, {:.2} MB, {:.1} ms to encode and write",
             o.vtk_format.name(),
-            vtk_written.files,
-            vtk_written.bytes as f64 / 1e6,
-            vtk_written.seconds * 1e3
+            written.files,
+            written.bytes as f64 / 1e6,
+            written.seconds * 1e3
         );
     }
-    Ok(())
 }
 
 /// Reads the run's model (the specimen's, or the file's) and sets `--friction-law` on it.
