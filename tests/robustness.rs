@@ -21,7 +21,8 @@
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::elements::gap::FrictionLaw;
 use membrane_contact::mech::elements::load::{pressure_force, pressure_signs};
-use membrane_contact::mech::model::{GapSupport, LoadSpec};
+use membrane_contact::mech::model::{GapSpec, GapSupport, LoadSpec, Model};
+use membrane_contact::mech::results::GapResult;
 use membrane_contact::mech::solve::report::StepReport;
 use membrane_contact::mech::solve::state::AnalysisState;
 use membrane_contact::mech::{Analysis, GapStatus, Results, SolverSettings};
@@ -194,16 +195,27 @@ fn violations(
     travel: Option<f64>,
 ) -> Vec<String> {
     let r = analysis.results();
-    let model = analysis.model();
-    let state = analysis.state();
     let at = format!(
         "{} after step {} of stage {}",
         s.name,
         step.step,
         step.stage + 1
     );
+    let analysis = &*analysis;
+    let mut found = unsummed_loads(analysis.model());
+    found.extend(equilibrium_violations(step, analysis, &r));
+    found.extend(gap_violations(analysis, &r, travel));
+    found.extend(curved_support_violations(analysis, &r));
+    found
+        .into_iter()
+        .map(|what| format!("{at}: {what}"))
+        .collect()
+}
+
+/// The loads the equilibrium check does not sum (nodal forces, gravity, cables), if any.
+fn unsummed_loads(model: &Model) -> Vec<String> {
     let mut out = vec![];
-    let mut fail = |what: String| out.push(format!("{at}: {what}"));
+    let mut fail = |what: String| out.push(what);
     let pressures_only = LoadSpec {
         pressures: model.loads.pressures.clone(),
         ..LoadSpec::default()
@@ -211,8 +223,15 @@ fn violations(
     if model.loads != pressures_only || !model.cables.is_empty() {
         fail("has nodal forces, gravity or cables, which this check does not sum".into());
     }
+    out
+}
 
-    // Equilibrium.
+/// Equilibrium of the whole film: reactions, gap and curved-support forces and pressures sum
+/// to within the step's residual per node.
+fn equilibrium_violations(step: &StepOutcome, analysis: &Analysis, r: &Results) -> Vec<String> {
+    let (model, state) = (analysis.model(), analysis.state());
+    let mut out = vec![];
+    let mut fail = |what: String| out.push(what);
     let mut sum = Vector3::from(r.total_reaction);
     let mut magnitude = sum.norm();
     for (g, res) in model.gaps.iter().zip(&r.gaps) {
@@ -249,84 +268,110 @@ fn violations(
             step.residual
         ));
     }
+    out
+}
 
-    // Gap laws.
+/// The gap laws at every gap on a fixed support point, by [`gap_law_violations`].
+fn gap_violations(analysis: &Analysis, r: &Results, travel: Option<f64>) -> Vec<String> {
+    let (model, state) = (analysis.model(), analysis.state());
+    let mut out = vec![];
     for (i, (g, res)) in model.gaps.iter().zip(&r.gaps).enumerate() {
         let GapSupport::Point(_) = g.support else {
             continue;
         };
-        let (n, t) = (res.normal_force, Vector2::from(res.friction));
         let mu = state.friction[i];
         let u = analysis.node_displacement(g.film_node);
-        let [x, y, z] = [g.frame.x, g.frame.y, g.frame.z].map(Vector3::from);
-        let (dx, dy, gap) = (x.dot(&u), y.dot(&u), g.initial_gap + z.dot(&u));
-        let length = ROUND_OFF * (u.norm() + g.initial_gap) + 1e-15;
-        if (res.slip_x - dx).abs() > length || (res.slip_y - dy).abs() > length {
+        out.extend(gap_law_violations(g, res, mu, u, travel));
+    }
+    out
+}
+
+/// One gap's laws, recomputed from its film node's displacement `u` (friction `mu`): slip,
+/// normal force, the friction cone and the slip bounded by the boundary `travel`.
+fn gap_law_violations(
+    g: &GapSpec,
+    res: &GapResult,
+    mu: f64,
+    u: Vector3<f64>,
+    travel: Option<f64>,
+) -> Vec<String> {
+    let mut out = vec![];
+    let mut fail = |what: String| out.push(what);
+    let (n, t) = (res.normal_force, Vector2::from(res.friction));
+    let [x, y, z] = [g.frame.x, g.frame.y, g.frame.z].map(Vector3::from);
+    let (dx, dy, gap) = (x.dot(&u), y.dot(&u), g.initial_gap + z.dot(&u));
+    let length = ROUND_OFF * (u.norm() + g.initial_gap) + 1e-15;
+    if (res.slip_x - dx).abs() > length || (res.slip_y - dy).abs() > length {
+        fail(format!(
+            "{}: slip ({:e}, {:e}) m, the node's displacement gives ({dx:e}, {dy:e})",
+            g.name, res.slip_x, res.slip_y
+        ));
+    }
+    if n.is_nan() || n < 0.0 {
+        fail(format!("{}: normal force {n:e} N < 0", g.name));
+    }
+    if res.status == GapStatus::Open {
+        if gap < -length || n != 0.0 || t != Vector2::zeros() {
             fail(format!(
-                "{}: slip ({:e}, {:e}) m, the node's displacement gives ({dx:e}, {dy:e})",
-                g.name, res.slip_x, res.slip_y
+                "{}: open with gap {gap:e} m and forces N = {n:e}, t = {t:?}",
+                g.name
             ));
         }
-        if n.is_nan() || n < 0.0 {
-            fail(format!("{}: normal force {n:e} N < 0", g.name));
-        }
-        if res.status == GapStatus::Open {
-            if gap < -length || n != 0.0 || t != Vector2::zeros() {
-                fail(format!(
-                    "{}: open with gap {gap:e} m and forces N = {n:e}, t = {t:?}",
-                    g.name
-                ));
-            }
-        } else {
-            let expected = g.normal_stiffness * (-gap).max(0.0);
-            if (n - expected).abs() > ROUND_OFF * (n + g.normal_stiffness * length) + 1e-12 {
-                fail(format!(
-                    "{}: N = {n:e} N, k_n ⟨−g⟩ = {expected:e} N",
-                    g.name
-                ));
-            }
-        }
-        // The cone to round-off in the force and in the slip: the results' forces are the law
-        // evaluated again with the committed history, a trial force `k_s (d − s_p)` whose
-        // difference keeps the round-off of `d` (a few ε |u|) where `d − s_p` is small.
-        let rounding = 16.0 * f64::EPSILON * (u.norm() + g.initial_gap);
-        let slack = ROUND_OFF * mu * n + g.tangential_stiffness * rounding + 1e-12;
-        let cone = mu * n + slack;
-        match g.friction_law {
-            FrictionLaw::Isotropic => {
-                if t.norm() > cone || (res.status == GapStatus::Slip && t.norm() < mu * n - slack) {
-                    fail(format!(
-                        "{}: {:?} with |t| = {:e} N, μN = {:e} N",
-                        g.name,
-                        res.status,
-                        t.norm(),
-                        mu * n
-                    ));
-                }
-            }
-            FrictionLaw::SlidingDirection => {
-                if t.x.abs() > cone {
-                    fail(format!(
-                        "{}: |t_x| = {:e} N > μN = {:e} N",
-                        g.name,
-                        t.x.abs(),
-                        mu * n
-                    ));
-                }
-            }
-        }
-        if let Some(travel) = travel
-            && res.slip_x.hypot(res.slip_y) > travel
-        {
+    } else {
+        let expected = g.normal_stiffness * (-gap).max(0.0);
+        if (n - expected).abs() > ROUND_OFF * (n + g.normal_stiffness * length) + 1e-12 {
             fail(format!(
-                "{}: slid {:e} m, farther than the boundary travelled ({travel:e} m)",
-                g.name,
-                res.slip_x.hypot(res.slip_y)
+                "{}: N = {n:e} N, k_n ⟨−g⟩ = {expected:e} N",
+                g.name
             ));
         }
     }
+    // The cone to round-off in the force and in the slip: the results' forces are the law
+    // evaluated again with the committed history, a trial force `k_s (d − s_p)` whose
+    // difference keeps the round-off of `d` (a few ε |u|) where `d − s_p` is small.
+    let rounding = 16.0 * f64::EPSILON * (u.norm() + g.initial_gap);
+    let slack = ROUND_OFF * mu * n + g.tangential_stiffness * rounding + 1e-12;
+    let cone = mu * n + slack;
+    match g.friction_law {
+        FrictionLaw::Isotropic => {
+            if t.norm() > cone || (res.status == GapStatus::Slip && t.norm() < mu * n - slack) {
+                fail(format!(
+                    "{}: {:?} with |t| = {:e} N, μN = {:e} N",
+                    g.name,
+                    res.status,
+                    t.norm(),
+                    mu * n
+                ));
+            }
+        }
+        FrictionLaw::SlidingDirection => {
+            if t.x.abs() > cone {
+                fail(format!(
+                    "{}: |t_x| = {:e} N > μN = {:e} N",
+                    g.name,
+                    t.x.abs(),
+                    mu * n
+                ));
+            }
+        }
+    }
+    if let Some(travel) = travel
+        && res.slip_x.hypot(res.slip_y) > travel
+    {
+        fail(format!(
+            "{}: slid {:e} m, farther than the boundary travelled ({travel:e} m)",
+            g.name,
+            res.slip_x.hypot(res.slip_y)
+        ));
+    }
+    out
+}
 
-    // Curved supports (results in model order: supports, then their nodes).
+/// The curved supports' laws: `N = k_n ⟨−gap⟩ ≥ 0`, no force when open, friction within μN.
+fn curved_support_violations(analysis: &Analysis, r: &Results) -> Vec<String> {
+    let (model, state) = (analysis.model(), analysis.state());
+    let mut out = vec![];
+    let mut fail = |what: String| out.push(what);
     let supports = model
         .curved_supports
         .iter()

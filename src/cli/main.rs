@@ -13,7 +13,7 @@ use membrane_contact::mech::results::summary::mpa;
 use membrane_contact::mech::results::vtk;
 use membrane_contact::mech::solve::IncrementObserver;
 use membrane_contact::mech::{
-    Analysis, FrictionLaw, LoadLevels, Model, Results, SettingNames, SolverSettings,
+    Analysis, FrictionLaw, LoadLevels, Model, Results, SettingNames, SolverSettings, StepReport,
 };
 use membrane_contact::specimens::ParallelArch;
 use membrane_contact::specimens::parallel_arch::{FramePath, OBSERVED_GAPS, etfe_plastic, table1};
@@ -144,30 +144,8 @@ fn setting_names(o: &RunArgs) -> SettingNames {
 }
 
 fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
-    let mut model = match &source {
-        Source::Specimen { spec, .. } => spec.model()?,
-        Source::File(file) => {
-            let name = file.display();
-            let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
-            Model::from_json(&text).map_err(|e| format!("{name}: {e}"))?
-        }
-    };
-    if let Some(law) = o.friction_law {
-        model.set_friction_law(law);
-    }
-    let defaults = SolverSettings::default();
-    let settings = SolverSettings {
-        iteration_matrix: o.matrix.into(),
-        max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
-        max_cutbacks: o.max_cutbacks.unwrap_or(defaults.max_cutbacks),
-        displacement_tolerance: o
-            .displacement_tolerance
-            .unwrap_or(defaults.displacement_tolerance),
-        residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
-        stabilization: !o.no_stabilization,
-        threads: o.threads,
-        ..defaults
-    };
+    let model = load_model(&source, o)?;
+    let settings = solver_settings(o);
     if let Some(mu) = o.mu {
         // The FMU's own check of its `mu` input: the CLI accepts exactly what the FMU accepts.
         path::check_input(&model, "mu", mu).map_err(|e| format!("--mu: {e}"))?;
@@ -188,46 +166,13 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
     }
-    let mut csv = CsvFiles::create(o, analysis.model().material.plasticity.is_some())?;
-    let mut outputs = report::Outputs::create(
-        analysis.model(),
-        o.line_reactions.as_deref(),
-        o.report.as_deref(),
-    )?;
-    let (mut vtk_steps, mut vtk_written) = (Vec::new(), VtkWritten::default());
-    if let Some(dir) = &o.vtk {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        // State 0000: the undeformed, prestressed film (as the FMU writes at initialization).
-        vtk_steps.push((0.0, 0));
-        let results = analysis.results();
-        write_vtk(
-            dir,
-            &analysis,
-            &results,
-            &vtk_steps,
-            o.vtk_format,
-            &mut vtk_written,
-        )?;
-    }
+    let mut writers = StepWriters::create(o, &mut analysis)?;
     let mut progress = Progress::new(
         !o.quiet && std::io::stderr().is_terminal(),
         path.steps.len(),
     );
-    // The step the increment log's lines belong to (set before each step).
-    let logged_step = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
-    if o.log_increments {
-        let (step, steps) = (logged_step.clone(), path.steps.len());
-        let started = std::time::Instant::now();
-        analysis.observe_increments(IncrementObserver::new(move |note| {
-            let k = step.load(std::sync::atomic::Ordering::Relaxed);
-            let t = started.elapsed().as_secs_f64();
-            eprintln!("step {k}/{steps} ({t:.1} s): {note}");
-        }));
-    }
-    let (mut iterations, mut cutbacks, mut increments) = (Vec::new(), 0, 0);
-    // Increments solved with the viscous stabilization on, and the step of the largest
-    // ratio of its work to the strain energy.
-    let (mut stabilized, mut stabilization) = (0, None::<(usize, f64, f64, f64)>);
+    let logged_step = log_increments(o, &mut analysis, path.steps.len());
+    let mut tally = Tally::default();
     let count = path.steps.len();
     // The contact warnings of the last step (said with its number, not again at the end).
     let mut last_contacts = vec![];
@@ -264,44 +209,8 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
                 ));
             }
         };
-        cutbacks += report.cutbacks;
-        stabilized += report.stabilized;
-        for w in [report.stabilization_warning(), report.dissipation_warning()]
-            .into_iter()
-            .flatten()
-        {
-            eprintln!("warning: step {step}: {w}");
-        }
-        if report.stabilized > 0 {
-            let ratio = report.dissipation_ratio();
-            if stabilization.is_none_or(|(_, r, _, _)| ratio > r) {
-                stabilization = Some((
-                    step,
-                    ratio,
-                    report.stabilization_energy,
-                    report.stabilization_dissipated,
-                ));
-            }
-        }
-        increments += report.iterations.len();
-        iterations.push(report.total_iterations());
-        let results =
-            (csv.any() || o.vtk.is_some() || outputs.wants_results()).then(|| analysis.results());
-        if let (Some(dir), Some(results)) = (&o.vtk, &results) {
-            vtk_steps.push((time, step));
-            write_vtk(
-                dir,
-                &analysis,
-                results,
-                &vtk_steps,
-                o.vtk_format,
-                &mut vtk_written,
-            )?;
-        }
-        if let Some(results) = &results {
-            csv.write_step(step, time, analysis.model(), results)?;
-            outputs.step(step, time, inputs, &report, &analysis, results)?;
-        }
+        tally.record(step, &report);
+        let results = writers.write(o, (step, time), inputs, &report, &mut analysis)?;
         last_contacts = contact_step_warnings(&mut analysis, results.as_ref());
         for w in &last_contacts {
             eprintln!("warning: step {step}: {w}");
@@ -314,44 +223,238 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
     membrane_contact::mech::check_results(analysis.model(), &results, None)
         .map_err(|e| format!("the results are not finite ({e}): refused"))?;
     report(height_mm, &analysis, &results);
-    outputs.finish(&analysis, &results, elapsed.as_secs_f64())?;
+    writers
+        .outputs
+        .finish(&analysis, &results, elapsed.as_secs_f64())?;
     for w in membrane_contact::mech::results::warnings::result_warnings(analysis.model(), &results)
     {
         if !last_contacts.contains(&w) {
             eprintln!("warning: {w}");
         }
     }
-    let total: usize = iterations.iter().sum();
-    out!(
-        "\nNewton: {count} steps, {increments} increments, {cutbacks} cut-backs, \
-         {total} iterations ({:.1} per increment), iterations per step {:?}; {:.1} ms",
-        total as f64 / increments.max(1) as f64,
-        iterations,
-        elapsed.as_secs_f64() * 1e3
-    );
-    if let Some((step, ratio, energy, dissipated)) = stabilization {
-        out!(
-            "stabilization: {stabilized} increments viscously stabilized; largest work taken out \
-             {dissipated:.3e} J at step {step} ({ratio:.2e} of the strain energy; bound {}), \
-             {energy:.3e} J left in its answer",
-            membrane_contact::mech::solve::DISSIPATION_BOUND
-        );
-    }
-    let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
-    out!(
-        "linear solves: {lu} LU, {ldlt} LDLᵀ, {gmres} GMRES on the symmetric part's LDLᵀ, \
-         {redone} of these redone by LU"
-    );
+    tally.print(count, elapsed, &analysis);
     if o.vtk.is_some() {
+        writers.print_vtk(o);
+    }
+    Ok(())
+}
+
+/// Where the converged steps' results go besides the summary: the CSV files, the line
+/// reactions and report, the VTK states.
+struct StepWriters {
+    csv: CsvFiles,
+    outputs: report::Outputs,
+    /// The (time, step) of each VTK state written.
+    vtk_steps: Vec<(f64, usize)>,
+    vtk_written: VtkWritten,
+}
+
+impl StepWriters {
+    /// Opens the CSV files and the outputs, and with `--vtk` writes state 0000.
+    fn create(o: &RunArgs, analysis: &mut Analysis) -> Result<Self, String> {
+        let csv = CsvFiles::create(o, analysis.model().material.plasticity.is_some())?;
+        let outputs = report::Outputs::create(
+            analysis.model(),
+            o.line_reactions.as_deref(),
+            o.report.as_deref(),
+        )?;
+        let (vtk_steps, vtk_written) = start_vtk(o, analysis)?;
+        Ok(Self {
+            csv,
+            outputs,
+            vtk_steps,
+            vtk_written,
+        })
+    }
+
+    /// Writes a converged step's results (its number and time) where they are wanted;
+    /// returns them, or `None` where nothing wants them.
+    fn write(
+        &mut self,
+        o: &RunArgs,
+        (step, time): (usize, f64),
+        inputs: &StepInputs,
+        report: &StepReport,
+        analysis: &mut Analysis,
+    ) -> Result<Option<Results>, String> {
+        let results = (self.csv.any() || o.vtk.is_some() || self.outputs.wants_results())
+            .then(|| analysis.results());
+        if let (Some(dir), Some(results)) = (&o.vtk, &results) {
+            self.vtk_steps.push((time, step));
+            write_vtk(
+                dir,
+                analysis,
+                results,
+                &self.vtk_steps,
+                o.vtk_format,
+                &mut self.vtk_written,
+            )?;
+        }
+        if let Some(results) = &results {
+            self.csv.write_step(step, time, analysis.model(), results)?;
+            self.outputs
+                .step(step, time, inputs, report, analysis, results)?;
+        }
+        Ok(results)
+    }
+
+    /// Prints what the VTK files took.
+    fn print_vtk(&self, o: &RunArgs) {
+        let written = &self.vtk_written;
         out!(
             "VTK ({}): {} .vtu files, {:.2} MB, {:.1} ms to encode and write",
             o.vtk_format.name(),
-            vtk_written.files,
-            vtk_written.bytes as f64 / 1e6,
-            vtk_written.seconds * 1e3
+            written.files,
+            written.bytes as f64 / 1e6,
+            written.seconds * 1e3
         );
     }
-    Ok(())
+}
+
+/// Reads the run's model (the specimen's, or the file's) and sets `--friction-law` on it.
+fn load_model(source: &Source<'_>, o: &RunArgs) -> Result<Model, String> {
+    let mut model = match source {
+        Source::Specimen { spec, .. } => spec.model()?,
+        Source::File(file) => {
+            let name = file.display();
+            let text = std::fs::read_to_string(file).map_err(|e| format!("{name}: {e}"))?;
+            Model::from_json(&text).map_err(|e| format!("{name}: {e}"))?
+        }
+    };
+    if let Some(law) = o.friction_law {
+        model.set_friction_law(law);
+    }
+    Ok(model)
+}
+
+/// The solver settings: the defaults, with the options given.
+fn solver_settings(o: &RunArgs) -> SolverSettings {
+    let defaults = SolverSettings::default();
+    SolverSettings {
+        iteration_matrix: o.matrix.into(),
+        max_iterations: o.max_iterations.unwrap_or(defaults.max_iterations),
+        max_cutbacks: o.max_cutbacks.unwrap_or(defaults.max_cutbacks),
+        displacement_tolerance: o
+            .displacement_tolerance
+            .unwrap_or(defaults.displacement_tolerance),
+        residual_tolerance: o.residual_tolerance.unwrap_or(defaults.residual_tolerance),
+        stabilization: !o.no_stabilization,
+        threads: o.threads,
+        ..defaults
+    }
+}
+
+/// With `--vtk`: creates its folder and writes state 0000; returns the steps written so far
+/// and what they took.
+fn start_vtk(
+    o: &RunArgs,
+    analysis: &mut Analysis,
+) -> Result<(Vec<(f64, usize)>, VtkWritten), String> {
+    let (mut vtk_steps, mut vtk_written) = (Vec::new(), VtkWritten::default());
+    if let Some(dir) = &o.vtk {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        // State 0000: the undeformed, prestressed film (as the FMU writes at initialization).
+        vtk_steps.push((0.0, 0));
+        let results = analysis.results();
+        write_vtk(
+            dir,
+            analysis,
+            &results,
+            &vtk_steps,
+            o.vtk_format,
+            &mut vtk_written,
+        )?;
+    }
+    Ok((vtk_steps, vtk_written))
+}
+
+/// With `--log-increments`: logs each increment on standard error; returns the step number
+/// the log's lines belong to (set before each step).
+fn log_increments(
+    o: &RunArgs,
+    analysis: &mut Analysis,
+    steps: usize,
+) -> std::sync::Arc<std::sync::atomic::AtomicUsize> {
+    let logged_step = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    if o.log_increments {
+        let step = logged_step.clone();
+        let started = std::time::Instant::now();
+        analysis.observe_increments(IncrementObserver::new(move |note| {
+            let k = step.load(std::sync::atomic::Ordering::Relaxed);
+            let t = started.elapsed().as_secs_f64();
+            eprintln!("step {k}/{steps} ({t:.1} s): {note}");
+        }));
+    }
+    logged_step
+}
+
+/// What the steps took: Newton iterations, increments, cut-backs and viscous stabilization.
+#[derive(Default)]
+struct Tally {
+    /// The Newton iterations of each step.
+    iterations: Vec<usize>,
+    cutbacks: usize,
+    increments: usize,
+    /// Increments solved with the viscous stabilization on.
+    stabilized: usize,
+    /// The step of the largest ratio of the stabilization's work to the strain energy: (step,
+    /// ratio, energy, dissipated).
+    stabilization: Option<(usize, f64, f64, f64)>,
+}
+
+impl Tally {
+    /// Adds a converged step's report, warning of its stabilization and dissipation.
+    fn record(&mut self, step: usize, report: &StepReport) {
+        self.cutbacks += report.cutbacks;
+        self.stabilized += report.stabilized;
+        for w in [report.stabilization_warning(), report.dissipation_warning()]
+            .into_iter()
+            .flatten()
+        {
+            eprintln!("warning: step {step}: {w}");
+        }
+        if report.stabilized > 0 {
+            let ratio = report.dissipation_ratio();
+            if self.stabilization.is_none_or(|(_, r, _, _)| ratio > r) {
+                self.stabilization = Some((
+                    step,
+                    ratio,
+                    report.stabilization_energy,
+                    report.stabilization_dissipated,
+                ));
+            }
+        }
+        self.increments += report.iterations.len();
+        self.iterations.push(report.total_iterations());
+    }
+
+    /// Prints the Newton statistics of the `count` steps, the stabilization's and the linear
+    /// solves'.
+    fn print(&self, count: usize, elapsed: std::time::Duration, analysis: &Analysis) {
+        let (iterations, increments) = (&self.iterations, self.increments);
+        let (cutbacks, stabilized) = (self.cutbacks, self.stabilized);
+        let total: usize = iterations.iter().sum();
+        out!(
+            "\nNewton: {count} steps, {increments} increments, {cutbacks} cut-backs, \
+             {total} iterations ({:.1} per increment), iterations per step {:?}; {:.1} ms",
+            total as f64 / increments.max(1) as f64,
+            iterations,
+            elapsed.as_secs_f64() * 1e3
+        );
+        if let Some((step, ratio, energy, dissipated)) = self.stabilization {
+            out!(
+                "stabilization: {stabilized} increments viscously stabilized; largest work taken \
+                 out {dissipated:.3e} J at step {step} ({ratio:.2e} of the strain energy; bound \
+                 {}), {energy:.3e} J left in its answer",
+                membrane_contact::mech::solve::DISSIPATION_BOUND
+            );
+        }
+        let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
+        out!(
+            "linear solves: {lu} LU, {ldlt} LDLᵀ, {gmres} GMRES on the symmetric part's LDLᵀ, \
+             {redone} of these redone by LU"
+        );
+    }
 }
 
 /// A progress line on the terminal (only there: a pipe or a file gets none): the step, its
@@ -644,6 +747,17 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     let model = analysis.model();
     out!("{}", size_line(model, ":"));
     report_loads(analysis);
+    report_contacts(model, results);
+    report_reactions(analysis, results);
+    report_contact_forces(model, results);
+    report_stresses(model, results);
+    if let Some(height_mm) = height_mm {
+        report_observed(height_mm, model, results);
+    }
+}
+
+/// Prints the gaps' and curved-support contacts' slips and forces, and the layer contacts.
+fn report_contacts(model: &Model, results: &Results) {
     if !model.gaps.is_empty() {
         out!(
             "\n{:<8} {:>11} {:>11} {:>10} {:>10}  status",
@@ -694,6 +808,12 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
     for line in membrane_contact::mech::elements::layer_contact::summary(model, results) {
         out!("{line}");
     }
+}
+
+/// Prints the reactions (groups with their hinge moments, support sets), the cables', chambers'
+/// and orifices' states and the total reaction.
+fn report_reactions(analysis: &Analysis, results: &Results) {
+    let model = analysis.model();
     for (i, (g, r)) in model.groups.iter().zip(&results.reactions).enumerate() {
         out!(
             "reaction of group {}: ({:.3}, {:.3}, {:.3}) N",
@@ -754,6 +874,11 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
         t[1],
         t[2]
     );
+}
+
+/// Prints the contact forces on the film and their share of its loads, where it has contacts.
+fn report_contact_forces(model: &Model, results: &Results) {
+    let t = results.total_reaction;
     if !model.gaps.is_empty() || !results.surface_contacts.is_empty() {
         let (c, all) = (
             results.contact_force(model),
@@ -776,6 +901,10 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
             c.z
         );
     }
+}
+
+/// Prints the stresses: the von Mises range, output points, element sets, plasticity, wrinkling.
+fn report_stresses(model: &Model, results: &Results) {
     let (lo, hi) = results.von_mises_range();
     out!(
         "equivalent (von Mises) stress: {} … {} MPa",
@@ -823,53 +952,55 @@ fn report(height_mm: Option<f64>, analysis: &Analysis, results: &Results) {
         let [taut, wrinkled, slack] = state_counts(&results.elements);
         println!("tension-field film: {taut} taut, {wrinkled} wrinkled, {slack} slack elements");
     }
-    if let Some(height_mm) = height_mm {
-        let measured = table1()
-            .into_iter()
-            .find(|m| (m.arch_height_mm - height_mm).abs() < 1e-9);
-        out!("\nobserved points (paper §4.4: points 2–5 = G2, G4, G6, G8):");
-        out!(
-            "{:<6} {:<5} {:>14} {:>14} {:>10}",
-            "point",
-            "gap",
-            "analysis mm",
-            "Table 1 mm",
-            "diff mm"
-        );
-        for (p, name) in OBSERVED_GAPS.iter().enumerate() {
-            // G<k> is the k-th film node on the arch: its gap, or its curved-support contact.
-            let slip = match model.gap_index(name) {
-                Some(i) => results.gaps[i].slip_x,
-                None => {
-                    let k: usize = name[1..].parse().unwrap_or(0);
-                    match results.surface_contacts.get(k.wrapping_sub(1)) {
-                        Some(c) => c.slip,
-                        None => continue,
-                    }
+}
+
+/// Prints the specimen's observed points beside Table 1's for its `height_mm`.
+fn report_observed(height_mm: f64, model: &Model, results: &Results) {
+    let measured = table1()
+        .into_iter()
+        .find(|m| (m.arch_height_mm - height_mm).abs() < 1e-9);
+    out!("\nobserved points (paper §4.4: points 2–5 = G2, G4, G6, G8):");
+    out!(
+        "{:<6} {:<5} {:>14} {:>14} {:>10}",
+        "point",
+        "gap",
+        "analysis mm",
+        "Table 1 mm",
+        "diff mm"
+    );
+    for (p, name) in OBSERVED_GAPS.iter().enumerate() {
+        // G<k> is the k-th film node on the arch: its gap, or its curved-support contact.
+        let slip = match model.gap_index(name) {
+            Some(i) => results.gaps[i].slip_x,
+            None => {
+                let k: usize = name[1..].parse().unwrap_or(0);
+                match results.surface_contacts.get(k.wrapping_sub(1)) {
+                    Some(c) => c.slip,
+                    None => continue,
                 }
-            } * 1e3;
-            match &measured {
-                Some(m) => out!(
-                    "{:<6} {:<5} {:>14.2} {:>14.1} {:>10.2}",
-                    p + 1,
-                    name,
-                    slip,
-                    m.points[p],
-                    slip - m.points[p]
-                ),
-                None => out!(
-                    "{:<6} {:<5} {:>14.2} {:>14} {:>10}",
-                    p + 1,
-                    name,
-                    slip,
-                    "-",
-                    "-"
-                ),
             }
+        } * 1e3;
+        match &measured {
+            Some(m) => out!(
+                "{:<6} {:<5} {:>14.2} {:>14.1} {:>10.2}",
+                p + 1,
+                name,
+                slip,
+                m.points[p],
+                slip - m.points[p]
+            ),
+            None => out!(
+                "{:<6} {:<5} {:>14.2} {:>14} {:>10}",
+                p + 1,
+                name,
+                slip,
+                "-",
+                "-"
+            ),
         }
-        if measured.is_none() {
-            out!("(Table 1 has only the 200, 300 and 400 mm specimens)");
-        }
+    }
+    if measured.is_none() {
+        out!("(Table 1 has only the 200, 300 and 400 mm specimens)");
     }
 }
 

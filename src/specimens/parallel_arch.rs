@@ -296,111 +296,23 @@ impl ParallelArch {
         self.check()?;
         let r = self.refinement;
         let n = CELLS * r;
-        let (dx, dy) = (self.frame_half_x / n as f64, self.frame_half_y / n as f64);
         let h = self.arch_height;
-        let id = |i: usize, j: usize| j * (n + 1) + i;
-        let mut nodes = Vec::with_capacity((n + 1) * (n + 1));
-        for j in 0..=n {
-            for i in 0..=n {
-                nodes.push([i as f64 * dx, j as f64 * dy, h]);
-            }
-        }
-        let mut triangles = Vec::with_capacity(2 * n * n);
-        for j in 0..n {
-            for i in 0..n {
-                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                triangles.push([a, b, c]);
-                triangles.push([a, c, d]);
-            }
-        }
-        let on = |pred: &dyn Fn(usize, usize) -> bool| -> Vec<usize> {
-            (0..=n)
-                .flat_map(|j| (0..=n).map(move |i| (i, j)))
-                .filter(|&(i, j)| pred(i, j))
-                .map(|(i, j)| id(i, j))
-                .collect()
-        };
-        let frame = on(&|i, j| i == n || j == n);
+        let (nodes, triangles) = self.mesh();
+        let frame = grid_nodes(n, &|i, j| i == n || j == n);
         let symmetry = vec![
             Symmetry {
                 name: "x0".into(),
                 normal: Axis::X,
-                nodes: on(&|i, j| i == 0 && j < n),
+                nodes: grid_nodes(n, &|i, j| i == 0 && j < n),
             },
             Symmetry {
                 name: "y0".into(),
                 normal: Axis::Y,
-                nodes: on(&|i, j| j == 0 && i < n),
+                nodes: grid_nodes(n, &|i, j| j == 0 && i < n),
             },
         ];
-        let radius = self.arch_radius();
-        let column = (self.arch_offset / dx).round() as usize;
-        let kn = self.normal_penalty_factor * self.material.membrane_stiffness();
-        let gaps: Vec<GapSpec> = (0..GAP_COUNT)
-            .map(|k| {
-                let node = id(column, k * r);
-                let a = Vector3::from(nodes[node]);
-                let centre = Vector3::new(a.x, 0.0, h - radius);
-                let to_film = a - centre;
-                let normal = to_film / to_film.norm();
-                let tangent = Vector3::new(0.0, normal.z, -normal.y);
-                GapSpec {
-                    name: format!("G{}", k + 1),
-                    film_node: node,
-                    support: GapSupport::Point((centre + normal * radius).into()),
-                    frame: GapFrame::from_x_and_z(tangent, normal),
-                    initial_gap: (to_film.norm() - radius).max(0.0),
-                    normal_stiffness: kn,
-                    tangential_stiffness: self.tangential_penalty_ratio * kn,
-                    friction: self.friction,
-                    friction_law: self.friction_law,
-                }
-            })
-            .collect();
-        let (gaps, curved_supports) = match self.contact {
-            SpecimenContact::Gaps => (gaps, vec![]),
-            SpecimenContact::CurvedSupport => {
-                let rp = self.pipe_radius;
-                let foot = (self.arch_half_span / radius).asin();
-                let support = CurvedSupport {
-                    name: "arch".into(),
-                    centreline: Centreline::Circle {
-                        centre: [column as f64 * dx, 0.0, h - radius],
-                        // About −x, from +z: the angle grows from the crown toward the foot (+y).
-                        axis: [-1.0, 0.0, 0.0],
-                        radius: radius - rp,
-                        angles: Some([-0.1, foot + 0.1]),
-                        start_direction: Some([0.0, 0.0, 1.0]),
-                    },
-                    tube_radius: rp,
-                    nodes: gaps.iter().map(|g| g.film_node).collect(),
-                    normal_stiffness: kn,
-                    tangential_stiffness: self.tangential_penalty_ratio * kn,
-                    friction: self.friction,
-                    friction_law: self.friction_law,
-                };
-                (vec![], vec![support])
-            }
-        };
-        let groups = match self.frame_path {
-            FramePath::Lowered => vec![BoundaryGroup {
-                name: "frame".into(),
-                nodes: frame,
-                target: self.target(),
-                components: None,
-                hinge: None,
-            }],
-            FramePath::Wrapped { .. } => frame
-                .iter()
-                .map(|&v| BoundaryGroup {
-                    name: format!("node{v}"),
-                    nodes: vec![v],
-                    target: self.wrapped_displacement(nodes[v], 1.0),
-                    components: None,
-                    hinge: None,
-                })
-                .collect(),
-        };
+        let (gaps, curved_supports) = self.contacts(&nodes);
+        let groups = self.groups(frame, &nodes);
         let model = Model {
             loads: Default::default(),
             outputs: Default::default(),
@@ -436,6 +348,126 @@ impl ParallelArch {
         model.validate().map_err(|e| e.to_string())?;
         Ok(model)
     }
+
+    /// The film's grid over the quarter frame at the arch height: its nodes (row by row) and
+    /// two triangles per cell.
+    fn mesh(&self) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+        let n = CELLS * self.refinement;
+        let (dx, dy) = (self.frame_half_x / n as f64, self.frame_half_y / n as f64);
+        let h = self.arch_height;
+        let id = |i: usize, j: usize| grid_node(n, i, j);
+        let mut nodes = Vec::with_capacity((n + 1) * (n + 1));
+        for j in 0..=n {
+            for i in 0..=n {
+                nodes.push([i as f64 * dx, j as f64 * dy, h]);
+            }
+        }
+        let mut triangles = Vec::with_capacity(2 * n * n);
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            }
+        }
+        (nodes, triangles)
+    }
+
+    /// The film's contact with the arch at the film nodes above it: gap elements, or one
+    /// curved support along the arch pipe.
+    fn contacts(&self, nodes: &[[f64; 3]]) -> (Vec<GapSpec>, Vec<CurvedSupport>) {
+        let r = self.refinement;
+        let n = CELLS * r;
+        let dx = self.frame_half_x / n as f64;
+        let h = self.arch_height;
+        let radius = self.arch_radius();
+        let column = (self.arch_offset / dx).round() as usize;
+        let kn = self.normal_penalty_factor * self.material.membrane_stiffness();
+        let gaps: Vec<GapSpec> = (0..GAP_COUNT)
+            .map(|k| {
+                let node = grid_node(n, column, k * r);
+                let a = Vector3::from(nodes[node]);
+                let centre = Vector3::new(a.x, 0.0, h - radius);
+                let to_film = a - centre;
+                let normal = to_film / to_film.norm();
+                let tangent = Vector3::new(0.0, normal.z, -normal.y);
+                GapSpec {
+                    name: format!("G{}", k + 1),
+                    film_node: node,
+                    support: GapSupport::Point((centre + normal * radius).into()),
+                    frame: GapFrame::from_x_and_z(tangent, normal),
+                    initial_gap: (to_film.norm() - radius).max(0.0),
+                    normal_stiffness: kn,
+                    tangential_stiffness: self.tangential_penalty_ratio * kn,
+                    friction: self.friction,
+                    friction_law: self.friction_law,
+                }
+            })
+            .collect();
+        match self.contact {
+            SpecimenContact::Gaps => (gaps, vec![]),
+            SpecimenContact::CurvedSupport => {
+                let rp = self.pipe_radius;
+                let foot = (self.arch_half_span / radius).asin();
+                let support = CurvedSupport {
+                    name: "arch".into(),
+                    centreline: Centreline::Circle {
+                        centre: [column as f64 * dx, 0.0, h - radius],
+                        // About −x, from +z: the angle grows from the crown toward the foot (+y).
+                        axis: [-1.0, 0.0, 0.0],
+                        radius: radius - rp,
+                        angles: Some([-0.1, foot + 0.1]),
+                        start_direction: Some([0.0, 0.0, 1.0]),
+                    },
+                    tube_radius: rp,
+                    nodes: gaps.iter().map(|g| g.film_node).collect(),
+                    normal_stiffness: kn,
+                    tangential_stiffness: self.tangential_penalty_ratio * kn,
+                    friction: self.friction,
+                    friction_law: self.friction_law,
+                };
+                (vec![], vec![support])
+            }
+        }
+    }
+
+    /// The boundary groups moving the `frame` nodes: one lowering them all, or one per node
+    /// following the wrapped film.
+    fn groups(&self, frame: Vec<usize>, nodes: &[[f64; 3]]) -> Vec<BoundaryGroup> {
+        match self.frame_path {
+            FramePath::Lowered => vec![BoundaryGroup {
+                name: "frame".into(),
+                nodes: frame,
+                target: self.target(),
+                components: None,
+                hinge: None,
+            }],
+            FramePath::Wrapped { .. } => frame
+                .iter()
+                .map(|&v| BoundaryGroup {
+                    name: format!("node{v}"),
+                    nodes: vec![v],
+                    target: self.wrapped_displacement(nodes[v], 1.0),
+                    components: None,
+                    hinge: None,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The index of node (`i`, `j`) of the (`n` + 1) × (`n` + 1) grid, numbered row by row.
+fn grid_node(n: usize, i: usize, j: usize) -> usize {
+    j * (n + 1) + i
+}
+
+/// The grid's nodes (`n` cells a side) whose (`i`, `j`) satisfy `pred`, row by row.
+fn grid_nodes(n: usize, pred: &dyn Fn(usize, usize) -> bool) -> Vec<usize> {
+    (0..=n)
+        .flat_map(|j| (0..=n).map(move |i| (i, j)))
+        .filter(|&(i, j)| pred(i, j))
+        .map(|(i, j)| grid_node(n, i, j))
+        .collect()
 }
 
 /// One row of the paper's Table 1.

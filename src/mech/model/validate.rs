@@ -47,9 +47,29 @@ impl Model {
 
     /// Checks every item; the first problem found is returned.
     pub fn validate(&self) -> Result<(), ModelError> {
-        let n = self.nodes.len();
-        let size = crate::mech::model::bounding_diagonal(&self.nodes);
-        if n == 0 || self.triangles.is_empty() {
+        self.validate_nodes()?;
+        self.validate_material()?;
+        self.validate_triangles()?;
+        self.check_frame_axis()?;
+        let mut names = HashSet::new();
+        let constrained = self.validate_supports(&mut names)?;
+        self.validate_groups(&mut names, &constrained)?;
+        self.validate_gaps(&mut names)?;
+        self.validate_loads(&mut names)?;
+        self.validate_outputs(&mut names)?;
+        self.validate_cables(&mut names)?;
+        self.validate_curved_supports(&mut names)?;
+        self.validate_chambers(&mut names)?;
+        self.validate_orifices(&mut names)?;
+        self.validate_layers(&mut names)?;
+        self.validate_layer_contacts(&mut names)?;
+        self.validate_text()?;
+        crate::mech::model::restraint::check(self)
+    }
+
+    /// Checks that there are nodes and triangles, that the name is an identifier and every node finite.
+    fn validate_nodes(&self) -> Result<(), ModelError> {
+        if self.nodes.is_empty() || self.triangles.is_empty() {
             return Err(ModelError::Empty {
                 message: "needs at least one node and one triangle".into(),
             });
@@ -67,17 +87,25 @@ impl Model {
                 });
             }
         }
-        let check_node = |item: &dyn Fn() -> String, node: usize| {
-            if node < n {
-                Ok(())
-            } else {
-                Err(ModelError::UnknownNode {
-                    item: item(),
-                    node,
-                    node_count: n,
-                })
-            }
-        };
+        Ok(())
+    }
+
+    /// An unknown-node error unless `node` is a node of the model; `item` names what refers to it.
+    fn check_node(&self, item: &dyn Fn() -> String, node: usize) -> Result<(), ModelError> {
+        let n = self.nodes.len();
+        if node < n {
+            Ok(())
+        } else {
+            Err(ModelError::UnknownNode {
+                item: item(),
+                node,
+                node_count: n,
+            })
+        }
+    }
+
+    /// Checks the material: E, ν, thickness, prestress, η, density, yield stress, temperature.
+    fn validate_material(&self) -> Result<(), ModelError> {
         let m = &self.material;
         if !(m.youngs_modulus > 0.0 && m.youngs_modulus.is_finite()) {
             return Err(ModelError::Material {
@@ -136,9 +164,14 @@ impl Model {
                 ),
             });
         }
+        Ok(())
+    }
+
+    /// Checks every triangle: known nodes, three distinct ones, not degenerate.
+    fn validate_triangles(&self) -> Result<(), ModelError> {
         for (t, tri) in self.triangles.iter().enumerate() {
             for &v in tri {
-                check_node(&|| format!("triangle {t}"), v)?;
+                self.check_node(&|| format!("triangle {t}"), v)?;
             }
             let x = tri.map(|v| Vector3::from(self.nodes[v]));
             if tri[0] == tri[1]
@@ -152,76 +185,45 @@ impl Model {
                 });
             }
         }
-        self.check_frame_axis()?;
-        // Constrained DOFs: 0 free, 1 fixed (support or symmetry), 2 prescribed by a group.
-        let mut constrained = vec![[false; 3]; n];
-        let mut names = HashSet::new();
+        Ok(())
+    }
+
+    /// Checks the support-set names and the supports' and symmetry planes' nodes; returns
+    /// which DOFs of each node they fix.
+    fn validate_supports(&self, names: &mut HashSet<String>) -> Result<Vec<[bool; 3]>, ModelError> {
+        let mut constrained = vec![[false; 3]; self.nodes.len()];
         for name in self.support_sets() {
-            check_name(&mut names, "support set", &name)?;
+            check_name(names, "support set", &name)?;
         }
         for s in &self.supports {
-            check_node(&|| "support".to_string(), s.node)?;
+            self.check_node(&|| "support".to_string(), s.node)?;
             for a in &s.fixed {
                 constrained[s.node][a.index()] = true;
             }
         }
         for s in &self.symmetry {
             for &v in &s.nodes {
-                check_node(&|| format!("symmetry plane '{}'", s.name), v)?;
+                self.check_node(&|| format!("symmetry plane '{}'", s.name), v)?;
                 constrained[v][s.normal.index()] = true;
             }
         }
-        let mut in_group = vec![None::<&str>; n];
+        Ok(constrained)
+    }
+
+    /// Checks the boundary groups (names join the namespace): their fields, known nodes, no
+    /// node in two groups, none prescribed where `constrained` fixes it.
+    fn validate_groups(
+        &self,
+        names: &mut HashSet<String>,
+        constrained: &[[bool; 3]],
+    ) -> Result<(), ModelError> {
+        let mut in_group = vec![None::<&str>; self.nodes.len()];
         for g in &self.groups {
-            check_name(&mut names, "boundary group", &g.name)?;
-            if g.nodes.is_empty() {
-                return Err(ModelError::Name {
-                    item: format!("boundary group '{}'", g.name),
-                    message: "has no nodes".into(),
-                });
-            }
-            if g.target.iter().any(|v| !v.is_finite()) {
-                return Err(ModelError::NotFinite {
-                    item: format!("boundary group '{}' target", g.name),
-                });
-            }
-            if let Some(axes) = &g.components {
-                let listed = axes.len();
-                if listed == 0 || g.prescribes().iter().filter(|&&p| p).count() != listed {
-                    return Err(ModelError::Name {
-                        item: format!("boundary group '{}'", g.name),
-                        message: "components must list each of \"x\", \"y\", \"z\" at most once, and at least one"
-                            .into(),
-                    });
-                }
-            }
-            if let Some(h) = &g.hinge {
-                let item = || format!("boundary group '{}' hinge", g.name);
-                if h.point.iter().chain(&h.axis).any(|v| !v.is_finite())
-                    || !h.target_angle.is_finite()
-                {
-                    return Err(ModelError::NotFinite { item: item() });
-                }
-                if Vector3::from(h.axis).norm() == 0.0 {
-                    return Err(ModelError::Name {
-                        item: item(),
-                        message: "axis is the zero vector".into(),
-                    });
-                }
-                if h.target_angle.abs() > Hinge::MAX_ANGLE {
-                    return Err(ModelError::Name {
-                        item: item(),
-                        message: format!(
-                            "target_angle {} rad is beyond two full turns ({:.4} rad)",
-                            h.target_angle,
-                            Hinge::MAX_ANGLE
-                        ),
-                    });
-                }
-            }
+            check_name(names, "boundary group", &g.name)?;
+            Self::validate_group_fields(g)?;
             let prescribed = g.prescribes();
             for &v in &g.nodes {
-                check_node(&|| format!("boundary group '{}'", g.name), v)?;
+                self.check_node(&|| format!("boundary group '{}'", g.name), v)?;
                 if let Some(other) = in_group[v] {
                     return Err(ModelError::Conflict {
                         node: v,
@@ -240,85 +242,148 @@ impl Model {
                 in_group[v] = Some(&g.name);
             }
         }
-        for gap in &self.gaps {
-            check_name(&mut names, "gap", &gap.name)?;
-            let bad = |message: String| ModelError::Gap {
-                gap: gap.name.clone(),
-                message,
-            };
-            check_node(&|| format!("gap '{}' film_node", gap.name), gap.film_node)?;
-            match &gap.support {
-                GapSupport::Node(b) => {
-                    check_node(&|| format!("gap '{}' support node", gap.name), *b)?;
-                    if *b == gap.film_node {
-                        return Err(bad("support node equals film node".into()));
-                    }
-                }
-                GapSupport::Point(p) => {
-                    if p.iter().any(|v| !v.is_finite()) {
-                        return Err(bad("support point is not finite".into()));
-                    }
-                }
-            }
-            let frame_values = gap.frame.x.iter().chain(&gap.frame.y).chain(&gap.frame.z);
-            if frame_values.clone().any(|v| !v.is_finite())
-                || gap.frame.orthonormality_error() > 1e-6
-            {
-                return Err(bad(format!(
-                    "frame is not orthonormal and right-handed with y = z × x (error {:.2e})",
-                    gap.frame.orthonormality_error()
-                )));
-            }
-            let positive = |v: f64| v > 0.0 && v.is_finite();
-            if !positive(gap.normal_stiffness) {
-                return Err(bad(format!(
-                    "normal_stiffness = {} must be > 0",
-                    gap.normal_stiffness
-                )));
-            }
-            if !positive(gap.tangential_stiffness) {
-                return Err(bad(format!(
-                    "tangential_stiffness = {} must be > 0",
-                    gap.tangential_stiffness
-                )));
-            }
-            if !(gap.friction >= 0.0 && gap.friction <= MAX_FRICTION) {
-                return Err(bad(format!(
-                    "friction μ = {} must lie in [0, {MAX_FRICTION}]",
-                    gap.friction
-                )));
-            }
-            if !(gap.initial_gap >= 0.0 && gap.initial_gap.is_finite()) {
-                return Err(bad(format!(
-                    "initial_gap = {} must be ≥ 0",
-                    gap.initial_gap
-                )));
-            }
-            let distance = gap.geometric_gap(&self.nodes);
-            let tolerance = GAP_GEOMETRY_TOLERANCE * size;
-            if (distance - gap.initial_gap).abs() > tolerance {
-                return Err(bad(format!(
-                    "initial_gap = {} m contradicts the geometry: the film node lies {distance:.6} m \
-                     from the support along the gap's z (the difference is beyond {tolerance:.2e} m, \
-                     {GAP_GEOMETRY_TOLERANCE} of the model's size{}); correct initial_gap, the \
-                     support or the frame",
-                    gap.initial_gap,
-                    if distance < 0.0 {
-                        ", and the node starts inside the support"
-                    } else {
-                        ""
-                    }
-                )));
+        Ok(())
+    }
+
+    /// Checks one boundary group's own fields: nodes listed, a finite target, its components
+    /// and hinge.
+    fn validate_group_fields(g: &BoundaryGroup) -> Result<(), ModelError> {
+        if g.nodes.is_empty() {
+            return Err(ModelError::Name {
+                item: format!("boundary group '{}'", g.name),
+                message: "has no nodes".into(),
+            });
+        }
+        if g.target.iter().any(|v| !v.is_finite()) {
+            return Err(ModelError::NotFinite {
+                item: format!("boundary group '{}' target", g.name),
+            });
+        }
+        if let Some(axes) = &g.components {
+            let listed = axes.len();
+            if listed == 0 || g.prescribes().iter().filter(|&&p| p).count() != listed {
+                return Err(ModelError::Name {
+                    item: format!("boundary group '{}'", g.name),
+                    message: "components must list each of \"x\", \"y\", \"z\" at most once, and at least one"
+                        .into(),
+                });
             }
         }
-        self.validate_loads(&mut names)?;
-        self.validate_outputs(&mut names)?;
-        self.validate_cables(&mut names)?;
-        self.validate_curved_supports(&mut names)?;
-        self.validate_chambers(&mut names)?;
-        self.validate_orifices(&mut names)?;
-        self.validate_layers(&mut names)?;
-        self.validate_layer_contacts(&mut names)?;
+        if let Some(h) = &g.hinge {
+            Self::validate_hinge(&g.name, h)?;
+        }
+        Ok(())
+    }
+
+    /// Checks a group's hinge: finite, a non-zero axis, a target angle within two turns.
+    fn validate_hinge(group: &str, h: &Hinge) -> Result<(), ModelError> {
+        let item = || format!("boundary group '{group}' hinge");
+        if h.point.iter().chain(&h.axis).any(|v| !v.is_finite()) || !h.target_angle.is_finite() {
+            return Err(ModelError::NotFinite { item: item() });
+        }
+        if Vector3::from(h.axis).norm() == 0.0 {
+            return Err(ModelError::Name {
+                item: item(),
+                message: "axis is the zero vector".into(),
+            });
+        }
+        if h.target_angle.abs() > Hinge::MAX_ANGLE {
+            return Err(ModelError::Name {
+                item: item(),
+                message: format!(
+                    "target_angle {} rad is beyond two full turns ({:.4} rad)",
+                    h.target_angle,
+                    Hinge::MAX_ANGLE
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// Checks the gaps (names join the namespace), each by [`Self::validate_gap`].
+    fn validate_gaps(&self, names: &mut HashSet<String>) -> Result<(), ModelError> {
+        let size = crate::mech::model::bounding_diagonal(&self.nodes);
+        for gap in &self.gaps {
+            check_name(names, "gap", &gap.name)?;
+            self.validate_gap(gap, size)?;
+        }
+        Ok(())
+    }
+
+    /// Checks one gap: its nodes or point, an orthonormal frame, positive stiffnesses, μ, and
+    /// an initial gap the geometry agrees with (within a fraction of the model's `size`).
+    fn validate_gap(&self, gap: &GapSpec, size: f64) -> Result<(), ModelError> {
+        let bad = |message: String| ModelError::Gap {
+            gap: gap.name.clone(),
+            message,
+        };
+        self.check_node(&|| format!("gap '{}' film_node", gap.name), gap.film_node)?;
+        match &gap.support {
+            GapSupport::Node(b) => {
+                self.check_node(&|| format!("gap '{}' support node", gap.name), *b)?;
+                if *b == gap.film_node {
+                    return Err(bad("support node equals film node".into()));
+                }
+            }
+            GapSupport::Point(p) => {
+                if p.iter().any(|v| !v.is_finite()) {
+                    return Err(bad("support point is not finite".into()));
+                }
+            }
+        }
+        let frame_values = gap.frame.x.iter().chain(&gap.frame.y).chain(&gap.frame.z);
+        if frame_values.clone().any(|v| !v.is_finite()) || gap.frame.orthonormality_error() > 1e-6 {
+            return Err(bad(format!(
+                "frame is not orthonormal and right-handed with y = z × x (error {:.2e})",
+                gap.frame.orthonormality_error()
+            )));
+        }
+        let positive = |v: f64| v > 0.0 && v.is_finite();
+        if !positive(gap.normal_stiffness) {
+            return Err(bad(format!(
+                "normal_stiffness = {} must be > 0",
+                gap.normal_stiffness
+            )));
+        }
+        if !positive(gap.tangential_stiffness) {
+            return Err(bad(format!(
+                "tangential_stiffness = {} must be > 0",
+                gap.tangential_stiffness
+            )));
+        }
+        if !(gap.friction >= 0.0 && gap.friction <= MAX_FRICTION) {
+            return Err(bad(format!(
+                "friction μ = {} must lie in [0, {MAX_FRICTION}]",
+                gap.friction
+            )));
+        }
+        if !(gap.initial_gap >= 0.0 && gap.initial_gap.is_finite()) {
+            return Err(bad(format!(
+                "initial_gap = {} must be ≥ 0",
+                gap.initial_gap
+            )));
+        }
+        let distance = gap.geometric_gap(&self.nodes);
+        let tolerance = GAP_GEOMETRY_TOLERANCE * size;
+        if (distance - gap.initial_gap).abs() > tolerance {
+            return Err(bad(format!(
+                "initial_gap = {} m contradicts the geometry: the film node lies {distance:.6} m \
+                 from the support along the gap's z (the difference is beyond {tolerance:.2e} m, \
+                 {GAP_GEOMETRY_TOLERANCE} of the model's size{}); correct initial_gap, the \
+                 support or the frame",
+                gap.initial_gap,
+                if distance < 0.0 {
+                    ", and the node starts inside the support"
+                } else {
+                    ""
+                }
+            )));
+        }
+        Ok(())
+    }
+
+    /// Checks the text bound for modelDescription.xml: the description and symmetry-plane names.
+    fn validate_text(&self) -> Result<(), ModelError> {
         check_xml_text("model description", &self.description)?;
         for s in &self.symmetry {
             check_xml_text(
@@ -326,7 +391,7 @@ impl Model {
                 &s.name,
             )?;
         }
-        crate::mech::model::restraint::check(self)
+        Ok(())
     }
 
     /// Checks an element selection: a non-empty list of existing triangles, each once.

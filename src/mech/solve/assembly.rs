@@ -105,126 +105,13 @@ pub struct PatternError(pub String);
 impl System {
     /// Numbers the DOFs, builds the elements and the pattern. `model` must be validated.
     pub fn new(model: &Model, lower_only: bool) -> Result<Self, PatternError> {
-        let n = model.nodes.len();
-        let mut dofs = vec![Dof::Free(0); 3 * n];
-        for s in &model.supports {
-            for a in &s.fixed {
-                dofs[3 * s.node + a.index()] = Dof::Fixed;
-            }
-        }
-        for s in &model.symmetry {
-            for &v in &s.nodes {
-                dofs[3 * v + s.normal.index()] = Dof::Fixed;
-            }
-        }
-        for (group, g) in model.groups.iter().enumerate() {
-            let prescribed = g.prescribes();
-            for &v in &g.nodes {
-                for component in (0..3).filter(|&c| prescribed[c]) {
-                    dofs[3 * v + component] = Dof::Prescribed { group, component };
-                }
-            }
-        }
-        let mut free_count = 0;
-        for d in dofs.iter_mut() {
-            if let Dof::Free(eq) = d {
-                *eq = free_count;
-                free_count += 1;
-            }
-        }
-        let mut thickness = vec![None; model.triangles.len()];
-        for l in &model.layers {
-            for e in model.selected_triangles(&l.elements) {
-                thickness[e] = Some(l.thickness);
-            }
-        }
-        let triangles = model
-            .triangles
-            .iter()
-            .zip(thickness)
-            .enumerate()
-            .map(|(k, (t, layer))| {
-                model
-                    .element_on(k, &model.nodes)
-                    .map(|e| (*t, layer.map_or(e, |h| e.with_thickness(h))))
-                    .map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let gaps: Vec<GapGeometry> = model
-            .gaps
-            .iter()
-            .map(|g| GapGeometry {
-                film_node: g.film_node,
-                support_node: match g.support {
-                    GapSupport::Node(b) => Some(b),
-                    GapSupport::Point(_) => None,
-                },
-                rotation: g.frame.rotation(),
-            })
-            .collect();
-
-        // Pattern: one pair per element-matrix entry between free DOFs, in assembly order.
-        let mut pairs: Vec<Pair<usize, usize>> =
-            Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
-        let mut entry_rows: Vec<Option<(usize, usize)>> = Vec::with_capacity(pairs.capacity());
-        let mut push_block = |global: &[usize]| {
-            // Column-major, like nalgebra's storage of the element matrix.
-            for &gj in global {
-                for &gi in global {
-                    let entry = match (dofs[gi], dofs[gj]) {
-                        (Dof::Free(i), Dof::Free(j)) if !lower_only || i >= j => Some((i, j)),
-                        _ => None,
-                    };
-                    if let Some((i, j)) = entry {
-                        pairs.push(Pair::new(i, j));
-                    }
-                    entry_rows.push(entry);
-                }
-            }
-        };
-        for (t, _) in &triangles {
-            push_block(&node_dofs(t));
-        }
-        let mut gap_offsets = Vec::with_capacity(gaps.len());
-        let mut offset = 81 * triangles.len();
-        for g in &gaps {
-            gap_offsets.push(offset);
-            let block = gap_dofs(g);
-            offset += block.len() * block.len();
-            push_block(&block);
-        }
+        let (dofs, free_count) = number_dofs(model);
+        let triangles = triangle_elements(model)?;
+        let gaps = gap_geometries(model);
         let layer_contacts = LayerContactSetup::new(model);
-        let mut pair_offsets = Vec::with_capacity(layer_contacts.blocks.len());
-        for (v, tri) in &layer_contacts.blocks {
-            pair_offsets.push(offset);
-            offset += 144;
-            let mut block = [0; 12];
-            block[..3].copy_from_slice(&[3 * v, 3 * v + 1, 3 * v + 2]);
-            block[3..].copy_from_slice(&node_dofs(tri));
-            push_block(&block);
-        }
-        // Keep every diagonal entry so that a DOF whose stiffness vanishes stays in the pattern.
-        for i in 0..free_count {
-            pairs.push(Pair::new(i, i));
-        }
-        let (symbolic, _) =
-            SymbolicSparseColMat::try_new_from_indices(free_count, free_count, &pairs)
-                .map_err(|e| PatternError(format!("sparsity pattern: {e:?}")))?;
-        if symbolic.compute_nnz() >= NO_SLOT as usize {
-            return Err(PatternError("more than 2^32 nonzeros".into()));
-        }
-        let col_ptr = symbolic.col_ptr();
-        let row_idx = symbolic.row_idx();
-        let slots = entry_rows
-            .iter()
-            .map(|e| match e {
-                None => NO_SLOT,
-                Some((i, j)) => {
-                    let rows = &row_idx[col_ptr[*j]..col_ptr[*j + 1]];
-                    (col_ptr[*j] + rows.binary_search(i).expect("entry is in the pattern")) as u32
-                }
-            })
-            .collect();
+        let mut entries =
+            PatternEntries::collect(&dofs, &triangles, &gaps, &layer_contacts, lower_only);
+        let (symbolic, slots) = entries.pattern(free_count)?;
         Ok(Self {
             dofs,
             free_count,
@@ -233,8 +120,8 @@ impl System {
             material: model.material.at_temperature(),
             symbolic,
             slots,
-            gap_offsets,
-            pair_offsets,
+            gap_offsets: entries.gap_offsets,
+            pair_offsets: entries.pair_offsets,
             layer_contacts,
             lower_only,
             threads: 1,
@@ -633,6 +520,179 @@ impl System {
                 }
             }
         }
+    }
+}
+
+/// Each global DOF's kind (supports and symmetry planes fix, boundary groups prescribe) with
+/// the free ones numbered in order, and the number of free DOFs.
+fn number_dofs(model: &Model) -> (Vec<Dof>, usize) {
+    let n = model.nodes.len();
+    let mut dofs = vec![Dof::Free(0); 3 * n];
+    for s in &model.supports {
+        for a in &s.fixed {
+            dofs[3 * s.node + a.index()] = Dof::Fixed;
+        }
+    }
+    for s in &model.symmetry {
+        for &v in &s.nodes {
+            dofs[3 * v + s.normal.index()] = Dof::Fixed;
+        }
+    }
+    for (group, g) in model.groups.iter().enumerate() {
+        let prescribed = g.prescribes();
+        for &v in &g.nodes {
+            for component in (0..3).filter(|&c| prescribed[c]) {
+                dofs[3 * v + component] = Dof::Prescribed { group, component };
+            }
+        }
+    }
+    let mut free_count = 0;
+    for d in dofs.iter_mut() {
+        if let Dof::Free(eq) = d {
+            *eq = free_count;
+            free_count += 1;
+        }
+    }
+    (dofs, free_count)
+}
+
+/// The model's triangles as elements, each with its layer's thickness where a layer selects it.
+fn triangle_elements(model: &Model) -> Result<Vec<([usize; 3], MembraneTriangle)>, PatternError> {
+    let mut thickness = vec![None; model.triangles.len()];
+    for l in &model.layers {
+        for e in model.selected_triangles(&l.elements) {
+            thickness[e] = Some(l.thickness);
+        }
+    }
+    model
+        .triangles
+        .iter()
+        .zip(thickness)
+        .enumerate()
+        .map(|(k, (t, layer))| {
+            model
+                .element_on(k, &model.nodes)
+                .map(|e| (*t, layer.map_or(e, |h| e.with_thickness(h))))
+                .map_err(|_| PatternError(format!("triangle {t:?} is degenerate")))
+        })
+        .collect()
+}
+
+/// The model's gaps as assembly needs them.
+fn gap_geometries(model: &Model) -> Vec<GapGeometry> {
+    model
+        .gaps
+        .iter()
+        .map(|g| GapGeometry {
+            film_node: g.film_node,
+            support_node: match g.support {
+                GapSupport::Node(b) => Some(b),
+                GapSupport::Point(_) => None,
+            },
+            rotation: g.frame.rotation(),
+        })
+        .collect()
+}
+
+/// The entries of every element matrix, in assembly order: triangles, gaps, layer-contact pairs.
+struct PatternEntries {
+    /// One pair per entry between free DOFs (only the lower triangle's when `lower_only`).
+    pairs: Vec<Pair<usize, usize>>,
+    /// Each entry's (row, column) equation, or `None` where it has a non-free DOF.
+    entry_rows: Vec<Option<(usize, usize)>>,
+    /// Offset of each gap's entries.
+    gap_offsets: Vec<usize>,
+    /// Offset of each layer-contact pair's entries.
+    pair_offsets: Vec<usize>,
+}
+
+impl PatternEntries {
+    /// Lists the entries of the triangles', gaps' and layer contacts' blocks.
+    fn collect(
+        dofs: &[Dof],
+        triangles: &[([usize; 3], MembraneTriangle)],
+        gaps: &[GapGeometry],
+        layer_contacts: &LayerContactSetup,
+        lower_only: bool,
+    ) -> Self {
+        // Pattern: one pair per element-matrix entry between free DOFs, in assembly order.
+        let mut pairs: Vec<Pair<usize, usize>> =
+            Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
+        let mut entry_rows: Vec<Option<(usize, usize)>> = Vec::with_capacity(pairs.capacity());
+        let mut push_block = |global: &[usize]| {
+            // Column-major, like nalgebra's storage of the element matrix.
+            for &gj in global {
+                for &gi in global {
+                    let entry = match (dofs[gi], dofs[gj]) {
+                        (Dof::Free(i), Dof::Free(j)) if !lower_only || i >= j => Some((i, j)),
+                        _ => None,
+                    };
+                    if let Some((i, j)) = entry {
+                        pairs.push(Pair::new(i, j));
+                    }
+                    entry_rows.push(entry);
+                }
+            }
+        };
+        for (t, _) in triangles {
+            push_block(&node_dofs(t));
+        }
+        let mut gap_offsets = Vec::with_capacity(gaps.len());
+        let mut offset = 81 * triangles.len();
+        for g in gaps {
+            gap_offsets.push(offset);
+            let block = gap_dofs(g);
+            offset += block.len() * block.len();
+            push_block(&block);
+        }
+        let mut pair_offsets = Vec::with_capacity(layer_contacts.blocks.len());
+        for (v, tri) in &layer_contacts.blocks {
+            pair_offsets.push(offset);
+            offset += 144;
+            let mut block = [0; 12];
+            block[..3].copy_from_slice(&[3 * v, 3 * v + 1, 3 * v + 2]);
+            block[3..].copy_from_slice(&node_dofs(tri));
+            push_block(&block);
+        }
+        Self {
+            pairs,
+            entry_rows,
+            gap_offsets,
+            pair_offsets,
+        }
+    }
+
+    /// The CSC pattern of the entries over `free_count` equations, every diagonal entry in it,
+    /// and each entry's slot in its value array.
+    fn pattern(
+        &mut self,
+        free_count: usize,
+    ) -> Result<(SymbolicSparseColMat<usize>, Vec<u32>), PatternError> {
+        let pairs = &mut self.pairs;
+        // Keep every diagonal entry so that a DOF whose stiffness vanishes stays in the pattern.
+        for i in 0..free_count {
+            pairs.push(Pair::new(i, i));
+        }
+        let (symbolic, _) =
+            SymbolicSparseColMat::try_new_from_indices(free_count, free_count, pairs)
+                .map_err(|e| PatternError(format!("sparsity pattern: {e:?}")))?;
+        if symbolic.compute_nnz() >= NO_SLOT as usize {
+            return Err(PatternError("more than 2^32 nonzeros".into()));
+        }
+        let col_ptr = symbolic.col_ptr();
+        let row_idx = symbolic.row_idx();
+        let slots = self
+            .entry_rows
+            .iter()
+            .map(|e| match e {
+                None => NO_SLOT,
+                Some((i, j)) => {
+                    let rows = &row_idx[col_ptr[*j]..col_ptr[*j + 1]];
+                    (col_ptr[*j] + rows.binary_search(i).expect("entry is in the pattern")) as u32
+                }
+            })
+            .collect();
+        Ok((symbolic, slots))
     }
 }
 
