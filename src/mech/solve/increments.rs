@@ -220,6 +220,17 @@ impl Collinear {
     }
 }
 
+/// The first iteration (at least 1) whose residual in `history` (one per iterate, the
+/// predictor's first) is within `tolerance`; the last where none is.
+fn first_within(history: &[f64], tolerance: f64) -> usize {
+    let last = history.len().saturating_sub(1).max(1);
+    history
+        .iter()
+        .skip(1)
+        .position(|r| *r <= tolerance)
+        .map_or(last, |k| k + 1)
+}
+
 impl Analysis {
     /// Moves every boundary group to the translation `target` (m) and the hinge angle
     /// `angles` (rad, one per group: 0 for a group without a hinge), and the loads to `loads`;
@@ -265,7 +276,7 @@ impl Analysis {
                 .set(STRATEGIES[row].damping, to - from);
             let attempt = self.solve_increment(&current, &path.motion(to), &path.levels(to));
             let kept = attempt.as_ref().map_or(true, |(state, history)| {
-                let n = self.sizing_iterations(history.len() - 1);
+                let n = self.judged_iterations(history.len() - 1);
                 control.keeps(n, state.history_changed_from(&current))
             });
             let how = (STRATEGIES[row].name, kept);
@@ -274,7 +285,7 @@ impl Analysis {
                 Ok((state, history)) if kept => {
                     let force = self.account_stabilized(&mut report, &state.displacement);
                     last_start = Some(std::mem::replace(&mut current, state));
-                    control.converged(to, self.sizing_iterations(history.len() - 1));
+                    control.converged(to, self.sizing_iterations(&history));
                     report.note_converged(history, force);
                 }
                 Err(last) if !control.refused(&mut report) => {
@@ -320,15 +331,30 @@ impl Analysis {
         Ok(())
     }
 
-    /// The iterations `N` the controller sizes the next increment by, from the `n` an increment
-    /// converged in: the Ju–Rowlands matrix converges linearly by design, so its iterations do
-    /// not measure the increment's nonlinearity (`N*` then).
-    fn sizing_iterations(&self, n: usize) -> f64 {
+    /// The iterations an increment took, `n`, as the controller keeps or refuses it by: `N*` for
+    /// the Ju–Rowlands matrix, which converges linearly by design.
+    fn judged_iterations(&self, n: usize) -> f64 {
         if self.converges_linearly() {
             Self::TARGET_ITERATIONS as f64
         } else {
             n.max(1) as f64
         }
+    }
+
+    /// The iterations `N` the controller sizes the next increment by, from the residuals
+    /// `history` of a converged increment's iterates: those until the residual first met its
+    /// tolerance (`N*` for the Ju–Rowlands matrix). Where the answer lies on a kink of the laws
+    /// (a contact at the stick–slip limit, an element at the taut–wrinkled edge) Newton's last
+    /// iterations converge linearly; the iterations the displacement criterion then adds grow
+    /// only with the logarithm of the increment, so they do not measure its nonlinearity, and
+    /// shrinking the increment for them multiplies the increments without removing them.
+    fn sizing_iterations(&self, history: &[f64]) -> f64 {
+        if self.converges_linearly() {
+            return Self::TARGET_ITERATIONS as f64;
+        }
+        let tolerance =
+            self.settings.residual_tolerance * max_abs(&self.work.internal).max(self.force_floor);
+        first_within(history, tolerance) as f64
     }
 
     /// Whether Newton's iterations converge linearly by design: the Ju–Rowlands matrix with
@@ -628,6 +654,18 @@ mod tests {
         let mixed = a.predict(&start, &motion(moved), &pressure(300.0));
         let extrapolated = free_dofs_extrapolated(&a, &start, [&same, &double], &[&back, &mixed]);
         assert!(extrapolated > 0, "the pressure step moved no free DOF");
+    }
+
+    /// The controller sizes by the iterations until the residual met its tolerance: the
+    /// linearly converging iterations after it are not counted; without a residual within it,
+    /// every iteration counts.
+    #[test]
+    fn increments_are_sized_by_the_iterations_to_equilibrium_not_by_a_linear_tail() {
+        let linear_tail = [1.0, 1e-4, 4e-6, 2e-6, 1e-6, 5e-7, 2e-7];
+        assert_eq!(first_within(&linear_tail, 1e-5), 2);
+        assert_eq!(first_within(&linear_tail, 1e-9), 6);
+        assert_eq!(first_within(&[1e-6], 1e-5), 1, "a model without free DOFs");
+        assert_eq!(first_within(&[1.0, 2e-6], 1e-5), 1);
     }
 
     /// A moving boundary extrapolates by its ratio where it keeps the direction (within 8°) of
