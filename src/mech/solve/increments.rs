@@ -274,7 +274,8 @@ impl Analysis {
             self.parts
                 .stabilization
                 .set(STRATEGIES[row].damping, to - from);
-            let attempt = self.solve_increment(&current, &path.motion(to), &path.levels(to));
+            let limit = (row == 0 && control.can_halve()).then_some(2 * Self::TARGET_ITERATIONS);
+            let attempt = self.solve_increment(&current, &path.motion(to), &path.levels(to), limit);
             let kept = attempt.as_ref().map_or(true, |(state, history)| {
                 let n = self.judged_iterations(history.len() - 1);
                 control.keeps(n, state.history_changed_from(&current))
@@ -352,9 +353,7 @@ impl Analysis {
         if self.converges_linearly() {
             return Self::TARGET_ITERATIONS as f64;
         }
-        let tolerance =
-            self.settings.residual_tolerance * max_abs(&self.work.internal).max(self.force_floor);
-        first_within(history, tolerance) as f64
+        first_within(history, self.residual_tolerance()) as f64
     }
 
     /// Whether Newton's iterations converge linearly by design: the Ju–Rowlands matrix with
@@ -366,16 +365,16 @@ impl Analysis {
 
     /// At the end of a step the stabilization carried: the undamped equilibrium at the step's
     /// target solved from the damped state, alternating with a pseudo-time march at the target
-    /// (implicit Euler on the damped flow, unconditionally stable), its
-    /// pseudo-time step `τ` growing [`Self::RELEASE_GROWTH`]-fold after each converged round
-    /// and cut as much after a refused one, until the damping force `c k̄ m ΔU/τ` is within the
-    /// residual tolerance: the state then balances the undamped model to the same tolerance as
-    /// a Newton answer (switched evolution relaxation, Mulder & van Leer 1985: as `τ → ∞` each
-    /// round becomes a Newton solve). Newton refused from a state is tried again only once the
-    /// march has taken [`Self::PROGRESS`]'s tenth off the damping force. At most
-    /// [`Self::RELEASE_ROUNDS`] rounds; where they do
-    /// not settle, the last converged state stays, its damping force's work reported against
-    /// the bound.
+    /// (implicit Euler on the damped flow, unconditionally stable) whose pseudo-time step `τ` is
+    /// sized like an increment ([`Controller::converged`]: `τ (N*/N)^½` within a factor
+    /// [`Self::GROWTH`] after a round converged in `N` iterations, halved after a refused one),
+    /// until the damping force `c k̄ m ΔU/τ` is within the residual tolerance: the state then
+    /// balances the undamped model to the same tolerance as a Newton answer (switched evolution
+    /// relaxation, Mulder & van Leer 1985: as `τ → ∞` each round becomes a Newton solve).
+    /// Newton refused from a state is tried again only once the march has taken
+    /// [`Self::PROGRESS`]'s tenth off the damping force. The march gives up after
+    /// `max_cutbacks` rounds refused or without that progress; the last converged state then
+    /// stays, its damping force's work reported against the bound.
     fn release_stabilization(
         &mut self,
         current: &mut AnalysisState,
@@ -389,51 +388,75 @@ impl Analysis {
         // The damping force of the last converged round, and at the last refusal of the
         // undamped equilibrium (∞: before any converged round).
         let (mut force, mut refused_at) = (f64::INFINITY, None::<f64>);
-        for round in 0..2 * Self::RELEASE_ROUNDS {
+        let mut setbacks = 0;
+        while setbacks <= self.settings.max_cutbacks {
             // Each round tries the undamped equilibrium first (Newton from the damped state),
-            // then one step of the march.
-            let damped = round % 2 == 1;
-            // Refused from a state, Newton is not tried again before the march has taken a
-            // tenth off the damping force: its iterations are most of the release's cost, and
-            // a wrinkled film without a unique equilibrium refuses every one.
-            if !damped && refused_at.is_some_and(|f| force >= Self::PROGRESS * f) {
-                continue;
-            }
-            let (row, how) = if damped {
-                (row, "release, damped")
-            } else {
-                (0, "release")
-            };
-            self.parts.stabilization.set(STRATEGIES[row].damping, tau);
-            let attempt = self.solve_increment(current, &motion, &levels);
-            self.note_attempt(report, row, (1.0, 1.0), (how, true), &attempt);
-            let Ok((mut state, history)) = attempt else {
-                if damped {
-                    tau /= Self::RELEASE_GROWTH;
-                } else {
-                    refused_at = Some(force);
+            // then one step of the march. Refused from a state, Newton is not tried again
+            // before the march has taken a tenth off the damping force: its iterations are most
+            // of the release's cost, and a wrinkled film without a unique equilibrium refuses
+            // every one.
+            for damped in [false, true] {
+                if !damped && refused_at.is_some_and(|f| force >= Self::PROGRESS * f) {
+                    continue;
                 }
-                continue;
-            };
-            force = self.account_stabilized(report, &state.displacement);
-            let tolerance = self.settings.residual_tolerance
-                * max_abs(&self.work.internal).max(self.force_floor);
-            // The step's last increment, for the next step's predictor, is the motion from the
-            // start of the last loaded increment to here.
-            for (l, a) in state.last_increment.iter_mut().zip(&current.last_increment) {
-                *l += a;
+                let (row, how) = if damped {
+                    (row, "release, damped")
+                } else {
+                    (0, "release")
+                };
+                self.parts.stabilization.set(STRATEGIES[row].damping, tau);
+                let attempt = self.solve_increment(current, &motion, &levels, None);
+                self.note_attempt(report, row, (1.0, 1.0), (how, true), &attempt);
+                let Ok((state, history)) = attempt else {
+                    if damped {
+                        (tau, setbacks) = (tau / 2.0, setbacks + 1);
+                    } else {
+                        refused_at = Some(force);
+                    }
+                    continue;
+                };
+                let ratio = (Self::TARGET_ITERATIONS as f64 / self.sizing_iterations(&history))
+                    .sqrt()
+                    .clamp(1.0 / Self::GROWTH, Self::GROWTH);
+                let before = force;
+                force = self.released_round(current, last_start, report, state, history);
+                if force <= self.residual_tolerance() {
+                    return;
+                }
+                setbacks += usize::from(force > Self::PROGRESS * before);
+                tau *= ratio;
             }
-            let loads = state.last_load_increment.iter_mut();
-            for (l, a) in loads.zip(&current.last_load_increment) {
-                *l += a;
-            }
-            report.note_converged(history, force);
-            *last_start = Some(std::mem::replace(current, state));
-            if force <= tolerance {
-                return;
-            }
-            tau *= Self::RELEASE_GROWTH;
         }
+    }
+
+    /// Takes the converged release round `state` (residuals `history`) as the step's state;
+    /// returns its damping force's largest magnitude (N).
+    fn released_round(
+        &mut self,
+        current: &mut AnalysisState,
+        last_start: &mut Option<AnalysisState>,
+        report: &mut StepReport,
+        mut state: AnalysisState,
+        history: Vec<f64>,
+    ) -> f64 {
+        let force = self.account_stabilized(report, &state.displacement);
+        // The step's last increment, for the next step's predictor, is the motion from the
+        // start of the last loaded increment to here.
+        for (l, a) in state.last_increment.iter_mut().zip(&current.last_increment) {
+            *l += a;
+        }
+        let loads = state.last_load_increment.iter_mut();
+        for (l, a) in loads.zip(&current.last_load_increment) {
+            *l += a;
+        }
+        report.note_converged(history, force);
+        *last_start = Some(std::mem::replace(current, state));
+        force
+    }
+
+    /// The residual tolerance at the last assembly (N).
+    fn residual_tolerance(&self) -> f64 {
+        self.settings.residual_tolerance * max_abs(&self.work.internal).max(self.force_floor)
     }
 
     /// Tells the observer (`progress.rs`) how the increment `from → to` of the step solved by
@@ -469,12 +492,6 @@ impl Analysis {
             converged: attempt.is_ok() && kept,
         });
     }
-
-    /// Most rounds [`Self::release_stabilization`] adds at a step's end.
-    pub(crate) const RELEASE_ROUNDS: usize = 20;
-    /// The factor of the release's pseudo-time step after a converged round (its inverse after
-    /// a refused one).
-    pub(crate) const RELEASE_GROWTH: f64 = 4.0;
 
     /// Accounts an increment converged at `u` (the stabilization's work over it added to the
     /// step's dissipated work; the work of the force the state carries is this increment's);
@@ -654,6 +671,47 @@ mod tests {
         let mixed = a.predict(&start, &motion(moved), &pressure(300.0));
         let extrapolated = free_dofs_extrapolated(&a, &start, [&same, &double], &[&back, &mixed]);
         assert!(extrapolated > 0, "the pressure step moved no free DOF");
+    }
+
+    /// An increment that slips is refused as soon as Newton passes the limit given, with the
+    /// iteration it stopped at, not after it converged; one that changes no history (the
+    /// pressurised disc) goes on past the limit to its equilibrium.
+    #[test]
+    fn an_increment_that_slips_is_refused_at_the_limit_and_one_without_history_goes_on() {
+        let spec = ParallelArch::default();
+        let model = spec.model().unwrap();
+        let target = spec.boundary_targets(&model, 1.0);
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        let start = a.state().clone();
+        let motion = GroupMotion {
+            angles: vec![0.0; target.len()],
+            translation: target,
+        };
+        let (state, history) = a
+            .solve_increment(&start, &motion, &start.loads, None)
+            .unwrap();
+        assert!(state.history_changed_from(&start) && history.len() > 3);
+        let refused = a.solve_increment(&start, &motion, &start.loads, Some(2));
+        assert!(
+            matches!(
+                refused,
+                Err(IncrementFailure::PathDependent { iteration: 2 })
+            ),
+            "{:?}",
+            refused.map(|(_, history)| history)
+        );
+        let text = include_str!("../../../examples/circular_membrane.json");
+        let model = crate::mech::model::Model::from_json(text).unwrap();
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        let start = a.state().clone();
+        let mut levels = start.loads.clone();
+        levels.pressure[0] = 100.0;
+        let still = GroupMotion {
+            translation: start.boundary.clone(),
+            angles: start.angles.clone(),
+        };
+        let (state, history) = a.solve_increment(&start, &still, &levels, Some(2)).unwrap();
+        assert!(!state.history_changed_from(&start) && history.len() > 3);
     }
 
     /// The controller sizes by the iterations until the residual met its tolerance: the

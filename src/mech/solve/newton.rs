@@ -226,6 +226,7 @@ impl Analysis {
         start: &AnalysisState,
         motion: &GroupMotion,
         levels: &LoadLevels,
+        dissipative_limit: Option<usize>,
     ) -> Result<(AnalysisState, Vec<f64>), IncrementFailure> {
         let u = self.predict(start, motion, levels);
         for c in self.parts.all_mut() {
@@ -244,6 +245,13 @@ impl Analysis {
                 && it.artificial <= record.residual_tolerance;
             if met && it.hold.held.is_empty() {
                 return self.commit_increment(start, motion, levels, it.u, it.residuals, iteration);
+            }
+            // An increment that changes a history and needs more iterations than the controller
+            // keeps of one is refused now, not after it converged (`Controller::keeps`).
+            if dissipative_limit == Some(iteration)
+                && self.changes_history(start, motion, levels, &it.u)
+            {
+                return Err(IncrementFailure::PathDependent { iteration });
             }
             let improved = it.progressed(record);
             if iteration == s.max_iterations {
@@ -407,6 +415,19 @@ impl Analysis {
             return Err(IncrementFailure::Diverged { iteration });
         }
         Ok((state, residuals))
+    }
+
+    /// Whether the iterate `u` (assembled last) changes a history of the state `start`: a gap's
+    /// slip, a plastic strain, a contact's status.
+    fn changes_history(
+        &self,
+        start: &AnalysisState,
+        motion: &GroupMotion,
+        levels: &LoadLevels,
+        u: &[f64],
+    ) -> bool {
+        self.commit_increment(start, motion, levels, u.to_vec(), Vec::new(), 0)
+            .is_ok_and(|(state, _)| state.history_changed_from(start))
     }
 
     /// The contacts whose status changed within the last `2 N*` iterates of

@@ -277,6 +277,12 @@ pub enum IncrementFailure {
         /// Film elements in compression (`σ2 < 0`, no wrinkling) at the last iterate.
         compressed: Vec<usize>,
     },
+    /// Not converged after [`Controller`]'s `2 N*` iterations at an iterate that changes a
+    /// history (friction slip, plastic flow): halved, so that the path-dependent answer follows
+    /// the load path.
+    ///
+    /// [`Controller`]: crate::mech::solve::increments
+    PathDependent { iteration: usize },
     /// NaN/Inf or runaway corrections.
     Diverged { iteration: usize },
     /// The Newton matrix could not be factorized.
@@ -289,6 +295,7 @@ impl IncrementFailure {
         match self {
             Self::MaxIterations { .. } => "iteration limit",
             Self::Stalled { .. } => "no progress",
+            Self::PathDependent { .. } => "more than 2 N* iterations",
             Self::Diverged { .. } => "diverged",
             Self::Singular { .. } => "singular matrix",
         }
@@ -378,6 +385,10 @@ impl IncrementFailure {
                 "Newton stopped making progress: move the inputs by less per step ({finer}), or loosen \
                  {residual_tolerance} if the residual reached is acceptable for your model"
             ),
+            Self::PathDependent { .. } => format!(
+                "the increment slipped or yielded and needed many iterations: move the inputs by less \
+                 per step ({finer})"
+            ),
             Self::Diverged { .. } => format!(
                 "the residual ran away or became non-finite: move the inputs by less per step ({finer})"
             ),
@@ -456,6 +467,11 @@ impl fmt::Display for IncrementFailure {
                 )?;
                 chatter(f, chattering, flipping, compressed)
             }
+            Self::PathDependent { iteration } => write!(
+                f,
+                "not converged after {iteration} iterations at an iterate that slips or yields: \
+                 refused so that a shorter increment follows the path-dependent answer's load path"
+            ),
             Self::Diverged { iteration } => {
                 write!(
                     f,
