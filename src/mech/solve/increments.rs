@@ -405,7 +405,10 @@ impl Analysis {
                     (0, "release")
                 };
                 self.parts.stabilization.set(STRATEGIES[row].damping, tau);
-                let attempt = self.solve_increment(current, &motion, &levels, None);
+                // The undamped try is given up like an increment that slips past `2 N*`
+                // iterations: the march goes on either way.
+                let limit = (!damped).then_some(2 * Self::TARGET_ITERATIONS);
+                let attempt = self.solve_increment(current, &motion, &levels, limit);
                 self.note_attempt(report, row, (1.0, 1.0), (how, true), &attempt);
                 let Ok((state, history)) = attempt else {
                     if damped {
