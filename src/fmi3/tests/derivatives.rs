@@ -533,21 +533,78 @@ fn fmi3_adjoint_of_reactions_is_one_solve_at_a_symmetric_tangent() {
         let (status, jtv) = fmu.adjoint(&unknowns, &knowns, &v);
         assert!(status <= 1, "{status}: {:?}", log.take());
         assert_eq!(fmu.tangent_solves() - before, solves, "μ = {mu}");
-        let columns: Vec<f64> = knowns
-            .iter()
-            .map(|k| {
-                let (status, column) = fmu.directional(&unknowns, &[k], &[1.0]);
-                assert!(status <= 1, "{status}: {:?}", log.take());
-                column.iter().zip(&v).map(|(c, v)| c * v).sum()
-            })
-            .collect();
-        let largest = columns.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
-        assert!(largest > 0.0);
-        let worst = jtv
-            .iter()
-            .zip(&columns)
-            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest));
+        let (columns, worst) = against_columns(&fmu, &log, (&unknowns, &knowns), (&v, &jtv));
         eprintln!("μ = {mu}: adjoint vs columns {worst:e} of the largest, {solves} solves");
         assert!(worst <= case.tolerance, "μ = {mu}: {jtv:?} vs {columns:?}");
     }
+}
+
+/// The one-solve adjoint of output points under slipping gaps through
+/// `fmi3GetAdjointDerivative` (issue 45: the transpose solve of an unsymmetric tangent): the
+/// specimen on gaps at μ = 0.2 (G1, G2 slip), two output points on free film nodes, `v` on
+/// their six displacements. TEST GOAL: one solve over the six inputs, and `vᵀ` times the
+/// columns of `fmi3GetDirectionalDerivative` to 1e-9 of the largest.
+#[test]
+fn fmi3_adjoint_of_points_is_one_solve_under_slipping_gaps() {
+    let case = Case {
+        law: FrictionLaw::Isotropic,
+        contact: SpecimenContact::Gaps,
+        mu: 0.2,
+        all_stick: false,
+        tolerance: 1e-9,
+    };
+    let mut model = every_input_specimen(case.law, case.contact);
+    let free: Vec<usize> = (0..model.nodes.len())
+        .filter(|&n| {
+            model.groups.iter().all(|g| !g.nodes.contains(&n))
+                && model.supports.iter().all(|s| s.node != n)
+        })
+        .collect();
+    for (name, node) in [("pa", free[free.len() / 3]), ("pb", free[free.len() / 2])] {
+        let name = name.to_string();
+        model
+            .outputs
+            .points
+            .push(crate::mech::model::OutputPoint { name, node });
+    }
+    let u = Unpacked::new("one solve, points", Source::Model(model));
+    let log = Log::default();
+    let fmu = lowered(&case, &u, &log);
+    assert_eq!(fmu.set("frame.dz", -0.06), 0);
+    assert!(fmu.step(11.0, 1.0) <= 1, "{:?}", log.take());
+    let unknowns = ["pa.ux", "pa.uy", "pa.uz", "pb.ux", "pb.uy", "pb.uz"];
+    let knowns: Vec<&str> = SEEDS.iter().map(|s| s.0).collect();
+    let v = [0.3, -0.7, 1.1, -0.4, 0.9, 0.5];
+    let before = fmu.tangent_solves();
+    let (status, jtv) = fmu.adjoint(&unknowns, &knowns, &v);
+    assert!(status <= 1, "{status}: {:?}", log.take());
+    assert_eq!(fmu.tangent_solves() - before, 1);
+    let (columns, worst) = against_columns(&fmu, &log, (&unknowns, &knowns), (&v, &jtv));
+    eprintln!("points under slip: adjoint vs columns {worst:e} of the largest, one solve");
+    assert!(worst <= case.tolerance, "{jtv:?} vs {columns:?}");
+}
+
+/// `vᵀ` times each column of `fmi3GetDirectionalDerivative` (a unit seed per known), and the
+/// largest difference of `jtv` from them relative to the largest (which must not be 0).
+fn against_columns(
+    fmu: &Fmu3<'_>,
+    log: &Log,
+    (unknowns, knowns): (&[&str], &[&str]),
+    (v, jtv): (&[f64], &[f64]),
+) -> (Vec<f64>, f64) {
+    let columns: Vec<f64> = knowns
+        .iter()
+        .map(|k| {
+            let (status, column) = fmu.directional(unknowns, &[k], &[1.0]);
+            assert!(status <= 1, "{status}: {:?}", log.take());
+            column.iter().zip(v).map(|(c, v)| c * v).sum()
+        })
+        .collect();
+    let largest = columns.iter().fold(0.0_f64, |m, c| m.max(c.abs()));
+    assert!(largest > 0.0);
+    let worst = jtv
+        .iter()
+        .zip(&columns)
+        .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest));
+    (columns, worst)
 }

@@ -64,14 +64,19 @@
 //! `vᵀ dy/dq = vᵀ ∂y/∂q − λᵀ ∂g_f/∂q`, `K_ffᵀ λ = (∂y/∂u_f)ᵀ v`: one solve for λ, then per
 //! input the residual's derivative above (two residual assemblies for a group's motion, the
 //! loads' residual for a load, the contacts' for μ) contracted with λ and with the reactions'
-//! weights. The factor held is that of `K`, so the solve is `Kᵀ`'s only for a symmetric tangent:
-//! the adjoint checks the held values (`|K_ij − K_ji| ≤ 1e-10 max |K|`) and refuses a follower
-//! pressure that acts (its load stiffness is unsymmetric); a sliding contact makes the tangent
-//! unsymmetric and is refused so. `(K_rf)ᵀ v` is then `K_fr v`: the residual's derivative along
-//! the restrained DOFs moved by the reactions' weights (a central difference, free DOFs held). The
-//! values agree with J's columns to the differences' accuracy (1e-6 in the test), not to the
-//! last bit: the columns are a difference of results along each response, the adjoint a
-//! contraction of residuals.
+//! weights. The solve is the held factor's transpose solve (`LinearSolver::solve_held_transpose`:
+//! the LU's transpose, or `Kᵀ = S − K_skew` on the symmetric part's LDLᵀ by Woodbury or GMRES,
+//! checked against `Kᵀ`), so a sliding contact or a follower pressure (an unsymmetric tangent)
+//! costs one solve too (issue 45: `vᵀ(J s) = (Jᵀ v)ᵀ s` to 9e-13 of the largest under a slipping
+//! gap, 4e-12 under a follower pressure, with output points' weights). For a reaction,
+//! `(K_rf)ᵀ v` is taken as `K_fr v`: the residual's derivative along the restrained DOFs moved
+//! by the reactions' weights (a central difference, free DOFs held), which holds only for a
+//! symmetric tangent; the rows `K_rf` themselves are not assembled (the pattern eliminates
+//! prescribed DOFs), so a reaction's weight under an unsymmetric tangent (the held values
+//! checked: `|K_ij − K_ji| ≤ 1e-10 max |K|`) is refused and the caller takes J's columns. The
+//! values agree with J's columns to the differences' accuracy (1e-6 in the test of reactions),
+//! not to the last bit: the columns are a difference of results along each response, the
+//! adjoint a contraction of residuals.
 
 use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::{ExternalLoad, LoadLevels};
@@ -203,7 +208,7 @@ impl Analysis {
             }
         }
         if !rhs.is_empty() {
-            self.solve_with_tangent(&start, &end, &mut rhs)
+            self.solve_with_tangent(&start, &end, &mut rhs, false)
                 .map_err(|e| format!("the tangent at the converged state: {}", e.0))?;
         }
         for (i, d) in self.system.dofs.iter().enumerate() {
@@ -371,10 +376,10 @@ impl Analysis {
     /// `Jᵀ v` over `seeds` (one value per seed: `vᵀ J seed`), `v` the weights of the group
     /// reactions and output points' displacements, J the derivatives
     /// [`Analysis::linear_response`] gives, at the cost of **one** solve with the held
-    /// tangent (module doc, "One-solve adjoint"). Errors: those of
-    /// [`Analysis::linear_response`], weights of the wrong size, and a tangent that is not
-    /// symmetric (a contact slides, a follower pressure acts): there `Kᵀ` is not the factor
-    /// held and the caller takes J's columns instead.
+    /// tangent's transpose (module doc, "One-solve adjoint"), symmetric or not. Errors: those
+    /// of [`Analysis::linear_response`], weights of the wrong size, and a reaction weighted
+    /// under an unsymmetric tangent (a contact slides, a follower pressure acts): its rows
+    /// `K_rf` are not held, so its `K_rfᵀ v` cannot be formed and the caller takes J's columns.
     pub fn adjoint_response(
         &mut self,
         weights: &OutputWeights,
@@ -388,26 +393,19 @@ impl Analysis {
         {
             return Err("the weights do not fit the model's groups and output points".into());
         }
-        if let Some(p) = end.loads.pressure.iter().find(|p| **p != 0.0) {
-            return Err(format!(
-                "a follower pressure acts ({p} Pa): its load stiffness is not symmetric"
-            ));
-        }
-        // A sliding contact makes the tangent unsymmetric: refused before the solve (the held
-        // values are checked after it all the same).
-        let results = self.results();
-        let slides = |s: GapStatus| s == GapStatus::Slip;
-        if results.gaps.iter().any(|g| slides(g.status))
-            || results.surface_contacts.iter().any(|c| slides(c.status))
-            || results.layer_contacts.iter().any(|c| slides(c.status))
-        {
-            return Err("a contact slides: the tangent is not symmetric".into());
-        }
         // w = Cᵀ v over the free DOFs: a reaction's row of C is K_rf (r: its restrained DOFs),
         // whose transpose is K_fr for a symmetric tangent, so its part is the residual's
-        // derivative along the restrained DOFs moved by the reactions' weights; a point's is
-        // its free DOFs.
+        // derivative along the restrained DOFs moved by the reactions' weights (checked below);
+        // a point's is its free DOFs.
         let restrained = self.restrained_weights(weights);
+        if restrained.iter().any(|&x| x != 0.0)
+            && let Some(why) = self.unsymmetric_cause(&end)
+        {
+            // Refused before the solve, so that the caller's columns are all it pays.
+            return Err(format!(
+                "{why}: a reaction's K_rfᵀ v is not the held difference K_fr v"
+            ));
+        }
         let mut w = vec![0.0; self.system.free_count];
         if restrained.iter().any(|&x| x != 0.0) {
             let dg = self.restrained_residual(&start, &end, &restrained);
@@ -424,12 +422,14 @@ impl Analysis {
                 }
             }
         }
-        // λ = K⁻ᵀ w: the one solve, with the factor of K = Kᵀ.
+        // λ = K⁻ᵀ w: the one solve, the held factor's transpose solve.
         let mut lambda = w;
         if lambda.iter().any(|&x| x != 0.0) {
-            self.solve_with_tangent(&start, &end, &mut lambda)
+            self.solve_with_tangent(&start, &end, &mut lambda, true)
                 .map_err(|e| format!("the tangent at the converged state: {}", e.0))?;
-            self.held_tangent_symmetric()?;
+            if restrained.iter().any(|&x| x != 0.0) {
+                self.held_tangent_symmetric()?;
+            }
         }
         let values = seeds
             .iter()
@@ -437,6 +437,21 @@ impl Analysis {
             .collect();
         self.state = end;
         values
+    }
+
+    /// What makes the tangent at `end` unsymmetric, if anything is known to: a follower
+    /// pressure that acts, a contact that slides (the held values are checked after the solve
+    /// all the same: a pressure over a closed surface leaves it symmetric).
+    fn unsymmetric_cause(&mut self, end: &AnalysisState) -> Option<String> {
+        if let Some(p) = end.loads.pressure.iter().find(|p| **p != 0.0) {
+            return Some(format!("a follower pressure acts ({p} Pa)"));
+        }
+        let results = self.results();
+        let slides = |s: GapStatus| s == GapStatus::Slip;
+        let any = results.gaps.iter().any(|g| slides(g.status))
+            || results.surface_contacts.iter().any(|c| slides(c.status))
+            || results.layer_contacts.iter().any(|c| slides(c.status));
+        any.then(|| "a contact slides".to_string())
     }
 
     /// `vᵀ J seed = vᵀ (∂y/∂q seed) − λᵀ ∂g_f/∂q seed`: the outputs' direct dependence on the
@@ -525,8 +540,10 @@ impl Analysis {
             .collect()
     }
 
-    /// Ok when the held tangent is symmetric to rounding (`|K_ij − K_ji| ≤ 1e-10 max |K|`),
-    /// so that its factor solves with `Kᵀ` too; else the error names the largest asymmetry.
+    /// Ok when the held tangent is symmetric to rounding (`|K_ij − K_ji| ≤ 1e-10 max |K|`), so
+    /// that a reaction's `K_rfᵀ v` is the difference `K_fr v`; else the error names the largest
+    /// asymmetry. The rows `K_rf` are not held (the pattern eliminates prescribed DOFs), so
+    /// under an unsymmetric tangent a reaction's adjoint cannot be formed from what is held.
     fn held_tangent_symmetric(&self) -> Result<(), String> {
         let Some(held) = self.held_tangent.as_deref() else {
             return Err("no tangent held".into());
@@ -545,7 +562,8 @@ impl Analysis {
         } else {
             Err(format!(
                 "the tangent is not symmetric (|K_ij − K_ji| up to {worst:e} of {largest:e}: a \
-                 contact slides): its transpose is not the factor held"
+                 contact slides or a follower pressure acts): a reaction's K_rfᵀ v is not the \
+                 held difference K_fr v"
             ))
         }
     }
@@ -588,14 +606,16 @@ impl Analysis {
         }
     }
 
-    /// Solves `K_ff x = rhs` in place with the consistent tangent at the converged state `end`
-    /// (histories of `start`): with the factor held when it is that state's (same state, same
-    /// increment start, no factorization since), else assembled and factorized, then held.
+    /// Solves `K_ff x = rhs` (`K_ffᵀ x = rhs` with `transpose`: an adjoint's solve) in place
+    /// with the consistent tangent at the converged state `end` (histories of `start`): with
+    /// the factor held when it is that state's (same state, same increment start, no
+    /// factorization since), else assembled and factorized, then held.
     fn solve_with_tangent(
         &mut self,
         start: &AnalysisState,
         end: &AnalysisState,
         rhs: &mut [f64],
+        transpose: bool,
     ) -> Result<(), FactorizationError> {
         self.tangent_solves += 1;
         if let Some(held) = self.held_tangent.as_deref_mut()
@@ -605,7 +625,11 @@ impl Analysis {
             && held.start == self.increment_start
         {
             let matrix = self.system.matrix(&held.values);
-            let solved = self.linear.solve_held(matrix, rhs);
+            let solved = if transpose {
+                self.linear.solve_held_transpose(matrix, rhs)
+            } else {
+                self.linear.solve_held(matrix, rhs)
+            };
             // A solution that failed its check was redone by a new factorization (of the same
             // matrix): that one is held now.
             held.factor = self.linear.factor_id();
@@ -617,7 +641,14 @@ impl Analysis {
         }
         self.assemble_at(&end.displacement, &end.loads, Some(1));
         let matrix = self.system.matrix(&self.work.values);
-        self.linear.factorize_and_solve(matrix, rhs)?;
+        if transpose {
+            // The factorization's own solve is not the one asked: its transpose follows.
+            let mut forward = rhs.to_vec();
+            self.linear.factorize_and_solve(matrix, &mut forward)?;
+            self.linear.solve_held_transpose(matrix, rhs)?;
+        } else {
+            self.linear.factorize_and_solve(matrix, rhs)?;
+        }
         self.held_tangent = Some(Box::new(HeldTangent {
             factor: self.linear.factor_id(),
             end: end.clone(),
@@ -736,6 +767,7 @@ fn with_friction(start: &AnalysisState, end: &AnalysisState, change: f64) -> Ana
 mod tests {
     use super::*;
     use crate::mech::Model;
+    use crate::mech::elements::gap::FrictionLaw;
     use crate::mech::solve::settings::SolverSettings;
     use crate::specimens::ParallelArch;
 
@@ -952,11 +984,7 @@ mod tests {
             largest = largest.max(v.abs());
             columns.push(v);
         }
-        assert!(largest > 0.0);
-        let worst = adjoint
-            .iter()
-            .zip(&columns)
-            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest));
+        let worst = worst_relative(&adjoint, &columns);
         eprintln!(
             "{} inputs: adjoint vs columns {worst:e} of the largest",
             seeds.len()
@@ -967,7 +995,8 @@ mod tests {
                 "input {k}: adjoint {adj} vs columns {col} (largest {largest})"
             );
         }
-        // A slipping contact: not the factor's transpose, refused (the FMU takes the columns).
+        // A slipping contact with a reaction weighted: K_rf is not held, refused (the FMU takes
+        // the columns).
         let (mut b, _) = lowered(3);
         if b.results().gaps.iter().any(|g| g.status == GapStatus::Slip) {
             let weights = OutputWeights::zero(&b);
@@ -1029,6 +1058,149 @@ mod tests {
         }
     }
 
+    /// The largest difference of `adjoint` from `columns`, relative to the largest column
+    /// (which must not be 0).
+    fn worst_relative(adjoint: &[f64], columns: &[f64]) -> f64 {
+        let largest = columns.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        assert!(largest > 0.0);
+        adjoint
+            .iter()
+            .zip(columns)
+            .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest))
+    }
+
+    /// `(Jᵀ v)ᵀ s` of the one-solve adjoint against `vᵀ (J s)` of J's columns for every seed
+    /// `s`, `v` pseudo-random weights on every output point's displacement: asserts that the
+    /// held tangent is unsymmetric, that the adjoint is one solve with one factorization and
+    /// its transpose solve on the factor's own path (no LU), and returns the largest difference
+    /// relative to the largest `vᵀ (J s)`.
+    fn adjoint_against_columns(a: &mut Analysis, seeds: &[Seed]) -> f64 {
+        let mut weights = OutputWeights::zero(a);
+        let mut x = 0.37_f64;
+        for w in weights.points.iter_mut().flatten() {
+            x = (x * 997.0 + 0.13).fract();
+            *w = 2.0 * x - 1.0;
+        }
+        let (solves, p) = (a.tangent_solves(), a.solve_profile());
+        let adjoint = a.adjoint_response(&weights, seeds).unwrap();
+        let q = a.solve_profile();
+        assert_eq!(a.tangent_solves(), solves + 1, "{} inputs", seeds.len());
+        assert_eq!(q.ldlt_count + q.lu_count, p.ldlt_count + p.lu_count + 1);
+        assert_eq!(
+            q.held_solves,
+            p.held_solves + 1,
+            "the transpose on the held factor"
+        );
+        assert!(
+            a.held_tangent_symmetric().is_err(),
+            "an unsymmetric tangent"
+        );
+        let columns: Vec<f64> = seeds
+            .iter()
+            .map(|s| {
+                let r = a.linear_response(s).unwrap();
+                let mut v = 0.0;
+                for (p, w) in weights.points.iter().enumerate() {
+                    for (c, wc) in w.iter().enumerate() {
+                        v += wc * r.derivative(|x| x.points[p][c]);
+                    }
+                }
+                v
+            })
+            .collect();
+        let worst = worst_relative(&adjoint, &columns);
+        eprintln!(
+            "{} inputs, path {:?}: adjoint vs columns {worst:e} of the largest",
+            seeds.len(),
+            (
+                q.woodbury_count - p.woodbury_count,
+                q.gmres_count - p.gmres_count
+            ),
+        );
+        worst
+    }
+
+    /// `first`, then a unit seed along each of every group's translations.
+    fn with_translations(a: &Analysis, first: Seed) -> Vec<Seed> {
+        let mut seeds = vec![first];
+        for g in 0..a.state().boundary.len() {
+            for c in 0..3 {
+                let mut s = Seed::zero(a);
+                s.translation[g][c] = 1.0;
+                seeds.push(s);
+            }
+        }
+        seeds
+    }
+
+    /// The adjoint of an unsymmetric tangent (issue 45): a slipping gap. MODEL: the specimen
+    /// lowered three twentieths with μ = 0.5 before the last step, under each friction law,
+    /// output points on every gap's film node. TEST GOAL: `vᵀ(J s) = (Jᵀ v)ᵀ s` to 1e-9 of the
+    /// largest over μ and every group's translations, the adjoint one transpose solve.
+    #[test]
+    fn an_adjoint_under_a_slipping_gap_transposes_the_columns_in_one_solve() {
+        for law in FrictionLaw::ALL {
+            let spec = ParallelArch {
+                friction_law: law,
+                ..ParallelArch::default()
+            };
+            let mut model = spec.model().unwrap();
+            let film: Vec<usize> = (0..model.nodes.len())
+                .filter(|&n| {
+                    model.groups.iter().all(|g| !g.nodes.contains(&n))
+                        && model.supports.iter().all(|s| s.node != n)
+                })
+                .step_by(7)
+                .collect();
+            for (k, &node) in film.iter().enumerate() {
+                let name = format!("p{k}");
+                model
+                    .outputs
+                    .points
+                    .push(crate::mech::model::OutputPoint { name, node });
+            }
+            let targets: Vec<_> = (1..=3)
+                .map(|k| spec.boundary_targets(&model, 0.05 * k as f64))
+                .collect();
+            let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+            for (k, t) in targets.iter().enumerate() {
+                if k == 2 {
+                    a.set_friction(0.5).unwrap();
+                }
+                a.step_to(t, 1).unwrap();
+            }
+            let slipping = a.results().gaps.iter().any(|g| g.status == GapStatus::Slip);
+            assert!(slipping, "{law:?}: a gap slips");
+            let seeds = with_translations(&a, mu(&a));
+            let worst = adjoint_against_columns(&mut a, &seeds);
+            assert!(worst <= 1e-9, "{law:?}: {worst:e}");
+        }
+    }
+
+    /// The adjoint of an unsymmetric tangent (issue 45): a follower pressure. MODEL:
+    /// `examples/cushion.json` with its pressure on the upper film's first 192 triangles only
+    /// (over the whole closed cushion the load stiffness is symmetric: the edge terms of the
+    /// loaded region cancel), at 200 Pa in four increments, its two output points. TEST GOAL:
+    /// `vᵀ(J s) = (Jᵀ v)ᵀ s` to 1e-9 of the largest over the pressure and the group's
+    /// translations, the adjoint one transpose solve.
+    #[test]
+    fn an_adjoint_under_a_follower_pressure_transposes_the_columns_in_one_solve() {
+        let part = format!("\"elements\": {:?}", (0..192).collect::<Vec<usize>>());
+        let json =
+            include_str!("../../../examples/cushion.json").replace("\"elements\": \"all\"", &part);
+        let model = Model::from_json(&json).unwrap();
+        let mut a = Analysis::new(model, SolverSettings::default()).unwrap();
+        let mut levels = a.state().loads.clone();
+        levels.pressure[0] = 200.0;
+        let target = a.state().boundary.clone();
+        a.step_to_with_loads(&target, &levels, 4).unwrap();
+        let mut pressure = Seed::zero(&a);
+        pressure.pressure[0] = 1.0;
+        let seeds = with_translations(&a, pressure);
+        let worst = adjoint_against_columns(&mut a, &seeds);
+        assert!(worst <= 1e-9, "{worst:e}");
+    }
+
     /// The exact right-hand side of a pressure seed (the loads' residual at the seed's levels)
     /// against a central difference of the whole residual on the cushion (whose follower
     /// pressure moves with the film), with a step of 1 Pa, which the residual's linearity in
@@ -1063,7 +1235,7 @@ mod tests {
                 du[f] = -(plus[i] - minus[i]) / 2.0;
             }
         }
-        a.solve_with_tangent(&start, &end, &mut du).unwrap();
+        a.solve_with_tangent(&start, &end, &mut du, false).unwrap();
         let points = a.model.outputs.points.clone();
         assert!(!points.is_empty());
         let mut pairs = vec![];

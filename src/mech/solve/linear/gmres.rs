@@ -21,8 +21,10 @@ pub(super) struct Krylov {
 pub(super) const KRYLOV_DIMENSION: usize = 40;
 /// Right-preconditioned GMRES (no restart) for `A x = b` from `x = 0`, to `‖b − A x‖₂ ≤ 1e-12 ‖b‖₂`;
 /// `x` receives the solution. False when it does not get there within [`KRYLOV_DIMENSION`].
+/// With `transpose` the system is `Aᵀ x = b` (the products read `a`'s columns as rows; the
+/// preconditioner, a symmetric part's LDLᵀ, serves both).
 pub(super) fn gmres(
-    a: SparseColMatRef<'_, usize, f64>,
+    (a, transpose): (SparseColMatRef<'_, usize, f64>, bool),
     b: &[f64],
     x: &mut [f64],
     precondition: &mut dyn FnMut(&mut [f64]),
@@ -62,9 +64,14 @@ pub(super) fn gmres(
         k.product.resize(n, 0.0);
         let w = &mut k.product;
         for c in 0..n {
+            let span = ptr[c]..ptr[c + 1];
+            if transpose {
+                w[c] = span.map(|p| values[p] * k.work[rows[p]]).sum();
+                continue;
+            }
             let z = k.work[c];
             if z != 0.0 {
-                for p in ptr[c]..ptr[c + 1] {
+                for p in span {
                     w[rows[p]] += values[p] * z;
                 }
             }

@@ -5,12 +5,12 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use crate::mech::solve::linear::Context;
-use crate::mech::solve::linear::accurate;
 use crate::mech::solve::linear::gmres;
 use crate::mech::solve::linear::ordering::{self, FillOrdering};
 use crate::mech::solve::linear::pool;
 use crate::mech::solve::linear::timed;
 use crate::mech::solve::linear::woodbury::woodbury_correction;
+use crate::mech::solve::linear::{accurate, accurate_transpose};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
@@ -274,7 +274,7 @@ impl SymmetricPart {
         } else {
             Path::Gmres
         };
-        self.solve_factored(a, rhs, true, ctx)
+        self.solve_factored(a, rhs, (true, false), ctx)
     }
 
     /// Solves `a x = rhs` on the LDLᵀ held (of `a`'s symmetric part) along [`Self::path`]:
@@ -283,11 +283,16 @@ impl SymmetricPart {
     /// Woodbury solution that fails the check is tried again by GMRES, and the path follows.
     /// False when no solution passes the accuracy check; `self.rhs` then holds the right-hand
     /// side.
+    ///
+    /// With `transpose` (only on a held factor, `fresh` false) the system is `aᵀ x = rhs`:
+    /// `aᵀ = S − K` has the same symmetric part, so the Woodbury block serves with the skew
+    /// part negated, and GMRES runs on `aᵀ` with the same preconditioner; each solution is
+    /// checked against `aᵀ`, and the path held is left as it was.
     pub(super) fn solve_factored(
         &mut self,
         a: SparseColMatRef<'_, usize, f64>,
         rhs: &mut [f64],
-        fresh: bool,
+        (fresh, transpose): (bool, bool),
         ctx: &mut Context<'_>,
     ) -> bool {
         let n = rhs.len();
@@ -297,7 +302,11 @@ impl SymmetricPart {
         let stack = MemStack::new(&mut self.scratch);
         let check = |x: &[f64], ctx: &mut Context<'_>| {
             timed(&mut ctx.profile.accuracy, || {
-                accurate(a, x, &self.rhs, &self.row_norms, ctx.krylov)
+                if transpose {
+                    accurate_transpose(a, x, &self.rhs, ctx.krylov)
+                } else {
+                    accurate(a, x, &self.rhs, &self.row_norms, ctx.krylov)
+                }
             })
         };
         if self.path == Path::Direct {
@@ -338,7 +347,8 @@ impl SymmetricPart {
                 Par::Seq,
                 MemStack::new(&mut self.block_scratch),
             );
-            let solved = woodbury_correction(&self.dofs, &self.skew, &self.block, rhs);
+            let sign = if transpose { -1.0 } else { 1.0 };
+            let solved = woodbury_correction(&self.dofs, (&self.skew, sign), &self.block, rhs);
             ctx.profile.woodbury += start.elapsed();
             ctx.profile.woodbury_count += 1;
             ctx.profile.woodbury_columns += columns;
@@ -346,14 +356,22 @@ impl SymmetricPart {
                 ctx.counts[3] += 1;
                 return true;
             }
-            self.path = Path::Gmres;
+            if !transpose {
+                self.path = Path::Gmres;
+            }
         }
         let start = Instant::now();
         let mut precondition = |v: &mut [f64]| {
             let x = MatMut::from_column_major_slice_mut(v, n, 1);
             ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack);
         };
-        let solved = gmres(a, &self.rhs, rhs, &mut precondition, ctx.krylov);
+        let solved = gmres(
+            (a, transpose),
+            &self.rhs,
+            rhs,
+            &mut precondition,
+            ctx.krylov,
+        );
         ctx.profile.gmres += start.elapsed();
         ctx.profile.gmres_count += 1;
         ctx.profile.gmres_iterations += ctx.krylov.last_iterations;

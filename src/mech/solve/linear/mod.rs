@@ -27,7 +27,11 @@
 //! right-hand side with it (the same path, the Woodbury block `W` reused, every solution
 //! checked), which is how each seed of a directional derivative costs one solve
 //! (`sensitivity.rs`). [`LinearSolver::factor_id`] names the factor held, so that a caller can
-//! tell that no factorization has replaced it since.
+//! tell that no factorization has replaced it since. [`LinearSolver::solve_held_transpose`]
+//! solves `Aᵀ x = b` with the same factor (an adjoint's solve, issue 45): the LU's transpose
+//! solve, or on the symmetric part's LDLᵀ the same path with `Aᵀ = S − K` (the Woodbury block
+//! reused with the skew part negated, GMRES on `Aᵀ` with the same preconditioner), checked
+//! against `Aᵀ` in every row and redone by an LU's transpose solve when the check fails.
 //!
 //! Buffers (factor values, scratch) are allocated once and reused every iteration; where the
 //! time goes is summed in [`SolveProfile`].
@@ -50,7 +54,6 @@ use std::time::{Duration, Instant};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
-use faer::sparse::linalg::lu::LuRef;
 use faer::{Conj, MatMut, Par};
 
 use crate::mech::solve::assembly::{Dof, System};
@@ -471,6 +474,45 @@ impl LinearSolver {
         rhs: &mut [f64],
     ) -> Result<(), FactorizationError> {
         let original = rhs.to_vec();
+        if self.solve_on_held(matrix, rhs, false) {
+            return Ok(());
+        }
+        rhs.copy_from_slice(&original);
+        self.factorize_and_solve(matrix, rhs)
+    }
+
+    /// Solves `matrixᵀ · x = rhs` in place with the factor held from the last
+    /// [`Self::factorize_and_solve`] of the same `matrix` (an adjoint's solve): the LU's
+    /// transpose solve; on the symmetric part's LDLᵀ, directly, by Woodbury with the skew part
+    /// negated (`Aᵀ = S − K`, the block `W` reused) or by GMRES on `Aᵀ` with the same
+    /// preconditioner, the solution checked against `Aᵀ` in every row. A solution that fails
+    /// the check, or no factor held, is redone by an LU of `matrix` (a new factor, a new
+    /// [`Self::factor_id`]) and its transpose solve.
+    pub fn solve_held_transpose(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+    ) -> Result<(), FactorizationError> {
+        if matches!(self.kind, Kind::Ldlt { .. }) {
+            // A lower-triangle (Ju–Rowlands) matrix is symmetric: its own transpose.
+            return self.solve_held(matrix, rhs);
+        }
+        let original = rhs.to_vec();
+        if self.solve_on_held(matrix, rhs, true) {
+            return Ok(());
+        }
+        rhs.copy_from_slice(&original);
+        self.lu_transpose(matrix, rhs)
+    }
+
+    /// `matrix x = rhs` (`matrixᵀ x = rhs` with `transpose`) in place along the held factor's
+    /// path; false when none is held or the solution fails its check or is not finite.
+    fn solve_on_held(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+        transpose: bool,
+    ) -> bool {
         let n = rhs.len();
         let solved = match &mut self.kind {
             _ if self.factor_id == 0 => false,
@@ -496,31 +538,41 @@ impl LinearSolver {
                     profile: &mut self.profile,
                     counts: &mut self.counts,
                 };
-                part.solve_factored(matrix, rhs, false, &mut ctx)
+                part.solve_factored(matrix, rhs, (false, transpose), &mut ctx)
             }
             Kind::Full { lu: Some(lu), .. } if self.held == Held::Lu => {
-                let start = Instant::now();
-                // The numeric part is the output of `factorize_numeric_lu` on this symbolic
-                // analysis (`held` is `Lu` only after it succeeded): what `new_unchecked` asks.
-                let factored = LuRef::new_unchecked(&lu.symbolic, &lu.numeric);
-                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                factored.solve_in_place_with_conj(
-                    Conj::No,
-                    x,
-                    Par::Seq,
-                    MemStack::new(&mut lu.scratch),
-                );
-                self.profile.lu += start.elapsed();
+                // `held` is `Lu` only after its numeric factorization succeeded.
+                timed(&mut self.profile.lu, || lu.solve(rhs, transpose));
                 true
             }
             _ => false,
         };
-        if solved && rhs.iter().all(|v| v.is_finite()) {
+        let solved = solved && rhs.iter().all(|v| v.is_finite());
+        if solved {
             self.profile.held_solves += 1;
+        }
+        solved
+    }
+
+    /// `matrixᵀ x = rhs` by a new LU of `matrix` (the fast paths skipped), then held.
+    fn lu_transpose(
+        &mut self,
+        matrix: SparseColMatRef<'_, usize, f64>,
+        rhs: &mut [f64],
+    ) -> Result<(), FactorizationError> {
+        let fast = std::mem::replace(&mut self.fast, false);
+        let mut forward = rhs.to_vec();
+        let factored = self.factorize_and_solve(matrix, &mut forward);
+        self.fast = fast;
+        factored?;
+        let Kind::Full { lu: Some(lu), .. } = &mut self.kind else {
+            return Err(FactorizationError("no LU for the transpose solve".into()));
+        };
+        timed(&mut self.profile.lu, || lu.solve(rhs, true));
+        if rhs.iter().all(|v| v.is_finite()) {
             return Ok(());
         }
-        rhs.copy_from_slice(&original);
-        self.factorize_and_solve(matrix, rhs)
+        self.finish_failure(matrix, rhs, Ok(()))
     }
 
     /// Names the DOFs behind a failed solution: non-finite matrix entries, then DOFs without any
@@ -730,6 +782,31 @@ fn accurate(
         }
     }
     let a = row_norms.iter().fold(0.0_f64, |m, &v| m.max(v));
+    within(r, a, x, b)
+}
+
+/// Whether `x` solves `matrixᵀ · x = b` to `1e-9 (‖Aᵀ‖∞‖x‖∞ + ‖b‖∞)` in every row (the
+/// column sums of `|A|` are `Aᵀ`'s row sums; `k`: buffers).
+fn accurate_transpose(
+    matrix: SparseColMatRef<'_, usize, f64>,
+    x: &[f64],
+    b: &[f64],
+    k: &mut Krylov,
+) -> bool {
+    k.residual.clear();
+    let mut a = 0.0_f64;
+    let (ptr, rows, values) = (matrix.col_ptr(), matrix.row_idx(), matrix.val());
+    for j in 0..matrix.ncols() {
+        let span = ptr[j]..ptr[j + 1];
+        a = a.max(span.clone().map(|p| values[p].abs()).sum());
+        k.residual
+            .push(span.map(|p| values[p] * x[rows[p]]).sum::<f64>() - b[j]);
+    }
+    within(&k.residual, a, x, b)
+}
+
+/// Whether every entry of the residual `r` is within `1e-9 (a ‖x‖∞ + ‖b‖∞)`.
+fn within(r: &[f64], a: f64, x: &[f64], b: &[f64]) -> bool {
     let xm = x.iter().fold(0.0_f64, |m, &v| m.max(v.abs()));
     let bm = b.iter().fold(0.0_f64, |m, &v| m.max(v.abs()));
     let limit = 1e-9 * (a * xm + bm);

@@ -297,6 +297,26 @@ type Case<'a> = (
 /// every path (the Ju–Rowlands LDLᵀ, the symmetric part's LDLᵀ directly, by Woodbury and by
 /// GMRES, the LU): no new factorization, the same factor identity, and the answer of a new
 /// factorization to 1e-12. A new factorization gets a new identity.
+/// Between profiles `p` and `q`: one held solve, no factorization, and the path `name` again
+/// (one more column for Woodbury, its block kept; one GMRES solve for GMRES).
+fn assert_one_held_solve_on_the_path(name: &str, p: &SolveProfile, q: &SolveProfile) {
+    assert_eq!(
+        (q.ldlt_count, q.lu_count, q.held_solves),
+        (p.ldlt_count, p.lu_count, 1),
+        "{name}"
+    );
+    let path = (
+        q.woodbury_columns - p.woodbury_columns,
+        q.gmres_count - p.gmres_count,
+    );
+    let expected = match name {
+        "Woodbury" => (1, 0),
+        "GMRES" => (0, 1),
+        _ => (0, 0),
+    };
+    assert_eq!(path, expected, "{name}");
+}
+
 #[test]
 fn a_held_factor_solves_another_right_hand_side_on_every_path() {
     let skew = unsymmetric(&[(2, 1, 1.5), (4, 1, -0.9), (4, 2, 0.4)]);
@@ -338,24 +358,8 @@ fn a_held_factor_solves_another_right_hand_side_on_every_path() {
             .collect();
         let mut held = second.clone();
         solver.solve_held(system.matrix(&v), &mut held).unwrap();
-        let q = solver.profile();
         assert_eq!(solver.factor_id(), id, "{name}");
-        assert_eq!(
-            (q.ldlt_count, q.lu_count, q.held_solves),
-            (p.ldlt_count, p.lu_count, 1),
-            "{name}"
-        );
-        // The same path again: one more column for Woodbury (its block kept), no GMRES for it.
-        let path = (
-            q.woodbury_columns - p.woodbury_columns,
-            q.gmres_count - p.gmres_count,
-        );
-        let expected = match name {
-            "Woodbury" => (1, 0),
-            "GMRES" => (0, 1),
-            _ => (0, 0),
-        };
-        assert_eq!(path, expected, "{name}");
+        assert_one_held_solve_on_the_path(name, &p, &solver.profile());
         let mut fresh = second;
         new_solver()
             .factorize_and_solve(system.matrix(&v), &mut fresh)
@@ -568,4 +572,81 @@ fn nested_dissection_splits_many_separate_equations_in_one_sweep() {
     assert_eq!(order.len(), n);
     let took = started.elapsed();
     assert!(took.as_secs_f64() < 3.0, "{took:?}");
+}
+
+/// `Aᵀ x = b` by a dense LU of the matrix of `entries` on the six equations.
+fn dense_transpose_solution(entries: &[(usize, usize, f64)], b: &[f64]) -> Vec<f64> {
+    let mut a = nalgebra::DMatrix::<f64>::zeros(6, 6);
+    for &(i, j, v) in entries {
+        a[(i, j)] += v;
+    }
+    let x = a
+        .transpose()
+        .lu()
+        .solve(&nalgebra::DVector::from_column_slice(b))
+        .expect("regular");
+    x.iter().copied().collect()
+}
+
+#[test]
+fn a_held_factor_solves_the_transpose_on_every_path_like_a_dense_reference() {
+    // The skew part large enough that Aᵀ's solution is far from A's (a wrong sign shows).
+    let skew = unsymmetric(&[(2, 1, 2.5), (4, 1, -1.9), (4, 2, 1.4)]);
+    let symmetric = unsymmetric(&[]);
+    let cases: [Case<'_>; 4] = [
+        ("direct", false, &symmetric, Some(UnsymmetricMethod::Auto)),
+        ("Woodbury", false, &skew, Some(UnsymmetricMethod::Woodbury)),
+        ("GMRES", false, &skew, Some(UnsymmetricMethod::Gmres)),
+        ("LU", false, &skew, None),
+    ];
+    let b: Vec<f64> = (0..6).map(|i| 1.0 - 0.3 * i as f64).collect();
+    for (name, lower_only, entries, method) in cases {
+        let system = system(lower_only);
+        let mut solver = LinearSolver::new(&system, true).unwrap();
+        match method {
+            Some(m) => solver.set_method(m),
+            None => solver.set_fast(false),
+        }
+        let v = values(&system, entries);
+        let mut first = vec![1.0; system.free_count];
+        solver
+            .factorize_and_solve(system.matrix(&v), &mut first)
+            .unwrap();
+        let (id, p) = (solver.factor_id(), solver.profile());
+        let mut x = b.clone();
+        solver
+            .solve_held_transpose(system.matrix(&v), &mut x)
+            .unwrap();
+        assert_eq!(solver.factor_id(), id, "{name}: no new factor");
+        assert_one_held_solve_on_the_path(name, &p, &solver.profile());
+        let reference = dense_transpose_solution(entries, &b);
+        let scale = reference.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        let difference = max_difference(&x, &reference);
+        assert!(difference <= 1e-12 * scale, "{name}: {difference:e}");
+    }
+}
+
+#[test]
+fn a_transpose_solve_without_a_held_factor_is_an_lu_of_the_matrix() {
+    let entries = unsymmetric(&[(2, 1, 2.5), (4, 1, -1.9), (4, 2, 1.4)]);
+    let system = system(false);
+    let mut solver = LinearSolver::new(&system, true).unwrap();
+    let v = values(&system, &entries);
+    let b: Vec<f64> = (0..6).map(|i| 0.5 + 0.2 * i as f64).collect();
+    let mut x = b.clone();
+    solver
+        .solve_held_transpose(system.matrix(&v), &mut x)
+        .unwrap();
+    assert_eq!(solver.profile().lu_count, 1);
+    assert_ne!(solver.factor_id(), 0, "the LU is held");
+    let reference = dense_transpose_solution(&entries, &b);
+    let scale = reference.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    assert!(max_difference(&x, &reference) <= 1e-12 * scale);
+    // The LU held now solves the next transpose without a factorization.
+    let mut again = b;
+    solver
+        .solve_held_transpose(system.matrix(&v), &mut again)
+        .unwrap();
+    assert_eq!(solver.profile().lu_count, 1);
+    assert_eq!(again, x);
 }

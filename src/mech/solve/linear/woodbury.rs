@@ -5,10 +5,11 @@ use nalgebra::{DMatrix, DVector};
 /// `x = y − W (I + K_CC W_C)⁻¹ K_CC y_C` from the block `[W y] = S⁻¹ [I_C b]` (column-major,
 /// `n` rows) and the skew entries `(i, j, k_ij)` below the diagonal (`k_ji = −k_ij`): the
 /// solution of `(S + K) x = b` (Woodbury's identity with `K = I_C K_CC I_Cᵀ`). False when the
-/// small matrix is singular.
+/// small matrix is singular. With `sign = −1` the skew part is negated: the solution of
+/// `Aᵀ x = (S − K) x = b` from the same block (`S` is symmetric, so `W` serves both).
 pub(super) fn woodbury_correction(
     dofs: &[usize],
-    skew: &[(usize, usize, f64)],
+    (skew, sign): (&[(usize, usize, f64)], f64),
     block: &[f64],
     x: &mut [f64],
 ) -> bool {
@@ -20,8 +21,8 @@ pub(super) fn woodbury_correction(
     let mut k = DMatrix::<f64>::zeros(c, c);
     for &(i, j, h) in skew {
         let (a, b) = (index(i), index(j));
-        k[(a, b)] += h;
-        k[(b, a)] -= h;
+        k[(a, b)] += sign * h;
+        k[(b, a)] -= sign * h;
     }
     let w_c = DMatrix::from_fn(c, c, |r, l| block[l * n + dofs[r]]);
     let y = &block[c * n..];
