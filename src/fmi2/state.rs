@@ -147,6 +147,14 @@ pub fn model_size(model: &Model) -> f64 {
 /// law the solver evaluates, under either friction law), and each curved-support contact's
 /// status and anchor likewise ([`SurfaceContacts::check_committed`]).
 pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), String> {
+    check_sizes(model, state)?;
+    let size = model_size(model);
+    check_values(model, state, size)?;
+    check_laws(model, state, size)
+}
+
+/// The sizes of a state's vectors against `model`'s.
+fn check_sizes(model: &Model, state: &AnalysisState) -> Result<(), String> {
     let (n, gaps, groups) = (model.dof_count(), model.gaps.len(), model.groups.len());
     let sizes = [
         ("displacements", state.displacement.len(), n),
@@ -222,7 +230,11 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             state.last_load_increment.len()
         ));
     }
-    let size = model_size(model);
+    Ok(())
+}
+
+/// A state's values: finite, within reach of a model of `size` (m), μ and angles in range.
+fn check_values(model: &Model, state: &AnalysisState, size: f64) -> Result<(), String> {
     let reach = MAX_DISPLACEMENT_IN_DIAGONALS * size;
     let bounded = |what: &str, values: &mut dyn Iterator<Item = f64>, limit: f64| match values
         .enumerate()
@@ -290,6 +302,11 @@ pub fn check_analysis_state(model: &Model, state: &AnalysisState) -> Result<(), 
             model.gaps[g].name
         ));
     }
+    Ok(())
+}
+
+/// Each gap's and curved-support contact's stored status and history against its own law.
+fn check_laws(model: &Model, state: &AnalysisState, size: f64) -> Result<(), String> {
     SurfaceContacts::new(model)
         .check_committed(&state.displacement, &state.contacts, size)
         .map_err(|(k, e)| {
