@@ -61,6 +61,7 @@ use crate::mech::solve::assembly::{Dof, System};
 mod gmres;
 mod ldlt;
 mod lu;
+mod multifrontal;
 pub mod ordering;
 mod pool;
 mod woodbury;

@@ -1,6 +1,6 @@
-//! The numeric factorizations on several threads (issue 42 item 1): faer's dense kernels inside
-//! its supernodal factorization (update products, the dense LDLᵀ of each diagonal block,
-//! triangular solves) run on a rayon pool made for one factorization by
+//! The numeric factorizations on several threads (issue 42 item 1): the multifrontal LDLᵀ's
+//! sibling subtrees and its large fronts' dense kernels (`multifrontal.rs`) run
+//! on a rayon pool made for one factorization by
 //! `ThreadPoolBuilder::build_scoped`, whose threads are joined before it returns; on Linux the
 //! caller then waits until the kernel no longer lists them (`/proc/self/task`), as after the
 //! assembly's threads. So no thread outlives a factorization, let alone an FMI call, and
@@ -15,6 +15,7 @@ use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{Par, Side};
 
 use crate::mech::solve::assembly::{idle_cores, worker};
+use crate::mech::solve::linear::multifrontal;
 
 /// Factors of at least this many values (128 MiB, the sheet from about 100 k DOF) are
 /// factorized on the idle cores when the thread count is automatic; below, one thread (on
@@ -73,7 +74,8 @@ pub(super) fn with_threads<R: Send>(threads: usize, f: impl FnOnce(Par) -> R + S
 }
 
 /// The numeric LDLᵀ of the lower triangle `lower` into `factor` on `threads` threads
-/// ([`with_threads`]; `scratch` sized for them).
+/// ([`with_threads`]; `scratch` sized for them): multifrontal on a supernodal analysis, faer's
+/// simplicial factorization on a simplicial one (small or sparse factors).
 pub(super) fn factorize_ldlt(
     symbolic: &SymbolicCholesky<usize>,
     factor: &mut [f64],
@@ -81,8 +83,11 @@ pub(super) fn factorize_ldlt(
     threads: usize,
     scratch: &mut MemBuffer,
 ) -> Result<(), LdltError> {
-    with_threads(threads, |par| {
-        symbolic
+    with_threads(threads, |par| match multifrontal::Tree::new(symbolic) {
+        Some(tree) => {
+            multifrontal::factorize(symbolic, &tree, factor, lower, par, MemStack::new(scratch))
+        }
+        None => symbolic
             .factorize_numeric_ldlt(
                 factor,
                 lower,
@@ -92,6 +97,6 @@ pub(super) fn factorize_ldlt(
                 MemStack::new(scratch),
                 Default::default(),
             )
-            .map(|_| ())
+            .map(|_| ()),
     })
 }

@@ -1,0 +1,372 @@
+//! The numeric LDLᵀ on faer's supernodal symbolic analysis as a multifrontal factorization
+//! (Duff & Reid 1983; Liu 1992, §4) whose sibling subtrees run on separate threads (issue 42
+//! item 1: the tree-level parallelism a nested-dissection ordering exposes). Each supernode's
+//! front gathers its columns of `A` and its children's update matrices (extend-add), factors its
+//! diagonal block (dense LDLᵀ), solves its off-diagonal rows and forms its own update matrix
+//! `−L_b D L_bᵀ` in one dense product, which the parent gathers. The factor is stored in faer's
+//! supernodal layout, so faer's solve reads it.
+//!
+//! The arithmetic is fixed by the tree, not by the threads: a front gathers its children in their
+//! order whichever finished first, and faer's dense kernels give the same bits on any `Par`; so
+//! every thread count gives the same bits (test
+//! `factorization_on_two_and_three_threads_gives_the_same_bits_as_on_one`).
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::{
+    LdltError, LdltRegularization, cholesky_in_place, cholesky_in_place_scratch,
+};
+use faer::linalg::matmul::triangular::{BlockStructure, matmul};
+use faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place;
+use faer::reborrow::*;
+use faer::sparse::SparseColMatRef;
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
+use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
+use faer::sparse::utils::permute_self_adjoint_to_unsorted;
+use faer::{Accum, MatMut, Par, Side};
+use rayon::prelude::*;
+use std::sync::Mutex;
+
+/// Subtrees of fewer flops than this are factorized on the thread that reached them (a task
+/// costs microseconds; this is about a tenth of a millisecond of work).
+const TASK_FLOPS: f64 = 1e6;
+
+/// Fronts with at least this many rows use the threads inside their dense kernels too.
+const PARALLEL_FRONT: usize = 256;
+
+/// The supernodal elimination tree: each supernode's children (ascending), the roots, and each
+/// subtree's flops.
+pub(super) struct Tree {
+    children: Vec<Vec<usize>>,
+    roots: Vec<usize>,
+    flops: Vec<f64>,
+}
+
+/// A supernode's columns `begin..end` and off-diagonal row pattern.
+struct Node<'a> {
+    begin: usize,
+    end: usize,
+    pattern: &'a [usize],
+}
+
+fn node(sym: &SymbolicSupernodalCholesky<usize>, s: usize) -> Node<'_> {
+    let start = sym.col_ptr_for_row_idx()[s];
+    Node {
+        begin: sym.supernode_begin()[s],
+        end: sym.supernode_end()[s],
+        pattern: &sym.row_idx()[start..start + sym.nnz_per_super()[s]],
+    }
+}
+
+impl Tree {
+    /// The tree of a supernodal analysis; None for a simplicial one (faer's own factorization
+    /// runs there).
+    pub(super) fn new(symbolic: &SymbolicCholesky<usize>) -> Option<Self> {
+        let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+            return None;
+        };
+        let count = sym.n_supernodes();
+        let mut of_column = vec![0; sym.nrows()];
+        for s in 0..count {
+            let n = node(sym, s);
+            of_column[n.begin..n.end].fill(s);
+        }
+        let mut tree = Self {
+            children: vec![Vec::new(); count],
+            roots: Vec::new(),
+            flops: vec![0.0; count],
+        };
+        for s in 0..count {
+            let n = node(sym, s);
+            let (k, m) = ((n.end - n.begin) as f64, n.pattern.len() as f64);
+            tree.flops[s] += k * k * (k / 3.0 + m) + m * m * k;
+            match n.pattern.first() {
+                Some(&row) => {
+                    let parent = of_column[row];
+                    tree.children[parent].push(s);
+                    tree.flops[parent] += tree.flops[s];
+                }
+                None => tree.roots.push(s),
+            }
+        }
+        Some(tree)
+    }
+}
+
+/// The LDLᵀ of the lower triangle `lower` into `factor` (faer's supernodal layout) on the
+/// parallelism `par` (module doc); faer's error for a zero pivot, at its permuted index.
+pub(super) fn factorize(
+    symbolic: &SymbolicCholesky<usize>,
+    tree: &Tree,
+    factor: &mut [f64],
+    lower: SparseColMatRef<'_, usize, f64>,
+    par: Par,
+    stack: &mut MemStack,
+) -> Result<(), LdltError> {
+    let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+        unreachable!("a tree exists for supernodal analyses only")
+    };
+    let n = lower.ncols();
+    let nnz = lower.row_idx().len();
+    let (mut values, stack) = stack.make_with(nnz, |_| 0.0);
+    let (mut col_ptr, stack) = stack.make_with(n + 1, |_| 0usize);
+    let (mut row_idx, stack) = stack.make_with(nnz, |_| 0usize);
+    let a = match symbolic.perm() {
+        Some(perm) => permute_self_adjoint_to_unsorted(
+            &mut values,
+            &mut col_ptr,
+            &mut row_idx,
+            lower,
+            perm,
+            Side::Lower,
+            Side::Lower,
+            stack,
+        )
+        .into_const(),
+        None => lower,
+    };
+    let mut slots = Vec::with_capacity(sym.n_supernodes());
+    let mut rest = factor;
+    for w in sym.col_ptr_for_val().windows(2) {
+        let (own, tail) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+        slots.push(Some(own));
+        rest = tail;
+    }
+    let job = Job {
+        sym,
+        tree,
+        a,
+        par,
+        slots: Mutex::new(slots),
+        pool: Mutex::new(Vec::new()),
+    };
+    job.subtrees(&tree.roots).map(|_| ())
+}
+
+/// What every front reads: the analysis, the tree, the permuted matrix, the parallelism, and
+/// each supernode's factor values, which its front takes.
+struct Job<'a, 'v> {
+    sym: &'a SymbolicSupernodalCholesky<usize>,
+    tree: &'a Tree,
+    a: SparseColMatRef<'a, usize, f64>,
+    par: Par,
+    slots: Mutex<Vec<Option<&'v mut [f64]>>>,
+    /// Buffers of finished update matrices, for the next fronts.
+    pool: Mutex<Vec<Vec<f64>>>,
+}
+
+/// A front's update matrix: its pattern's lower triangle, column-major, `m × m`.
+type Update = Vec<f64>;
+
+impl Job<'_, '_> {
+    /// Factorizes the subtrees rooted at `roots`, on separate threads where the parallelism
+    /// and their flops allow; their update matrices in their order.
+    fn subtrees(&self, roots: &[usize]) -> Result<Vec<Update>, LdltError> {
+        let heavy = roots
+            .iter()
+            .filter(|&&r| self.tree.flops[r] >= TASK_FLOPS)
+            .count();
+        if heavy >= 2 && self.par.degree() > 1 {
+            roots.par_iter().map(|&r| self.subtree(r)).collect()
+        } else {
+            roots.iter().map(|&r| self.subtree(r)).collect()
+        }
+    }
+
+    /// Factorizes the subtree rooted at `s`: the children's subtrees, then the front of `s`.
+    /// Returns the update matrix of `s`.
+    fn subtree(&self, s: usize) -> Result<Update, LdltError> {
+        let updates = self.subtrees(&self.tree.children[s])?;
+        let own = self.slots.lock().unwrap_or_else(|e| e.into_inner())[s]
+            .take()
+            .expect("each supernode's front runs once");
+        let update = self.front(s, own, &updates);
+        updates.into_iter().for_each(|u| self.give_back(u));
+        update
+    }
+
+    /// The front of `s`: gathers `A`'s columns and the children's `updates` into the
+    /// supernode's values `own` and a new update matrix, factorizes and eliminates.
+    fn front(&self, s: usize, own: &mut [f64], updates: &[Update]) -> Result<Update, LdltError> {
+        let n = node(self.sym, s);
+        let (k, m) = (n.end - n.begin, n.pattern.len());
+        let children = &self.tree.children[s];
+        own.fill(0.0);
+        self.gather_columns(&n, own);
+        let mut update = self.buffer(m * m);
+        for (&c, u) in children.iter().zip(updates) {
+            extend_add(&n, node(self.sym, c).pattern, u, (own, &mut update), true);
+        }
+        let par = if k + m >= PARALLEL_FRONT {
+            self.par
+        } else {
+            Par::Seq
+        };
+        let mut ls = MatMut::from_column_major_slice_mut(own, k + m, k);
+        let (mut top, mut bottom) = ls.rb_mut().split_at_row_mut(k);
+        factor_block(top.rb_mut(), par).map_err(|e| match e {
+            LdltError::ZeroPivot { index } => LdltError::ZeroPivot {
+                index: index + n.begin,
+            },
+        })?;
+        solve_unit_lower_triangular_in_place(top.rb(), bottom.rb_mut().transpose_mut(), par);
+        if m > 0 {
+            // `bottom` is `L_b D` here: kept, then scaled to `L_b`; the update is `−(L_b D) L_bᵀ`.
+            let mut kept = self.buffer(m * k);
+            let mut w = MatMut::from_column_major_slice_mut(&mut kept, m, k);
+            w.copy_from(bottom.rb());
+            for j in 0..k {
+                let d = top[(j, j)].recip();
+                bottom.rb_mut().col_mut(j).iter_mut().for_each(|x| *x *= d);
+            }
+            matmul(
+                MatMut::from_column_major_slice_mut(&mut update, m, m),
+                BlockStructure::TriangularLower,
+                Accum::Replace,
+                w.rb(),
+                BlockStructure::Rectangular,
+                bottom.rb().transpose(),
+                BlockStructure::Rectangular,
+                -1.0,
+                par,
+            );
+            self.give_back(kept);
+            for (&c, u) in children.iter().zip(updates) {
+                extend_add(&n, node(self.sym, c).pattern, u, (own, &mut update), false);
+            }
+        }
+        Ok(update)
+    }
+
+    /// A buffer of `len` values from the pool (its values are whatever they were).
+    fn buffer(&self, len: usize) -> Vec<f64> {
+        if len == 0 {
+            return Vec::new();
+        }
+        let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
+        let best = (0..pool.len())
+            .filter(|&i| pool[i].capacity() >= len)
+            .min_by_key(|&i| pool[i].capacity());
+        let mut b = match best {
+            Some(i) => pool.swap_remove(i),
+            None => Vec::new(),
+        };
+        drop(pool);
+        b.resize(len, 0.0);
+        b
+    }
+
+    /// Returns a buffer to the pool.
+    fn give_back(&self, b: Vec<f64>) {
+        if b.capacity() > 0 {
+            self.pool.lock().unwrap_or_else(|e| e.into_inner()).push(b);
+        }
+    }
+
+    /// Adds `A`'s lower entries in the columns of `n` to its values (rows inside the block at
+    /// their offset, the others at their place in the pattern).
+    fn gather_columns(&self, n: &Node<'_>, own: &mut [f64]) {
+        let rows = n.end - n.begin + n.pattern.len();
+        for j in n.begin..n.end {
+            let column = &mut own[(j - n.begin) * rows..][..rows];
+            let (idx, val) = (self.a.row_idx_of_col(j), self.a.val_of_col(j));
+            for (i, &v) in idx.zip(val) {
+                if i < j {
+                    continue;
+                }
+                let local = if i < n.end {
+                    i - n.begin
+                } else {
+                    let at = n
+                        .pattern
+                        .binary_search(&i)
+                        .expect("A's pattern lies in the symbolic factor's");
+                    n.end - n.begin + at
+                };
+                column[local] += v;
+            }
+        }
+    }
+}
+
+/// Adds a child's update matrix `u` over its pattern `child` into the front of `n`: with
+/// `columns` its columns in the front's columns to the supernode's values `own`, else the
+/// others to the front's update matrix. Rows whose places follow each other are added as one
+/// run.
+fn extend_add(
+    n: &Node<'_>,
+    child: &[usize],
+    u: &[f64],
+    (own, update): (&mut [f64], &mut [f64]),
+    columns: bool,
+) {
+    let k = n.end - n.begin;
+    let (rows, m) = (k + n.pattern.len(), n.pattern.len());
+    // The child's pattern lies in the front's columns and pattern (both ascending): merge.
+    let mut local = Vec::with_capacity(child.len());
+    let mut at = 0;
+    for &r in child {
+        if r < n.end {
+            local.push(r - n.begin);
+        } else {
+            while n.pattern[at] != r {
+                at += 1;
+            }
+            local.push(k + at);
+        }
+    }
+    // Runs of consecutive places (start in the child, length), never across the block's edge.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for (p, &l) in local.iter().enumerate() {
+        match runs.last_mut() {
+            Some((start, len)) if local[*start] + *len == l && (l != k) => *len += 1,
+            _ => runs.push((p, 1)),
+        }
+    }
+    let mc = child.len();
+    // The child's columns in the front's columns come first (ascending places).
+    let split = local.partition_point(|&l| l < k);
+    let range = if columns { 0..split } else { split..mc };
+    let mut first_run = 0;
+    for q in range {
+        while runs[first_run].0 + runs[first_run].1 <= q {
+            first_run += 1;
+        }
+        let gj = local[q];
+        let column = &u[q * mc..(q + 1) * mc];
+        let (target, shift) = if gj < k {
+            (&mut own[gj * rows..(gj + 1) * rows], 0)
+        } else {
+            (&mut update[(gj - k) * m..(gj - k + 1) * m], k)
+        };
+        for &(start, len) in &runs[first_run..] {
+            let from = start.max(q);
+            let to = start + len;
+            let place = local[from] - shift;
+            let dst = &mut target[place..place + (to - from)];
+            for (d, v) in dst.iter_mut().zip(&column[from..to]) {
+                *d += v;
+            }
+        }
+    }
+}
+
+/// The dense LDLᵀ of a front's diagonal block in place (`D` on the diagonal, unit `L` below,
+/// zeros above, as faer's supernodal layout holds it).
+fn factor_block(mut top: MatMut<'_, f64>, par: Par) -> Result<(), LdltError> {
+    let k = top.nrows();
+    let mut scratch = MemBuffer::new(cholesky_in_place_scratch::<f64>(k, par, Default::default()));
+    cholesky_in_place(
+        top.rb_mut(),
+        LdltRegularization::default(),
+        par,
+        MemStack::new(&mut scratch),
+        Default::default(),
+    )?;
+    for j in 0..k {
+        for i in 0..j {
+            top[(i, j)] = 0.0;
+        }
+    }
+    Ok(())
+}
