@@ -25,6 +25,7 @@ use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
 use faer::sparse::utils::permute_self_adjoint_to_unsorted;
 use faer::{Accum, MatMut, Par, Side};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::sync::Mutex;
 
 /// Subtrees of fewer flops than this are factorized on the thread that reached them (a task
@@ -138,7 +139,7 @@ pub(super) fn factorize(
         a,
         par,
         slots: Mutex::new(slots),
-        pool: Mutex::new(Vec::new()),
+        pool: Mutex::new(BTreeMap::new()),
     };
     job.subtrees(&tree.roots).map(|_| ())
 }
@@ -151,8 +152,8 @@ struct Job<'a, 'v> {
     a: SparseColMatRef<'a, usize, f64>,
     par: Par,
     slots: Mutex<Vec<Option<&'v mut [f64]>>>,
-    /// Buffers of finished update matrices, for the next fronts.
-    pool: Mutex<Vec<Vec<f64>>>,
+    /// Buffers of finished update matrices, for the next fronts, by capacity.
+    pool: Mutex<BTreeMap<usize, Vec<Vec<f64>>>>,
 }
 
 /// A front's update matrix: its pattern's lower triangle, column-major, `m × m`.
@@ -238,18 +239,25 @@ impl Job<'_, '_> {
         Ok(update)
     }
 
-    /// A buffer of `len` values from the pool (its values are whatever they were).
+    /// A buffer of `len` values from the pool, the smallest that holds them (its values are
+    /// whatever they were).
     fn buffer(&self, len: usize) -> Vec<f64> {
         if len == 0 {
             return Vec::new();
         }
         let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
-        let best = (0..pool.len())
-            .filter(|&i| pool[i].capacity() >= len)
-            .min_by_key(|&i| pool[i].capacity());
-        let mut b = match best {
-            Some(i) => pool.swap_remove(i),
-            None => Vec::new(),
+        let fit = pool
+            .range_mut(len..)
+            .next()
+            .map(|(&size, list)| (size, list.pop()));
+        let mut b = match fit {
+            Some((size, Some(b))) => {
+                if pool.get(&size).is_some_and(Vec::is_empty) {
+                    pool.remove(&size);
+                }
+                b
+            }
+            _ => Vec::new(),
         };
         drop(pool);
         b.resize(len, 0.0);
@@ -259,7 +267,8 @@ impl Job<'_, '_> {
     /// Returns a buffer to the pool.
     fn give_back(&self, b: Vec<f64>) {
         if b.capacity() > 0 {
-            self.pool.lock().unwrap_or_else(|e| e.into_inner()).push(b);
+            let mut pool = self.pool.lock().unwrap_or_else(|e| e.into_inner());
+            pool.entry(b.capacity()).or_default().push(b);
         }
     }
 
