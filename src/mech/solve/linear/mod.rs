@@ -1,8 +1,9 @@
 //! Sparse factorization of the Newton matrix with the symbolic analysis done once per analysis.
 //!
-//! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer` supernodal/simplicial Cholesky structure,
-//!   AMD ordering, nested dissection from 100 k equations: `ordering.rs`), which also handles
-//!   the indefinite matrices of compressed films;
+//! * symmetric (Ju–Rowlands) matrix: LDLᵀ (`faer`'s supernodal/simplicial symbolic analysis,
+//!   AMD ordering, nested dissection from 100 k equations: `ordering.rs`; a supernodal one is
+//!   factorized multifrontally, sibling subtrees on separate threads: `multifrontal.rs`),
+//!   which also handles the indefinite matrices of compressed films;
 //! * the consistent tangent `A` (full pattern): one pass over its lower triangle forms the
 //!   symmetric part `S = (A + Aᵀ)/2` through a transpose map built once, the row sums of `|A|`
 //!   and the entries of the skew part `K = (A − Aᵀ)/2` above `1e-12` of the largest entry; then
