@@ -379,3 +379,121 @@ fn factor_block(mut top: MatMut<'_, f64>, par: Par) -> Result<(), LdltError> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::linalg::SupernodalThreshold;
+    use faer::sparse::linalg::cholesky::{
+        CholeskySymbolicParams, SymmetricOrdering, factorize_symbolic_cholesky,
+    };
+    use faer::sparse::{SparseColMat, Triplet};
+
+    /// The lower triangle of a symmetric matrix on an `n × n` grid of 3-DOF nodes, each node
+    /// coupled to its 8 neighbours: diagonally dominant, with a negative diagonal entry every
+    /// 5th DOF (an indefinite matrix the unpivoted LDLᵀ still takes: a compressed film's).
+    fn grid(n: usize) -> SparseColMat<usize, f64> {
+        let dofs = 3 * n * n;
+        let mut entries = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let v = j * n + i;
+                for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1), (-1, 1)] {
+                    let (i2, j2) = (i as i64 + di, j as i64 + dj);
+                    if i2 < 0 || j2 < 0 || i2 >= n as i64 || j2 >= n as i64 {
+                        continue;
+                    }
+                    let w = j2 as usize * n + i2 as usize;
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            let (r, c) = (3 * w + a, 3 * v + b);
+                            if r < c {
+                                continue;
+                            }
+                            let value = if r == c {
+                                if r % 5 == 0 {
+                                    -40.0
+                                } else {
+                                    40.0 + (r % 7) as f64
+                                }
+                            } else {
+                                -1.0 + 0.1 * ((r + 2 * c) % 5) as f64
+                            };
+                            entries.push(Triplet::new(r, c, value));
+                        }
+                    }
+                }
+            }
+        }
+        SparseColMat::try_new_from_triplets(dofs, dofs, &entries).unwrap()
+    }
+
+    /// faer's supernodal analysis of `a` (forced supernodal), its multifrontal factor on
+    /// `threads` threads, and faer's own factor.
+    fn factors(a: &SparseColMat<usize, f64>, threads: usize) -> (Vec<f64>, Vec<f64>) {
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let symbolic =
+            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+                .unwrap();
+        let tree = Tree::new(&symbolic).expect("a supernodal analysis");
+        let len = symbolic.len_val();
+        let req = symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
+        let mut scratch = MemBuffer::new(req);
+        let mut ours = vec![0.0; len];
+        super::super::pool::with_threads(threads, |par| {
+            factorize(
+                &symbolic,
+                &tree,
+                &mut ours,
+                a.as_ref(),
+                par,
+                MemStack::new(&mut scratch),
+            )
+        })
+        .unwrap();
+        let mut theirs = vec![0.0; len];
+        symbolic
+            .factorize_numeric_ldlt(
+                &mut theirs,
+                a.as_ref(),
+                Side::Lower,
+                LdltRegularization::default(),
+                Par::Seq,
+                MemStack::new(&mut scratch),
+                Default::default(),
+            )
+            .unwrap();
+        (ours, theirs)
+    }
+
+    #[test]
+    fn multifrontal_factor_equals_faers_left_looking_factor_to_rounding() {
+        let a = grid(30);
+        let (ours, theirs) = factors(&a, 1);
+        let scale = theirs.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let worst = ours
+            .iter()
+            .zip(&theirs)
+            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(
+            worst <= 1e-12 * scale,
+            "largest difference {worst:e} of {scale:e}"
+        );
+    }
+
+    #[test]
+    fn multifrontal_factor_has_the_same_bits_on_two_threads_as_on_one() {
+        let a = grid(40);
+        let (one, _) = factors(&a, 1);
+        let (two, _) = factors(&a, 2);
+        let differ = one
+            .iter()
+            .zip(&two)
+            .filter(|(x, y)| x.to_bits() != y.to_bits())
+            .count();
+        assert_eq!(differ, 0, "{differ} of {} values differ", one.len());
+    }
+}
