@@ -6,13 +6,14 @@ use std::time::Instant;
 
 use crate::mech::solve::linear::Context;
 use crate::mech::solve::linear::gmres;
+use crate::mech::solve::linear::multifrontal::Analysed;
 use crate::mech::solve::linear::ordering::{self, FillOrdering};
 use crate::mech::solve::linear::pool;
 use crate::mech::solve::linear::timed;
 use crate::mech::solve::linear::woodbury::woodbury_correction;
 use crate::mech::solve::linear::{accurate, accurate_transpose};
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
+use faer::sparse::linalg::cholesky::LdltRef;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par};
 
@@ -22,7 +23,7 @@ use faer::{Conj, MatMut, Par};
 pub(super) struct SymmetricPart {
     /// The lower triangle of the pattern (the Ju–Rowlands matrix's pattern: same analysis).
     pub(super) lower: Arc<SymbolicSparseColMat<usize>>,
-    pub(super) symbolic: Arc<SymbolicCholesky<usize>>,
+    pub(super) symbolic: Arc<Analysed>,
     /// Allocated at the first factorization.
     pub(super) factor: Vec<f64>,
     /// Slot in the full pattern of the transpose of each lower entry (`u32::MAX`: none).
@@ -100,6 +101,7 @@ impl SymmetricPart {
             transpose.iter().all(|&t| t != u32::MAX) && 2 * lower_count - n == rows.len();
         let lower = SymbolicSparseColMat::new_checked(n, n, lower_ptr, None, lower_rows);
         let symbolic = ordering::analyse(lower.as_ref(), ordering).map_err(|e| format!("{e:?}"))?;
+        let symbolic = Analysed::new(symbolic, lower.as_ref());
         Ok(Self::with_analysis(
             Arc::new(lower),
             Arc::new(symbolic),
@@ -111,7 +113,7 @@ impl SymmetricPart {
     /// The part over an analysed pattern, with empty work arrays (one place lists them).
     pub(super) fn with_analysis(
         lower: Arc<SymbolicSparseColMat<usize>>,
-        symbolic: Arc<SymbolicCholesky<usize>>,
+        symbolic: Arc<Analysed>,
         transpose: Arc<[u32]>,
         structural: bool,
     ) -> Self {

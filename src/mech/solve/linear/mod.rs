@@ -54,7 +54,7 @@ use std::time::{Duration, Instant};
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::cholesky::{LdltRef, SymbolicCholesky};
+use faer::sparse::linalg::cholesky::LdltRef;
 use faer::{Conj, MatMut, Par};
 
 use crate::mech::solve::assembly::{Dof, System};
@@ -73,6 +73,7 @@ pub use pool::PARALLEL_MIN_FACTOR;
 use gmres::{Krylov, gmres};
 use ldlt::SymmetricPart;
 use lu::LuPart;
+use multifrontal::Analysed;
 
 /// A factorization failure (singular or non-finite matrix); the message names the nodes.
 #[derive(Clone, Debug, PartialEq)]
@@ -168,7 +169,7 @@ static FACTORS: AtomicU64 = AtomicU64::new(1);
 
 enum Kind {
     Ldlt {
-        symbolic: Arc<SymbolicCholesky<usize>>,
+        symbolic: Arc<Analysed>,
         factor: Vec<f64>,
     },
     Full {
@@ -264,6 +265,7 @@ impl LinearSolver {
         let started = Instant::now();
         let kind = if system.is_lower_only() {
             let symbolic = ordering::analyse(system.pattern(), ordering).map_err(err)?;
+            let symbolic = Analysed::new(symbolic, system.pattern());
             let factor = vec![0.0; symbolic.len_val()];
             Kind::Ldlt {
                 symbolic: Arc::new(symbolic),

@@ -18,12 +18,11 @@ use faer::linalg::cholesky::ldlt::factor::{
 use faer::linalg::matmul::triangular::{BlockStructure, matmul};
 use faer::linalg::triangular_solve::solve_unit_lower_triangular_in_place;
 use faer::reborrow::*;
-use faer::sparse::SparseColMatRef;
 use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
 use faer::sparse::linalg::cholesky::supernodal::SymbolicSupernodalCholesky;
-use faer::sparse::utils::permute_self_adjoint_to_unsorted;
-use faer::{Accum, MatMut, Par, Side};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{Accum, MatMut, Par};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::Mutex;
@@ -35,14 +34,41 @@ const TASK_FLOPS: f64 = 1e6;
 /// Fronts with at least this many rows use the threads inside their dense kernels too.
 const PARALLEL_FRONT: usize = 256;
 
-/// The supernodal elimination tree: each supernode's children (ascending), the roots, and each
-/// subtree's flops.
+/// faer's symbolic analysis with the multifrontal factorization's tree (None: a simplicial
+/// analysis, which faer factorizes).
+pub(super) struct Analysed {
+    pub(super) symbolic: SymbolicCholesky<usize>,
+    pub(super) tree: Option<Tree>,
+}
+
+impl std::ops::Deref for Analysed {
+    type Target = SymbolicCholesky<usize>;
+    fn deref(&self) -> &Self::Target {
+        &self.symbolic
+    }
+}
+
+impl Analysed {
+    /// The analysis of the lower triangle `lower`, with its tree.
+    pub(super) fn new(
+        symbolic: SymbolicCholesky<usize>,
+        lower: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Self {
+        let tree = Tree::new(&symbolic, lower);
+        Self { symbolic, tree }
+    }
+}
+
+/// The supernodal elimination tree: each supernode's children (ascending), the roots, each
+/// subtree's flops, and where each lower entry of the matrix goes: per supernode (`gather_ptr`),
+/// the entry's index in the matrix's values and its place in the supernode's values.
 pub(super) struct Tree {
     children: Vec<Vec<usize>>,
     roots: Vec<usize>,
     flops: Vec<f64>,
+    gather_ptr: Vec<usize>,
+    gather: Vec<(u32, u32)>,
 }
-
 /// A supernode's columns `begin..end` and off-diagonal row pattern.
 struct Node<'a> {
     begin: usize,
@@ -60,9 +86,12 @@ fn node(sym: &SymbolicSupernodalCholesky<usize>, s: usize) -> Node<'_> {
 }
 
 impl Tree {
-    /// The tree of a supernodal analysis; None for a simplicial one (faer's own factorization
-    /// runs there).
-    pub(super) fn new(symbolic: &SymbolicCholesky<usize>) -> Option<Self> {
+    /// The tree of a supernodal analysis of the lower triangle `lower`; None for a simplicial
+    /// one, or where an index does not fit 32 bits.
+    fn new(
+        symbolic: &SymbolicCholesky<usize>,
+        lower: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Option<Self> {
         let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
             return None;
         };
@@ -76,6 +105,8 @@ impl Tree {
             children: vec![Vec::new(); count],
             roots: Vec::new(),
             flops: vec![0.0; count],
+            gather_ptr: Vec::new(),
+            gather: Vec::new(),
         };
         for s in 0..count {
             let n = node(sym, s);
@@ -90,42 +121,68 @@ impl Tree {
                 None => tree.roots.push(s),
             }
         }
+        tree.gather_map(sym, &of_column, symbolic.perm(), lower)?;
         Some(tree)
+    }
+
+    /// Where each lower entry of the matrix goes in the factor: its permuted row and column
+    /// (swapped into the lower triangle), the supernode of the column, the row's place there.
+    fn gather_map(
+        &mut self,
+        sym: &SymbolicSupernodalCholesky<usize>,
+        of_column: &[usize],
+        perm: Option<faer::perm::PermRef<'_, usize>>,
+        lower: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Option<()> {
+        let new_index = |i: usize| perm.map_or(i, |p| p.arrays().1[i]);
+        let mut placed: Vec<(usize, u32, u32)> = Vec::with_capacity(lower.row_idx().len());
+        for j in 0..lower.ncols() {
+            let span = lower.col_ptr()[j]..lower.col_ptr()[j + 1];
+            for (e, &i) in span.clone().zip(&lower.row_idx()[span]) {
+                if i < j {
+                    continue;
+                }
+                let (a, b) = (new_index(i), new_index(j));
+                let (row, col) = (a.max(b), a.min(b));
+                let s = of_column[col];
+                let n = node(sym, s);
+                let rows = n.end - n.begin + n.pattern.len();
+                let local = if row < n.end {
+                    row - n.begin
+                } else {
+                    n.end - n.begin + n.pattern.binary_search(&row).ok()?
+                };
+                let place = (col - n.begin) * rows + local;
+                placed.push((s, u32::try_from(e).ok()?, u32::try_from(place).ok()?));
+            }
+        }
+        placed.sort_unstable_by_key(|&(s, _, _)| s);
+        self.gather_ptr = vec![0; self.children.len() + 1];
+        for &(s, _, _) in &placed {
+            self.gather_ptr[s + 1] += 1;
+        }
+        for s in 0..self.children.len() {
+            self.gather_ptr[s + 1] += self.gather_ptr[s];
+        }
+        self.gather = placed.into_iter().map(|(_, e, p)| (e, p)).collect();
+        Some(())
     }
 }
 
-/// The LDLᵀ of the lower triangle `lower` into `factor` (faer's supernodal layout) on the
-/// parallelism `par` (module doc); faer's error for a zero pivot, at its permuted index.
+/// The LDLᵀ of the lower triangle `lower` (the pattern `tree` was made for) into `factor`
+/// (faer's supernodal layout) on the parallelism `par` (module doc); faer's error for a zero
+/// pivot, at its permuted index.
 pub(super) fn factorize(
-    symbolic: &SymbolicCholesky<usize>,
+    analysed: &Analysed,
     tree: &Tree,
     factor: &mut [f64],
     lower: SparseColMatRef<'_, usize, f64>,
     par: Par,
-    stack: &mut MemStack,
 ) -> Result<(), LdltError> {
-    let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+    let SymbolicCholeskyRaw::Supernodal(sym) = analysed.raw() else {
         unreachable!("a tree exists for supernodal analyses only")
     };
-    let n = lower.ncols();
-    let nnz = lower.row_idx().len();
-    let (mut values, stack) = stack.make_with(nnz, |_| 0.0);
-    let (mut col_ptr, stack) = stack.make_with(n + 1, |_| 0usize);
-    let (mut row_idx, stack) = stack.make_with(nnz, |_| 0usize);
-    let a = match symbolic.perm() {
-        Some(perm) => permute_self_adjoint_to_unsorted(
-            &mut values,
-            &mut col_ptr,
-            &mut row_idx,
-            lower,
-            perm,
-            Side::Lower,
-            Side::Lower,
-            stack,
-        )
-        .into_const(),
-        None => lower,
-    };
+    let a = lower.val();
     let mut slots = Vec::with_capacity(sym.n_supernodes());
     let mut rest = factor;
     for w in sym.col_ptr_for_val().windows(2) {
@@ -144,12 +201,12 @@ pub(super) fn factorize(
     job.subtrees(&tree.roots).map(|_| ())
 }
 
-/// What every front reads: the analysis, the tree, the permuted matrix, the parallelism, and
+/// What every front reads: the analysis, the tree, the matrix's values, the parallelism, and
 /// each supernode's factor values, which its front takes.
 struct Job<'a, 'v> {
     sym: &'a SymbolicSupernodalCholesky<usize>,
     tree: &'a Tree,
-    a: SparseColMatRef<'a, usize, f64>,
+    a: &'a [f64],
     par: Par,
     slots: Mutex<Vec<Option<&'v mut [f64]>>>,
     /// Buffers of finished update matrices, for the next fronts, by capacity.
@@ -193,7 +250,7 @@ impl Job<'_, '_> {
         let (k, m) = (n.end - n.begin, n.pattern.len());
         let children = &self.tree.children[s];
         own.fill(0.0);
-        self.gather_columns(&n, own);
+        self.gather_columns(s, own);
         let mut update = self.buffer(m * m);
         for (&c, u) in children.iter().zip(updates) {
             extend_add(&n, node(self.sym, c).pattern, u, (own, &mut update), true);
@@ -272,28 +329,11 @@ impl Job<'_, '_> {
         }
     }
 
-    /// Adds `A`'s lower entries in the columns of `n` to its values (rows inside the block at
-    /// their offset, the others at their place in the pattern).
-    fn gather_columns(&self, n: &Node<'_>, own: &mut [f64]) {
-        let rows = n.end - n.begin + n.pattern.len();
-        for j in n.begin..n.end {
-            let column = &mut own[(j - n.begin) * rows..][..rows];
-            let (idx, val) = (self.a.row_idx_of_col(j), self.a.val_of_col(j));
-            for (i, &v) in idx.zip(val) {
-                if i < j {
-                    continue;
-                }
-                let local = if i < n.end {
-                    i - n.begin
-                } else {
-                    let at = n
-                        .pattern
-                        .binary_search(&i)
-                        .expect("A's pattern lies in the symbolic factor's");
-                    n.end - n.begin + at
-                };
-                column[local] += v;
-            }
+    /// Adds the matrix's lower entries in the columns of `s` to its values (the tree's map).
+    fn gather_columns(&self, s: usize, own: &mut [f64]) {
+        let span = self.tree.gather_ptr[s]..self.tree.gather_ptr[s + 1];
+        for &(e, place) in &self.tree.gather[span] {
+            own[place as usize] += self.a[e as usize];
         }
     }
 }
@@ -383,6 +423,7 @@ fn factor_block(mut top: MatMut<'_, f64>, par: Par) -> Result<(), LdltError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use faer::Side;
     use faer::sparse::linalg::SupernodalThreshold;
     use faer::sparse::linalg::cholesky::{
         CholeskySymbolicParams, SymmetricOrdering, factorize_symbolic_cholesky,
@@ -438,20 +479,15 @@ mod tests {
         let symbolic =
             factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
                 .unwrap();
-        let tree = Tree::new(&symbolic).expect("a supernodal analysis");
+        let analysed = Analysed::new(symbolic, a.symbolic());
+        let tree = analysed.tree.as_ref().expect("a supernodal analysis");
+        let symbolic = &analysed.symbolic;
         let len = symbolic.len_val();
         let req = symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default());
         let mut scratch = MemBuffer::new(req);
         let mut ours = vec![0.0; len];
         super::super::pool::with_threads(threads, |par| {
-            factorize(
-                &symbolic,
-                &tree,
-                &mut ours,
-                a.as_ref(),
-                par,
-                MemStack::new(&mut scratch),
-            )
+            factorize(&analysed, tree, &mut ours, a.as_ref(), par)
         })
         .unwrap();
         let mut theirs = vec![0.0; len];

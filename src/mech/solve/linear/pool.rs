@@ -11,11 +11,10 @@ use std::sync::Mutex;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::sparse::SparseColMatRef;
-use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::{Par, Side};
 
 use crate::mech::solve::assembly::{idle_cores, worker};
-use crate::mech::solve::linear::multifrontal;
+use crate::mech::solve::linear::multifrontal::{self, Analysed};
 
 /// Factors of at least this many values (128 MiB, the sheet from about 100 k DOF) are
 /// factorized on the idle cores when the thread count is automatic; below, one thread (on
@@ -77,16 +76,14 @@ pub(super) fn with_threads<R: Send>(threads: usize, f: impl FnOnce(Par) -> R + S
 /// ([`with_threads`]; `scratch` sized for them): multifrontal on a supernodal analysis, faer's
 /// simplicial factorization on a simplicial one (small or sparse factors).
 pub(super) fn factorize_ldlt(
-    symbolic: &SymbolicCholesky<usize>,
+    symbolic: &Analysed,
     factor: &mut [f64],
     lower: SparseColMatRef<'_, usize, f64>,
     threads: usize,
     scratch: &mut MemBuffer,
 ) -> Result<(), LdltError> {
-    with_threads(threads, |par| match multifrontal::Tree::new(symbolic) {
-        Some(tree) => {
-            multifrontal::factorize(symbolic, &tree, factor, lower, par, MemStack::new(scratch))
-        }
+    with_threads(threads, |par| match &symbolic.tree {
+        Some(tree) => multifrontal::factorize(symbolic, tree, factor, lower, par),
         None => symbolic
             .factorize_numeric_ldlt(
                 factor,
