@@ -107,9 +107,10 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     out.
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
-    ``geodesic_from`` (a line of boundary nodes, or a list of lines) and ``strip_width`` (m, one
-    for all lines or one per line): geodesic seams that far apart along the surface, the film split
-    along them (``--geodesic-from``, ``--strip-width``);
+    ``geodesic_from`` (a line of boundary nodes, or a line across the film from boundary to
+    boundary, itself a seam with the others on both sides; or a list of lines) and ``strip_width``
+    (m, one for all lines or one per line): geodesic seams that far apart along the surface, the
+    film split along them (``--geodesic-from``, ``--strip-width``);
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
     ``svg`` / ``erection_model``: files to write the outlines and the erection model to;
     ``erection_models``: a folder to write every erection's model to as it is erected

@@ -179,8 +179,12 @@ fn geodesic_split(model: &Model, a: &PatternArgs<'_>) -> Result<Option<SplitFilm
         let lengths: Vec<String> = (seams.seams.iter())
             .map(|s| format!("{:.4}", s.last().map_or(0.0, |g| g.length)))
             .collect();
+        let inside = match seams.start_seam {
+            Some(k) => format!(" (the start line, inside the film, is seam {k})"),
+            None => String::new(),
+        };
         eprintln!(
-            "geodesic seams: {} seams {width} m apart along a transverse geodesic of {:.4} m, lengths {} m",
+            "geodesic seams: {} seams {width} m apart along a transverse geodesic of {:.4} m, lengths {} m{inside}",
             seams.seams.len(),
             seams.transverse.last().map_or(0.0, |g| g.length),
             lengths.join(", ")
