@@ -1127,6 +1127,7 @@ fn element_wise_iteration_stops_when_the_largest_error_grows_and_keeps_the_best_
         Ok(Erected {
             frictional: vec![false; model.nodes.len()],
             elements,
+            contacts: vec![],
         })
     };
     let settings = ElementSettings {

@@ -43,6 +43,9 @@ def test_pattern_cuts_the_found_catenoid_into_four_equal_strips_with_their_disto
         assert s["size"] == pytest.approx([1.4830, 1.0701], abs=1e-4)
         assert s["distortion"]["max"] == pytest.approx(0.08233, abs=1e-5)
         assert s["compensation"][0] == pytest.approx(0.00114, abs=1e-5)
+        # The outline (the cut strip's boundary edges) spans the strip's size.
+        xs, ys = ([p[c] for edge in s["outline"] for p in edge] for c in (0, 1))
+        assert [max(xs) - min(xs), max(ys) - min(ys)] == pytest.approx(s["size"], abs=1e-12)
     assert svg.read_text().startswith("<svg")
     uniform = pattern(found, seam_planes=[(0, 0, 0, 1, 0, 0)], compensation=0.5)
     assert [s["compensation"] for s in uniform["strips"]] == [[0.005, 0.005]] * 2
@@ -78,6 +81,14 @@ def test_by_element_erections_over_the_drum_with_friction_name_what_friction_hol
     report = pattern(DRUM, erect=3, by_element=True)
     erections = report["erections"]
     assert len(erections) == 3 and erections[-1]["max_error"] > 0.1
+    # Each erection's stresses give its largest error away from the rails.
+    drum = json.loads(DRUM.read_text())
+    rails = {v for g in drum["groups"] for v in g["nodes"]}
+    for e in erections:
+        errors = [max(abs(s[0] - 2e6), abs(s[1] - 2e6)) / 2e6
+                  for t, s in zip(drum["triangles"], e["stress"]) if not rails & set(t)]
+        assert len(e["stress"]) == len(drum["triangles"])
+        assert max(errors) == pytest.approx(e["max_error"], rel=1e-12)
     assert set(report["held_by_friction"]) <= set(report["stalled"]) and report["held_by_friction"]
     frictionless = json.loads(DRUM.read_text())
     frictionless["curved_supports"][0]["friction"] = 0.0
