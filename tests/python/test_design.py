@@ -129,6 +129,37 @@ def test_vault_bay_erects_to_its_prestress_without_friction_and_names_what_frict
     assert element_path["held_by_friction"] and set(element_path["held_by_friction"]) == set(element_path["stalled"])
 
 
+def test_vault_bay_contact_nodes_off_the_crown_end_sliding_at_mu_n_whatever_the_rail_path():
+    """Why the vault bay's end state does not depend on its erection path (the drum's does): on
+    the straight path (rails down 0.10 m and out 0.03 m together) and both winding ones (down then
+    out, out then down), every contact node off the crown ends sliding towards its rail, its
+    friction force μN pointing to the crown (along the arch: the rings' ξ1 grows eastwards) and
+    none across; the crown's nodes (arches and ridge) stick with almost no tangential force (the
+    bay is symmetric). A sliding node carries μN whatever came before, so the end state is the
+    end's alone: the three paths' stresses agree within 1e-5 of the target."""
+    bay = _vault_bay()
+    found = form_find(bay.vault_bay(), on_supports=True)
+    seams = [(0, bay.BAY * k / 8, 0, 0, 1, 0) for k in range(1, 8)]
+    stresses = []
+    for path in ([(0.10, 0.03)], [(0.10, 0.03), (0.0, 0.03)], [(0.10, 0.03), (0.10, 0.0)]):
+        erection = pattern(found, seam_planes=seams, erect=1, by_element=True, rail_path=path,
+                           erect_increments=20)["erections"][0]
+        contacts = erection["contacts"]
+        assert len(contacts) == 119
+        for c in contacts:
+            x, f = found["nodes"][c["node"]][0], math.hypot(*c["friction"])
+            if abs(x) < 1e-9:
+                assert c["status"] == "Stick" and f < 0.05 * bay.MU * c["normal_force"], c
+            else:
+                assert c["status"] == "Slip" and f == pytest.approx(bay.MU * c["normal_force"], rel=1e-9), c
+                assert c["friction"][0] * x < 0 and abs(c["friction"][1]) < 1e-3 * f, c
+        assert sum(abs(found["nodes"][c["node"]][0]) < 1e-9 for c in contacts) == 9
+        stresses.append(erection["stress"])
+    for other in stresses[1:]:
+        apart = max(abs(p - q) for u, v in zip(other, stresses[0]) for p, q in zip(u, v))
+        assert apart < 1e-5 * 1.5e6, apart
+
+
 def test_design_iterations_figure_drum_rows_match_its_csv_golden_number():
     """``examples/design_iterations.py``: its drum rows (computed again here) give the golden
     number of ``docs/figures/design_iterations.csv``: the largest error of the first erection over
