@@ -92,13 +92,18 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             strip_width: float | Sequence[float] | None = None,
             erection_models: str | Path | None = None) -> dict[str, Any]:
     """The cutting pattern of a (form found) model (``membrane-contact pattern``): a dict with
-    ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation`` and
-    ``distortion`` ``{max, rms}`` as strains) and ``erections`` (per erection: ``mean_error``,
-    ``max_error`` and each strip's ``compensation``; empty without ``erect``).
+    ``strips`` (per strip: ``triangles``, ``size`` (m, length and width), ``compensation``,
+    ``distortion`` ``{max, rms}`` as strains and ``outline``, the cut strip's boundary edges as
+    ``[[x0, y0], [x1, y1]]`` in m) and ``erections`` (per erection: ``mean_error``, ``max_error``
+    and each strip's ``compensation``; empty without ``erect``).
 
     ``by_element=True`` (with ``erect``) corrects every triangle's reference lengths instead of
     each strip's two compensations (``pattern --by-element``): the errors are then taken away from
-    the rails, each erection also has ``worst_triangle`` and ``yielded``, and the report has
+    the rails, each erection also has ``worst_triangle``, ``yielded``, ``stress`` (every
+    triangle's ``[sx, sy, txy]`` in Pa after erection) and ``contacts`` (every contact node of the
+    curved supports at the end: ``node``, ``support``, ``status`` ``"Open"``, ``"Stick"`` or
+    ``"Slip"``, ``normal_force`` and ``friction`` ``[along, across]`` in N, ``slip`` in m along
+    the support), and the report has
     ``stalled`` (triangles above the tolerance whose error did not halve) and ``held_by_friction``
     (those of them that friction holds on a support: their stress does not follow their cut).
     ``rail_path=(up, in)`` (m): the erections start with the rails that far above and inward of
@@ -107,9 +112,10 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     out.
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
-    ``geodesic_from`` (a line of boundary nodes, or a list of lines) and ``strip_width`` (m, one
-    for all lines or one per line): geodesic seams that far apart along the surface, the film split
-    along them (``--geodesic-from``, ``--strip-width``);
+    ``geodesic_from`` (a line of boundary nodes, or a line across the film from boundary to
+    boundary, itself a seam with the others on both sides; or a list of lines) and ``strip_width``
+    (m, one for all lines or one per line): geodesic seams that far apart along the surface, the
+    film split along them (``--geodesic-from``, ``--strip-width``);
     ``compensation``: ``"prestress"``, a percentage, or ``(along, across)`` percentages;
     ``svg`` / ``erection_model``: files to write the outlines and the erection model to;
     ``erection_models``: a folder to write every erection's model to as it is erected

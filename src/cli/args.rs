@@ -116,8 +116,9 @@ pub enum Command {
         seam_nodes: Vec<String>,
         /// Geodesic seams from this line of boundary nodes: straightest geodesics (Polthier &
         /// Schmies 1998) perpendicular to a transverse one, --strip-width apart along it; repeat
-        /// for more start lines. The film is split along the seams (nodes added where they
-        /// cross its triangles' edges), so the strips' outlines follow them.
+        /// for more start lines. A line across the film (boundary to boundary) is itself a seam,
+        /// with the others on both sides of it. The film is split along the seams (nodes added
+        /// where they cross its triangles' edges), so the strips' outlines follow them.
         #[arg(long, value_name = "N1,N2,…", requires = "strip_width")]
         geodesic_from: Vec<String>,
         /// The width (m, along the surface) between the geodesic seams of --geodesic-from: one

@@ -11,12 +11,12 @@ use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
-    ElementSettings, ErectContacts, away_from_rails, compensate_elements, erect_through,
-    rail_waypoints,
+    ContactEnd, ElementSettings, ErectContacts, away_from_rails, compensate_elements,
+    erect_through, rail_waypoints,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::geodesic::geodesic_seams;
-use membrane_contact::mech::patterning::outline::{OutlineLabel, dxf, svg};
+use membrane_contact::mech::patterning::outline::{OutlineLabel, boundary_edges, dxf, svg};
 use membrane_contact::mech::patterning::reference::{erection_model, reference_geometry};
 use membrane_contact::mech::patterning::seams::{
     SeamPlane, strips_by_node_lines, strips_by_planes,
@@ -179,8 +179,12 @@ fn geodesic_split(model: &Model, a: &PatternArgs<'_>) -> Result<Option<SplitFilm
         let lengths: Vec<String> = (seams.seams.iter())
             .map(|s| format!("{:.4}", s.last().map_or(0.0, |g| g.length)))
             .collect();
+        let inside = match seams.start_seam {
+            Some(k) => format!(" (the start line, inside the film, is seam {k})"),
+            None => String::new(),
+        };
         eprintln!(
-            "geodesic seams: {} seams {width} m apart along a transverse geodesic of {:.4} m, lengths {} m",
+            "geodesic seams: {} seams {width} m apart along a transverse geodesic of {:.4} m, lengths {} m{inside}",
             seams.seams.len(),
             seams.transverse.last().map_or(0.0, |g| g.length),
             lengths.join(", ")
@@ -356,6 +360,8 @@ fn compensate_by_elements(
                 "outside_tolerance": outside,
                 "yielded": h.yielded,
                 "compensation": h.compensation,
+                "stress": h.stresses,
+                "contacts": h.contacts.iter().map(|c| contact_json(model, c)).collect::<Vec<_>>(),
             })
         })
         .collect();
@@ -367,13 +373,32 @@ fn compensate_by_elements(
     Ok((outcome.cut, report))
 }
 
-/// A cut strip as JSON: its triangles, size (m), compensation and distortion (strains).
-fn strip_json(c: &CutStrip) -> serde_json::Value {
+/// A contact node at the end of an erection as JSON: node, support (name), status, normal and
+/// friction forces (N), slip (m).
+fn contact_json(model: &Model, c: &ContactEnd) -> serde_json::Value {
+    serde_json::json!({
+        "node": c.node,
+        "support": model.curved_supports.get(c.support).map(|s| s.name.as_str()),
+        "status": c.status,
+        "normal_force": c.normal_force,
+        "friction": c.friction,
+        "slip": c.slip,
+    })
+}
+
+/// A cut strip as JSON: its triangles, size (m), compensation, distortion (strains) and its
+/// outline (the compensated flat strip's boundary edges, m).
+fn strip_json(model: &Model, c: &CutStrip) -> serde_json::Value {
+    let outline: Vec<[[f64; 2]; 2]> = boundary_edges(model, &c.strip)
+        .into_iter()
+        .map(|[a, b]| [c.strip.flat[a], c.strip.flat[b]])
+        .collect();
     serde_json::json!({
         "triangles": c.strip.triangles,
         "size": c.size,
         "compensation": c.compensation,
         "distortion": { "max": c.distortion.max_strain, "rms": c.distortion.rms_strain },
+        "outline": outline,
     })
 }
 
@@ -426,7 +451,10 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
         cut_pattern(&model, strips, compensation)?
     };
     if let Some(file) = a.report {
-        report["strips"] = cut.iter().map(strip_json).collect::<Vec<_>>().into();
+        report["strips"] = (cut.iter())
+            .map(|c| strip_json(&model, c))
+            .collect::<Vec<_>>()
+            .into();
         write_text(Some(file), &(report.to_string() + "\n"))?;
     }
     for (k, c) in cut.iter().enumerate() {

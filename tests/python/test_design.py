@@ -43,6 +43,9 @@ def test_pattern_cuts_the_found_catenoid_into_four_equal_strips_with_their_disto
         assert s["size"] == pytest.approx([1.4830, 1.0701], abs=1e-4)
         assert s["distortion"]["max"] == pytest.approx(0.08233, abs=1e-5)
         assert s["compensation"][0] == pytest.approx(0.00114, abs=1e-5)
+        # The outline (the cut strip's boundary edges) spans the strip's size.
+        xs, ys = ([p[c] for edge in s["outline"] for p in edge] for c in (0, 1))
+        assert [max(xs) - min(xs), max(ys) - min(ys)] == pytest.approx(s["size"], abs=1e-12)
     assert svg.read_text().startswith("<svg")
     uniform = pattern(found, seam_planes=[(0, 0, 0, 1, 0, 0)], compensation=0.5)
     assert [s["compensation"] for s in uniform["strips"]] == [[0.005, 0.005]] * 2
@@ -78,6 +81,14 @@ def test_by_element_erections_over_the_drum_with_friction_name_what_friction_hol
     report = pattern(DRUM, erect=3, by_element=True)
     erections = report["erections"]
     assert len(erections) == 3 and erections[-1]["max_error"] > 0.1
+    # Each erection's stresses give its largest error away from the rails.
+    drum = json.loads(DRUM.read_text())
+    rails = {v for g in drum["groups"] for v in g["nodes"]}
+    for e in erections:
+        errors = [max(abs(s[0] - 2e6), abs(s[1] - 2e6)) / 2e6
+                  for t, s in zip(drum["triangles"], e["stress"]) if not rails & set(t)]
+        assert len(e["stress"]) == len(drum["triangles"])
+        assert max(errors) == pytest.approx(e["max_error"], rel=1e-12)
     assert set(report["held_by_friction"]) <= set(report["stalled"]) and report["held_by_friction"]
     frictionless = json.loads(DRUM.read_text())
     frictionless["curved_supports"][0]["friction"] = 0.0
@@ -116,6 +127,37 @@ def test_vault_bay_erects_to_its_prestress_without_friction_and_names_what_frict
     last = element_path["erections"][-1]
     assert last["max_error"] > 0.05 and last["outside_tolerance"] > 0 and last["yielded"] == 0
     assert element_path["held_by_friction"] and set(element_path["held_by_friction"]) == set(element_path["stalled"])
+
+
+def test_vault_bay_contact_nodes_off_the_crown_end_sliding_at_mu_n_whatever_the_rail_path():
+    """Why the vault bay's end state does not depend on its erection path (the drum's does): on
+    the straight path (rails down 0.10 m and out 0.03 m together) and both winding ones (down then
+    out, out then down), every contact node off the crown ends sliding towards its rail, its
+    friction force μN pointing to the crown (along the arch: the rings' ξ1 grows eastwards) and
+    none across; the crown's nodes (arches and ridge) stick with almost no tangential force (the
+    bay is symmetric). A sliding node carries μN whatever came before, so the end state is the
+    end's alone: the three paths' stresses agree within 1e-5 of the target."""
+    bay = _vault_bay()
+    found = form_find(bay.vault_bay(), on_supports=True)
+    seams = [(0, bay.BAY * k / 8, 0, 0, 1, 0) for k in range(1, 8)]
+    stresses = []
+    for path in ([(0.10, 0.03)], [(0.10, 0.03), (0.0, 0.03)], [(0.10, 0.03), (0.10, 0.0)]):
+        erection = pattern(found, seam_planes=seams, erect=1, by_element=True, rail_path=path,
+                           erect_increments=20)["erections"][0]
+        contacts = erection["contacts"]
+        assert len(contacts) == 119
+        for c in contacts:
+            x, f = found["nodes"][c["node"]][0], math.hypot(*c["friction"])
+            if abs(x) < 1e-9:
+                assert c["status"] == "Stick" and f < 0.05 * bay.MU * c["normal_force"], c
+            else:
+                assert c["status"] == "Slip" and f == pytest.approx(bay.MU * c["normal_force"], rel=1e-9), c
+                assert c["friction"][0] * x < 0 and abs(c["friction"][1]) < 1e-3 * f, c
+        assert sum(abs(found["nodes"][c["node"]][0]) < 1e-9 for c in contacts) == 9
+        stresses.append(erection["stress"])
+    for other in stresses[1:]:
+        apart = max(abs(p - q) for u, v in zip(other, stresses[0]) for p, q in zip(u, v))
+        assert apart < 1e-5 * 1.5e6, apart
 
 
 def test_design_iterations_figure_drum_rows_match_its_csv_golden_number():

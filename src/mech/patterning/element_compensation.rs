@@ -45,6 +45,25 @@ pub struct Erected {
     /// Per node: in contact and held by friction at the end, on a curved support or a gap:
     /// sticking, or sliding against a friction force.
     pub frictional: Vec<bool>,
+    /// Every contact node of the curved supports at the end, in the supports' order.
+    pub contacts: Vec<ContactEnd>,
+}
+
+/// A contact node of a curved support at the end of an erection.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactEnd {
+    /// The film node.
+    pub node: usize,
+    /// The index of the curved support.
+    pub support: usize,
+    /// Open, sticking or sliding.
+    pub status: GapStatus,
+    /// Normal force (N).
+    pub normal_force: f64,
+    /// Friction force along the support (`ξ1`) and across it (`ξ2`) (N): against the slip.
+    pub friction: [f64; 2],
+    /// Arc length slid along the support while in contact (m).
+    pub slip: f64,
 }
 
 /// Erects a model by the analysis and returns its stresses and the nodes friction holds.
@@ -156,9 +175,19 @@ fn erected(analysis: &mut Analysis) -> Erected {
         status == GapStatus::Stick || (status == GapStatus::Slip && friction > 0.0)
     };
     let mut frictional = vec![false; model.nodes.len()];
-    let contact_nodes = model.curved_supports.iter().flat_map(|s| s.nodes.iter());
-    for (&v, c) in contact_nodes.zip(&results.surface_contacts) {
-        frictional[v] |= held(c.status, c.friction_force);
+    let contact_nodes = (model.curved_supports.iter().enumerate())
+        .flat_map(|(k, s)| s.nodes.iter().map(move |&v| (k, v)));
+    let mut contacts = Vec::new();
+    for ((support, node), c) in contact_nodes.zip(&results.surface_contacts) {
+        frictional[node] |= held(c.status, c.friction_force);
+        contacts.push(ContactEnd {
+            node,
+            support,
+            status: c.status,
+            normal_force: c.normal_force,
+            friction: c.friction,
+            slip: c.slip,
+        });
     }
     for (g, r) in model.gaps.iter().zip(&results.gaps) {
         frictional[g.film_node] |= held(r.status, r.friction_force);
@@ -166,6 +195,7 @@ fn erected(analysis: &mut Analysis) -> Erected {
     Erected {
         elements: results.elements,
         frictional,
+        contacts,
     }
 }
 
@@ -315,6 +345,10 @@ pub struct ElementIteration {
     pub yielded: usize,
     /// Each strip's overall compensation `[c_x, c_y]` (its cut lengths against the flat strip).
     pub compensation: Vec<[f64; 2]>,
+    /// Every triangle's stress `[σx, σy, τxy]` after erection (Pa, the erection model's frames).
+    pub stresses: Vec<[f64; 3]>,
+    /// The curved supports' contact nodes at the end ([`Erected::contacts`]).
+    pub contacts: Vec<ContactEnd>,
 }
 
 /// The outcome of [`compensate_elements`].
@@ -358,6 +392,8 @@ fn record(
         yielded: erected.elements.iter().filter(|e| plastic(e)).count(),
         element_errors: errors,
         compensation: cut.iter().map(|c| c.compensation).collect(),
+        stresses: erected.elements.iter().map(|e| e.stress).collect(),
+        contacts: erected.contacts.clone(),
     }
 }
 

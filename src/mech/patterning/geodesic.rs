@@ -13,10 +13,13 @@
 //! transverse geodesic goes into the film perpendicular to the line; seam `k` starts at arc
 //! length `k w` along it and runs perpendicular to it both ways (on a developable surface the
 //! seams are then the parallels at distance `k w` of the start line: on a cylinder, its
-//! generators). *Strips*: a triangle lies beyond seam `k` when its centroid lies on the far
-//! side of the seam's nearest segment; its strip is the number of seams it lies beyond. The
-//! strips' edges follow the triangles on either side of each seam (as with seam planes): the
-//! mesh is not split along the geodesic.
+//! generators). A start line inside the film (from boundary to boundary) is itself a seam, and
+//! the transverse geodesic goes from its middle to both sides: the seams lie at `k w` on each
+//! side, numbered from the side on the line's left (walking from its first node to its last,
+//! the triangles' normals up) to its right. *Strips*: a triangle lies beyond a seam when its
+//! centroid lies on the far side (along the transverse geodesic) of the seam's nearest segment;
+//! its strip is the number of seams it lies beyond. The strips' edges follow the triangles on either side of each seam (as
+//! with seam planes): the mesh is not split along the geodesic ([`super::split`] does).
 
 use std::collections::HashMap;
 
@@ -50,10 +53,16 @@ enum Entry {
 /// Geodesics seams of a strip width from a start line.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeodesicSeams {
-    /// The transverse geodesic from the start line's middle, across the film.
+    /// The transverse geodesic through the start line's middle, across the film (from the
+    /// boundary, through the start, to the boundary for a start line inside the film).
     pub transverse: Vec<GeodesicPoint>,
-    /// Each seam, from one boundary to the other.
+    /// The arc length of the start line's middle along `transverse` (0 on the boundary).
+    pub origin: f64,
+    /// Each seam, from one boundary to the other, in their order along `transverse` (inside the
+    /// film: from the start line's left to its right).
     pub seams: Vec<Vec<GeodesicPoint>>,
+    /// The index in `seams` of the start line itself, when it lies inside the film.
+    pub start_seam: Option<usize>,
     /// The triangles of each strip, from the start line on.
     pub strips: Vec<Vec<usize>>,
 }
@@ -106,6 +115,15 @@ impl<'a> Surface<'a> {
     /// The triangle across edge `[a, b]` from `t` (none on the boundary).
     fn across_edge(&self, t: usize, a: usize, b: usize) -> Option<usize> {
         self.by_edge[&key(a, b)].iter().copied().find(|&s| s != t)
+    }
+
+    /// Whether node `v` lies on the film's boundary (an edge of one triangle ends at it).
+    fn on_boundary(&self, v: usize) -> bool {
+        self.by_vertex[v].iter().any(|&t| {
+            let tri = self.model.triangles[t];
+            tri.iter()
+                .any(|&u| u != v && self.by_edge[&key(u, v)].len() == 1)
+        })
     }
 
     /// The first exit of the ray `p + s d` from `t`: `(s, [a, b], λ)` on edge `a → b`.
@@ -271,9 +289,18 @@ pub fn point_at(path: &[GeodesicPoint], s: f64) -> GeodesicPoint {
     }
 }
 
-/// Where the transverse geodesic starts: the middle (by length) of the start `line`, in the
-/// triangle on its boundary edge there, going into the film perpendicular to the line.
-fn start_of(surface: &Surface<'_>, line: &[usize]) -> Result<(usize, [f64; 3], [f64; 3]), String> {
+/// Where the transverse geodesic starts: the middle (by length) of the start line.
+struct Start {
+    /// The middle point.
+    point: [f64; 3],
+    /// The triangle on each side of the line there (one on the boundary; inside the film two,
+    /// the right one first) and the direction into it, perpendicular to the line.
+    sides: Vec<(usize, [f64; 3])>,
+}
+
+/// The start of the transverse geodesic from the start `line`, checked: its nodes are nodes,
+/// consecutive ones share a triangle edge, and a line inside the film ends on the boundary.
+fn start_of(surface: &Surface<'_>, line: &[usize]) -> Result<Start, String> {
     let n = surface.model.nodes.len();
     if let Some(v) = line.iter().find(|&&v| v >= n) {
         return Err(format!(
@@ -300,10 +327,18 @@ fn start_of(surface: &Surface<'_>, line: &[usize]) -> Result<(usize, [f64; 3], [
         - 1;
     let (a, b) = (line[i], line[i + 1]);
     let triangles = &surface.by_edge[&key(a, b)];
-    if triangles.len() != 1 {
+    if triangles.len() > 2 {
         return Err(format!(
-            "geodesic seams: the start line's segment {a}–{b} is not on the film's boundary"
+            "geodesic seams: the start line's segment {a}–{b} is an edge of more than two triangles"
         ));
+    }
+    if triangles.len() == 2 {
+        let ends = [line[0], line[line.len() - 1]];
+        if let Some(v) = ends.into_iter().find(|&v| !surface.on_boundary(v)) {
+            return Err(format!(
+                "geodesic seams: the start line lies inside the film but its end node {v} is not on the film's boundary"
+            ));
+        }
     }
     let e = surface.x(b) - surface.x(a);
     let p = surface.x(a) + e * ((half - lengths[i]) / e.norm());
@@ -312,11 +347,68 @@ fn start_of(surface: &Surface<'_>, line: &[usize]) -> Result<(usize, [f64; 3], [
         (true, Some(before)) => surface.x(b) - surface.x(line[before]),
         _ => e,
     };
-    let into = across(
-        surface.x(surface.third(triangles[0], a, b)) - surface.x(a),
-        tangent.normalize(),
-    );
-    Ok((triangles[0], p.into(), into.into()))
+    let mut sides: Vec<(usize, V3)> = (triangles.iter())
+        .map(|&t| {
+            let into = across(
+                surface.x(surface.third(t, a, b)) - surface.x(a),
+                tangent.normalize(),
+            );
+            (t, into)
+        })
+        .collect();
+    // Inside the film the right side (walking along the line, the normals up) goes first: the
+    // transverse geodesic then runs from the left side's boundary to the right side's.
+    sides.sort_by_key(|&(t, d)| tangent.cross(&d).dot(&surface.normal(t)) > 0.0);
+    Ok(Start {
+        point: p.into(),
+        sides: sides.into_iter().map(|(t, d)| (t, d.into())).collect(),
+    })
+}
+
+/// The start `line` as a seam: its nodes, each segment in a triangle of its edge.
+fn line_seam(surface: &Surface<'_>, line: &[usize]) -> Vec<GeodesicPoint> {
+    let mut length = 0.0;
+    let mut seam = Vec::with_capacity(line.len());
+    for (i, &v) in line.iter().enumerate() {
+        let (a, b) = (line[i.min(line.len() - 2)], line[i.min(line.len() - 2) + 1]);
+        let chord = surface.x(b) - surface.x(a);
+        seam.push(GeodesicPoint {
+            point: surface.x(v).into(),
+            triangle: surface.by_edge[&key(a, b)][0],
+            direction: chord.normalize().into(),
+            length,
+        });
+        if i + 1 < line.len() {
+            length += (surface.x(line[i + 1]) - surface.x(v)).norm();
+        }
+    }
+    seam
+}
+
+/// The geodesic `back` (from a point) reversed and joined to `forward` (from the same point):
+/// one path, each point's direction the chord to the next and its length from the path's start.
+fn joined(back: &[GeodesicPoint], forward: Vec<GeodesicPoint>) -> Vec<GeodesicPoint> {
+    // The segment from back[j+1] to back[j] lies in back[j]'s triangle.
+    let mut path: Vec<GeodesicPoint> = (1..back.len())
+        .rev()
+        .map(|j| GeodesicPoint {
+            point: back[j].point,
+            triangle: back[j - 1].triangle,
+            ..back[j]
+        })
+        .collect();
+    path.extend(forward);
+    let mut length = 0.0;
+    for i in 0..path.len() {
+        let next = path.get(i + 1).map_or(path[i].point, |g| g.point);
+        let chord = V3::from(next) - V3::from(path[i].point);
+        path[i].length = length;
+        if chord.norm() > 0.0 {
+            path[i].direction = chord.normalize().into();
+        }
+        length += chord.norm();
+    }
+    path
 }
 
 /// One seam through `g` (a point of the transverse geodesic), perpendicular to it, from
@@ -325,27 +417,7 @@ fn seam_through(surface: &Surface<'_>, g: GeodesicPoint) -> Vec<GeodesicPoint> {
     let along = surface.normal(g.triangle).cross(&V3::from(g.direction));
     let forward = surface.trace(g.triangle, g.point, along.into(), f64::INFINITY);
     let back = surface.trace(g.triangle, g.point, (-along).into(), f64::INFINITY);
-    // The back half reversed: the segment from back[j+1] to back[j] lies in back[j]'s triangle.
-    let mut seam: Vec<GeodesicPoint> = (1..back.len())
-        .rev()
-        .map(|j| GeodesicPoint {
-            point: back[j].point,
-            triangle: back[j - 1].triangle,
-            ..back[j]
-        })
-        .collect();
-    seam.extend(forward);
-    let mut length = 0.0;
-    for i in 0..seam.len() {
-        let next = seam.get(i + 1).map_or(seam[i].point, |g| g.point);
-        let chord = V3::from(next) - V3::from(seam[i].point);
-        seam[i].length = length;
-        if chord.norm() > 0.0 {
-            seam[i].direction = chord.normalize().into();
-        }
-        length += chord.norm();
-    }
-    seam
+    joined(&back, forward)
 }
 
 /// Whether `c` lies on the side of `seam` that `towards` (a point and direction near it)
@@ -369,7 +441,9 @@ fn beyond(surface: &Surface<'_>, seam: &[GeodesicPoint], c: V3, towards: (V3, V3
 }
 
 /// The geodesic seams at arc lengths `k · width` (`k = 1, 2, …`) along the transverse geodesic
-/// from the start `line` (mesh nodes along the film's boundary), and the strips between them.
+/// from the start `line` (mesh nodes along the film's boundary, or across the film from
+/// boundary to boundary: then the line is a seam and the others lie on both sides of it), and
+/// the strips between them.
 pub fn geodesic_seams(model: &Model, line: &[usize], width: f64) -> Result<GeodesicSeams, String> {
     if !(width > 0.0 && width.is_finite()) {
         return Err(format!(
@@ -377,22 +451,62 @@ pub fn geodesic_seams(model: &Model, line: &[usize], width: f64) -> Result<Geode
         ));
     }
     let surface = Surface::new(model);
-    let (t, p, d) = start_of(&surface, line)?;
-    let transverse = surface.trace(t, p, d, f64::INFINITY);
-    let total = transverse.last().map_or(0.0, |g| g.length);
-    let at: Vec<GeodesicPoint> = (1..)
-        .map(|k| k as f64 * width)
-        .take_while(|&s| s < total - 1e-6 * width)
-        .map(|s| point_at(&transverse, s))
+    let start = start_of(&surface, line)?;
+    let halves: Vec<Vec<GeodesicPoint>> = (start.sides.iter())
+        .map(|&(t, d)| surface.trace(t, start.point, d, f64::INFINITY))
         .collect();
-    let seams: Vec<Vec<GeodesicPoint>> = at.iter().map(|&g| seam_through(&surface, g)).collect();
+    let (transverse, origin) = match &halves[..] {
+        // The start point is the back half's last point, reversed: at index back.len() − 1.
+        [forward, back] => {
+            let path = joined(back, forward.clone());
+            let origin = path[back.len() - 1].length;
+            (path, origin)
+        }
+        _ => (halves[0].clone(), 0.0),
+    };
+    let total = transverse.last().map_or(0.0, |g| g.length);
+    let before = (1..)
+        .map(|k| origin - k as f64 * width)
+        .take_while(|&s| s > 1e-6 * width);
+    let after = (1..)
+        .map(|k| origin + k as f64 * width)
+        .take_while(|&s| s < total - 1e-6 * width);
+    let mut offsets: Vec<f64> = before.collect();
+    offsets.reverse();
+    let start_seam = (start.sides.len() == 2).then_some(offsets.len());
+    offsets.extend(start_seam.map(|_| origin));
+    offsets.extend(after);
+    let at: Vec<GeodesicPoint> = offsets.iter().map(|&s| point_at(&transverse, s)).collect();
+    let seams: Vec<Vec<GeodesicPoint>> = (at.iter().enumerate())
+        .map(|(k, &g)| match start_seam == Some(k) {
+            true => line_seam(&surface, line),
+            false => seam_through(&surface, g),
+        })
+        .collect();
+    Ok(GeodesicSeams {
+        strips: strips_between(&surface, &seams, &at, width),
+        transverse,
+        origin,
+        seams,
+        start_seam,
+    })
+}
+
+/// The triangles of each strip: those beyond the same number of `seams` (each crossing the
+/// transverse geodesic at its point of `at`), in their order.
+fn strips_between(
+    surface: &Surface<'_>,
+    seams: &[Vec<GeodesicPoint>],
+    at: &[GeodesicPoint],
+    width: f64,
+) -> Vec<Vec<usize>> {
     let mut strips: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
-    for (t, tri) in model.triangles.iter().enumerate() {
+    for (t, tri) in surface.model.triangles.iter().enumerate() {
         let c = tri.iter().map(|&v| surface.x(v)).sum::<V3>() / 3.0;
-        let index = (seams.iter().zip(&at))
+        let index = (seams.iter().zip(at))
             .filter(|(seam, g)| {
                 beyond(
-                    &surface,
+                    surface,
                     seam,
                     c,
                     (V3::from(g.point), V3::from(g.direction) * width),
@@ -401,9 +515,5 @@ pub fn geodesic_seams(model: &Model, line: &[usize], width: f64) -> Result<Geode
             .count();
         strips.entry(index).or_default().push(t);
     }
-    Ok(GeodesicSeams {
-        transverse,
-        seams,
-        strips: strips.into_values().collect(),
-    })
+    strips.into_values().collect()
 }
