@@ -5,8 +5,10 @@ Two FMUs coupled by the project's co-simulation master (``membrane_contact.coupl
 mass flow of the same step): the cushion (``examples/cushion_air.json`` shaped as two spherical
 caps, its air sealed at 300 Pa: ``membrane_contact.inflation.cushion_model``) and the inflation
 unit (``fmu/inflation``: fan curve, non-return valve, leakage, pressure switch 250/350 Pa with a
-1.5 s start/stop delay). Quiet until 60 s, then 0.5 kPa of snow (ramped over 10 s, lying for
-50 s, melting over 10 s), then a gust of 0.4 kPa suction on the top layer at 170 s.
+1.5 s start/stop delay, and a snow mode that raises the switch's band to 400/550 Pa). Quiet
+until 60 s, then 0.5 kPa of snow (ramped over 10 s, lying for 50 s, melting over 10 s; the
+unit's snow mode is on while it lies: ``membrane_contact.inflation.snow_lies``), then a gust of
+0.4 kPa suction on the top layer at 170 s.
 
 Writes a plot of the cushion's pressure, the fan's duty and the top layer's deflection
 (``--out``, PNG) and the records (``--csv``), and prints the largest pressure during the snow
@@ -28,14 +30,15 @@ sys.path.insert(0, str(ROOT / "python"))
 
 from membrane_contact.coupling import closing  # noqa: E402
 from membrane_contact.inflation import (  # noqa: E402
-    COLUMNS, cushion_system, pack_cushion_fmu, pack_unit_fmu, run_events)
+    COLUMNS, cushion_system, pack_cushion_fmu, pack_unit_fmu, run_events, snow_lies)
 
 #: The run's length (s): past the gust, the unit back at its cycle.
 DURATION = 240.0
 
 
 def plot(run, path):
-    """Pressure with the switch's band, the fan's duty per step, the crowns' deflections."""
+    """Pressure with the switch's band (the snow band while snow mode is on), the fan's duty per
+    step, the crowns' deflections."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -46,8 +49,9 @@ def plot(run, path):
     a.plot(t, run["pressure"], label="cushion")
     a.plot(t, run["snow"], "--", label="snow (plan)")
     a.plot(t, -run["wind"], ":", label="wind (suction < 0)")
-    for p in (250.0, 350.0):
-        a.axhline(p, color="grey", lw=0.5)
+    snow = run["snowMode"] > 0.0
+    for normal, snowy in ((250.0, 400.0), (350.0, 550.0)):
+        a.step(t, [snowy if s else normal for s in snow], where="pre", color="grey", lw=0.5)
     a.set_ylabel("pressure (Pa)")
     a.legend(loc="upper right")
     b.step(t, run["duty"], where="pre", label="duty of the step")
@@ -72,7 +76,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         film_fmu, unit_fmu = pack_cushion_fmu(tmp, root=ROOT), pack_unit_fmu(tmp, root=ROOT)
         with closing(cushion_system(film_fmu, unit_fmu)) as system:
-            run = run_events(system, DURATION, a.step)
+            run = run_events(system, DURATION, a.step, snow_mode=snow_lies)
     plot(run, a.out)
     if a.csv:
         with open(a.csv, "w", newline="") as f:

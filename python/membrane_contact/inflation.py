@@ -180,7 +180,13 @@ def couple(film, unit):
 
 #: What :func:`run_events` records per communication step, by column.
 COLUMNS = ("time", "pressure", "volume", "mass", "top", "bottom", "snow", "wind", "fed", "massFlow", "fanOn",
-           "duty", "dutyTotal", "fanFlow")
+           "duty", "dutyTotal", "fanFlow", "snowMode")
+
+
+def snow_lies(loads: dict) -> bool:
+    """The unit's snow mode as a roof's controller with a snow sensor sets it: on while the
+    weather's snow load lies on the top layer (``snow.pressure > 0``)."""
+    return loads.get("snow.pressure", 0.0) > 0.0
 
 
 def snow_and_gust(t: float, snow: float = 500.0, suction: float = 400.0) -> dict:
@@ -194,12 +200,14 @@ def snow_and_gust(t: float, snow: float = 500.0, suction: float = 400.0) -> dict
             "wind.pressure": suction * ramp(170.0, 172.0, 182.0, 184.0)}
 
 
-def run_events(system, duration: float, h: float = 1.0, weather=snow_and_gust, scheme: str = "staggered") -> dict:
+def run_events(system, duration: float, h: float = 1.0, weather=snow_and_gust, scheme: str = "staggered",
+               snow_mode=None) -> dict:
     """Steps the cushion system (:func:`cushion_system`) over ``duration`` in steps of ``h``,
     the top layer's loads of each step ``weather(t + h)`` (reached at the step's end), with the
     master's ``scheme``; returns the records of :data:`COLUMNS` as lists, the first row the
     initial state. ``fed``: the pressure the unit held over the step; ``massFlow``: its flow,
-    the one the film took in."""
+    the one the film took in. ``snow_mode``: a function of a step's loads giving the unit's
+    ``snowMode`` for that step (e.g. :func:`snow_lies`); None leaves it as it is."""
     import numpy as np
 
     film, unit = system.film, system.structure
@@ -208,12 +216,15 @@ def run_events(system, duration: float, h: float = 1.0, weather=snow_and_gust, s
     def record(loads):
         rows.append((film.time, film["air.pressure"], film["air.volume"], film["air.mass"], film["crownTop.uz"],
                      film["crownBottom.uz"], loads["snow.pressure"], loads["wind.pressure"], unit["pressure"],
-                     unit["massFlow"], unit["fanOn"], unit["duty"], unit["dutyTotal"], unit["fanFlow"]))
+                     unit["massFlow"], unit["fanOn"], unit["duty"], unit["dutyTotal"], unit["fanFlow"],
+                     float(unit["snowMode"])))
 
     record(weather(film.time))
     for _ in range(int(round(duration / h))):
         loads = weather(film.time + h)
         film.set(loads)
+        if snow_mode is not None:
+            unit.set({"snowMode": bool(snow_mode(loads))})
         system.step(h, scheme)
         record(loads)
     return {name: np.asarray(column) for name, column in zip(COLUMNS, zip(*rows))}

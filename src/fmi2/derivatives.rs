@@ -1,6 +1,8 @@
 //! `fmi2GetDirectionalDerivative` (issue 21 item 1): derivatives of the Real outputs of the
 //! converged state with respect to the inputs (group displacements and angles, pressures,
-//! nodal forces, `mu`), from the core's linear response (`Analysis::linear_response`: the last
+//! nodal forces, `mu`, and a chamber's `supplyPressure`, `heating` and `massFlow`: the air a
+//! step of size `h` adds is `massFlow · h`, so its derivative is `h` times the air's, `h` the
+//! last step's, 0 after a restored state), from the core's linear response (`Analysis::linear_response`: the last
 //! increment's Newton equation linearized at its solution; the consistent tangent factorized at
 //! the first call after a step or a restored state, each later call one solve with that
 //! factor). One-sided where a gap sits on a switch; see the core's module doc. After a step of
@@ -59,7 +61,7 @@ impl Instance {
                 )));
             }
             let d = if scale > 0.0 { d / scale } else { d };
-            if !add_to_seed(&mut s, &v.binding, d) {
+            if !add_to_seed(&mut s, &v.binding, d, built.step_size) {
                 return Err(Failure::error(format!(
                     "known {} (value reference {r}) is not an input",
                     v.name
@@ -125,7 +127,8 @@ impl Instance {
         let mut seeds = Vec::with_capacity(knowns.len());
         for &r in knowns {
             let mut s = Seed::zero(&built.analysis);
-            add_to_seed(&mut s, &variables.get(r as usize)?.binding, 1.0).then_some(())?;
+            let binding = &variables.get(r as usize)?.binding;
+            add_to_seed(&mut s, binding, 1.0, built.step_size).then_some(())?;
             seeds.push(s);
         }
         let values = built.analysis.adjoint_response(&weights, &seeds).ok()?;
@@ -167,13 +170,18 @@ fn path_warning(increments: usize, what: &str) -> Failure {
 }
 
 /// Adds `d` along the input bound to `binding` to `seed`; false if it is not an input.
-fn add_to_seed(seed: &mut Seed, binding: &Binding, d: f64) -> bool {
+/// `<chamber>.massFlow` moves the air by `d · h` (`h`: the size of the step that reached the
+/// state, 0 after a restored state: no step, no air).
+fn add_to_seed(seed: &mut Seed, binding: &Binding, d: f64, h: f64) -> bool {
     match *binding {
         Binding::GroupDisplacement { group, axis } => seed.translation[group][axis] += d,
         Binding::GroupAngle(g) => seed.angles[g] += d,
         Binding::Pressure(k) => seed.pressure[k] += d,
         Binding::NodalForce { set, axis } => seed.force[set][axis] += d,
         Binding::Friction => seed.friction += d,
+        Binding::ChamberSupply(k) => seed.supply[k] += d,
+        Binding::ChamberHeating(k) => seed.heating[k] += d,
+        Binding::ChamberMassFlow(k) => seed.air[k] += d * h,
         _ => return false,
     }
     true
@@ -186,8 +194,11 @@ fn add_to_seed(seed: &mut Seed, binding: &Binding, d: f64) -> bool {
 /// laws whose increments do not add up to one over the whole step: a slipping contact pushed
 /// across its slip direction turns it in each increment by an amount that depends on the
 /// increment's slip (the return map's `μN k_s / |t*|` across), so the step's earlier
-/// increments answer a seed too. Open and sticking contacts and an elastic film do not: the
-/// step's end depends on its end inputs alone.
+/// increments answer a seed too. An orifice that passes air does too: its transfer is
+/// integrated over the increments, each of its own length, so the last increment's linear
+/// response holds only that increment's share of it (issue 43). Open and sticking contacts, an
+/// elastic film and sealed chambers without orifices do not: the step's end depends on its
+/// end inputs alone.
 fn path_dependent(increments: usize, results: &Results) -> Option<String> {
     if increments <= 1 {
         return None;
@@ -200,10 +211,20 @@ fn path_dependent(increments: usize, results: &Results) -> Option<String> {
         .filter(|&s| s == GapStatus::Slip)
         .count();
     let yielded = results.plastic_summary().map_or(0, |p| p.yielded_elements);
-    match (sliding, yielded) {
-        (0, 0) => None,
-        (s, 0) => Some(format!("{s} contacts slide")),
-        (0, y) => Some(format!("{y} film elements yielded")),
-        (s, y) => Some(format!("{s} contacts slide and {y} film elements yielded")),
+    let passing = results
+        .orifices
+        .iter()
+        .filter(|o| o.mass_flow != 0.0)
+        .count();
+    let mut what = vec![];
+    if sliding > 0 {
+        what.push(format!("{sliding} contacts slide"));
     }
+    if yielded > 0 {
+        what.push(format!("{yielded} film elements yielded"));
+    }
+    if passing > 0 {
+        what.push(format!("{passing} orifices pass air"));
+    }
+    (!what.is_empty()).then(|| what.join(" and "))
 }

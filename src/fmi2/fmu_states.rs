@@ -101,6 +101,7 @@ impl Instance {
                 }
                 // The restored state's derivatives are those of one increment from it.
                 built.step_increments = 0;
+                built.step_size = 0.0;
                 Some(built)
             }
         };

@@ -39,6 +39,10 @@ pub(super) struct Built {
     /// (`derivatives.rs`), which are the step's only where this is 1 or the path did not
     /// matter.
     pub(super) step_increments: usize,
+    /// The size `h` of the step that reached the present state (0 where
+    /// [`Self::step_increments`] is): `<chamber>.massFlow` added `massFlow · h` of air over it,
+    /// so its derivatives are `h` times the air's.
+    pub(super) step_size: f64,
     /// The results of the state `checked_step` has just reached, already checked finite: the
     /// outputs are made of them (taken by `refresh_outputs`, so never stale).
     pub(super) checked: Option<Results>,
@@ -191,6 +195,7 @@ impl Instance {
             parameters: parameters_of(&self.description.variables, values),
             increments,
             step_increments: 0,
+            step_size: 0.0,
             checked: None,
             warnings: vec![],
         })

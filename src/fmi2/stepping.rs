@@ -82,12 +82,14 @@ impl Instance {
         match checked_step(built, &targets, &angles, &loads, &self.logger) {
             Ok(report) => {
                 step_average_flows(built, &moved, h);
+                built.step_size = h;
                 self.step_converged(t + h, &report)
             }
             Err(e) => {
                 if let Some(before) = before {
                     built.analysis.set_state(before).map_err(Failure::error)?;
                     built.step_increments = 0;
+                    built.step_size = 0.0;
                 }
                 Err(self.step_refused(t, h, e))
             }

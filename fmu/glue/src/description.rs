@@ -17,18 +17,31 @@ pub enum Causality {
 pub enum Variability {
     Fixed,
     Tunable,
+    /// Changes only at communication points: the variability of a Boolean input.
+    Discrete,
     Continuous,
 }
 
-/// One Real (FMI 2.0) / Float64 (FMI 3.0) scalar.
+/// A variable's type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VarType {
+    /// `Real` (FMI 2.0) / `Float64` (FMI 3.0).
+    Real,
+    /// `Boolean`: the model holds it as 0 or 1 among its reals; it has no unit.
+    Boolean,
+}
+
+/// One Real (FMI 2.0) / Float64 (FMI 3.0) or Boolean scalar.
 #[derive(Clone, Copy, Debug)]
 pub struct Variable {
     pub name: &'static str,
     pub vr: u32,
+    pub var_type: VarType,
     pub causality: Causality,
     pub variability: Variability,
     pub unit: &'static str,
-    /// The start value (inputs and parameters); outputs have none (`initial` calculated).
+    /// The start value (inputs and parameters; a Boolean's 0 or 1); outputs have none
+    /// (`initial` calculated).
     pub start: Option<f64>,
     pub description: &'static str,
 }
@@ -68,20 +81,42 @@ pub struct Description {
 
 impl Variable {
     /// Its attributes as both versions write them: name to description (FMI 2.0's
-    /// `ScalarVariable`), and unit and start (FMI 2.0's `Real`); FMI 3.0's `Float64` has both.
+    /// `ScalarVariable`), and unit and start (FMI 2.0's `Real`, `Boolean`: start alone); FMI
+    /// 3.0's `Float64` and `Boolean` have both.
     fn attributes(&self) -> (String, String) {
+        if self.var_type == VarType::Boolean {
+            let start = self
+                .start
+                .map_or(String::new(), |s| format!("start=\"{}\"", s != 0.0));
+            return (self.head(), start);
+        }
         let start = self
             .start
             .map_or(String::new(), |s| format!(" start=\"{s}\""));
-        let head = format!(
+        (
+            self.head(),
+            format!("unit=\"{}\"{start}", escape(self.unit)),
+        )
+    }
+
+    /// The attributes from name to description.
+    fn head(&self) -> String {
+        format!(
             "name=\"{}\" valueReference=\"{}\" causality=\"{}\" variability=\"{}\" description=\"{}\"",
             escape(self.name),
             self.vr,
             causality(self.causality),
             variability(self.variability),
             escape(self.description)
-        );
-        (head, format!("unit=\"{}\"{start}", escape(self.unit)))
+        )
+    }
+
+    /// The element's name: FMI 2.0's (inside `ScalarVariable`) and FMI 3.0's.
+    fn element(&self) -> (&'static str, &'static str) {
+        match self.var_type {
+            VarType::Real => ("Real", "Float64"),
+            VarType::Boolean => ("Boolean", "Boolean"),
+        }
     }
 }
 
@@ -135,8 +170,9 @@ impl Description {
             let (head, unit) = v.attributes();
             let _ = writeln!(
                 x,
-                "    <!-- {} --><ScalarVariable {head}><Real {unit}/></ScalarVariable>",
-                i + 1
+                "    <!-- {} --><ScalarVariable {head}><{} {unit}/></ScalarVariable>",
+                i + 1,
+                v.element().0
             );
         }
         x.push_str("  </ModelVariables>\n  <ModelStructure>\n");
@@ -160,7 +196,7 @@ impl Description {
         self.variables.iter().map(|v| v.vr + 1).max().unwrap_or(0)
     }
 
-    /// The FMI 3.0 `modelDescription.xml`: the same table as Float64 variables, `time` added
+    /// The FMI 3.0 `modelDescription.xml`: the same table as Float64 (and Boolean) variables, `time` added
     /// ([`Self::time_vr`]), the token as `instantiationToken`, dependencies by value reference.
     pub fn fmi3_xml(&self) -> String {
         let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
@@ -193,7 +229,7 @@ impl Description {
         );
         for v in self.variables {
             let (head, unit) = v.attributes();
-            let _ = writeln!(x, "    <Float64 {head} {unit}/>");
+            let _ = writeln!(x, "    <{} {head} {unit}/>", v.element().1);
         }
         x.push_str("  </ModelVariables>\n  <ModelStructure>\n");
         for (tag, list) in [
@@ -338,6 +374,7 @@ fn variability(v: Variability) -> &'static str {
     match v {
         Variability::Fixed => "fixed",
         Variability::Tunable => "tunable",
+        Variability::Discrete => "discrete",
         Variability::Continuous => "continuous",
     }
 }

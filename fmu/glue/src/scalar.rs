@@ -1,12 +1,14 @@
 //! The instance core of a model of Real scalars ([`ScalarModel`], e.g. the hydraulic jack): the
 //! phases, values by reference checked against the variable table, stepping with refusal and
 //! rollback (a refused step leaves the last good state), FMU states, logging. [`Scalar`]
-//! implements [`Core`], so the C layers export it as it is.
+//! implements [`Core`], so the C layers export it as it is. A Boolean variable of the table
+//! (`VarType::Boolean`, e.g. the inflation unit's `snowMode`) is held by the model as a real 0
+//! or 1 and read and written only as a Boolean.
 
 use std::collections::HashMap;
 
 use crate::core::{Core, Instantiation};
-use crate::description::{Causality, Description, Variability};
+use crate::description::{Causality, Description, VarType, Variability};
 use crate::logger::Logger;
 use crate::phase::{Failure, Outcome, Phase};
 use crate::status::Status;
@@ -115,6 +117,42 @@ impl<M: ScalarModel> Scalar<M> {
             })
     }
 
+    /// Why `vr` is not a variable of type `t` (`time`, FMI 3.0's independent variable, is a
+    /// Real).
+    fn of_type(vr: u32, t: VarType) -> Outcome {
+        let d = M::description();
+        if vr == d.time_vr() && t == VarType::Real {
+            return Ok(());
+        }
+        let v = (d.variable(vr))
+            .ok_or_else(|| Failure::error(format!("unknown value reference {vr}")))?;
+        if v.var_type != t {
+            return Err(Failure::error(format!(
+                "{} (value reference {vr}) is a {:?} variable, not a {t:?} one",
+                v.name, v.var_type
+            )));
+        }
+        Ok(())
+    }
+
+    /// Sets `values` (reals; a Boolean's 0 or 1) of `vr`, all or nothing: every value is
+    /// checked, and in initialization mode the outputs they give, before any is kept.
+    fn set_values(&mut self, vr: &[u32], values: &[f64]) -> Outcome {
+        for (&r, &v) in vr.iter().zip(values) {
+            self.settable(r)?;
+            M::check(r, v).map_err(Failure::error)?;
+        }
+        let mut next = self.model.clone();
+        for (&r, &v) in vr.iter().zip(values) {
+            next.set(r, v);
+        }
+        if self.phase == Phase::Initialization {
+            next.initialize().map_err(Failure::error)?;
+        }
+        self.model = next;
+        Ok(())
+    }
+
     /// Why `vr` may not be set now.
     fn settable(&self, vr: u32) -> Outcome {
         let v = (M::description().variable(vr))
@@ -205,9 +243,8 @@ impl<M: ScalarModel> Core for Scalar<M> {
     /// variable).
     fn get_real(&mut self, vr: &[u32], values: &mut [f64]) -> Outcome {
         let d = M::description();
-        let known = |r: u32| r == d.time_vr() || d.variable(r).is_some();
-        if let Some(r) = vr.iter().find(|&&r| !known(r)) {
-            return Err(Failure::error(format!("unknown value reference {r}")));
+        for &r in vr {
+            Self::of_type(r, VarType::Real)?;
         }
         for (v, &r) in values.iter_mut().zip(vr) {
             *v = if r == d.time_vr() {
@@ -222,19 +259,30 @@ impl<M: ScalarModel> Core for Scalar<M> {
     /// All or nothing: every value is checked, and in initialization mode the outputs they
     /// give, before any is kept.
     fn set_real(&mut self, vr: &[u32], values: &[f64]) -> Outcome {
-        for (&r, &v) in vr.iter().zip(values) {
-            self.settable(r)?;
-            M::check(r, v).map_err(Failure::error)?;
+        for &r in vr {
+            Self::of_type(r, VarType::Real)?;
         }
-        let mut next = self.model.clone();
-        for (&r, &v) in vr.iter().zip(values) {
-            next.set(r, v);
+        self.set_values(vr, values)
+    }
+
+    /// The table's Boolean variables.
+    fn get_boolean(&mut self, vr: &[u32], values: &mut [bool]) -> Outcome {
+        for &r in vr {
+            Self::of_type(r, VarType::Boolean)?;
         }
-        if self.phase == Phase::Initialization {
-            next.initialize().map_err(Failure::error)?;
+        for (v, &r) in values.iter_mut().zip(vr) {
+            *v = self.model.get(r) != 0.0;
         }
-        self.model = next;
         Ok(())
+    }
+
+    /// As [`Core::set_real`], each value held as 0 or 1.
+    fn set_boolean(&mut self, vr: &[u32], values: &[bool]) -> Outcome {
+        for &r in vr {
+            Self::of_type(r, VarType::Boolean)?;
+        }
+        let reals: Vec<f64> = values.iter().map(|&b| f64::from(u8::from(b))).collect();
+        self.set_values(vr, &reals)
     }
 
     fn do_step(&mut self, t: f64, h: f64) -> Outcome {

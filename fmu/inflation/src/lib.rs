@@ -13,7 +13,14 @@
 //! * an on/off **pressure switch with hysteresis**: its contact closes at `p ≤ switchOn` and
 //!   opens at `p ≥ switchOff` ([`demand`]), and the fan follows its contact after
 //!   `switchDelay` seconds (the motor's start/stop timer, which keeps the fan from cycling at
-//!   every flicker of the pressure).
+//!   every flicker of the pressure);
+//! * a **snow mode**, as real units have (the roof's controller, or a snow sensor, sets it
+//!   while snow lies on the cushion): while the Boolean input `snowMode` is true the switch
+//!   works in the snow band `snowSwitchOn`/`snowSwitchOff` (default 400/550 Pa) instead, so
+//!   that the cushion is held stiffer against the snow. The contact keeps its state when the
+//!   band changes and sees the pressure against the new band at the next step: switched on at
+//!   300 Pa it closes (300 ≤ 400) and the fan starts after its delay; switched off at 500 Pa it
+//!   opens (500 ≥ 350).
 //!
 //! **Contract of a step.** The cushion's pressure is held at its input value over the
 //! co-simulation step (the film FMU steps with the unit's flow of the same step: a Jacobi or
@@ -28,7 +35,7 @@
 
 pub mod fmi;
 
-use fmi_glue::description::{Causality, Dependencies, Description, Variability, Variable};
+use fmi_glue::description::{Causality, Dependencies, Description, VarType, Variability, Variable};
 pub use fmi_glue::scalar::short;
 
 /// Value references, in the order of `modelDescription.xml`.
@@ -63,8 +70,17 @@ pub mod vr {
     pub const FAN_FLOW: u32 = 13;
     /// Output: the leak out of the cushion, the step's average (m³/s).
     pub const LEAK_FLOW: u32 = 14;
+    /// Input (Boolean, held as 0 or 1): the switch works in the snow band.
+    pub const SNOW_MODE: u32 = 15;
+    /// Parameter: in snow mode the contact closes at or below it (Pa).
+    pub const SNOW_SWITCH_ON: u32 = 16;
+    /// Parameter: in snow mode the contact opens at or above it (Pa).
+    pub const SNOW_SWITCH_OFF: u32 = 17;
     /// Number of variables.
-    pub const COUNT: usize = 15;
+    pub const COUNT: usize = 18;
+    /// Number of variables before the snow mode (a serialized state of that version holds
+    /// their values alone).
+    pub const FORMER_COUNT: usize = 15;
 }
 
 /// Variable names by value reference (the model description's).
@@ -84,17 +100,21 @@ pub const NAMES: [&str; vr::COUNT] = [
     "dutyTotal",
     "fanFlow",
     "leakFlow",
+    "snowMode",
+    "snowSwitchOn",
+    "snowSwitchOff",
 ];
 
 /// The GUID of the model description (also its FMI 3.0 instantiation token).
 pub const GUID: &str = "{23e2e275-59ab-4657-9fef-1bb35aa2f008}";
 
 /// Default values (the model description's `start`), by value reference; outputs 0. A unit
-/// for a cushion of about 2 m span held at 250–350 Pa: a fan of 800 Pa shut-off and 1 L/s free
-/// delivery, 10 mm² of leaks at a discharge coefficient of 0.6, air at 1.2 kg/m³, a 1.5 s
-/// start/stop timer.
+/// for a cushion of about 2 m span held at 250–350 Pa, at 400–550 Pa in snow mode (off at
+/// the start): a fan of 800 Pa shut-off and 1 L/s free delivery, 10 mm² of leaks at a discharge
+/// coefficient of 0.6, air at 1.2 kg/m³, a 1.5 s start/stop timer.
 pub const START: [f64; vr::COUNT] = [
-    300.0, 800.0, 1.0e-3, 1.0e-5, 0.6, 1.2, 250.0, 350.0, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+    300.0, 800.0, 1.0e-3, 1.0e-5, 0.6, 1.2, 250.0, 350.0, 1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+    400.0, 550.0,
 ];
 
 /// The variable table and the rest of the model description: `modelDescription.xml` and
@@ -103,7 +123,7 @@ pub static DESCRIPTION: Description = Description {
     model_name: "InflationUnit",
     model_identifier: "inflation_unit",
     token: GUID,
-    description: "Inflation unit of an ETFE cushion: a fan with a quadratic curve behind a non-return valve, a leakage orifice to the outside, an on/off pressure switch with hysteresis and a start/stop delay. The cushion's pressure is held over each step; the net mass flow into the cushion is the step's average.",
+    description: "Inflation unit of an ETFE cushion: a fan with a quadratic curve behind a non-return valve, a leakage orifice to the outside, an on/off pressure switch with hysteresis, a snow mode that raises its band, and a start/stop delay. The cushion's pressure is held over each step; the net mass flow into the cushion is the step's average.",
     generation_tool: "membrane-contact fmu/inflation",
     can_get_and_set_fmu_state: true,
     can_serialize_fmu_state: true,
@@ -128,7 +148,8 @@ pub static DESCRIPTION: Description = Description {
     initial_unknowns: &OUTPUTS,
 };
 
-/// Every output depends on the cushion's pressure of the same step (direct feedthrough).
+/// Every output depends on the cushion's pressure of the same step (direct feedthrough) and on
+/// the snow mode (the switch's band).
 const OUTPUTS: [Dependencies; 6] = [
     depends(vr::MASS_FLOW),
     depends(vr::FAN_ON),
@@ -141,7 +162,7 @@ const OUTPUTS: [Dependencies; 6] = [
 const fn depends(output: u32) -> Dependencies {
     Dependencies {
         output,
-        on: &[vr::PRESSURE],
+        on: &[vr::PRESSURE, vr::SNOW_MODE],
     }
 }
 
@@ -161,10 +182,25 @@ const fn variable(
     Variable {
         name: NAMES[k as usize],
         vr: k,
+        var_type: VarType::Real,
         causality,
         variability,
         unit,
         start,
+        description: text,
+    }
+}
+
+/// The Boolean input of value reference `k` (held as 0 or 1), its start from [`START`].
+const fn boolean_input(k: u32, text: &'static str) -> Variable {
+    Variable {
+        name: NAMES[k as usize],
+        vr: k,
+        var_type: VarType::Boolean,
+        causality: Causality::Input,
+        variability: Variability::Discrete,
+        unit: "",
+        start: Some(START[k as usize]),
         description: text,
     }
 }
@@ -263,6 +299,22 @@ const VARIABLES: [Variable; vr::COUNT] = [
         "m3/s",
         "volume flow out through the leakage orifice (negative: in) over the last step (0 before the first)",
     ),
+    boolean_input(
+        vr::SNOW_MODE,
+        "snow mode: while true the switch works in the snow band snowSwitchOn/snowSwitchOff instead of switchOn/switchOff (set it while snow lies on the cushion)",
+    ),
+    variable(
+        vr::SNOW_SWITCH_ON,
+        Parameter,
+        "Pa",
+        "in snow mode the pressure switch calls for the fan at a cushion pressure <= snowSwitchOn (below snowSwitchOff)",
+    ),
+    variable(
+        vr::SNOW_SWITCH_OFF,
+        Parameter,
+        "Pa",
+        "in snow mode the pressure switch stops the fan at a cushion pressure >= snowSwitchOff (above snowSwitchOn)",
+    ),
 ];
 
 /// The fan's delivery `Q_max √(1 − p/p₀)` (m³/s) through its non-return valve against the
@@ -306,6 +358,7 @@ pub fn check_value(vr: u32, value: f64) -> Result<(), String> {
         vr::FAN_PRESSURE | vr::AIR_DENSITY if value <= 0.0 => "must be > 0",
         vr::FAN_FLOW_MAX | vr::LEAK_AREA | vr::SWITCH_DELAY if value < 0.0 => "must be >= 0",
         vr::LEAK_COEFFICIENT if !(0.0..=1.0).contains(&value) => "must lie in [0, 1]",
+        vr::SNOW_MODE if value != 0.0 && value != 1.0 => "must be 0 or 1 (false or true)",
         _ => return Ok(()),
     };
     Err(format!("{name} = {shown} {rule}"))
@@ -331,6 +384,9 @@ pub struct Unit {
 
 /// Numbers of a serialized [`Unit`]: the values, then contact, timer, on time, run time, time.
 const NUMBERS: usize = vr::COUNT + 5;
+/// Numbers of a state serialized before the snow mode: the values of the first
+/// [`vr::FORMER_COUNT`] variables, then the same five.
+const FORMER_NUMBERS: usize = vr::FORMER_COUNT + 5;
 
 impl Default for Unit {
     fn default() -> Self {
@@ -356,18 +412,34 @@ impl Unit {
         self.v(vr::FAN_ON) != 0.0
     }
 
-    /// The switch band's rule across two parameters: `switchOn < switchOff`.
+    /// The switch bands' rule across two parameters: `switchOn < switchOff`, and
+    /// `snowSwitchOn < snowSwitchOff`.
     fn check_band(&self) -> Result<(), String> {
-        let (on, off) = (self.v(vr::SWITCH_ON), self.v(vr::SWITCH_OFF));
-        if on < off {
-            Ok(())
+        for (on, off) in [
+            (vr::SWITCH_ON, vr::SWITCH_OFF),
+            (vr::SNOW_SWITCH_ON, vr::SNOW_SWITCH_OFF),
+        ] {
+            let (p_on, p_off) = (self.v(on), self.v(off));
+            if p_on >= p_off {
+                return Err(format!(
+                    "{} = {} Pa must lie below {} = {} Pa (in initialization mode set both in \
+                     one call)",
+                    NAMES[on as usize],
+                    short(p_on),
+                    NAMES[off as usize],
+                    short(p_off)
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The switch's band `(on, off)` now: the snow band in snow mode.
+    pub fn band(&self) -> (f64, f64) {
+        if self.v(vr::SNOW_MODE) != 0.0 {
+            (self.v(vr::SNOW_SWITCH_ON), self.v(vr::SNOW_SWITCH_OFF))
         } else {
-            Err(format!(
-                "switchOn = {} Pa must lie below switchOff = {} Pa (in initialization mode set \
-                 both in one call)",
-                short(on),
-                short(off)
-            ))
+            (self.v(vr::SWITCH_ON), self.v(vr::SWITCH_OFF))
         }
     }
 
@@ -406,17 +478,13 @@ impl Unit {
     }
 
     /// The unit at power-on with the inputs and parameters as they are: the fan runs iff the
-    /// pressure is at or below `switchOn` (its contact closed); the averaged outputs 0.
-    /// Refused, the unit unchanged, where `switchOn >= switchOff`.
+    /// pressure is at or below the band's on pressure ([`Self::band`]: its contact closed); the
+    /// averaged outputs 0. Refused, the unit unchanged, where a band is reversed.
     pub fn initialize(&mut self) -> Result<(), String> {
         self.check_band()?;
         let mut next = *self;
-        next.contact = demand(
-            false,
-            next.v(vr::PRESSURE),
-            next.v(vr::SWITCH_ON),
-            next.v(vr::SWITCH_OFF),
-        );
+        let (on, off) = next.band();
+        next.contact = demand(false, next.v(vr::PRESSURE), on, off);
         next.values[vr::FAN_ON as usize] = f64::from(u8::from(next.contact));
         (next.timer, next.on_time, next.run_time) = (0.0, 0.0, 0.0);
         next.set_outputs(0.0);
@@ -440,13 +508,8 @@ impl Unit {
     /// output or the time would not be finite.
     pub fn step(&mut self, h: f64) -> Result<(), String> {
         let mut next = *self;
-        let p = next.v(vr::PRESSURE);
-        next.contact = demand(
-            next.contact,
-            p,
-            next.v(vr::SWITCH_ON),
-            next.v(vr::SWITCH_OFF),
-        );
+        let (on, off) = next.band();
+        next.contact = demand(next.contact, next.v(vr::PRESSURE), on, off);
         if next.contact == next.fan_is_on() {
             next.timer = 0.0;
         }
@@ -505,14 +568,25 @@ impl Unit {
     }
 
     /// The unit of [`Self::to_numbers`]' numbers, checked: their count, every value by its
-    /// variable's rule, the switch band, flags 0 or 1, times finite and not negative.
+    /// variable's rule, the switch bands, flags 0 or 1, times finite and not negative. A state
+    /// serialized before the snow mode ([`FORMER_NUMBERS`]) reads with snow mode off and the
+    /// snow band at its defaults.
     pub fn from_numbers(n: &[f64]) -> Result<Self, String> {
-        if n.len() != NUMBERS {
-            return Err(format!(
-                "a serialized state of the unit has {NUMBERS} numbers, not {}",
-                n.len()
-            ));
-        }
+        let upgraded;
+        let n = match n.len() {
+            NUMBERS => n,
+            FORMER_NUMBERS => {
+                let (values, rest) = n.split_at(vr::FORMER_COUNT);
+                upgraded = [values, &START[vr::FORMER_COUNT..], rest].concat();
+                &upgraded
+            }
+            other => {
+                return Err(format!(
+                    "a serialized state of the unit has {NUMBERS} numbers ({FORMER_NUMBERS} \
+                     before the snow mode), not {other}"
+                ));
+            }
+        };
         for (k, &x) in n[..vr::COUNT].iter().enumerate() {
             check_value(k as u32, x).map_err(|e| format!("serialized state: {e}"))?;
         }

@@ -177,11 +177,126 @@ fn a_state_as_numbers_reads_back_equal_and_forged_numbers_are_refused() {
         m[k] = x;
         Unit::from_numbers(&m).unwrap_err()
     };
-    assert!(Unit::from_numbers(&n[1..]).unwrap_err().contains("19"));
+    let e = Unit::from_numbers(&n[1..]).unwrap_err();
+    assert!(
+        e.contains("has 23 numbers (20 before the snow mode), not 22"),
+        "{e}"
+    );
     assert!(forged(vr::AIR_DENSITY as usize, 0.0).contains("airDensity = 0 must be > 0"));
     assert!(forged(vr::FAN_ON as usize, 0.5).contains("must be 0 or 1"));
     assert!(forged(vr::COUNT + 1, -1.0).contains("not negative"));
     assert!(forged(vr::SWITCH_ON as usize, 500.0).contains("must lie below switchOff"));
+    assert!(forged(vr::SNOW_MODE as usize, 0.5).contains("snowMode = 0.5 must be 0 or 1"));
+    assert!(
+        forged(vr::SNOW_SWITCH_OFF as usize, 300.0)
+            .contains("snowSwitchOn = 400 Pa must lie below snowSwitchOff = 300 Pa")
+    );
+}
+
+/// The snow mode (issue 43): the switch's hysteresis in the snow band `snowSwitchOn` = 400,
+/// `snowSwitchOff` = 550 Pa as in the normal band: the contact closes exactly at the band's on
+/// pressure, opens exactly at its off pressure, and holds in between; the same pressures in the
+/// normal band (250/350 Pa) switch the other way where the bands differ.
+#[test]
+fn in_snow_mode_the_switch_keeps_its_hysteresis_in_the_snow_band() {
+    let pressures = [
+        500.0,
+        400.000_001,
+        400.0,
+        500.0,
+        549.999_999,
+        550.0,
+        450.0,
+        300.0,
+    ];
+    let run = |snow: f64| {
+        let mut u = unit(&[
+            (vr::PRESSURE, 500.0),
+            (vr::SWITCH_DELAY, 0.0),
+            (vr::SNOW_MODE, snow),
+        ]);
+        let mut fan = vec![];
+        for p in pressures {
+            step_at(&mut u, p, 1.0);
+            fan.push(u.values[vr::FAN_ON as usize]);
+        }
+        fan
+    };
+    assert_eq!(run(1.0), [0.0, 0.0, 1.0, 1.0, 1.0, 0.0, 0.0, 1.0]);
+    // The normal band: everything above 350 Pa opens the contact; 300 Pa holds it open.
+    assert_eq!(run(0.0), [0.0; 8]);
+    let snowy = unit(&[(vr::SNOW_MODE, 1.0)]);
+    assert_eq!(snowy.band(), (400.0, 550.0));
+    assert_eq!(unit(&[]).band(), (250.0, 350.0));
+}
+
+/// The snow mode switched on and off between steps (issue 43): the contact keeps its state and
+/// sees the next step's pressure against the new band. At 300 Pa (in the normal band, the fan
+/// off) snow mode closes the contact (300 ≤ 400) and the fan starts after its 1.5 s delay; at
+/// 500 Pa (in the snow band, the fan running) leaving snow mode opens it (500 ≥ 350) and the
+/// fan stops after its delay. At power-on in snow mode the snow band decides the fan.
+#[test]
+fn switching_the_snow_mode_moves_the_switch_to_the_other_band() {
+    let mut u = unit(&[(vr::PRESSURE, 300.0)]);
+    step_at(&mut u, 300.0, 1.0);
+    assert_eq!((u.contact, u.values[vr::FAN_ON as usize]), (false, 0.0));
+    u.values[vr::SNOW_MODE as usize] = 1.0;
+    step_at(&mut u, 300.0, 1.0);
+    assert!(u.contact, "300 Pa is below the snow band's 400 Pa");
+    assert_eq!(u.values[vr::FAN_ON as usize], 0.0, "the delay runs");
+    step_at(&mut u, 300.0, 1.0);
+    assert_eq!(
+        (u.values[vr::FAN_ON as usize], u.values[vr::DUTY as usize]),
+        (1.0, 0.5)
+    );
+    // In the snow band the fan runs on up to 550 Pa: 500 Pa holds it.
+    step_at(&mut u, 500.0, 1.0);
+    assert_eq!((u.contact, u.values[vr::FAN_ON as usize]), (true, 1.0));
+    u.values[vr::SNOW_MODE as usize] = 0.0;
+    step_at(&mut u, 500.0, 1.0);
+    assert!(!u.contact, "500 Pa is above the normal band's 350 Pa");
+    step_at(&mut u, 500.0, 1.0);
+    assert_eq!(
+        (u.values[vr::FAN_ON as usize], u.values[vr::DUTY as usize]),
+        (0.0, 0.5)
+    );
+    // Power-on: 300 Pa calls for the fan in snow mode only.
+    assert_eq!(
+        unit(&[(vr::PRESSURE, 300.0)]).values[vr::FAN_ON as usize],
+        0.0
+    );
+    let snowy = unit(&[(vr::PRESSURE, 300.0), (vr::SNOW_MODE, 1.0)]);
+    assert_eq!(snowy.values[vr::FAN_ON as usize], 1.0);
+    // A reversed snow band is refused by name, the unit unchanged.
+    let mut u = unit(&[]);
+    u.values[vr::SNOW_SWITCH_ON as usize] = 600.0;
+    let before = u;
+    let e = u.initialize().unwrap_err();
+    assert!(
+        e.contains("snowSwitchOn = 600 Pa must lie below snowSwitchOff = 550 Pa"),
+        "{e}"
+    );
+    assert_eq!(u, before);
+}
+
+/// A state serialized before the snow mode (20 numbers: the first 15 variables, then the
+/// contact, timer, on time, run time, time) reads back with snow mode off and the snow band at
+/// its defaults, and continues as the unit it was saved from.
+#[test]
+fn a_state_serialized_before_the_snow_mode_reads_back_with_snow_mode_off() {
+    let mut u = unit(&[]);
+    step_at(&mut u, 200.0, 1.0);
+    let n = u.to_numbers();
+    let former: Vec<f64> = [&n[..vr::FORMER_COUNT], &n[vr::COUNT..]].concat();
+    assert_eq!(former.len(), 20);
+    let mut read = Unit::from_numbers(&former).unwrap();
+    assert_eq!(read, u);
+    assert_eq!(read.values[vr::SNOW_MODE as usize], 0.0);
+    for p in [200.0, 300.0, 360.0] {
+        step_at(&mut u, p, 1.0);
+        step_at(&mut read, p, 1.0);
+    }
+    assert_eq!(read, u);
 }
 
 mod through_the_glue {
@@ -257,6 +372,48 @@ mod through_the_glue {
         bytes[at..at + 8].copy_from_slice(&(-1.0f64).to_le_bytes());
         let e = message(i.deserialize_fmu_state(&bytes, 0).unwrap_err());
         assert!(e.contains("airDensity = -1 must be > 0"), "{e}");
+    }
+
+    /// `snowMode` through the glue (issue 43): a Boolean, set and read as one (fmi2SetBoolean /
+    /// fmi3SetBoolean), refused as a Real and the Reals refused as Booleans, naming them; set
+    /// between steps it moves the switch to the snow band; a state serialized by the glue keeps
+    /// it.
+    #[test]
+    fn snow_mode_is_a_boolean_input_that_moves_the_switch_and_is_kept_in_states() {
+        let mut i = instance();
+        let mut b = [true];
+        i.get_boolean(&[vr::SNOW_MODE], &mut b).unwrap();
+        assert!(!b[0], "off at the start");
+        let e = message(i.set_real(&[vr::SNOW_MODE], &[1.0]).unwrap_err());
+        assert!(
+            e.contains("snowMode (value reference 15) is a Boolean variable"),
+            "{e}"
+        );
+        let e = message(i.get_real(&[vr::SNOW_MODE], &mut [0.0]).unwrap_err());
+        assert!(e.contains("is a Boolean variable, not a Real one"), "{e}");
+        let e = message(i.set_boolean(&[vr::PRESSURE], &[true]).unwrap_err());
+        assert!(
+            e.contains("pressure (value reference 0) is a Real variable"),
+            "{e}"
+        );
+        // 300 Pa: in the normal band the fan stays off; in snow mode it starts after its delay.
+        run(&mut i, 0.0, &[300.0, 300.0]);
+        let fan = |i: &mut Instance| {
+            let mut on = [f64::NAN];
+            i.get_real(&[vr::FAN_ON], &mut on).unwrap();
+            on[0]
+        };
+        assert_eq!(fan(&mut i), 0.0);
+        i.set_boolean(&[vr::SNOW_MODE], &[true]).unwrap();
+        let saved = i.get_fmu_state(0).unwrap();
+        let bytes = i.serialize_fmu_state(saved).unwrap();
+        run(&mut i, 2.0, &[300.0, 300.0]);
+        assert_eq!(fan(&mut i), 1.0);
+        let read = i.deserialize_fmu_state(&bytes, 0).unwrap();
+        i.set_fmu_state(read).unwrap();
+        i.get_boolean(&[vr::SNOW_MODE], &mut b).unwrap();
+        assert!(b[0], "the state holds the snow mode");
+        assert_eq!(fan(&mut i), 0.0);
     }
 
     #[test]

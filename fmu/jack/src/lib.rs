@@ -22,7 +22,7 @@
 
 pub mod fmi;
 
-use fmi_glue::description::{Causality, Dependencies, Description, Variability, Variable};
+use fmi_glue::description::{Causality, Dependencies, Description, VarType, Variability, Variable};
 pub use fmi_glue::scalar::short;
 
 /// Value references, in the order of `modelDescription.xml`.
@@ -129,6 +129,7 @@ const fn variable(
     Variable {
         name: NAMES[k as usize],
         vr: k,
+        var_type: VarType::Real,
         causality,
         variability,
         unit,

@@ -31,7 +31,7 @@ struct Sided {
 
 impl Fmu<'_> {
     /// `fmi2GetDirectionalDerivative` of `unknowns` along `known` (seed 1): status and values.
-    fn derivative_status(&self, unknowns: &[&str], known: &str) -> (c_int, Vec<f64>) {
+    pub(super) fn derivative_status(&self, unknowns: &[&str], known: &str) -> (c_int, Vec<f64>) {
         self.derivative_seeded(unknowns, known, 1.0)
     }
 
@@ -57,6 +57,43 @@ impl Fmu<'_> {
         names.iter().map(|n| self.real(n)).collect()
     }
 
+    /// From the current state: the step `[t, t + dt]` to `end` repeated with `known` moved by
+    /// each of `shifts`, then unmoved, and the derivatives of `outputs` along `known` there:
+    /// the outputs of each step (the unmoved one last) and the derivatives; the FMU is left at
+    /// the start of the step.
+    pub(super) fn repeated(
+        &self,
+        (t, dt): (f64, f64),
+        end: &[(&str, f64)],
+        (known, shifts): (&str, &[f64]),
+        outputs: &[&str],
+    ) -> (Vec<Vec<f64>>, Vec<f64>) {
+        let mut start: Fmi2FmuState = std::ptr::null_mut();
+        assert_eq!(unsafe { fmi2_get_fmu_state(self.c, &mut start) }, 0);
+        let step = |shift: f64| {
+            assert_eq!(unsafe { fmi2_set_fmu_state(self.c, start) }, 0);
+            for &(n, v) in end {
+                let v = if n == known { v + shift } else { v };
+                assert_eq!(self.set_real(n, v), 0, "{n}");
+            }
+            assert_eq!(
+                self.step(t, dt),
+                0,
+                "{known} {shift}: {:?}",
+                self.log.take()
+            );
+            self.reals(outputs)
+        };
+        let points: Vec<Vec<f64>> = shifts.iter().chain([&0.0]).map(|&x| step(x)).collect();
+        let (status, derivative) = self.derivative_status(outputs, known);
+        assert_eq!(status, 0, "{known}: {:?}", self.log.take());
+        unsafe {
+            assert_eq!(fmi2_set_fmu_state(self.c, start), 0);
+            assert_eq!(fmi2_free_fmu_state(self.c, &mut start), 0);
+        }
+        (points, derivative)
+    }
+
     /// From the current state: the step `[t, t + 1]` to `end`, the derivatives of `outputs`
     /// w.r.t. `known` there, and its one-sided differences from the same step repeated with
     /// `known` moved by `±h, …, ±4h`; the FMU is left at the start of the step.
@@ -68,34 +105,15 @@ impl Fmu<'_> {
         h: f64,
         outputs: &[&str],
     ) -> Vec<Sided> {
-        let mut start: Fmi2FmuState = std::ptr::null_mut();
-        assert_eq!(unsafe { fmi2_get_fmu_state(self.c, &mut start) }, 0);
-        let step = |shift: f64| {
-            assert_eq!(unsafe { fmi2_set_fmu_state(self.c, start) }, 0);
-            for &(n, v) in end {
-                let v = if n == known { v + shift } else { v };
-                assert_eq!(self.set_real(n, v), 0, "{n}");
-            }
-            assert_eq!(
-                self.step(t, 1.0),
-                0,
-                "{known} {shift}: {:?}",
-                self.log.take()
-            );
-            self.reals(outputs)
-        };
         // Fourth-order one-sided differences (points 0, ±h, …, ±4h): the slip direction of a
         // slipping gap turns over a length of its last slip increment, which a lower order
         // turns into more than 1e-6 of the derivative at any step above the rounding.
-        let plus: Vec<Vec<f64>> = (1..=4).map(|k| step(k as f64 * h)).collect();
-        let minus: Vec<Vec<f64>> = (1..=4).map(|k| step(-(k as f64) * h)).collect();
-        let at = step(0.0);
-        let (status, derivative) = self.derivative_status(outputs, known);
-        assert_eq!(status, 0, "{known}: {:?}", self.log.take());
-        unsafe {
-            assert_eq!(fmi2_set_fmu_state(self.c, start), 0);
-            assert_eq!(fmi2_free_fmu_state(self.c, &mut start), 0);
-        }
+        let shifts: Vec<f64> = [1.0, 2.0, 3.0, 4.0, -1.0, -2.0, -3.0, -4.0]
+            .iter()
+            .map(|k| k * h)
+            .collect();
+        let (points, derivative) = self.repeated((t, 1.0), end, (known, &shifts), outputs);
+        let (plus, minus, at) = (&points[..4], &points[4..8], &points[8]);
         (0..outputs.len())
             .map(|i| Sided {
                 derivative: derivative[i],

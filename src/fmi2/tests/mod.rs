@@ -17,6 +17,7 @@
 //! | file | what |
 //! |---|---|
 //! | `derivatives.rs` | directional derivatives of every input against one-sided differences of steps |
+//! | `chamber_derivatives.rs` | derivatives of models with gas chambers against central differences of steps |
 //! | `lifecycle.rs` | instantiation, call order per phase, logging, reset, threads, fmi2Fatal |
 //! | `values.rs` | strings, model-changing parameters, load inputs, outputs against the core |
 //! | `stepping.rs` | Discard and retry, refused inputs, assumption warnings, stick and slip |
@@ -28,6 +29,7 @@
 //! or NUL-terminated literals holding the announced number of elements; the deliberately bad
 //! arguments are NULL pointers, which the functions must reject without dereferencing.
 
+pub(crate) mod chamber_derivatives;
 pub(crate) mod derivatives;
 mod fmu_states;
 mod lifecycle;

@@ -608,3 +608,138 @@ fn against_columns(
         .fold(0.0_f64, |m, (a, c)| m.max((a - c).abs() / largest));
     (columns, worst)
 }
+
+/// `vᵀ (J s)` against `(Jᵀ v)ᵀ s` over `unknowns` and `knowns` (`v`, `s` pseudo-random, `J s`
+/// from one call seeding every known), relative to `Σ |v_i J_ij s_j|` (J's unit columns): the
+/// outputs' units differ (Pa, m³, kg, m, N), so no sum of them is a scale.
+fn transpose_gap(fmu: &Fmu3<'_>, log: &Log, (unknowns, knowns): (&[&str], &[&str])) -> f64 {
+    let (v, s) = (random(unknowns.len(), 7), random(knowns.len(), 3));
+    let (status, jtv) = fmu.adjoint(unknowns, knowns, &v);
+    assert!(status <= 1, "{status}: {:?}", log.take());
+    let (status, js) = fmu.directional(unknowns, knowns, &s);
+    assert!(status <= 1, "{status}: {:?}", log.take());
+    let mut size = 0.0;
+    for (j, k) in knowns.iter().enumerate() {
+        let (status, column) = fmu.directional(unknowns, &[k], &[1.0]);
+        assert!(status <= 1, "{status}: {:?}", log.take());
+        size += column
+            .iter()
+            .zip(&v)
+            .map(|(c, v)| (c * v * s[j]).abs())
+            .sum::<f64>();
+    }
+    assert!(size > 0.0);
+    let left: f64 = v.iter().zip(&js).map(|(v, x)| v * x).sum();
+    let right: f64 = jtv.iter().zip(&s).map(|(x, s)| x * s).sum();
+    (left - right).abs() / size
+}
+
+/// Issue 43 item 4: the adjoint of a model with chambers is the directional derivative's
+/// transpose. MODELS: `examples/cushion_air.json` (adiabatic air) with snow on its top layer,
+/// inflated by its supply to 300 Pa, sealed, then a step of 0.5 s with snow, heating and air fed
+/// in; `examples/two_chamber_orifice.json` inflated to 300/400 Pa and sealed, then 0.5 s of air
+/// through its orifice (an unsymmetric pneumatic coupling). TEST GOAL:
+/// `vᵀ(J s) = (Jᵀ v)ᵀ s` to 1e-10 over the chambers' outputs, the crowns' deflections and the
+/// rim's reaction against every chamber input, the snow and the rim's dz; and, under the
+/// orifice, `Jᵀ v` of the crowns' displacements alone is one transpose solve of the held
+/// tangent (its pneumatic stiffness transposed, `Aᵀ`), equal to `vᵀ` times J's columns to 1e-9
+/// of the largest.
+#[test]
+fn fmi3_adjoint_of_chamber_models_is_the_transpose_of_their_directional_derivative() {
+    let tight = [
+        ("solver.displacementTolerance", 1e-12),
+        ("solver.residualTolerance", 1e-9),
+    ];
+    let model = crate::fmi2::tests::chamber_derivatives::snowy_cushion(1.4);
+    let u = Unpacked::new("cushion adjoint", Source::Model(model));
+    let log = Log::default();
+    let fmu = Fmu3::initialized(
+        &u,
+        &log,
+        &[tight[0], tight[1], ("air.supplyPressure", 0.0)],
+        &[("solver.incrementsPerStep", 1)],
+    );
+    for (k, p) in [150.0, 300.0].into_iter().enumerate() {
+        assert_eq!(fmu.set("air.supplyPressure", p), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+    }
+    assert_eq!(fmu.set_bool("air.sealed", true), 0);
+    assert_eq!(fmu.step(2.0, 1.0), 0, "{:?}", log.take());
+    for (n, v) in [
+        ("snow.pressure", 200.0),
+        ("air.heating", 5.0),
+        ("air.massFlow", 2e-4),
+    ] {
+        assert_eq!(fmu.set(n, v), 0);
+    }
+    assert_eq!(fmu.step(3.0, 0.5), 0, "{:?}", log.take());
+    let unknowns = [
+        "air.pressure",
+        "air.volume",
+        "air.mass",
+        "air.temperature",
+        "crownTop.uz",
+        "crownBottom.uz",
+        "rim.Rz",
+    ];
+    let knowns = [
+        "snow.pressure",
+        "air.heating",
+        "air.massFlow",
+        "air.supplyPressure",
+        "rim.dz",
+    ];
+    let gap = transpose_gap(&fmu, &log, (&unknowns, &knowns));
+    eprintln!("sealed cushion: vᵀ(J s) − (Jᵀ v)ᵀ s = {gap:e} of Σ|v J s|");
+    assert!(gap <= 1e-10, "{gap:e}");
+
+    let model =
+        crate::mech::Model::from_json(include_str!("../../../examples/two_chamber_orifice.json"))
+            .unwrap();
+    let u = Unpacked::new("orifice adjoint", Source::Model(model));
+    let fmu = Fmu3::initialized(&u, &log, &tight, &[("solver.incrementsPerStep", 1)]);
+    for (k, f) in [0.25, 0.5, 1.0].into_iter().enumerate() {
+        assert_eq!(fmu.set("upper.supplyPressure", 300.0 * f), 0);
+        assert_eq!(fmu.set("lower.supplyPressure", 400.0 * f), 0);
+        assert_eq!(fmu.step(k as f64, 1.0), 0, "{:?}", log.take());
+    }
+    assert_eq!(fmu.set_bool("upper.sealed", true), 0);
+    assert_eq!(fmu.set_bool("lower.sealed", true), 0);
+    assert_eq!(fmu.set("upper.heating", 4.0), 0);
+    assert_eq!(fmu.step(3.0, 0.5), 0, "{:?}", log.take());
+    let knowns = [
+        "upper.heating",
+        "lower.heating",
+        "upper.massFlow",
+        "lower.massFlow",
+        "rim.dz",
+    ];
+    let chambers = [
+        "upper.pressure",
+        "upper.volume",
+        "upper.mass",
+        "lower.pressure",
+        "lower.volume",
+        "lower.mass",
+        "hole.massFlow",
+        "crownMiddle.uz",
+    ];
+    let gap = transpose_gap(&fmu, &log, (&chambers, &knowns));
+    eprintln!("orifice: vᵀ(J s) − (Jᵀ v)ᵀ s = {gap:e} of Σ|v J s|");
+    assert!(gap <= 1e-10, "{gap:e}");
+    let points = [
+        "crownTop.ux",
+        "crownTop.uz",
+        "crownMiddle.uz",
+        "crownBottom.uy",
+        "crownBottom.uz",
+    ];
+    let v = [0.3, -0.7, 1.1, -0.4, 0.9];
+    let before = fmu.tangent_solves();
+    let (status, jtv) = fmu.adjoint(&points, &knowns, &v);
+    assert!(status <= 1, "{status}: {:?}", log.take());
+    assert_eq!(fmu.tangent_solves() - before, 1, "one transpose solve");
+    let (columns, worst) = against_columns(&fmu, &log, (&points, &knowns), (&v, &jtv));
+    eprintln!("orifice, points: adjoint vs columns {worst:e} of the largest, one solve");
+    assert!(worst <= 1e-9, "{jtv:?} vs {columns:?}");
+}

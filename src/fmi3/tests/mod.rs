@@ -163,6 +163,11 @@ impl<'a> Fmu3<'a> {
         unsafe { set_float64(self.c, &self.u.vr(name), 1, &v, 1) }
     }
 
+    fn set_bool(&self, name: &str, v: bool) -> c_int {
+        let v = u8::from(v);
+        unsafe { set_boolean(self.c, &self.u.vr(name), 1, &v, 1) }
+    }
+
     fn floats(&self, names: &[&str]) -> Vec<f64> {
         let refs: Vec<u32> = names.iter().map(|n| self.u.vr(n)).collect();
         let mut v = vec![f64::NAN; refs.len()];

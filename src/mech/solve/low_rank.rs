@@ -10,33 +10,60 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::mech::solve::analysis::Analysis;
-use crate::mech::solve::contributions::ChamberState;
-use crate::mech::solve::linear::FactorizationError;
+use crate::mech::solve::contributions::{ChamberState, LowRank};
+use crate::mech::solve::linear::{FactorizationError, LinearSolver};
 
 /// `Σ a_i b_i`.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-impl Analysis {
-    /// Turns `rhs = S⁻¹ b` (the sparse matrix of the last assembly, factorized) into the
-    /// solution with the chambers' `G A Gᵀ` added; nothing without a sealed chamber.
-    pub(crate) fn add_low_rank(&mut self, rhs: &mut [f64]) -> Result<(), FactorizationError> {
-        let terms = self.parts.chambers.low_rank().clone();
-        let (columns, a) = (&terms.columns, &terms.matrix);
-        let m = columns.len();
-        if m == 0 || a.iter().all(|&x| x == 0.0) {
-            return Ok(());
-        }
-        let matrix = self.system.matrix(&self.work.values);
-        let mut z = Vec::with_capacity(m);
-        for g in columns {
+impl LowRank {
+    /// Whether it adds nothing (no sealed chamber, or `A = 0`).
+    pub fn is_empty(&self) -> bool {
+        self.columns.is_empty() || self.matrix.iter().all(|&x| x == 0.0)
+    }
+
+    /// `Z = S⁻¹ G` (`S⁻ᵀ G` with `transpose`: an adjoint's), one solve per column with the
+    /// factor `linear` holds for `matrix`.
+    pub(crate) fn solved_columns(
+        &self,
+        linear: &mut LinearSolver,
+        matrix: faer::sparse::SparseColMatRef<'_, usize, f64>,
+        transpose: bool,
+    ) -> Result<Vec<Vec<f64>>, FactorizationError> {
+        let mut z = Vec::with_capacity(self.columns.len());
+        for g in &self.columns {
             let mut column = g.clone();
-            self.linear.solve_held(matrix, &mut column)?;
+            if transpose {
+                linear.solve_held_transpose(matrix, &mut column)?;
+            } else {
+                linear.solve_held(matrix, &mut column)?;
+            }
             z.push(column);
         }
+        Ok(z)
+    }
+
+    /// Turns `rhs = S⁻¹ b` into `(S + G A Gᵀ)⁻¹ b` given `z = S⁻¹ G`; with `transpose`,
+    /// `rhs = S⁻ᵀ b` into `(S + G A Gᵀ)⁻ᵀ b` given `z = S⁻ᵀ G` (the same identity with `Aᵀ`).
+    pub(crate) fn correct(
+        &self,
+        z: &[Vec<f64>],
+        rhs: &mut [f64],
+        transpose: bool,
+    ) -> Result<(), FactorizationError> {
+        if self.is_empty() {
+            return Ok(());
+        }
+        let (columns, m) = (&self.columns, self.columns.len());
+        let a = if transpose {
+            self.matrix.transpose()
+        } else {
+            self.matrix.clone()
+        };
         let gz = DMatrix::from_fn(m, m, |i, j| dot(&columns[i], &z[j]));
-        let small = DMatrix::identity(m, m) + gz * a;
+        let small = DMatrix::identity(m, m) + gz * &a;
         let gy = DVector::from_fn(m, |i, _| dot(&columns[i], rhs));
         let t = small.lu().solve(&gy).ok_or_else(|| {
             FactorizationError("the chambers' pneumatic stiffness made the matrix singular".into())
@@ -48,6 +75,20 @@ impl Analysis {
             }
         }
         Ok(())
+    }
+}
+
+impl Analysis {
+    /// Turns `rhs = S⁻¹ b` (the sparse matrix of the last assembly, factorized) into the
+    /// solution with the chambers' `G A Gᵀ` added; nothing without a sealed chamber.
+    pub(crate) fn add_low_rank(&mut self, rhs: &mut [f64]) -> Result<(), FactorizationError> {
+        let terms = self.parts.chambers.low_rank().clone();
+        if terms.is_empty() {
+            return Ok(());
+        }
+        let matrix = self.system.matrix(&self.work.values);
+        let z = terms.solved_columns(&mut self.linear, matrix, false)?;
+        terms.correct(&z, rhs, false)
     }
 
     /// Encloses the gas of every supplied chamber at its converged pressure and volume (the

@@ -25,6 +25,12 @@
 //! * loads (pressures, nodal forces): exact. The residual is linear in the load levels
 //!   (a follower pressure's force is `p/6 (x2 − x1) × (x3 − x1)` at the current positions), so
 //!   the loads' residual at the seed's levels is `∂g/∂λ · seed` itself;
+//! * a chamber's inputs (its supply's pressure, its air's temperature rise, the air supplied;
+//!   issue 43): the central difference of the chambers' residual alone (nothing else depends
+//!   on them), the gas of the increment's start with the orifices' exchange over the
+//!   increment, as Newton evaluates it. A sealed chamber's pressure is affine in the air added
+//!   and in the temperature, a supplied one's is its supply's level: exact but for rounding;
+//!   through an orifice (the backward-Euler transfer) to the difference's ε²;
 //! * μ (every gap's and curved-support contact's own coefficient, each moved by the seed): the
 //!   central difference of the residual of the gaps and curved-support contacts alone
 //!   (nothing else depends on μ), step ε below. A slipping gap's force `μ N t` is linear in μ
@@ -38,6 +44,15 @@
 //!   (the same answers as FMU steps to 1e-6, unchanged). The difference's rounding is
 //!   that of the residual over ε: for a pressure seed on the cushion it was 5e-8 of the
 //!   derivatives, which the exact load form removed.
+//!
+//! With gas chambers (issue 43) `K_ff` is the sparse tangent `S` (the pressure's load
+//! stiffness `−p ∂²V/∂u²` in it) plus the sealed chambers' pneumatic stiffness `G A Gᵀ`, solved
+//! as Newton's correction solves it (`solve/low_rank.rs`: the Sherman–Morrison–Woodbury update
+//! of `S`'s factor, `S⁻¹ G` solved at the first seed and held with the factor; the transpose
+//! solve of an adjoint takes `Aᵀ`, which an orifice makes differ from `A`). A supplied chamber
+//! adds no such term: its pressure is its supply's level, fixed in `u`. The chambers' outputs
+//! (pressure, volume, mass, temperature) at the points below are those of the gas a step
+//! ending there would commit.
 //!
 //! The results then move along `(du, dp, dλ, dμ)`: [`Response`] holds them at `±h, ±2h` along
 //! it (`h ≥ ε`, large enough that the rounding of the displacements does not swamp a small
@@ -78,12 +93,13 @@
 //! not to the last bit: the columns are a difference of results along each response, the
 //! adjoint a contraction of residuals.
 
+use crate::mech::elements::chamber::GasLaw;
 use crate::mech::elements::gap::{GapStatus, IterationMatrix};
 use crate::mech::elements::load::{ExternalLoad, LoadLevels};
 use crate::mech::results::Results;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
-use crate::mech::solve::contributions::{Contribution, Evaluation};
+use crate::mech::solve::contributions::{Contribution, Evaluation, LowRank};
 use crate::mech::solve::linear::FactorizationError;
 use crate::mech::solve::state::{AnalysisState, GroupMotion};
 
@@ -108,6 +124,11 @@ pub(in crate::mech) struct HeldTangent {
     start: Option<AnalysisState>,
     /// Its values on the system's pattern (the solves' accuracy check and GMRES read them).
     values: Vec<f64>,
+    /// The sealed chambers' pneumatic stiffness `G A Gᵀ` at that state, beside the sparse
+    /// values (`solve/low_rank.rs`).
+    low_rank: LowRank,
+    /// `S⁻¹ G` and `S⁻ᵀ G` of [`Self::low_rank`], each solved at its first use.
+    solved: [Option<Vec<Vec<f64>>>; 2],
 }
 
 /// A direction in the end values of a step's inputs (each in the input's own unit).
@@ -123,6 +144,12 @@ pub struct Seed {
     pub force: Vec<[f64; 3]>,
     /// Friction coefficient of every gap and curved-support contact.
     pub friction: f64,
+    /// Per chamber: the pressure its supply holds (Pa; [`LoadLevels::chambers`]).
+    pub supply: Vec<f64>,
+    /// Per chamber: the air's temperature rise (K; [`LoadLevels::heating`]).
+    pub heating: Vec<f64>,
+    /// Per chamber: the air supplied since the start (kg; [`LoadLevels::air`]).
+    pub air: Vec<f64>,
 }
 
 impl Seed {
@@ -135,7 +162,16 @@ impl Seed {
             pressure: vec![0.0; state.loads.pressure.len()],
             force: vec![[0.0; 3]; state.loads.force.len()],
             friction: 0.0,
+            supply: vec![0.0; analysis.model().chambers.len()],
+            heating: vec![0.0; analysis.model().chambers.len()],
+            air: vec![0.0; analysis.model().chambers.len()],
         }
+    }
+
+    /// Whether it moves a chamber's input (supply, heating, air).
+    fn moves_chambers(&self) -> bool {
+        let moves = |v: &[f64]| v.iter().any(|&x| x != 0.0);
+        moves(&self.supply) || moves(&self.heating) || moves(&self.air)
     }
 }
 
@@ -222,8 +258,8 @@ impl Analysis {
     }
 
     /// The increment's start and the converged state a seed's derivatives are taken at, once
-    /// the analysis and the seed allow them (the consistent tangent, no gas chambers, a seed of
-    /// the model's sizes).
+    /// the analysis and the seed allow them (the consistent tangent, a seed of the model's
+    /// sizes).
     fn derivative_states(&self, seed: &Seed) -> Result<(AnalysisState, AnalysisState), String> {
         if self.settings.iteration_matrix != IterationMatrix::Consistent {
             return Err(
@@ -231,19 +267,16 @@ impl Analysis {
             );
         }
         let end = self.state.clone();
-        if !end.chambers.is_empty() {
-            return Err(
-                "derivatives are not available for a model with gas chambers: \
-                        the pneumatic stiffness is not in the held tangent"
-                    .into(),
-            );
-        }
+        let chambers = self.model.chambers.len();
         if seed.translation.len() != end.boundary.len()
             || seed.angles.len() != end.angles.len()
             || seed.pressure.len() != end.loads.pressure.len()
             || seed.force.len() != end.loads.force.len()
+            || [&seed.supply, &seed.heating, &seed.air]
+                .iter()
+                .any(|v| v.len() != chambers)
         {
-            return Err("the seed does not fit the model's groups and load sets".into());
+            return Err("the seed does not fit the model's groups, load sets and chambers".into());
         }
         let start = self.increment_start.clone().unwrap_or_else(|| end.clone());
         Ok((start, end))
@@ -279,6 +312,7 @@ impl Analysis {
                 largest = largest.max(relative(d[c], f[c], 1.0));
             }
         }
+        largest = largest.max(self.chamber_seed_scale(end, seed));
         if !largest.is_finite() {
             return Err("the seed holds values that are not finite".into());
         }
@@ -336,7 +370,63 @@ impl Analysis {
         if seed.friction != 0.0 {
             self.add_friction_derivative(start, end, eps * seed.friction, &mut dg, 1.0 / eps);
         }
+        if seed.moves_chambers() {
+            self.add_chamber_derivative(start, end, seed, eps, &mut dg);
+        }
         (du, dg)
+    }
+
+    /// The largest of a seed's chamber inputs, each relative to its value: the supply's
+    /// pressure (at least 1 Pa), the air's absolute temperature, its mass (at least 1 mg).
+    fn chamber_seed_scale(&self, end: &AnalysisState, seed: &Seed) -> f64 {
+        let mut largest = 0.0_f64;
+        for (k, spec) in self.model.chambers.iter().enumerate() {
+            let level = |v: &[f64]| v.get(k).copied().unwrap_or(0.0);
+            let gas = end.chambers.get(k).copied().unwrap_or_default();
+            let law = GasLaw {
+                kappa: spec.kappa,
+                atmosphere: spec.atmosphere,
+                temperature: spec.temperature,
+            };
+            let temperature = spec.temperature + level(&end.loads.heating);
+            let mass = law.mass(gas.pressure, gas.volume, temperature);
+            largest = largest
+                .max(seed.supply[k].abs() / level(&end.loads.chambers).abs().max(1.0))
+                .max(seed.heating[k].abs() / temperature.abs())
+                .max(seed.air[k].abs() / mass.abs().max(1e-6));
+        }
+        largest
+    }
+
+    /// Adds the central difference of the chambers' residual (nothing else depends on their
+    /// inputs) along `seed`'s chamber inputs, step `eps`, at the converged displacements, the
+    /// gas of `start` (with the orifices' exchange over the increment, as Newton's): exact but
+    /// for rounding without orifices (the pressure is affine in the supply's level, in the air
+    /// added and in the temperature), to the difference's `eps²` with them.
+    fn add_chamber_derivative(
+        &mut self,
+        start: &AnalysisState,
+        end: &AnalysisState,
+        seed: &Seed,
+        eps: f64,
+        dg: &mut [f64],
+    ) {
+        let mut g = [vec![0.0; dg.len()], vec![0.0; dg.len()]];
+        for (sign, g) in [1.0, -1.0].into_iter().zip(&mut g) {
+            let (_, levels, _) = moved(end, seed, sign * eps);
+            let at = Evaluation {
+                system: &self.system,
+                u: &end.displacement,
+                levels: &levels,
+                iteration: None,
+                matrix: self.settings.iteration_matrix,
+            };
+            self.parts.chambers.restore(start);
+            self.parts.chambers.add(&at, g, None);
+        }
+        for ((d, p), m) in dg.iter_mut().zip(&g[0]).zip(&g[1]) {
+            *d += (p - m) / (2.0 * eps);
+        }
     }
 
     /// The results at `−2h, −h, h, 2h` along the response `du` (every DOF) to `seed`, and `h`.
@@ -445,6 +535,14 @@ impl Analysis {
     fn unsymmetric_cause(&mut self, end: &AnalysisState) -> Option<String> {
         if let Some(p) = end.loads.pressure.iter().find(|p| **p != 0.0) {
             return Some(format!("a follower pressure acts ({p} Pa)"));
+        }
+        if let Some(o) = self.model.orifices.first()
+            && end.chambers.iter().any(|c| c.sealed)
+        {
+            return Some(format!(
+                "orifice '{}' couples its chambers' pressures (unsymmetrically)",
+                o.name
+            ));
         }
         let results = self.results();
         let slides = |s: GapStatus| s == GapStatus::Slip;
@@ -633,7 +731,8 @@ impl Analysis {
             // A solution that failed its check was redone by a new factorization (of the same
             // matrix): that one is held now.
             held.factor = self.linear.factor_id();
-            return solved;
+            solved?;
+            return self.add_held_low_rank(rhs, transpose);
         }
         let from = with_friction(start, end, 0.0);
         for c in self.parts.all_mut() {
@@ -654,8 +753,37 @@ impl Analysis {
             end: end.clone(),
             start: self.increment_start.clone(),
             values: self.work.values.clone(),
+            low_rank: self.parts.chambers.low_rank().clone(),
+            solved: [None, None],
         }));
-        Ok(())
+        self.add_held_low_rank(rhs, transpose)
+    }
+
+    /// Turns `rhs = S⁻¹ b` (`S⁻ᵀ b` with `transpose`), solved with the held tangent's sparse
+    /// part, into the solution with its chambers' pneumatic stiffness `G A Gᵀ` (the Newton
+    /// correction's Woodbury update, `solve/low_rank.rs`), `S⁻¹ G` solved at the first seed
+    /// and kept: nothing without a sealed chamber.
+    fn add_held_low_rank(
+        &mut self,
+        rhs: &mut [f64],
+        transpose: bool,
+    ) -> Result<(), FactorizationError> {
+        let Some(held) = self.held_tangent.as_deref_mut() else {
+            return Ok(());
+        };
+        if held.low_rank.is_empty() {
+            return Ok(());
+        }
+        let slot = &mut held.solved[usize::from(transpose)];
+        if slot.is_none() {
+            let matrix = self.system.matrix(&held.values);
+            *slot = Some(
+                held.low_rank
+                    .solved_columns(&mut self.linear, matrix, transpose)?,
+            );
+        }
+        let z = slot.as_deref().expect("solved above");
+        held.low_rank.correct(z, rhs, transpose)
     }
 
     /// The results and the out-of-balance force of every DOF at displacements `u` and the
@@ -690,7 +818,8 @@ impl Analysis {
         // contacts (their anchors) and a plastic film: elsewhere one evaluation serves both.
         let commit = !trial.contacts.is_empty()
             || !trial.layer_contacts.is_empty()
-            || !trial.plastic.is_empty();
+            || !trial.plastic.is_empty()
+            || !trial.chambers.is_empty();
         let mut internal = None;
         if commit {
             self.assemble_at(&trial.displacement, &trial.loads, None);
@@ -739,12 +868,23 @@ fn moved(end: &AnalysisState, seed: &Seed, s: f64) -> Moved {
             .map(|(f, d)| std::array::from_fn(|c| f[c] + s * d[c]))
             .collect(),
         gravity: end.loads.gravity,
-        chambers: end.loads.chambers.clone(),
-        heating: end.loads.heating.clone(),
-        air: end.loads.air.clone(),
+        chambers: shifted(&end.loads.chambers, &seed.supply, s),
+        heating: shifted(&end.loads.heating, &seed.heating, s),
+        air: shifted(&end.loads.air, &seed.air, s),
         time: end.loads.time,
     };
     (motion, levels, s * seed.friction)
+}
+
+/// The chambers' levels `v` moved by `s d` (an entry `v` lacks read as 0, as the levels read
+/// it); `v` itself where `d` is zero.
+fn shifted(v: &[f64], d: &[f64], s: f64) -> Vec<f64> {
+    if d.iter().all(|&x| x == 0.0) {
+        return v.to_vec();
+    }
+    (0..v.len().max(d.len()))
+        .map(|k| v.get(k).copied().unwrap_or(0.0) + s * d.get(k).copied().unwrap_or(0.0))
+        .collect()
 }
 
 /// `u + s d`.
