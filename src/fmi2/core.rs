@@ -2,8 +2,8 @@
 //! (`fmi_glue::export_fmi2!` in `exports.rs`, `fmi_glue::export_fmi3!` in `src/fmi3`) call.
 //! Each method forwards to the instance's own, so both versions drive the same code; the FMI 3.0 directional
 //! derivative is made of the 2.0 one's columns (one per known, [`Columns`]), so that the
-//! adjoint is its exact transpose; an adjoint of reactions and point displacements at a
-//! symmetric tangent is one solve instead (`Instance::adjoint_in_one_solve`).
+//! adjoint is its exact transpose; an adjoint of reactions and point displacements is one
+//! solve instead (`Instance::adjoint_in_one_solve`).
 
 use std::path::Path;
 
@@ -200,8 +200,8 @@ impl Core for Instance {
     }
 
     /// One solve with the held factor (`Instance::adjoint_in_one_solve`) where the unknowns
-    /// are reactions and point displacements and the tangent is symmetric; else J's columns,
-    /// the directional derivative's exact transpose.
+    /// are reactions and point displacements; else J's columns, the directional derivative's
+    /// exact transpose.
     fn adjoint_derivative(
         &mut self,
         unknowns: &[u32],

@@ -98,9 +98,8 @@ impl Instance {
 impl Instance {
     /// `fmi3GetAdjointDerivative` in one solve (`Analysis::adjoint_response`): `out = Jᵀ v`,
     /// when every unknown is a reaction (a group's, a support set's, the total) or an output
-    /// point's displacement, every known an input, and, where a reaction is weighted, the held
-    /// tangent symmetric (no contact slides, no follower pressure acts: its rows `K_rf` are not
-    /// held); output points alone take the transpose solve of any tangent (issue 45).
+    /// point's displacement and every known an input, at any tangent (a sliding contact, a
+    /// follower pressure: the transpose solve, the reactions' rows `K_rf` assembled; issue 45).
     /// None otherwise: the caller takes J's columns, which also name what is refused.
     pub(crate) fn adjoint_in_one_solve(
         &mut self,

@@ -159,3 +159,71 @@ fn structure(table: &[Variable], arrays: &[u32]) -> String {
     }
     xml + "  </ModelStructure>"
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fmi2::description::describe;
+    use crate::fmi2::resources::Source;
+    use crate::mech::Model;
+    use crate::specimens::ParallelArch;
+
+    /// The values of attribute `name` over the text's elements whose tag is one of `tags`.
+    fn attributes<'a>(xml: &'a str, tags: &[&str], name: &str) -> Vec<&'a str> {
+        let mut out = vec![];
+        for element in xml.split('<').skip(1) {
+            let tag = element.split([' ', '>', '/', '\n']).next().unwrap_or("");
+            if !tags.contains(&tag) {
+                continue;
+            }
+            let key = format!(" {name}=\"");
+            if let Some(at) = element.find(&key) {
+                let rest = &element[at + key.len()..];
+                out.push(&rest[..rest.find('"').unwrap()]);
+            }
+        }
+        out
+    }
+
+    /// FMI 3.0 (§2.4.7.5, the variables' `unit`: "referencing a `<UnitDefinitions><Unit>` with
+    /// the same `name`, which must exist"; `displayUnit` one of that unit's `<DisplayUnit>`s; a
+    /// list element present holds at least one item): every unit of every scalar and array
+    /// variable is defined, on the specimen and on user models with hinges, curved supports,
+    /// chambers and cables, and each defined unit is used.
+    #[test]
+    fn every_unit_of_the_fmi3_description_is_defined_in_unit_definitions() {
+        let mut sources = vec![Source::ParallelArch(ParallelArch::default())];
+        for json in [
+            include_str!("../../examples/hinged_panel.json"),
+            include_str!("../../examples/crossing_supports.json"),
+            include_str!("../../examples/cushion_air.json"),
+            include_str!("../../examples/two_chamber_orifice.json"),
+            include_str!("../../examples/two_layers_touching.json"),
+        ] {
+            sources.push(Source::Model(Model::from_json(json).unwrap()));
+        }
+        for source in &sources {
+            let d = describe(source).unwrap();
+            let xml = model_description(&d);
+            let defined = attributes(&xml, &["Unit"], "name");
+            assert!(!defined.is_empty(), "{}: no <Unit>", d.model.name);
+            let types = ["Float64", "Int32", "Boolean", "String", "UInt64"];
+            let used = attributes(&xml, &types, "unit");
+            assert!(!used.is_empty(), "{}", d.model.name);
+            for unit in &used {
+                assert!(
+                    defined.contains(unit),
+                    "{}: unit {unit} undefined",
+                    d.model.name
+                );
+            }
+            for unit in &defined {
+                assert!(used.contains(unit), "{}: unit {unit} unused", d.model.name);
+            }
+            let displays = attributes(&xml, &["DisplayUnit"], "name");
+            for display in attributes(&xml, &types, "displayUnit") {
+                assert!(displays.contains(&display), "{}: {display}", d.model.name);
+            }
+        }
+    }
+}

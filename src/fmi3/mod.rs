@@ -15,8 +15,8 @@
 //! their serialization, `fmi3GetDirectionalDerivative` and `fmi3GetAdjointDerivative`, both made
 //! of J's columns (`fmi_glue::core::Columns`: the adjoint is the directional derivative's exact
 //! transpose, at one held solve per known), but for an adjoint of reactions and point
-//! displacements at a symmetric tangent, which is one solve (`Instance::adjoint_in_one_solve`;
-//! `docs/fmu.md` says when and why not for the other outputs), a terminal per boundary group
+//! displacements, which is one solve at any tangent (`Instance::adjoint_in_one_solve`;
+//! `docs/fmu.md` says why not for the other outputs), a terminal per boundary group
 //! ([`terminals`]). Checked against steps in `tests/derivatives.rs`.
 
 pub mod arrays;

@@ -5,6 +5,7 @@ is packed from the library and model description that the wheel ships."""
 
 from __future__ import annotations
 
+import io
 import subprocess
 import sys
 import zipfile
@@ -290,6 +291,28 @@ def test_staggered_exchange_hands_the_jacks_new_position_to_the_film_in_the_same
         system.run(30.0, 10.0, "jacobi")
         # Jacobi: the film reached the jack's position of the step before
         assert system.film["frame.dz"] != system.structure["dz"]
+
+
+def test_fmpy_ssp_simulation_refuses_fmi3_components(tmp_path):
+    """Why the SSP archives hold the FMI 2.0 FMUs (docs/fmu.md): fmpy 0.3.32's simulate_ssp
+    drives every component that is not FMI 1.0 as an FMI 2.0 one (fmpy/ssp/simulation.py,
+    instantiate_fmu: FMU2Slave), which looks for the library in the 2.0 folder binaries/linux64/,
+    so an archive of the FMI 3.0 film and jack (valid SSP: write_ssp takes any FMUs) stops at the
+    film's instantiation. When this fails, fmpy runs FMI 3.0 components: pack the SSP with them
+    and compare with the 2.0 SSP's run."""
+    from conftest import fmu_pack
+    r = fmu_pack("--fmi-version", "3", "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    film3 = tmp_path / "ParallelArch_fmi3.fmu"
+    jack3 = pack_jack_fmu(tmp_path, fmi_version=3)
+    ssp = write_ssp(tmp_path / "erection3.ssp", film3, jack3, film_parameters=FILM, jack_parameters=JACK,
+                    stop=10.0, step=5.0)
+    with zipfile.ZipFile(ssp) as z:
+        for fmu in ("resources/film.fmu", "resources/jack.fmu"):
+            with zipfile.ZipFile(io.BytesIO(z.read(fmu))) as inner:
+                assert b'fmiVersion="3.0"' in inner.read("modelDescription.xml"), fmu
+    with pytest.raises(Exception, match=r"Cannot find shared library .*binaries/linux64/ParallelArch\.so"):
+        simulate_ssp(str(ssp), stop_time=10.0, step_size=5.0, parameter_set=fmpy_parameter_set(ssp))
 
 
 def test_ssp_command_line_packs_both_fmus_with_the_values_set_and_refuses_a_bad_setting(fmu_path, jack_fmu, tmp_path):

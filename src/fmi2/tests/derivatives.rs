@@ -157,14 +157,19 @@ pub(crate) fn every_input_specimen(law: FrictionLaw, contact: SpecimenContact) -
         axis: [0.0, 1.0, 0.0],
         target_angle: 0.0,
     });
-    model.loads.pressures.push(PressureSet {
+    model.loads.pressures.push(cover());
+    model
+}
+
+/// The follower pressure set `cover` on every triangle, at 0 Pa.
+pub(crate) fn cover() -> PressureSet {
+    PressureSet {
         kind: Default::default(),
         name: "cover".into(),
         elements: ElementSelection::All(AllElements::All),
         pressure: 0.0,
         towards: None,
-    });
-    model
+    }
 }
 
 /// The Real outputs of the state (those with derivatives).

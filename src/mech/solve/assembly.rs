@@ -270,6 +270,40 @@ impl System {
         }
     }
 
+    /// A serial copy of the system whose value array goes on past [`System::nonzeros`] with the
+    /// rows of the constrained DOFs, which the pattern drops: every element-matrix entry at a
+    /// constrained row and a free column gets a slot of its own there, and `rows[k]` is (the
+    /// global row, the free column) of slot `nonzeros() + k`. Assembled into `nonzeros() +
+    /// rows.len()` values by the same contributions, its first `nonzeros()` are the system's
+    /// matrix bit for bit and the rest sum to `K_rf` (a reaction's gradient; the adjoint's
+    /// `K_rfᵀ v`, `solve/sensitivity.rs`).
+    pub fn with_constrained_rows(&self) -> Result<(System, Vec<(usize, usize)>), PatternError> {
+        let mut copy = self.clone();
+        copy.set_threads(1);
+        let nnz = self.nonzeros();
+        let (mut k, mut rows) = (0, vec![]);
+        for_each_entry(
+            &self.triangles,
+            &self.gaps,
+            &self.layer_contacts,
+            |gi, gj| {
+                if let (Dof::Fixed | Dof::Prescribed { .. }, Dof::Free(j)) =
+                    (self.dofs[gi], self.dofs[gj])
+                {
+                    copy.slots[k] = (nnz + rows.len()) as u32;
+                    rows.push((gi, j));
+                }
+                k += 1;
+            },
+        );
+        if nnz + rows.len() >= NO_SLOT as usize {
+            return Err(PatternError(
+                "more than 2^32 entries with the constrained rows".into(),
+            ));
+        }
+        Ok((copy, rows))
+    }
+
     /// Relative displacement `d = R (u_A − u_B)` of gap `g` in its local frame.
     pub fn gap_relative(&self, g: usize, u: &[f64]) -> Vector3<f64> {
         let gap = &self.gaps[g];
@@ -619,41 +653,17 @@ impl PatternEntries {
         let mut pairs: Vec<Pair<usize, usize>> =
             Vec::with_capacity(81 * triangles.len() + 36 * gaps.len());
         let mut entry_rows: Vec<Option<(usize, usize)>> = Vec::with_capacity(pairs.capacity());
-        let mut push_block = |global: &[usize]| {
-            // Column-major, like nalgebra's storage of the element matrix.
-            for &gj in global {
-                for &gi in global {
-                    let entry = match (dofs[gi], dofs[gj]) {
-                        (Dof::Free(i), Dof::Free(j)) if !lower_only || i >= j => Some((i, j)),
-                        _ => None,
-                    };
-                    if let Some((i, j)) = entry {
-                        pairs.push(Pair::new(i, j));
-                    }
-                    entry_rows.push(entry);
+        let (gap_offsets, pair_offsets) =
+            for_each_entry(triangles, gaps, layer_contacts, |gi, gj| {
+                let entry = match (dofs[gi], dofs[gj]) {
+                    (Dof::Free(i), Dof::Free(j)) if !lower_only || i >= j => Some((i, j)),
+                    _ => None,
+                };
+                if let Some((i, j)) = entry {
+                    pairs.push(Pair::new(i, j));
                 }
-            }
-        };
-        for (t, _) in triangles {
-            push_block(&node_dofs(t));
-        }
-        let mut gap_offsets = Vec::with_capacity(gaps.len());
-        let mut offset = 81 * triangles.len();
-        for g in gaps {
-            gap_offsets.push(offset);
-            let block = gap_dofs(g);
-            offset += block.len() * block.len();
-            push_block(&block);
-        }
-        let mut pair_offsets = Vec::with_capacity(layer_contacts.blocks.len());
-        for (v, tri) in &layer_contacts.blocks {
-            pair_offsets.push(offset);
-            offset += 144;
-            let mut block = [0; 12];
-            block[..3].copy_from_slice(&[3 * v, 3 * v + 1, 3 * v + 2]);
-            block[3..].copy_from_slice(&node_dofs(tri));
-            push_block(&block);
-        }
+                entry_rows.push(entry);
+            });
         Self {
             pairs,
             entry_rows,
@@ -694,6 +704,46 @@ impl PatternEntries {
             .collect();
         Ok((symbolic, slots))
     }
+}
+
+/// Calls `entry(row, column)` with the global DOFs of every element-matrix entry in assembly
+/// order (the order of the slot table): each triangle's 9×9, each gap's 3×3 or 6×6, each
+/// layer-contact pair's 12×12, column-major like nalgebra's storage. Returns the offsets of
+/// the gaps' and the pairs' entries.
+fn for_each_entry(
+    triangles: &[([usize; 3], MembraneTriangle)],
+    gaps: &[GapGeometry],
+    layer_contacts: &LayerContactSetup,
+    mut entry: impl FnMut(usize, usize),
+) -> (Vec<usize>, Vec<usize>) {
+    let mut block = |global: &[usize]| {
+        for &gj in global {
+            for &gi in global {
+                entry(gi, gj);
+            }
+        }
+    };
+    for (t, _) in triangles {
+        block(&node_dofs(t));
+    }
+    let mut gap_offsets = Vec::with_capacity(gaps.len());
+    let mut offset = 81 * triangles.len();
+    for g in gaps {
+        gap_offsets.push(offset);
+        let dofs = gap_dofs(g);
+        offset += dofs.len() * dofs.len();
+        block(&dofs);
+    }
+    let mut pair_offsets = Vec::with_capacity(layer_contacts.blocks.len());
+    for (v, tri) in &layer_contacts.blocks {
+        pair_offsets.push(offset);
+        offset += 144;
+        let mut dofs = [0; 12];
+        dofs[..3].copy_from_slice(&[3 * v, 3 * v + 1, 3 * v + 2]);
+        dofs[3..].copy_from_slice(&node_dofs(tri));
+        block(&dofs);
+    }
+    (gap_offsets, pair_offsets)
 }
 
 /// The automatic assembly thread count for `triangles` triangles (see [`System::set_threads`]).
