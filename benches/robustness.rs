@@ -1,13 +1,14 @@
 //! Robustness benchmark (`cargo bench --bench robustness`): every load path of
 //! [`scenarios::robustness_grid`] (≥ 500: the specimen family, panels over two arches with an
 //! edge jacked about a hinge, strips over cylinders, a film edge on an arch, the wrapped
-//! specimens, and ETFE's plastic film on specimens, cushions and panels) run with the
+//! specimens, ETFE's plastic film on specimens, cushions and panels, and three-layer cushions
+//! with sealed air inverted by snow) run with the
 //! default solver settings and the FMU's default increments per step. Prints, per family, how
 //! many paths converge, Newton iterations per increment (mean over all converged increments,
 //! and the most in one increment), cut-backs, and the first failure; then the total.
 //!
-//! Options (after `--`): `--family NAME` (specimen, panel, strip, arch-edge, wrapped, plastic;
-//! repeatable),
+//! Options (after `--`): `--family NAME` (specimen, panel, strip, arch-edge, wrapped, plastic,
+//! cushion; repeatable),
 //! `--quick` (every 10th path of each family), `--failures` (print every failed path),
 //! `--threads N` (paths run in parallel, default: available cores), `--check` (exit with status 1
 //! unless every path run converges, after listing the failures: CI runs

@@ -169,6 +169,7 @@ impl ArchEdge {
             model: self.model()?,
             path: LoadPath {
                 stages: vec![Stage {
+                    air: Default::default(),
                     targets: vec![[0.0, 0.0, -depth * self.arch_height]],
                     steps,
                     friction: None,

@@ -11,6 +11,7 @@ use crate::specimens::scenarios::Scenario;
 use crate::specimens::scenarios::SpecimenPath;
 use crate::specimens::scenarios::Stage;
 use crate::specimens::scenarios::WrappedSpecimen;
+use crate::specimens::scenarios::cushion_paths;
 
 // ------------------------------------------------------------------------- benchmark grid
 
@@ -31,7 +32,8 @@ use crate::specimens::scenarios::WrappedSpecimen;
 ///   (18 paths);
 /// * wrapped: `H` ∈ {0.2, 0.3, 0.4} m × contact ∈ {gaps, curved support} × `μ` ∈ {0, 0.2, 0.8}
 ///   × {`ε` = 0.02 in 10 steps, 0.04 in 40, 0.04 in 40 then released in 10} (54 paths);
-/// * plastic: [`plastic_paths`].
+/// * plastic: [`plastic_paths`];
+/// * cushion: [`cushion_paths`].
 ///
 /// `increments_per_step` is the FMU's default for every path except the CLI-style panel ramp.
 ///
@@ -152,6 +154,7 @@ pub fn robustness_grid(increments_per_step: usize) -> Result<Vec<Scenario>, Stri
         }
     }
     out.extend(plastic_paths(ips)?);
+    out.extend(cushion_paths(ips)?);
     Ok(out)
 }
 
@@ -207,6 +210,7 @@ pub fn plastic_paths(increments_per_step: usize) -> Result<Vec<Scenario>, String
         };
         let mut s = panel.jacked(1, 5, None, ips)?;
         s.path.stages.push(Stage {
+            air: Default::default(),
             targets: panel.jack_targets(back * panel.angle_for_drop(corner_drop)),
             steps: 5,
             friction: None,
@@ -238,6 +242,7 @@ pub fn plastic_paths(increments_per_step: usize) -> Result<Vec<Scenario>, String
             // A quarter of the extension released: path time from 1 back to 7/8.
             let release = 10;
             s.path.stages.extend((1..=release).map(|k| Stage {
+                air: Default::default(),
                 targets:
                     specimen.boundary_targets(&s.model, 1.0 - 0.125 * k as f64 / release as f64),
                 steps: 1,

@@ -136,6 +136,7 @@ impl CircularMembrane {
             return Err("cushion path: steps must be ≥ 1 and the pressures finite".into());
         }
         let stage = |p: f64| Stage {
+            air: Default::default(),
             targets: vec![[0.0; 3]],
             steps,
             friction: None,

@@ -3,7 +3,8 @@
 //!
 //! A [`Scenario`] is a validated [`Model`] plus a [`LoadPath`]: stages, each a target for every
 //! boundary group reached in a number of communication steps (targets interpolated linearly
-//! within a stage, as the CLI and a ramping master do), optionally with `μ` for the stage.
+//! within a stage, as the CLI and a ramping master do), optionally with `μ` for the stage, and
+//! what the stage does with the gas chambers ([`Air`]: supplies ramped, or the air sealed).
 //! [`Scenario::run`] drives [`Analysis::step_to`] once per communication step, as the FMU does,
 //! and records per step: converged or the error text, Newton iterations, increments, cut-backs.
 //!
@@ -62,6 +63,10 @@
 //! on the specimens lowered at every height and wrapped then partly released, on circular
 //! cushions inflated past yield and deflated, and on panels jacked and released.
 //!
+//! **Cushion** ([`cushion_paths`], issue 43): a three-layer circular cushion ([`LayeredCushion`]:
+//! top, perforated middle, bottom) inflated by a supply, its air sealed, snow on the top raised
+//! until the top inverts onto the middle layer (frictional layer contact), then removed.
+//!
 //! **Circular membrane** ([`CircularMembrane`], issue 8): a flat disc meshed in rings (the
 //! centre, then `6k` nodes on ring `k`), its rim a boundary group `rim` held at zero (so the FMU
 //! reports the rim reaction), a pressure set `top` on every triangle (normals +Z). Hencky's
@@ -84,6 +89,7 @@
 //! | `strip` | [`CylinderStrip`] |
 //! | `edge` | [`ArchEdge`] |
 //! | `membrane` | [`CircularMembrane`] |
+//! | `cushion` | [`LayeredCushion`], [`cushion_paths`] |
 //! | `grid` | the robustness benchmark's grid ([`robustness_grid`], [`grid_slice`]) |
 
 use std::fmt;
@@ -93,6 +99,7 @@ use crate::mech::model::Model;
 use crate::mech::solve::{Analysis, SolverSettings, StepError};
 
 mod arc;
+mod cushion;
 mod edge;
 mod grid;
 mod membrane;
@@ -101,6 +108,7 @@ mod specimen;
 mod strip;
 
 pub use arc::{CircularSupport, GapConstants, gaps_on_arc};
+pub use cushion::{LayeredCushion, cushion_paths};
 pub use edge::ArchEdge;
 pub use grid::{grid_slice, plastic_paths, robustness_grid};
 pub use membrane::CircularMembrane;
@@ -122,6 +130,21 @@ pub struct Stage {
     pub friction: Option<f64>,
     /// Pressure of every pressure set at the end of the stage (Pa, model order; `None`: kept).
     pub pressure: Option<Vec<f64>>,
+    /// What the stage does with the model's gas chambers.
+    pub air: Air,
+}
+
+/// What a [`Stage`] does with the model's gas chambers (issue 43).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Air {
+    /// Nothing: supplies keep their pressure, enclosed gas stays enclosed.
+    #[default]
+    Kept,
+    /// Every chamber's supply ramped to these pressures (Pa, model order) over the stage.
+    Supplied(Vec<f64>),
+    /// Every chamber's gas enclosed at the start of the stage, at the converged state
+    /// ([`Analysis::seal_chambers`]).
+    Sealed,
 }
 
 /// A load path: stages from the unloaded state, and the increments of every step.
@@ -157,17 +180,20 @@ pub enum Family {
     Wrapped,
     /// ETFE's elasto-plastic film ([`plastic_paths`]): specimens, cushions, panels.
     Plastic,
+    /// Three-layer cushions with sealed air under snow ([`cushion_paths`]).
+    Cushion,
 }
 
 impl Family {
     /// Every family, in table order.
-    pub const ALL: [Family; 6] = [
+    pub const ALL: [Family; 7] = [
         Self::Specimen,
         Self::Panel,
         Self::Strip,
         Self::ArchEdge,
         Self::Wrapped,
         Self::Plastic,
+        Self::Cushion,
     ];
 
     /// Short name (the benchmark's `--family` filter).
@@ -179,6 +205,7 @@ impl Family {
             Self::ArchEdge => "arch-edge",
             Self::Wrapped => "wrapped",
             Self::Plastic => "plastic",
+            Self::Cushion => "cushion",
         }
     }
 }
@@ -327,6 +354,18 @@ impl Scenario {
             let mut end = levels.clone();
             if let Some(p) = &stage.pressure {
                 end.pressure.clone_from(p);
+            }
+            let sealed = match &stage.air {
+                Air::Kept => Ok(()),
+                Air::Supplied(p) => {
+                    end.chambers.clone_from(p);
+                    Ok(())
+                }
+                Air::Sealed => analysis.seal_chambers(),
+            };
+            if let Err(e) = sealed {
+                outcome.setup_error = Some(format!("stage {}: {e}", s + 1));
+                return outcome;
             }
             if let Some(mu) = stage.friction
                 && let Err(e) = analysis.set_friction(mu)

@@ -198,6 +198,7 @@ impl ArchPanel {
         let angle = self.angle_for_drop(self.corner_drop);
         let stages_list = (1..=stages)
             .map(|k| Stage {
+                air: Default::default(),
                 targets: self.jack_targets(angle * k as f64 / stages as f64),
                 steps,
                 friction: if k == 1 { mu } else { None },

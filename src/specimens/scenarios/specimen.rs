@@ -66,6 +66,7 @@ impl SpecimenPath {
         let down = [0.0, 0.0, -self.depth * h];
         let half = self.steps.div_ceil(2);
         let stage = |t: [f64; 3], steps| Stage {
+            air: Default::default(),
             targets: vec![t],
             steps,
             friction: None,
@@ -137,6 +138,7 @@ impl WrappedSpecimen {
         }
         let model = spec.model()?;
         let stage = |t: f64| Stage {
+            air: Default::default(),
             targets: spec.boundary_targets(&model, t),
             steps: 1,
             friction: None,

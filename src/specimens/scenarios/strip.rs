@@ -145,6 +145,7 @@ impl CylinderStrip {
             ),
             path: LoadPath {
                 stages: vec![Stage {
+                    air: Default::default(),
                     targets: model.groups.iter().map(|g| g.target).collect(),
                     steps,
                     friction: None,
