@@ -312,9 +312,14 @@ impl SymmetricPart {
             })
         };
         if self.path == Path::Direct {
-            let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
             timed(&mut ctx.profile.ldlt_solve, || {
-                ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, &mut *stack)
+                pool::solve_ldlt(
+                    &self.symbolic,
+                    &self.factor,
+                    rhs,
+                    self.threads,
+                    &mut self.scratch,
+                )
             });
             if check(rhs, ctx) {
                 ctx.counts[1] += 1;

@@ -657,14 +657,12 @@ impl LinearSolver {
                 let start = Instant::now();
                 pool::factorize_ldlt(symbolic, factor, matrix, self.threads, &mut self.scratch)
                     .map_err(|e| FactorizationError(format!("LDLᵀ: {e:?}")))?;
-                let ldlt = LdltRef::new(&**symbolic, factor);
-                let stack = MemStack::new(&mut self.scratch);
                 self.profile.ldlt += start.elapsed();
                 self.profile.ldlt_count += 1;
                 self.held = Held::Ldlt;
-                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
+                let threads = self.threads;
                 timed(&mut self.profile.ldlt_solve, || {
-                    ldlt.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack)
+                    pool::solve_ldlt(symbolic, factor, rhs, threads, &mut self.scratch)
                 });
             }
             Kind::Full { lu, symmetric } => {

@@ -400,6 +400,188 @@ fn extend_add(
     }
 }
 
+/// Solves `A x = rhs` in place with the factor `factor` of [`factorize`] on the parallelism
+/// `par`: `L y = P b` by the tree (each subtree passes its contributions to the rows of its
+/// root's pattern up, as the factorization passes update matrices), `D z = y`, then `Lᵀ w = z`
+/// from the roots down (each front reads its pattern's values from its parent), `x = Pᵀ w`.
+/// The sums are fixed by the tree, so every thread count gives the same bits.
+pub(super) fn solve(analysed: &Analysed, tree: &Tree, factor: &[f64], rhs: &mut [f64], par: Par) {
+    let SymbolicCholeskyRaw::Supernodal(sym) = analysed.raw() else {
+        unreachable!("a tree exists for supernodal analyses only")
+    };
+    let perm = analysed.perm();
+    let forward_index = |i: usize| perm.map_or(i, |p| p.arrays().0[i]);
+    let b: Vec<f64> = (0..rhs.len()).map(|i| rhs[forward_index(i)]).collect();
+    let mut w = vec![0.0; rhs.len()];
+    let mut slots = Vec::with_capacity(sym.n_supernodes());
+    let mut rest = w.as_mut_slice();
+    for s in 0..sym.n_supernodes() {
+        let n = node(sym, s);
+        let (own, tail) = std::mem::take(&mut rest).split_at_mut(n.end - n.begin);
+        slots.push(Some(own));
+        rest = tail;
+    }
+    let sweep = Sweep {
+        sym,
+        tree,
+        factor,
+        b: &b,
+        par,
+        y: Mutex::new(vec![None; sym.n_supernodes()]),
+        slots: Mutex::new(slots),
+    };
+    let heavy = |r: &usize| tree.flops[*r] >= TASK_FLOPS;
+    let parallel = par.degree() > 1 && tree.roots.iter().filter(|r| heavy(r)).count() >= 2;
+    let each = |r: &usize| {
+        sweep.forward(*r);
+        sweep.backward(*r, Vec::new());
+    };
+    if parallel {
+        tree.roots.par_iter().for_each(each);
+    } else {
+        tree.roots.iter().for_each(each);
+    }
+    drop(sweep);
+    for (i, x) in w.into_iter().enumerate() {
+        rhs[forward_index(i)] = x;
+    }
+}
+
+/// What the two sweeps of [`solve`] share: the analysis, the factor, the permuted right-hand
+/// side, each supernode's `z = D⁻¹ y` once its forward step is done, and its slice of the answer.
+struct Sweep<'a, 'w> {
+    sym: &'a SymbolicSupernodalCholesky<usize>,
+    tree: &'a Tree,
+    factor: &'a [f64],
+    b: &'a [f64],
+    par: Par,
+    y: Mutex<Vec<Option<Vec<f64>>>>,
+    slots: Mutex<Vec<Option<&'w mut [f64]>>>,
+}
+
+impl Sweep<'_, '_> {
+    /// Whether the children of `s` go to separate threads.
+    fn split(&self, s: usize) -> bool {
+        let heavy = self.tree.children[s]
+            .iter()
+            .filter(|&&c| self.tree.flops[c] >= TASK_FLOPS)
+            .count();
+        heavy >= 2 && self.par.degree() > 1
+    }
+
+    /// The supernode's values as a matrix: `k + m` rows, `k` columns.
+    fn values(&self, s: usize) -> faer::MatRef<'_, f64> {
+        let ptr = self.sym.col_ptr_for_val();
+        let n = node(self.sym, s);
+        let (k, m) = (n.end - n.begin, n.pattern.len());
+        faer::MatRef::from_column_major_slice(&self.factor[ptr[s]..ptr[s + 1]], k + m, k)
+    }
+
+    /// `L y = b` over the subtree of `s`: stores `z_s = D⁻¹ y_s` and returns the subtree's
+    /// contributions to the rows of the pattern of `s`.
+    fn forward(&self, s: usize) -> Vec<f64> {
+        let children = &self.tree.children[s];
+        let ups: Vec<Vec<f64>> = if self.split(s) {
+            children.par_iter().map(|&c| self.forward(c)).collect()
+        } else {
+            children.iter().map(|&c| self.forward(c)).collect()
+        };
+        let n = node(self.sym, s);
+        let k = n.end - n.begin;
+        let mut ys = self.b[n.begin..n.end].to_vec();
+        let mut up = vec![0.0; n.pattern.len()];
+        for (&c, u) in children.iter().zip(&ups) {
+            let mut at = 0;
+            for (&r, v) in node(self.sym, c).pattern.iter().zip(u) {
+                if r < n.end {
+                    ys[r - n.begin] += v;
+                } else {
+                    while n.pattern[at] != r {
+                        at += 1;
+                    }
+                    up[at] += v;
+                }
+            }
+        }
+        let l = self.values(s);
+        let (top, bottom) = l.split_at_row(k);
+        solve_unit_lower_triangular_in_place(
+            top,
+            MatMut::from_column_major_slice_mut(&mut ys, k, 1),
+            Par::Seq,
+        );
+        if !up.is_empty() {
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(&mut up, n.pattern.len(), 1),
+                Accum::Add,
+                bottom,
+                faer::MatRef::from_column_major_slice(&ys, k, 1),
+                -1.0,
+                Par::Seq,
+            );
+        }
+        for (j, y) in ys.iter_mut().enumerate() {
+            *y /= top[(j, j)];
+        }
+        self.y.lock().unwrap_or_else(|e| e.into_inner())[s] = Some(ys);
+        up
+    }
+
+    /// `Lᵀ w = z` over the subtree of `s`, given `w` at the rows of its pattern.
+    fn backward(&self, s: usize, above: Vec<f64>) {
+        let n = node(self.sym, s);
+        let k = n.end - n.begin;
+        let mut ws = self.y.lock().unwrap_or_else(|e| e.into_inner())[s]
+            .take()
+            .expect("the forward sweep stored it");
+        let l = self.values(s);
+        let (top, bottom) = l.split_at_row(k);
+        if !above.is_empty() {
+            faer::linalg::matmul::matmul(
+                MatMut::from_column_major_slice_mut(&mut ws, k, 1),
+                Accum::Add,
+                bottom.transpose(),
+                faer::MatRef::from_column_major_slice(&above, above.len(), 1),
+                -1.0,
+                Par::Seq,
+            );
+        }
+        faer::linalg::triangular_solve::solve_unit_upper_triangular_in_place(
+            top.transpose(),
+            MatMut::from_column_major_slice_mut(&mut ws, k, 1),
+            Par::Seq,
+        );
+        let down = |c: usize| -> Vec<f64> {
+            let mut at = 0;
+            node(self.sym, c)
+                .pattern
+                .iter()
+                .map(|&r| {
+                    if r < n.end {
+                        ws[r - n.begin]
+                    } else {
+                        while n.pattern[at] != r {
+                            at += 1;
+                        }
+                        above[at]
+                    }
+                })
+                .collect()
+        };
+        let children = &self.tree.children[s];
+        let parts: Vec<(usize, Vec<f64>)> = children.iter().map(|&c| (c, down(c))).collect();
+        self.slots.lock().unwrap_or_else(|e| e.into_inner())[s]
+            .take()
+            .expect("each supernode's answer is written once")
+            .copy_from_slice(&ws);
+        if self.split(s) {
+            parts.into_par_iter().for_each(|(c, v)| self.backward(c, v));
+        } else {
+            parts.into_iter().for_each(|(c, v)| self.backward(c, v));
+        }
+    }
+}
+
 /// The dense LDLᵀ of a front's diagonal block in place (`D` on the diagonal, unit `L` below,
 /// zeros above, as faer's supernodal layout holds it).
 fn factor_block(mut top: MatMut<'_, f64>, par: Par) -> Result<(), LdltError> {
@@ -531,5 +713,58 @@ mod tests {
             .filter(|(x, y)| x.to_bits() != y.to_bits())
             .count();
         assert_eq!(differ, 0, "{differ} of {} values differ", one.len());
+    }
+
+    /// The tree's solve and faer's on the same factor, on `threads` threads.
+    fn solves(n: usize, threads: usize) -> (Vec<f64>, Vec<f64>) {
+        let a = grid(n);
+        let params = CholeskySymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+            ..Default::default()
+        };
+        let symbolic =
+            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
+                .unwrap();
+        let analysed = Analysed::new(symbolic, a.symbolic());
+        let tree = analysed.tree.as_ref().expect("a supernodal analysis");
+        let mut factor = vec![0.0; analysed.len_val()];
+        factorize(&analysed, tree, &mut factor, a.as_ref(), Par::Seq).unwrap();
+        let b: Vec<f64> = (0..a.ncols()).map(|i| 1.0 + (i % 11) as f64).collect();
+        let mut ours = b.clone();
+        super::super::pool::with_threads(threads, |par| {
+            solve(&analysed, tree, &factor, &mut ours, par)
+        });
+        let mut theirs = b;
+        let req = analysed.solve_in_place_scratch::<f64>(1, Par::Seq);
+        let mut scratch = MemBuffer::new(req);
+        faer::sparse::linalg::cholesky::LdltRef::new(&analysed.symbolic, &factor)
+            .solve_in_place_with_conj(
+                faer::Conj::No,
+                MatMut::from_column_major_slice_mut(&mut theirs, a.ncols(), 1),
+                Par::Seq,
+                MemStack::new(&mut scratch),
+            );
+        (ours, theirs)
+    }
+
+    #[test]
+    fn tree_solve_equals_faers_solve_to_rounding_with_the_same_bits_on_two_threads() {
+        let (one, theirs) = solves(40, 1);
+        let scale = theirs.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let worst = one
+            .iter()
+            .zip(&theirs)
+            .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(
+            worst <= 1e-12 * scale,
+            "largest difference {worst:e} of {scale:e}"
+        );
+        let (two, _) = solves(40, 2);
+        let differ = one
+            .iter()
+            .zip(&two)
+            .filter(|(x, y)| x.to_bits() != y.to_bits())
+            .count();
+        assert_eq!(differ, 0, "{differ} values differ on two threads");
     }
 }

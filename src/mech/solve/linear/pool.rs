@@ -11,7 +11,8 @@ use std::sync::Mutex;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::{LdltError, LdltRegularization};
 use faer::sparse::SparseColMatRef;
-use faer::{Par, Side};
+use faer::sparse::linalg::cholesky::LdltRef;
+use faer::{Conj, MatMut, Par, Side};
 
 use crate::mech::solve::assembly::{idle_cores, worker};
 use crate::mech::solve::linear::multifrontal::{self, Analysed};
@@ -96,4 +97,30 @@ pub(super) fn factorize_ldlt(
             )
             .map(|_| ()),
     })
+}
+
+/// Solves `A x = rhs` in place with the LDLᵀ `factor` of `symbolic` on `threads` threads: the
+/// tree's two sweeps on a supernodal analysis (`multifrontal::solve`), faer's simplicial solve
+/// otherwise (`scratch` sized for it).
+pub(super) fn solve_ldlt(
+    symbolic: &Analysed,
+    factor: &[f64],
+    rhs: &mut [f64],
+    threads: usize,
+    scratch: &mut MemBuffer,
+) {
+    match &symbolic.tree {
+        Some(tree) => with_threads(threads, |par| {
+            multifrontal::solve(symbolic, tree, factor, rhs, par)
+        }),
+        None => {
+            let n = rhs.len();
+            LdltRef::new(&symbolic.symbolic, factor).solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(rhs, n, 1),
+                Par::Seq,
+                MemStack::new(scratch),
+            );
+        }
+    }
 }
