@@ -651,9 +651,8 @@ mod tests {
         SparseColMat::try_new_from_triplets(dofs, dofs, &entries).unwrap()
     }
 
-    /// faer's supernodal analysis of `a` (forced supernodal), its multifrontal factor on
-    /// `threads` threads, and faer's own factor.
-    fn factors(a: &SparseColMat<usize, f64>, threads: usize) -> (Vec<f64>, Vec<f64>) {
+    /// faer's AMD analysis of `a`, forced supernodal, with its tree.
+    fn analysed(a: &SparseColMat<usize, f64>) -> Analysed {
         let params = CholeskySymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
@@ -661,7 +660,13 @@ mod tests {
         let symbolic =
             factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
                 .unwrap();
-        let analysed = Analysed::new(symbolic, a.symbolic());
+        Analysed::new(symbolic, a.symbolic())
+    }
+
+    /// faer's supernodal analysis of `a` (forced supernodal), its multifrontal factor on
+    /// `threads` threads, and faer's own factor.
+    fn factors(a: &SparseColMat<usize, f64>, threads: usize) -> (Vec<f64>, Vec<f64>) {
+        let analysed = analysed(a);
         let tree = analysed.tree.as_ref().expect("a supernodal analysis");
         let symbolic = &analysed.symbolic;
         let len = symbolic.len_val();
@@ -718,14 +723,7 @@ mod tests {
     /// The tree's solve and faer's on the same factor, on `threads` threads.
     fn solves(n: usize, threads: usize) -> (Vec<f64>, Vec<f64>) {
         let a = grid(n);
-        let params = CholeskySymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-            ..Default::default()
-        };
-        let symbolic =
-            factorize_symbolic_cholesky(a.symbolic(), Side::Lower, SymmetricOrdering::Amd, params)
-                .unwrap();
-        let analysed = Analysed::new(symbolic, a.symbolic());
+        let analysed = analysed(&a);
         let tree = analysed.tree.as_ref().expect("a supernodal analysis");
         let mut factor = vec![0.0; analysed.len_val()];
         factorize(&analysed, tree, &mut factor, a.as_ref(), Par::Seq).unwrap();
