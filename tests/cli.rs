@@ -1218,3 +1218,68 @@ fn the_summary_prints_the_contact_force_on_the_film() {
         "{out}"
     );
 }
+
+/// TEST GOAL (issue 43): a `--path` table closes a chamber's valve (`<chamber>.sealed`, 0 or 1)
+/// as a step starts, as the FMU does: the cushion inflated by its supply to 300 Pa, then sealed
+/// and heated by 30 K, keeps its air, `(p + p_a) V / T` to 1e-9, and its pressure rises above
+/// the supply's; `--chambers-csv` writes each step's pressure, volume, temperature, mass and
+/// valve. A cell other than 0 or 1 is refused naming line and column.
+#[test]
+fn a_path_table_seals_a_chamber_and_the_chambers_csv_follows_its_air() {
+    let dir = scratch("seal");
+    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion_air.json");
+    let table = write_file(
+        &dir,
+        "seal.csv",
+        "time, air.supplyPressure, air.sealed, air.heating\n1, 300, 0, 0\n2, 300, 1, 30\n",
+    );
+    let csv = dir.join("chambers.csv");
+    let (ok, out, err) = cli(&[
+        "model",
+        example,
+        "--path",
+        &table,
+        "--quiet",
+        "--chambers-csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("(enclosed air)"), "{out}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .skip(1)
+        .map(|l| {
+            l.split(',')
+                .enumerate()
+                .filter(|&(k, _)| k != 2)
+                .map(|(_, c)| c.parse().unwrap())
+                .collect()
+        })
+        .collect();
+    assert!(
+        text.starts_with("step,time,chamber,pressure_Pa,volume_m3,temperature_K,mass_kg,sealed\n"),
+        "{text}"
+    );
+    // step, time, pressure, volume, temperature, mass, sealed
+    let [first, second] = [&rows[0], &rows[1]];
+    assert_eq!(
+        (first[0], first[6], second[0], second[6]),
+        (1.0, 0.0, 2.0, 1.0)
+    );
+    assert!(
+        (first[2] - 300.0).abs() < 1e-9 && second[2] > 310.0,
+        "{text}"
+    );
+    assert!((second[4] - first[4] - 30.0).abs() < 1e-9, "{text}");
+    let air = |r: &[f64]| (r[2] + 101_325.0) * r[3] / r[4];
+    assert!((air(second) / air(first) - 1.0).abs() < 1e-9, "{text}");
+    assert!((second[5] / first[5] - 1.0).abs() < 1e-9, "{text}");
+    let bad = write_file(&dir, "bad.csv", "air.sealed\n0.5\n");
+    let (ok, _, err) = cli(&["model", example, "--path", &bad]);
+    assert!(
+        !ok && err.contains("bad.csv line 2, column 'air.sealed': '0.5' is not 0 or 1"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -270,8 +270,9 @@ pub struct RunArgs {
     pub steps: Option<u32>,
     /// A staged load path instead of the linear ramp: a CSV table, one row per step, whose
     /// columns are FMU input names (<group>.dx/dy/dz/angle, <set>.pressure, <set>.Fx/Fy/Fz,
-    /// mu) and an optional first column time; inputs without a column keep their FMU start
-    /// values.
+    /// mu, <chamber>.supplyPressure/heating, <chamber>.sealed as 0 or 1: the valve closes as
+    /// the step starts) and an optional first column time; inputs without a column keep their
+    /// FMU start values.
     #[arg(long, value_name = "TABLE.csv")]
     pub path: Option<PathBuf>,
     /// Iteration matrix.
@@ -313,6 +314,10 @@ pub struct RunArgs {
     /// and status of every slave node) of every step as CSV.
     #[arg(long, value_name = "FILE")]
     pub layer_contacts_csv: Option<PathBuf>,
+    /// Write each chamber's pressure, volume, temperature, air mass and valve of every step as
+    /// CSV.
+    #[arg(long, value_name = "FILE")]
+    pub chambers_csv: Option<PathBuf>,
     /// Write the reactions per unit length along every boundary group and named support set
     /// of every step as CSV (N/m: each node's reaction over its tributary length, half its film
     /// edges along the line).

@@ -182,6 +182,13 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         if let Some(mu) = inputs.mu {
             analysis.set_friction(mu)?;
         }
+        // A chamber's valve closes (or opens) as the step starts, as in the FMU.
+        let valves = analysis.state().chambers.iter().map(|c| c.sealed);
+        if !valves.eq(inputs.sealed.iter().copied()) {
+            analysis
+                .set_chambers_sealed(&inputs.sealed)
+                .map_err(|e| format!("step {step}/{count}: {e}"))?;
+        }
         // The path's time: the step's length moves air through the orifices.
         let loads = LoadLevels {
             time,
@@ -499,6 +506,7 @@ struct CsvFiles {
     gaps: Option<(std::fs::File, String)>,
     elements: Option<(std::fs::File, String)>,
     layers: Option<(std::fs::File, String)>,
+    chambers: Option<(std::fs::File, String)>,
 }
 
 impl CsvFiles {
@@ -524,6 +532,10 @@ impl CsvFiles {
                 "step,time,contact,node,triangle,gap_m,normal_force_N,pressure_Pa,\
                  friction_x_N,friction_y_N,friction_z_N,slip_mm,status",
             )?,
+            chambers: open(
+                &o.chambers_csv,
+                "step,time,chamber,pressure_Pa,volume_m3,temperature_K,mass_kg,sealed",
+            )?,
             elements: open(
                 &o.elements_csv,
                 &format!(
@@ -541,7 +553,10 @@ impl CsvFiles {
     }
 
     fn any(&self) -> bool {
-        self.gaps.is_some() || self.elements.is_some() || self.layers.is_some()
+        self.gaps.is_some()
+            || self.elements.is_some()
+            || self.layers.is_some()
+            || self.chambers.is_some()
     }
 
     fn write_step(
@@ -583,6 +598,21 @@ impl CsvFiles {
                     fz,
                     c.slip * 1e3,
                     c.status
+                )
+                .map_err(|e| format!("{name}: {e}"))?;
+            }
+        }
+        if let Some((f, name)) = self.chambers.as_mut() {
+            for c in &results.chambers {
+                writeln!(
+                    f,
+                    "{step},{time},{},{:e},{:e},{:e},{:e},{}",
+                    c.name,
+                    c.pressure,
+                    c.volume,
+                    c.temperature,
+                    c.mass,
+                    u8::from(c.sealed)
                 )
                 .map_err(|e| format!("{name}: {e}"))?;
             }

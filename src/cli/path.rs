@@ -10,14 +10,15 @@
 //!
 //! A UTF-8 byte-order mark (spreadsheets write one) is skipped. Blank lines and lines starting
 //! with `#` are skipped; cells are trimmed. Every cell is checked as `fmi2SetReal` checks the
-//! input ([`Variable::check_value`]: `mu` in `[0, 10]`, …). An input without a
+//! input ([`Variable::check_value`]: `mu` in `[0, 10]`, …); a Boolean input (a chamber's valve
+//! `<chamber>.sealed`) is written 0 or 1. An input without a
 //! column keeps its FMU start value (a group's displacement and angle 0, a load the model
 //! file's, reached in the first step as by the FMU); `mu` applies from the first row when it has
 //! a column. The optional first column `time` (increasing) is the pseudo-time of the VTK
 //! collection; without it, row k of N is at k/N.
 
 use membrane_contact::fmi2::variables::{
-    Causality, Kind, StepInputs, Value, Variable, message_real, step_inputs, variables,
+    Causality, Kind, StepInputs, Value, VarType, Variable, message_real, step_inputs, variables,
 };
 use membrane_contact::mech::Model;
 
@@ -76,22 +77,35 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
                 names.len()
             ));
         }
+        let at = |k: usize| format!("{source} line {line}, column '{}'", names[k]);
         let number = |k: usize| -> Result<f64, String> {
-            let at = || format!("{source} line {line}, column '{}'", names[k]);
             let v: f64 = cells[k]
                 .parse()
-                .map_err(|_| format!("{}: '{}' is not a number", at(), cells[k]))?;
+                .map_err(|_| format!("{}: '{}' is not a number", at(k), cells[k]))?;
             if !v.is_finite() {
-                return Err(format!("{}: {v} is not finite", at()));
+                return Err(format!("{}: {v} is not finite", at(k)));
             }
-            // An input's cell passes the FMU's own check of the value (fmi2SetReal's).
-            let input = k
-                .checked_sub(usize::from(has_time))
-                .map(|c| &table[columns[c]]);
-            match input.map(|var| var.check_value(&Value::Real(v))) {
-                Some(Err(e)) => Err(format!("{}: {e}", at())),
-                _ => Ok(v),
-            }
+            Ok(v)
+        };
+        // An input's cell: a Boolean input (a chamber's valve) is 0 or 1; each passes the
+        // FMU's own check of the value (fmi2SetReal's, fmi2SetBoolean's).
+        let input = |k: usize, var: &Variable| -> Result<Value, String> {
+            let value = match var.var_type {
+                VarType::Boolean => match cells[k] {
+                    "0" => Value::Boolean(false),
+                    "1" => Value::Boolean(true),
+                    cell => {
+                        return Err(format!(
+                            "{}: '{cell}' is not 0 or 1 (a Boolean input)",
+                            at(k)
+                        ));
+                    }
+                },
+                _ => Value::Real(number(k)?),
+            };
+            var.check_value(&value)
+                .map_err(|e| format!("{}: {e}", at(k)))?;
+            Ok(value)
         };
         if has_time {
             let t = number(0)?;
@@ -107,7 +121,7 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
             times.push(t);
         }
         for (k, &c) in columns.iter().enumerate() {
-            values[c] = Value::Real(number(k + usize::from(has_time))?);
+            values[c] = input(k + usize::from(has_time), &table[c])?;
         }
         rows.push(step_inputs(model, &table, &values, mu_given));
     }
@@ -281,6 +295,26 @@ mod tests {
             let e = read(text, &specimen(), "t.csv").unwrap_err();
             assert!(e.contains(expected), "'{e}' lacks '{expected}'");
         }
+    }
+
+    #[test]
+    fn a_chambers_valve_column_of_zeros_and_ones_opens_and_closes_it_per_step() {
+        let model = Model::from_json(include_str!("../../examples/cushion_air.json")).unwrap();
+        let path = read(
+            "air.supplyPressure, air.sealed, air.heating\n300, 0, 0\n300, 1, 30\n300, 0, 0\n",
+            &model,
+            "t.csv",
+        )
+        .unwrap();
+        let sealed: Vec<_> = path.steps.iter().map(|s| s.sealed[0]).collect();
+        assert_eq!(sealed, [false, true, false]);
+        assert_eq!(path.steps[1].loads.heating[0], 30.0);
+        assert_eq!(path.steps[0].loads.chambers[0], 300.0);
+        let e = read("air.sealed\ntrue\n", &model, "t.csv").unwrap_err();
+        assert!(
+            e.contains("t.csv line 2, column 'air.sealed': 'true' is not 0 or 1"),
+            "{e}"
+        );
     }
 
     #[test]
