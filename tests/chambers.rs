@@ -2,17 +2,20 @@
 //! differences, the model file's checks, and a two-layer circular cushion against the
 //! Föppl–Hencky membrane with Boyle's law for the enclosed air.
 
+use membrane_contact::mech::elements::chamber::ChamberGeometry;
 use membrane_contact::mech::elements::load::LoadLevels;
-use membrane_contact::mech::elements::triangle::Material;
+use membrane_contact::mech::elements::material::{Wrinkling, WrinklingState};
+use membrane_contact::mech::elements::plasticity::{Plasticity, etfe_datasheet_hardening};
+use membrane_contact::mech::elements::triangle::{ElementVector, Material};
 use membrane_contact::mech::model::{
     AllElements, ChamberSpec, ClosingPlane, ElementSelection, Layer, Model, OrificeSpec,
     PressureSet, Towards,
 };
-use membrane_contact::mech::solve::assembly::{Dof, System};
-use membrane_contact::mech::solve::contributions::{Chambers, Contribution, Evaluation};
+use membrane_contact::mech::solve::assembly::{Dof, System, node_dofs};
+use membrane_contact::mech::solve::contributions::{Chambers, Contribution, Evaluation, Triangles};
 use membrane_contact::mech::{Analysis, IterationMatrix, SolverSettings};
 use membrane_contact::specimens::scenarios::CircularMembrane;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, Vector3};
 
 mod common;
 use common::{assert_example_file, dense, film, hencky, worst_fd_mismatch};
@@ -71,29 +74,7 @@ fn chamber_tangent(
     levels: &LoadLevels,
     u: &[f64],
 ) -> (Vec<f64>, DMatrix<f64>) {
-    let mut residual = vec![0.0; u.len()];
-    let mut values = vec![0.0; system.nonzeros()];
-    let at = Evaluation {
-        system,
-        u,
-        levels,
-        iteration: Some(1),
-        matrix: IterationMatrix::Consistent,
-    };
-    chambers.add(&at, &mut residual, Some(&mut values));
-    let mut k = dense(system, &values);
-    let low_rank = chambers.low_rank();
-    let g = DMatrix::from_fn(system.free_count, low_rank.columns.len(), |i, j| {
-        low_rank.columns[j][i]
-    });
-    k += &g * &low_rank.matrix * g.transpose();
-    let mut free = vec![0.0; system.free_count];
-    for (i, d) in system.dofs.iter().enumerate() {
-        if let Dof::Free(eq) = d {
-            free[*eq] = residual[i];
-        }
-    }
-    (free, k)
+    film_and_air_tangent(None, chambers, system, levels, u)
 }
 
 /// The chamber's tangent (the load stiffness `−p ∂²V/∂u²` and, sealed, the pneumatic stiffness
@@ -930,5 +911,197 @@ fn an_orifice_beside_a_supplied_chamber_fills_or_empties_it_to_the_supplys_press
         assert!((gained + moved).abs() < 1e-12 * r.chambers[1].mass);
         assert_eq!(r.chambers[0].pressure, supply);
         assert!(moved.signum() == (before.chambers[1].pressure - supply).signum());
+    }
+}
+
+/// The film's and the air's free residual and full free–free tangent at `u`: the triangles'
+/// tangent where given (taut, wrinkled, slack or plastic, from the converged history
+/// `triangles` holds), the chambers' load stiffness and, sealed, their pneumatic stiffness
+/// `G A Gᵀ`.
+fn film_and_air_tangent(
+    triangles: Option<&mut Triangles>,
+    chambers: &mut Chambers,
+    system: &System,
+    levels: &LoadLevels,
+    u: &[f64],
+) -> (Vec<f64>, DMatrix<f64>) {
+    let mut residual = vec![0.0; u.len()];
+    let mut values = vec![0.0; system.nonzeros()];
+    let at = Evaluation {
+        system,
+        u,
+        levels,
+        iteration: Some(1),
+        matrix: IterationMatrix::Consistent,
+    };
+    if let Some(triangles) = triangles {
+        triangles.add(&at, &mut residual, Some(&mut values));
+    }
+    chambers.add(&at, &mut residual, Some(&mut values));
+    let mut k = dense(system, &values);
+    let low_rank = chambers.low_rank();
+    let g = DMatrix::from_fn(system.free_count, low_rank.columns.len(), |i, j| {
+        low_rank.columns[j][i]
+    });
+    k += &g * &low_rank.matrix * g.transpose();
+    let mut free = vec![0.0; system.free_count];
+    for (i, d) in system.dofs.iter().enumerate() {
+        if let Dof::Free(eq) = d {
+            free[*eq] = residual[i];
+        }
+    }
+    (free, k)
+}
+
+/// The film states the FD check below puts the cushion's film in.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FilmState {
+    Taut,
+    Wrinkled,
+    Slack,
+    Yielded,
+}
+
+/// The two-layer cushion (radius 1 m, 3 rings, 200 µm, tension-field film without the
+/// regularisation, so that its matrix is the exact derivative) and a displacement that puts its
+/// film in `state`: both layers domed (±50 mm at the centre, with a ripple) and stretched
+/// radially by `c` (the rim too): taut with 1 MPa prestress (`c = 0`); wrinkled without
+/// prestress, pulled in (`c = −0.001`: the hoop strain negative, the meridian stretched by
+/// the dome towards the rim); slack (`c = −0.01`: both negative); yielded (ETFE's data-sheet
+/// plasticity, `c = +0.03`: 3 % each way, past the 21 MPa initial yield).
+fn cushion_in(state: FilmState) -> (Model, Vec<f64>) {
+    let mut material = film(if state == FilmState::Taut { 1e6 } else { 0.0 });
+    material.wrinkling = Wrinkling::TensionField;
+    material.wrinkling_regularisation = 0.0;
+    if state == FilmState::Yielded {
+        material.plasticity = Some(Plasticity {
+            hardening: etfe_datasheet_hardening(),
+        });
+    }
+    let c = match state {
+        FilmState::Taut => 0.0,
+        FilmState::Wrinkled => -0.001,
+        FilmState::Slack => -0.01,
+        FilmState::Yielded => 0.03,
+    };
+    let model = cushion(1.0, 3, material, 300.0);
+    let top_nodes = 1 + 3 * 3 * 4;
+    let mut u = vec![0.0; model.dof_count()];
+    for (v, x) in model.nodes.iter().enumerate() {
+        let r2 = x[0] * x[0] + x[1] * x[1];
+        let side = if v < top_nodes { 1.0 } else { -1.0 };
+        let ripple = 1e-4 * (1.0 - r2);
+        u[3 * v] = c * x[0] + ripple * (v as f64 * 0.7).sin();
+        u[3 * v + 1] = c * x[1] + ripple * (v as f64 * 1.3).cos();
+        u[3 * v + 2] = side * 0.05 * (1.0 - r2) * (1.0 + 0.1 * (v as f64).sin());
+    }
+    (model, u)
+}
+
+/// The chamber's volume gradient, and the whole tangent of film and air (the film's in its
+/// state, the chamber's load stiffness and, sealed, the pneumatic rank-one term) match central
+/// differences of the volume and of the residual with the cushion's film taut, wrinkled, slack
+/// and yielded (each state checked to be reached: every triangle taut, some wrinkled, every
+/// one slack, every one flowing plastically from a virgin history), the air supplied and
+/// sealed. Fails with the pneumatic term dropped or its sign flipped.
+#[test]
+fn film_and_air_tangent_matches_finite_differences_in_every_film_state() {
+    use FilmState::*;
+    for state in [Taut, Wrinkled, Slack, Yielded] {
+        let (model, u) = cushion_in(state);
+        let system = System::new(&model, false).unwrap();
+        let analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
+        let start = analysis.state().clone();
+        let levels = LoadLevels::of_model(&model);
+        let geometry = ChamberGeometry::new(&model, &model.chambers[0]).unwrap();
+        let x = |u: &[f64]| -> Vec<Vector3<f64>> {
+            (model.nodes.iter().enumerate())
+                .map(|(v, p)| {
+                    Vector3::from(*p) + Vector3::new(u[3 * v], u[3 * v + 1], u[3 * v + 2])
+                })
+                .collect()
+        };
+        let volume = geometry.volume(&x(&u));
+        assert!(volume > 0.05, "{state:?}: volume {volume}");
+
+        // The film's state at u (the plastic flow from the virgin history, as Newton's trial).
+        let mut triangles = Triangles::default();
+        triangles.restore(&start);
+        let mut chambers = Chambers::new(&model);
+        chambers.restore(&start);
+        film_and_air_tangent(Some(&mut triangles), &mut chambers, &system, &levels, &u);
+        let mut trial = start.clone();
+        triangles.commit(&start, &mut trial);
+        let mut counts = [0usize; 3];
+        let mut flowing = 0;
+        for (e, (nodes, tri)) in system.triangles.iter().enumerate() {
+            let dofs = node_dofs(nodes);
+            let ue = ElementVector::from_fn(|i, _| u[dofs[i]]);
+            let s = match model.material.plastic_film() {
+                None => tri.stress_state(&model.material, &ue),
+                Some(f) => tri.stress_state_plastic(&model.material, &f, &trial.plastic[e], &ue),
+            };
+            counts[s.state as usize] += 1;
+            flowing += usize::from(
+                trial
+                    .plastic
+                    .get(e)
+                    .is_some_and(|h| h.equivalent_plastic_strain > 0.0),
+            );
+        }
+        let n = system.triangles.len();
+        let reached = match state {
+            Taut => counts[WrinklingState::Taut as usize] == n,
+            Wrinkled => counts[WrinklingState::Wrinkled as usize] > 0,
+            Slack => counts[WrinklingState::Slack as usize] == n,
+            Yielded => flowing == n,
+        };
+        assert!(
+            reached,
+            "{state:?} not reached: [taut, wrinkled, slack] {counts:?}, {flowing} flowing"
+        );
+
+        for sealed in [false, true] {
+            let mut begin = start.clone();
+            if sealed {
+                // The air enclosed at 300 Pa in the volume it has at u.
+                begin.chambers[0].sealed = true;
+                begin.chambers[0].constant = (300.0 + 101_325.0) * volume;
+            }
+            chambers.restore(&begin);
+            let (_, k) =
+                film_and_air_tangent(Some(&mut triangles), &mut chambers, &system, &levels, &u);
+            assert_eq!(chambers.low_rank().columns.len(), usize::from(sealed));
+            let worst = worst_fd_mismatch(&system, &u, 1e-7, &k, |v| {
+                film_and_air_tangent(Some(&mut triangles), &mut chambers, &system, &levels, v).0
+            });
+            assert!(
+                worst < 1e-6 * k.amax(),
+                "{state:?}, sealed {sealed}: worst {worst:e} of {:e}",
+                k.amax()
+            );
+            if sealed {
+                // g = ∂V/∂u, the rank-one term's column, against central differences of V
+                // (linear in each coordinate alone: a long step is exact but for rounding),
+                // the column of an evaluation at u itself.
+                film_and_air_tangent(Some(&mut triangles), &mut chambers, &system, &levels, &u);
+                let g = &chambers.low_rank().columns[0];
+                let h = 1e-3;
+                let mut worst: f64 = 0.0;
+                for (i, d) in system.dofs.iter().enumerate() {
+                    let Dof::Free(eq) = d else { continue };
+                    let (mut up, mut um) = (u.clone(), u.clone());
+                    up[i] += h;
+                    um[i] -= h;
+                    let fd = (geometry.volume(&x(&up)) - geometry.volume(&x(&um))) / (2.0 * h);
+                    worst = worst.max((fd - g[*eq]).abs());
+                }
+                let scale = g.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                assert!(
+                    worst < 1e-10 * scale,
+                    "{state:?}: gradient off by {worst:e} of {scale:e}"
+                );
+            }
+        }
     }
 }
