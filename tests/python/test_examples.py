@@ -406,3 +406,50 @@ def test_fig8_plastic_refits_both_films_and_keeps_the_plastic_films_residual_str
         assert abs(float(linear[p]["slip_released_mm"])) < 1.0
         assert float(plastic[p]["residual_plastic_strain"]) > 0.01
         assert float(plastic[p]["slip_released_mm"]) > 1.0
+
+
+#: examples/cushion_three_layer.py's golden number: the lower chamber's pressure (Pa) under
+#: 1.5 kPa of snow, its air enclosed at 300 Pa, the top layer inverted onto the middle one.
+#: Tolerance 0.5 Pa: the mesh moves it by 0.1 Pa (8 x 16 or 12 x 24 cells instead of 10 x 20),
+#: adiabatic air (κ = 1.4) by +1.3 Pa, a layer contact ten times softer by -3.1 Pa.
+CUSHION_SNOW_LOWER = 1331.3
+
+
+def cushion_stages(stdout):
+    """The example's table: {row label: [value per stage]} (the first number of each cell)."""
+    lines = stdout.splitlines()
+    header = next(i for i, line in enumerate(lines) if line.split()[:1] == ["inflated"])
+    table = {}
+    for line in lines[header + 1:]:
+        label, _, cells = line.partition("  ")
+        if not cells.strip() or ":" in label:
+            break
+        table[label.strip()] = [float(c.split("/")[0]) for c in cells.split()]
+    return table
+
+
+def test_three_layer_cushion_lands_its_top_on_the_middle_layer_under_snow_and_keeps_its_air(tmp_path):
+    """The rectangular three-layer cushion (3 m x 6 m, 250/100/250 µm plastic ETFE) through
+    inflation, snow, wind suction and sun, by the CLI along a staged path: the script's own checks
+    pass (each enclosed chamber's gas law to 1e-6, the vertical reactions equal to the snow and
+    suction loads to 1e-6: it exits non-zero otherwise); under the snow the top lies on the middle
+    layer over most of the 18 m² and the lower air carries it at the golden pressure, the bottom
+    layer yields; suction lowers both chambers' pressure, the sun raises it; the picture is
+    written."""
+    out = run_example("cushion_three_layer.py", tmp_path)
+    assert_png(tmp_path / "cushion_three_layer.png")
+    assert "gas law: (p + p_a) V / T of each enclosed chamber kept to" in out
+    golden = float(out.split("lower chamber under the snow:")[1].split()[0])
+    assert golden == pytest.approx(CUSHION_SNOW_LOWER, abs=0.5)
+    t = cushion_stages(out)
+    inflated, snow, melted, wind, calm, sun = range(6)
+    assert t["upper chamber (Pa)"][inflated] == t["lower chamber (Pa)"][inflated] == 300.0
+    assert t["upper chamber (Pa)"][snow] == 300.0, "the upper chamber is held by its supply"
+    assert 14.0 < t["contact area (m²)"][snow] < 18.0
+    assert t["contact area (m²)"][wind] == t["contact area (m²)"][sun] == 0.0
+    assert t["plastic strain bottom"][snow] > 0.0 and t["plastic strain top"][snow] == 0.0
+    assert t["plastic strain bottom"][sun] == t["plastic strain bottom"][snow], "kept once unloaded"
+    for chamber in ("upper chamber (Pa)", "lower chamber (Pa)"):
+        assert t[chamber][wind] < t[chamber][calm] < t[chamber][sun]
+    for edge in ("long edges max/mean (kN/m)", "short edges max/mean (kN/m)"):
+        assert t[edge][snow] > t[edge][inflated] > 0.0
