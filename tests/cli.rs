@@ -1219,24 +1219,17 @@ fn the_summary_prints_the_contact_force_on_the_film() {
     );
 }
 
-/// TEST GOAL (issue 43): a `--path` table closes a chamber's valve (`<chamber>.sealed`, 0 or 1)
-/// as a step starts, as the FMU does: the cushion inflated by its supply to 300 Pa, then sealed
-/// and heated by 30 K, keeps its air, `(p + p_a) V / T` to 1e-9, and its pressure rises above
-/// the supply's; `--chambers-csv` writes each step's pressure, volume, temperature, mass and
-/// valve. A cell other than 0 or 1 is refused naming line and column.
-#[test]
-fn a_path_table_seals_a_chamber_and_the_chambers_csv_follows_its_air() {
-    let dir = scratch("seal");
-    let example = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion_air.json");
-    let table = write_file(
-        &dir,
-        "seal.csv",
-        "time, air.supplyPressure, air.sealed, air.heating\n1, 300, 0, 0\n2, 300, 1, 30\n",
-    );
+const CUSHION_AIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/cushion_air.json");
+
+/// Runs `examples/cushion_air.json` along the path `table` (CSV text) with `--chambers-csv`:
+/// the printed summary and the CSV's text with its rows' numbers (step, time, pressure, volume,
+/// temperature, mass, valve; the chamber's name left out).
+fn cushion_air_path(dir: &std::path::Path, table: &str) -> (String, String, Vec<Vec<f64>>) {
+    let table = write_file(dir, "path.csv", table);
     let csv = dir.join("chambers.csv");
     let (ok, out, err) = cli(&[
         "model",
-        example,
+        CUSHION_AIR,
         "--path",
         &table,
         "--quiet",
@@ -1244,9 +1237,8 @@ fn a_path_table_seals_a_chamber_and_the_chambers_csv_follows_its_air() {
         csv.to_str().unwrap(),
     ]);
     assert!(ok, "{err}");
-    assert!(out.contains("(enclosed air)"), "{out}");
     let text = std::fs::read_to_string(&csv).unwrap();
-    let rows: Vec<Vec<f64>> = text
+    let rows = text
         .lines()
         .skip(1)
         .map(|l| {
@@ -1257,6 +1249,22 @@ fn a_path_table_seals_a_chamber_and_the_chambers_csv_follows_its_air() {
                 .collect()
         })
         .collect();
+    (out, text, rows)
+}
+
+/// TEST GOAL (issue 43): a `--path` table closes a chamber's valve (`<chamber>.sealed`, 0 or 1)
+/// as a step starts, as the FMU does: the cushion inflated by its supply to 300 Pa, then sealed
+/// and heated by 30 K, keeps its air, `(p + p_a) V / T` to 1e-9, and its pressure rises above
+/// the supply's; `--chambers-csv` writes each step's pressure, volume, temperature, mass and
+/// valve. A cell other than 0 or 1 is refused naming line and column.
+#[test]
+fn a_path_table_seals_a_chamber_and_the_chambers_csv_follows_its_air() {
+    let dir = scratch("seal");
+    let (out, text, rows) = cushion_air_path(
+        &dir,
+        "time, air.supplyPressure, air.sealed, air.heating\n1, 300, 0, 0\n2, 300, 1, 30\n",
+    );
+    assert!(out.contains("(enclosed air)"), "{out}");
     assert!(
         text.starts_with("step,time,chamber,pressure_Pa,volume_m3,temperature_K,mass_kg,sealed\n"),
         "{text}"
@@ -1276,9 +1284,44 @@ fn a_path_table_seals_a_chamber_and_the_chambers_csv_follows_its_air() {
     assert!((air(second) / air(first) - 1.0).abs() < 1e-9, "{text}");
     assert!((second[5] / first[5] - 1.0).abs() < 1e-9, "{text}");
     let bad = write_file(&dir, "bad.csv", "air.sealed\n0.5\n");
-    let (ok, _, err) = cli(&["model", example, "--path", &bad]);
+    let (ok, _, err) = cli(&["model", CUSHION_AIR, "--path", &bad]);
     assert!(
         !ok && err.contains("bad.csv line 2, column 'air.sealed': '0.5' is not 0 or 1"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// TEST GOAL (issue 43): a `--path` table's `<chamber>.massFlow` (kg/s) feeds a sealed chamber
+/// its flow times the step's length (the time column), as the FMU does: 0.01 kg/s over 2 s adds
+/// 0.02 kg to 1e-12 and the pressure is the gas law's for the mass at the volume the film lets
+/// it take; a flow that would leave no air is refused naming the input.
+#[test]
+fn a_path_tables_mass_flow_feeds_a_sealed_chamber_its_flow_times_the_step() {
+    let dir = scratch("mass-flow");
+    let (_, text, rows) = cushion_air_path(
+        &dir,
+        "time, air.supplyPressure, air.sealed, air.massFlow\n1, 300, 0, 0\n3, 300, 1, 0.01\n",
+    );
+    // step, time, pressure, volume, temperature, mass, sealed
+    let (before, after) = (&rows[0], &rows[1]);
+    assert!(
+        ((after[5] - before[5]) / 0.02 - 1.0).abs() < 1e-12,
+        "{text}"
+    );
+    let gas_law = after[5] * 287.05 * after[4] / after[3] - 101_325.0;
+    assert!(
+        (after[2] - gas_law).abs() < 1e-6 && after[2] > 360.0,
+        "{text}"
+    );
+    let drain = write_file(
+        &dir,
+        "drain.csv",
+        "time, air.supplyPressure, air.sealed, air.massFlow\n1, 300, 0, 0\n2, 300, 1, -1\n",
+    );
+    let (ok, _, err) = cli(&["model", CUSHION_AIR, "--path", &drain, "--quiet"]);
+    assert!(
+        !ok && err.contains("step 2/2: air.massFlow = -1 kg/s over the step of 1 s would leave"),
         "{err}"
     );
     let _ = std::fs::remove_dir_all(&dir);

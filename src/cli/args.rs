@@ -270,9 +270,9 @@ pub struct RunArgs {
     pub steps: Option<u32>,
     /// A staged load path instead of the linear ramp: a CSV table, one row per step, whose
     /// columns are FMU input names (<group>.dx/dy/dz/angle, <set>.pressure, <set>.Fx/Fy/Fz,
-    /// mu, <chamber>.supplyPressure/heating, <chamber>.sealed as 0 or 1: the valve closes as
-    /// the step starts) and an optional first column time; inputs without a column keep their
-    /// FMU start values.
+    /// mu, <chamber>.supplyPressure/heating/massFlow, <chamber>.sealed as 0 or 1: the valve
+    /// closes as the step starts) and an optional first column time (a massFlow acts over the
+    /// step's length); inputs without a column keep their FMU start values.
     #[arg(long, value_name = "TABLE.csv")]
     pub path: Option<PathBuf>,
     /// Iteration matrix.

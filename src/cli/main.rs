@@ -26,7 +26,7 @@ mod report;
 
 use args::{Cli, Command, RunArgs, SpecimenArgs};
 use clap::Parser;
-use membrane_contact::fmi2::variables::StepInputs;
+use membrane_contact::fmi2::variables::{Kind, StepInputs, supplied_air, variables};
 use path::StagedPath;
 
 /// `println!` for the results on standard output, through [`print_line`]: a reader that closes
@@ -122,8 +122,13 @@ fn load_path(
             mu: None,
             sealed: model.chambers.iter().map(|c| c.sealed).collect(),
         })
-        .collect();
-    Ok(StagedPath { times, steps: rows })
+        .collect::<Vec<_>>();
+    let values = vec![vec![]; rows.len()];
+    Ok(StagedPath {
+        times,
+        steps: rows,
+        values,
+    })
 }
 
 /// The options that a failed step's advice names. Each `--path` row is one step, split into
@@ -162,6 +167,7 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
         Source::Specimen { height_mm, .. } => Some(height_mm),
         Source::File(_) => None,
     };
+    let table = variables(&model, Kind::Model);
     let mut analysis = Analysis::new(model, settings).map_err(|e| e.to_string())?;
     if let Some(mu) = o.mu {
         analysis.set_friction(mu)?;
@@ -189,9 +195,14 @@ fn run(source: Source<'_>, o: &RunArgs) -> Result<(), String> {
                 .set_chambers_sealed(&inputs.sealed)
                 .map_err(|e| format!("step {step}/{count}: {e}"))?;
         }
-        // The path's time: the step's length moves air through the orifices.
+        // The path's time: the step's length moves air through the orifices, and feeds the
+        // sealed chambers their `<chamber>.massFlow` (the FMU's running total of air supplied).
+        let h = time - if k == 0 { 0.0 } else { path.times[k - 1] };
+        let air = supplied_air(&analysis, &table, &path.values[k], &inputs.sealed, h)
+            .map_err(|e| format!("step {step}/{count}: {e}"))?;
         let loads = LoadLevels {
             time,
+            air,
             ..inputs.loads.clone()
         };
         let report = match analysis.step_to_motion(

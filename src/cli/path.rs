@@ -15,7 +15,8 @@
 //! column keeps its FMU start value (a group's displacement and angle 0, a load the model
 //! file's, reached in the first step as by the FMU); `mu` applies from the first row when it has
 //! a column. The optional first column `time` (increasing) is the pseudo-time of the VTK
-//! collection; without it, row k of N is at k/N.
+//! collection and the time over which a row's `<chamber>.massFlow` (kg/s) feeds a sealed chamber
+//! (and its orifices pass air); without it, row k of N is at k/N.
 
 use membrane_contact::fmi2::variables::{
     Causality, Kind, StepInputs, Value, VarType, Variable, message_real, step_inputs, variables,
@@ -29,6 +30,9 @@ pub struct StagedPath {
     pub times: Vec<f64>,
     /// What each step asks for.
     pub steps: Vec<StepInputs>,
+    /// Each step's input values, in the order of the FMU's variable table (empty for a ramp):
+    /// the chambers' mass flows, which the step integrates over its length.
+    pub values: Vec<Vec<Value>>,
 }
 
 /// Reads a staged path for `model` from the CSV `text` (`source` names it in errors).
@@ -67,7 +71,7 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
         .iter()
         .map(|v| v.start.clone().unwrap_or(Value::Real(0.0)))
         .collect();
-    let (mut times, mut rows) = (Vec::new(), Vec::new());
+    let (mut times, mut rows, mut row_values) = (Vec::new(), Vec::new(), Vec::new());
     for (line, row) in lines {
         let cells: Vec<&str> = row.split(',').map(str::trim).collect();
         if cells.len() != names.len() {
@@ -124,6 +128,7 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
             values[c] = input(k + usize::from(has_time), &table[c])?;
         }
         rows.push(step_inputs(model, &table, &values, mu_given));
+        row_values.push(values.clone());
     }
     if rows.is_empty() {
         return Err(format!("{source}: no steps (only a header)"));
@@ -132,7 +137,11 @@ pub fn read(text: &str, model: &Model, source: &str) -> Result<StagedPath, Strin
         let n = rows.len() as f64;
         times = (1..=rows.len()).map(|k| k as f64 / n).collect();
     }
-    Ok(StagedPath { times, steps: rows })
+    Ok(StagedPath {
+        times,
+        steps: rows,
+        values: row_values,
+    })
 }
 
 /// Checks `value` for the FMU input `name` of `model` as `fmi2SetReal` does
