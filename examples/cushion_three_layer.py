@@ -315,6 +315,8 @@ def plot(path, work, model, section, ends, lines):
         edge = sorted((float(r["y_m"]), float(r["q_N_per_m"]) / 1e3)
                       for r in lines[k + 1].values() if r["line"] == "west")
         b.plot([y for y, _ in edge], [q for _, q in edge], "o-", color=colour, label=name, ms=3)
+    a.set_title("section through the middle (y = 3 m) at the end of each stage", fontsize=10)
+    b.set_title("reaction per unit length along the long edge x = 0", fontsize=10)
     a.set_xlabel("x across the span at y = 3 m (m)")
     a.set_ylabel("z (mm): top -, middle :, bottom --")
     a.legend(fontsize=8)

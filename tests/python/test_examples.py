@@ -22,6 +22,8 @@ exist and are not empty, every number is finite, and the physics of §4.4:
   mm; the plastic film's stress stays on its hardening curve while the linear film's does not;
   released, the linear film returns to the start with nothing left, the plastic film keeps its
   plastic strain and its slips.
+* the rectangular three-layer cushion (``cushion_three_layer.py``): its gas-law and balance
+  checks pass, the top lands on the middle layer under snow, the lower chamber's golden pressure.
 
 Not checked: how the pictures look.
 """
