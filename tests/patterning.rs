@@ -42,6 +42,7 @@
 mod common;
 
 use common::{analysis_stress_error, film_model, surface_grid};
+use membrane_contact::mech::elements::gap::GapStatus;
 use membrane_contact::mech::elements::material::{Material, Wrinkling};
 use membrane_contact::mech::elements::triangle::MembraneTriangle;
 use membrane_contact::mech::formfinding::contact::{ContactSettings, find_shape_with_contact};
@@ -56,7 +57,7 @@ use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
     ElementCompensation, ElementSettings, Erected, away_from_rails, compensate_elements,
     erect_along, erect_through, erect_with_contacts, rail_start_offsets, rail_waypoints,
-    refit_strips,
+    refit_strips, settling_waypoints,
 };
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
@@ -1309,4 +1310,108 @@ fn a_winding_rail_path_matters_only_with_friction_and_the_compensation_along_it_
     let kept_model = read(&dir.join(format!("models/erection-{}.json", kept.unwrap())));
     assert!(kept_model.unwrap() == read(&best).unwrap());
     std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn settling_waypoints_alternate_past_and_short_of_the_places_shrinking_by_the_ratio() {
+    // After [0.10, 0.03] (down 0.10 m and out 0.03 m to the places), the rails pass their places
+    // by 1 mm along that leg, come back 0.5 mm short, pass by 0.25 mm: w_k = (−1)^{k+1} a rᵏ d.
+    let path = [[0.3, 0.0], [0.10, 0.03]];
+    let w = settling_waypoints(&path, 1e-3, 0.5, 3).unwrap();
+    assert_eq!(w[..2], path);
+    let d = [0.10, 0.03].map(|c: f64| c / 0.10f64.hypot(0.03));
+    for (k, a) in [-1e-3, 5e-4, -2.5e-4].into_iter().enumerate() {
+        let expected = d.map(|c| a * c);
+        assert!(
+            (0..2).all(|c| (w[2 + k][c] - expected[c]).abs() < 1e-15),
+            "{k}: {:?} against {expected:?}",
+            w[2 + k]
+        );
+    }
+    assert_eq!(w.len(), 5);
+    // Refused, naming what is wrong.
+    let refused = [
+        (settling_waypoints(&[], 1e-3, 0.5, 3), "--rail-path"),
+        (
+            settling_waypoints(&[[0.0, 0.0]], 1e-3, 0.5, 3),
+            "no direction",
+        ),
+        (settling_waypoints(&path, -1e-3, 0.5, 3), "amplitude -0.001"),
+        (settling_waypoints(&path, 1e-3, 1.0, 3), "ratio 1"),
+    ];
+    for (r, says) in refused {
+        let Err(e) = r else { panic!("accepted: {r:?}") };
+        assert!(e.contains(says), "{e}");
+    }
+}
+
+#[test]
+fn settling_the_rails_ends_the_drum_film_sticking_at_its_prestress_where_the_path_alone_leaves_a_capstan_fall()
+ {
+    // The drum film (μ = 0.3), prestress compensation, rails down 0.10 m and out 0.03 m: every
+    // contact node off the sticking ones slides and the error away from the rails is 21 %. The
+    // same path then settled (1 mm past the places and back, 12 waypoints shrinking by 0.7):
+    // every contact node sticks and every triangle away from the rails is within 5 %.
+    let model = film_over_drum(0.3);
+    let cut = cut_pattern(&model, whole(&model), Compensation::Prestress).unwrap();
+    let erection = erection_model(&model, reference_geometry(&model, &cut).unwrap());
+    let counted = away_from_rails(&model);
+    let target = model.material.prestress[0];
+    let largest = |e: &Erected| {
+        (e.elements.iter().zip(&counted))
+            .filter(|(_, c)| **c)
+            .map(|(s, _)| {
+                (s.stress[0] - target)
+                    .abs()
+                    .max((s.stress[1] - target).abs())
+            })
+            .fold(0.0, f64::max)
+            / target
+    };
+    let path = [[0.10, 0.03]];
+    let settled = settling_waypoints(&path, 1e-3, 0.7, 12).unwrap();
+    let plain = erect_through(erection.clone(), 10, &rail_waypoints(&model, &path)).unwrap();
+    let settled = erect_through(erection, 10, &rail_waypoints(&model, &settled)).unwrap();
+    let sliding = |e: &Erected| {
+        (e.contacts.iter())
+            .filter(|c| c.status == GapStatus::Slip)
+            .count()
+    };
+    let (before, after) = (largest(&plain), largest(&settled));
+    eprintln!(
+        "drum, μ = 0.3: largest error away from the rails {:.2} % on the path, {:.2} % settled; sliding contact nodes {} and {} of {}",
+        100.0 * before,
+        100.0 * after,
+        sliding(&plain),
+        sliding(&settled),
+        settled.contacts.len()
+    );
+    assert!(before > 0.15 && sliding(&plain) > 0, "{before}");
+    assert!(after < 0.05 && sliding(&settled) == 0, "{after}");
+    // The CLI settles the same way (`--settle`), and takes waypoints below or outside the
+    // rails' places as they are written (`--rail-path -0.001,-0.0003`).
+    let drum = format!("{}/examples/drum.json", env!("CARGO_MANIFEST_DIR"));
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+            .args(["pattern", &drum, "--erect", "1", "--by-element"])
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let out = run(&["--rail-path", "0.10,0.03", "--settle", "0.001,0.7,12"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("0 triangles yielded"), "{stdout}");
+    let out = run(&["--rail-path", "0.10,0.03", "--rail-path", "-0.001,-0.0003"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = run(&["--rail-path", "0.10,0.03", "--settle", "0.001,0.7,2.5"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("2.5 cycles"));
 }
