@@ -170,7 +170,7 @@ pub enum Command {
         /// the last leg, come back short of them by RATIO times that, and so on, CYCLES
         /// waypoints in all, then end at their places (friction then holds the film at a
         /// nearly even tension instead of the capstan's fall from the rails).
-        #[arg(long, value_name = "AMPLITUDE,RATIO,CYCLES", value_parser = parse_settle, requires = "rail_path")]
+        #[arg(long, value_name = "AMPLITUDE,RATIO,CYCLES", value_parser = parse_settle, requires = "rail_path", allow_hyphen_values = true)]
         settle: Option<(f64, f64, usize)>,
         /// Increments of each erection.
         #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]

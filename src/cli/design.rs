@@ -415,8 +415,7 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let mut report = serde_json::json!({ "erections": [] });
     let path = match a.settle {
         Some((amplitude, ratio, cycles)) => {
-            settling_waypoints(a.rail_path, amplitude, ratio, cycles)
-                .map_err(|e| format!("--settle: {e}"))?
+            settling_waypoints(a.rail_path, amplitude, ratio, cycles)?
         }
         None => a.rail_path.to_vec(),
     };
