@@ -1338,6 +1338,7 @@ fn settling_waypoints_alternate_past_and_short_of_the_places_shrinking_by_the_ra
         ),
         (settling_waypoints(&path, -1e-3, 0.5, 3), "amplitude -0.001"),
         (settling_waypoints(&path, 1e-3, 1.0, 3), "ratio 1"),
+        (settling_waypoints(&path, 1e-3, 0.5, 1001), "1001 cycles"),
     ];
     for (r, says) in refused {
         let Err(e) = r else { panic!("accepted: {r:?}") };

@@ -112,6 +112,10 @@ pub fn rail_waypoints(found: &Model, path: &[[f64; 2]]) -> Vec<Vec<(usize, [f64;
         .collect()
 }
 
+/// The most waypoints [`settling_waypoints`] takes (reversals far below the stick springs' travel
+/// change nothing).
+pub const MAX_SETTLING_CYCLES: usize = 1000;
+
 /// The rails' waypoints `[up, in]` of a path that settles the film on its frictional supports:
 /// `path`, then `cycles` waypoints past and short of the rails' places in turn along the last
 /// waypoint's direction, the first `amplitude` (m) past them, each next `ratio` (0 < ratio < 1)
@@ -141,6 +145,11 @@ pub fn settling_waypoints(
     }
     if !(ratio > 0.0 && ratio < 1.0) {
         return Err(format!("settling: ratio {ratio} is not between 0 and 1"));
+    }
+    if cycles > MAX_SETTLING_CYCLES {
+        return Err(format!(
+            "settling: {cycles} cycles, more than {MAX_SETTLING_CYCLES} (each is a leg of the erection)"
+        ));
     }
     let d = [up / length, inward / length];
     let mut waypoints = path.to_vec();
