@@ -88,6 +88,7 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
             erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
             rail_path: Sequence[float] | Sequence[Sequence[float]] | None = None,
+            settle: Sequence[float] | None = None,
             geodesic_from: Sequence[int] | Sequence[Sequence[int]] | None = None,
             strip_width: float | Sequence[float] | None = None,
             erection_models: str | Path | None = None) -> dict[str, Any]:
@@ -109,7 +110,10 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     ``rail_path=(up, in)`` (m): the erections start with the rails that far above and inward of
     their places and pull them down and out (``--rail-path``); a list of such pairs is a winding
     path, the rails going through each in turn, e.g. ``[(0.10, 0.03), (0.0, 0.03)]``: down, then
-    out.
+    out. ``settle=(amplitude, ratio, cycles)`` (with ``rail_path``): then the rails pass their
+    places by ``amplitude`` m along the last leg, come back short of them by ``ratio`` times that,
+    and so on, ``cycles`` waypoints, and end at their places (``--settle``): the film settles on
+    its frictional supports at a nearly even tension (the vault bay: ``(0.001, 0.5, 8)``).
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
     ``geodesic_from`` (a line of boundary nodes, or a line across the film from boundary to
@@ -144,7 +148,10 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             args.append("--by-element")
         if rail_path is not None:
             for waypoint in (rail_path if _nested(rail_path) else [rail_path]):
-                args += ["--rail-path", ",".join(repr(float(v)) for v in waypoint)]
+                args.append("--rail-path=" + ",".join(repr(float(v)) for v in waypoint))
+        if settle is not None:
+            amplitude, ratio, cycles = settle
+            args.append(f"--settle={float(amplitude)!r},{float(ratio)!r},{int(cycles)}")
         if svg is not None:
             args += ["--svg", str(svg)]
         if erection_model is not None:

@@ -162,8 +162,16 @@ pub enum Command {
         /// its fitted reference and the rails drawn straight to their places. Repeat for a
         /// winding path: the rails go through each waypoint in turn, then to their places
         /// (`--rail-path 0.10,0.03 --rail-path 0,0.03`: down, then out).
-        #[arg(long, value_name = "UP,IN", value_parser = parse_pair, allow_negative_numbers = true)]
+        /// A waypoint below or outside the rails' places has negative numbers
+        /// (`--rail-path -0.001,-0.0003`).
+        #[arg(long, value_name = "UP,IN", value_parser = parse_pair, allow_hyphen_values = true)]
         rail_path: Vec<[f64; 2]>,
+        /// Settle the film after the rail path: the rails pass their places by AMPLITUDE m along
+        /// the last leg, come back short of them by RATIO times that, and so on, CYCLES
+        /// waypoints in all, then end at their places (friction then holds the film at a
+        /// nearly even tension instead of the capstan's fall from the rails).
+        #[arg(long, value_name = "AMPLITUDE,RATIO,CYCLES", value_parser = parse_settle, requires = "rail_path", allow_hyphen_values = true)]
+        settle: Option<(f64, f64, usize)>,
         /// Increments of each erection.
         #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         erect_increments: u32,
@@ -385,6 +393,16 @@ fn parse_pair(s: &str) -> Result<[f64; 2], String> {
         [a, b] if a.is_finite() && b.is_finite() => Ok([a, b]),
         _ => Err("two finite numbers: UP,IN".to_string()),
     }
+}
+
+/// `AMPLITUDE,RATIO,CYCLES` of `--settle`.
+fn parse_settle(s: &str) -> Result<(f64, f64, usize), String> {
+    let expected = "AMPLITUDE,RATIO,CYCLES: a length (m), a ratio and a whole number";
+    let [a, r, n] = parse_numbers::<3>(s, expected)?;
+    if n < 0.0 || n.fract() != 0.0 {
+        return Err(format!("{n} cycles: {expected}"));
+    }
+    Ok((a, r, n as usize))
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {

@@ -12,7 +12,7 @@ use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
     ContactEnd, ElementSettings, ErectContacts, away_from_rails, compensate_elements,
-    erect_through, rail_waypoints,
+    erect_through, rail_waypoints, settling_waypoints,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::geodesic::geodesic_seams;
@@ -130,6 +130,8 @@ pub struct PatternArgs<'a> {
     pub by_element: bool,
     /// The rails' offsets `[up, in]` (m) at each waypoint of the erection path.
     pub rail_path: &'a [[f64; 2]],
+    /// Settling after the rail path: amplitude (m), ratio, cycles ([`settling_waypoints`]).
+    pub settle: Option<(f64, f64, usize)>,
     /// A folder to write each erection's model to (`erection-K.json`), as the loop erects it.
     pub erection_models: Option<&'a PathBuf>,
     /// Where to write the report as JSON.
@@ -411,7 +413,13 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let (model, strips) = strips(read_model(a.file)?, &a)?;
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
-    let path = rail_waypoints(&model, a.rail_path);
+    let path = match a.settle {
+        Some((amplitude, ratio, cycles)) => {
+            settling_waypoints(a.rail_path, amplitude, ratio, cycles)?
+        }
+        None => a.rail_path.to_vec(),
+    };
+    let path = rail_waypoints(&model, &path);
     let (iterations, tolerance, increments) = a.erect;
     let mut count = 0;
     // Each erection's model is written first (`--erection-models DIR`), then erected.

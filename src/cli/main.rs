@@ -1208,6 +1208,7 @@ fn main() -> ExitCode {
             erect,
             by_element,
             rail_path,
+            settle,
             erect_tolerance,
             erect_increments,
             report,
@@ -1224,6 +1225,7 @@ fn main() -> ExitCode {
             erect: (*erect, *erect_tolerance / 100.0, *erect_increments as usize),
             by_element: *by_element,
             rail_path: rail_path.as_slice(),
+            settle: *settle,
             report: report.as_ref(),
         }),
         Command::ExportSpecimen {

@@ -112,6 +112,55 @@ pub fn rail_waypoints(found: &Model, path: &[[f64; 2]]) -> Vec<Vec<(usize, [f64;
         .collect()
 }
 
+/// The most waypoints [`settling_waypoints`] takes (reversals far below the stick springs' travel
+/// change nothing).
+pub const MAX_SETTLING_CYCLES: usize = 1000;
+
+/// The rails' waypoints `[up, in]` of a path that settles the film on its frictional supports:
+/// `path`, then `cycles` waypoints past and short of the rails' places in turn along the last
+/// waypoint's direction, the first `amplitude` (m) past them, each next `ratio` (0 < ratio < 1)
+/// times the one before, `w_k = (−1)^{k+1} amplitude ratioᵏ d` with `d` the last waypoint's
+/// unit direction; the rails then end at their places. Each reversal slides the film back over a
+/// shorter arc than the one before, so the last state sticks with a tension nearly even along the
+/// supports instead of the capstan's fall (docs/mechanics.md, "Settling the film").
+pub fn settling_waypoints(
+    path: &[[f64; 2]],
+    amplitude: f64,
+    ratio: f64,
+    cycles: usize,
+) -> Result<Vec<[f64; 2]>, String> {
+    let Some(&[up, inward]) = path.last() else {
+        return Err("settling: give the erection path to settle after (--rail-path)".into());
+    };
+    let length = up.hypot(inward);
+    if !(length.is_finite() && length > 0.0) {
+        return Err(format!(
+            "settling: the last waypoint [{up}, {inward}] has no direction to settle along"
+        ));
+    }
+    if !(amplitude.is_finite() && amplitude > 0.0) {
+        return Err(format!(
+            "settling: amplitude {amplitude} m is not a positive length"
+        ));
+    }
+    if !(ratio > 0.0 && ratio < 1.0) {
+        return Err(format!("settling: ratio {ratio} is not between 0 and 1"));
+    }
+    if cycles > MAX_SETTLING_CYCLES {
+        return Err(format!(
+            "settling: {cycles} cycles, more than {MAX_SETTLING_CYCLES} (each is a leg of the erection)"
+        ));
+    }
+    let d = [up / length, inward / length];
+    let mut waypoints = path.to_vec();
+    let mut a = -amplitude;
+    for _ in 0..cycles {
+        waypoints.push(d.map(|c| a * c));
+        a *= -ratio;
+    }
+    Ok(waypoints)
+}
+
 /// Erects `model` (an [`super::reference::erection_model`], one group `node<k>` per held node)
 /// in two stages: first each node `k` of `start` to its target plus its offset (the rails lifted
 /// and drawn in: the film laid on the supports slack), then every group to its target (the rails
