@@ -369,173 +369,192 @@ impl Path {
     /// the parabola's Newton iteration); `r` the tube's radius (in `ξ1`'s surface length).
     pub(super) fn foot(&self, x: &Vector3<f64>, near: f64, r: f64) -> Foot {
         match self {
-            Path::Circle { frame, radius, arc } => {
-                let rc = *radius;
-                let rel = x - frame.centre;
-                let q = rel - frame.a * frame.a.dot(&rel);
-                let angle = unwrapped_angle(frame, &q, near);
-                let at = |phi: f64| {
-                    let e = frame.e1 * phi.cos() + frame.e2 * phi.sin();
-                    let t = frame.a.cross(&e);
-                    (frame.centre + e * rc, e, t)
-                };
-                let reference = rc + r;
-                let angle = match arc {
-                    None => angle,
-                    Some([lo, hi]) => {
-                        // The angle, shifted by whole turns toward the middle of the arc.
-                        let tau = std::f64::consts::TAU;
-                        let phi = angle - tau * ((angle - 0.5 * (lo + hi)) / tau).round();
-                        if !(*lo..=*hi).contains(&phi) {
-                            let (p_lo, _, t_lo) = at(*lo);
-                            let (p_hi, _, t_hi) = at(*hi);
-                            return if (x - p_lo).norm() <= (x - p_hi).norm() {
-                                Foot::End {
-                                    u: *lo,
-                                    point: p_lo,
-                                    tangent: t_lo,
-                                    g: reference * lo,
-                                }
-                            } else {
-                                Foot::End {
-                                    u: *hi,
-                                    point: p_hi,
-                                    tangent: t_hi,
-                                    g: reference * hi,
-                                }
-                            };
-                        }
-                        phi
-                    }
-                };
-                let (c, e, t) = at(angle);
-                Foot::Smooth {
-                    u: angle,
-                    c: [c, t * rc, -e * rc],
-                    g: [reference * angle, reference, 0.0],
-                }
-            }
+            Path::Circle { frame, radius, arc } => circle_foot(frame, *radius, *arc, x, near, r),
             Path::Parabola {
                 apex,
                 along,
                 up,
                 k,
                 half_span,
-            } => {
-                let (k, l) = (*k, *half_span);
-                let rel = x - apex;
-                let (pa, pu) = (rel.dot(along), rel.dot(up));
-                // (x − C(s))·C'(s) = pa − (1 + 2k pu) s − 2k² s³ =: h(s), h' = −D.
-                let c1 = 1.0 + 2.0 * k * pu;
-                let h = |s: f64| {
-                    (
-                        pa - c1 * s - 2.0 * k * k * s * s * s,
-                        -c1 - 6.0 * k * k * s * s,
-                    )
-                };
-                let point = |s: f64| apex + along * s - up * (k * s * s);
-                // h decreases except on (−s_c, s_c) when c1 < 0: the minima of the distance are
-                // its roots where it decreases, within [−L, L]; the ends are candidates too.
-                let mut cuts = vec![-l];
-                if c1 < 0.0 {
-                    let sc = (-c1 / (6.0 * k * k)).sqrt();
-                    cuts.extend([-sc, sc].into_iter().filter(|s| s.abs() < l));
-                }
-                cuts.push(l);
-                let mut best: Option<(f64, f64, bool)> = None;
-                let mut consider = |s: f64, interior: bool| {
-                    let d = (x - point(s)).norm_squared();
-                    if best.is_none_or(|(bd, _, _)| d < bd) {
-                        best = Some((d, s, interior));
-                    }
-                };
-                for w in cuts.windows(2) {
-                    let (lo, hi) = (w[0], w[1]);
-                    if h(0.5 * (lo + hi)).1 < 0.0 && h(lo).0 >= 0.0 && h(hi).0 <= 0.0 {
-                        consider(bracketed_newton(h, lo, hi, near), true);
-                    }
-                }
-                consider(-l, false);
-                consider(l, false);
-                let (_, s, interior) = best.unwrap_or((0.0, 0.0, true));
-                let w = 2.0 * k * s;
-                let root = (1.0 + w * w).sqrt();
-                let arc = |s: f64| {
-                    let w = 2.0 * k * s;
-                    (w * (1.0 + w * w).sqrt() + w.asinh()) / (4.0 * k)
-                };
-                let g = arc(s) - arc(-l) + r * (w.atan() + (2.0 * k * l).atan());
-                let c1v = along - up * w;
-                if interior {
-                    let g1 = root + 2.0 * k * r / (1.0 + w * w);
-                    let g2 =
-                        2.0 * k * w / root - 8.0 * k * k * r * w / ((1.0 + w * w) * (1.0 + w * w));
-                    Foot::Smooth {
-                        u: s,
-                        c: [point(s), c1v, -up * (2.0 * k)],
-                        g: [g, g1, g2],
+            } => parabola_foot([apex, along, up], [*k, *half_span], x, near, r),
+            Path::Polyline(p) => polyline_foot(p, x, r),
+        }
+    }
+}
+
+/// [`Path::foot`] on a ring of radius `rc` (an arc `[from, to]` where given).
+fn circle_foot(
+    frame: &Frame,
+    rc: f64,
+    arc: Option<[f64; 2]>,
+    x: &Vector3<f64>,
+    near: f64,
+    r: f64,
+) -> Foot {
+    let rel = x - frame.centre;
+    let q = rel - frame.a * frame.a.dot(&rel);
+    let angle = unwrapped_angle(frame, &q, near);
+    let at = |phi: f64| {
+        let e = frame.e1 * phi.cos() + frame.e2 * phi.sin();
+        let t = frame.a.cross(&e);
+        (frame.centre + e * rc, e, t)
+    };
+    let reference = rc + r;
+    let angle = match arc {
+        None => angle,
+        Some([lo, hi]) => {
+            // The angle, shifted by whole turns toward the middle of the arc.
+            let tau = std::f64::consts::TAU;
+            let phi = angle - tau * ((angle - 0.5 * (lo + hi)) / tau).round();
+            if !(lo..=hi).contains(&phi) {
+                let (p_lo, _, t_lo) = at(lo);
+                let (p_hi, _, t_hi) = at(hi);
+                return if (x - p_lo).norm() <= (x - p_hi).norm() {
+                    Foot::End {
+                        u: lo,
+                        point: p_lo,
+                        tangent: t_lo,
+                        g: reference * lo,
                     }
                 } else {
                     Foot::End {
-                        u: s,
-                        point: point(s),
-                        tangent: c1v / root,
-                        g,
+                        u: hi,
+                        point: p_hi,
+                        tangent: t_hi,
+                        g: reference * hi,
                     }
-                }
-            }
-            Path::Polyline(p) => {
-                // The nearest segment (first of equals), its parameter before clamping.
-                let mut best = (f64::INFINITY, 0, 0.0);
-                for (j, t) in p.tangents.iter().enumerate() {
-                    let len = p.length[j + 1] - p.length[j];
-                    let tau = (x - p.points[j]).dot(t);
-                    let d = (x - (p.points[j] + t * tau.clamp(0.0, len))).norm_squared();
-                    if d < best.0 {
-                        best = (d, j, tau);
-                    }
-                }
-                let (_, j, tau) = best;
-                let len = p.length[j + 1] - p.length[j];
-                let last = p.tangents.len() - 1;
-                let vertex = if tau <= 0.0 {
-                    j
-                } else if tau >= len {
-                    j + 1
-                } else {
-                    let t = p.tangents[j];
-                    return Foot::Smooth {
-                        u: p.length[j] + tau,
-                        c: [p.points[j] + t * tau, t, Vector3::zeros()],
-                        g: [p.length[j] + tau + r * p.turn[j], 1.0, 0.0],
-                    };
                 };
-                if vertex == 0 || vertex == last + 1 {
-                    let s = vertex.min(last);
-                    return Foot::End {
-                        u: p.length[vertex],
-                        point: p.points[vertex],
-                        tangent: p.tangents[s],
-                        g: p.length[vertex] + r * p.turn[s],
-                    };
-                }
-                // An inner vertex: the corner's zone starts at the incoming segment's normal on
-                // the convex side (the side the turn tells; for a straight vertex the node's).
-                let outer = p.tangents[vertex - 1].cross(&p.normal);
-                let delta = p.turn[vertex] - p.turn[vertex - 1];
-                let side = if delta != 0.0 {
-                    delta
-                } else {
-                    (x - p.points[vertex]).dot(&outer)
-                };
-                Foot::Corner {
-                    u: p.length[vertex],
-                    point: p.points[vertex],
-                    base: p.length[vertex] + r * p.turn[vertex - 1],
-                    start: if side >= 0.0 { outer } else { -outer },
-                }
             }
+            phi
         }
+    };
+    let (c, e, t) = at(angle);
+    Foot::Smooth {
+        u: angle,
+        c: [c, t * rc, -e * rc],
+        g: [reference * angle, reference, 0.0],
+    }
+}
+
+/// [`Path::foot`] on the parabola `C(s) = apex + s along − k s² up`, `|s| ≤ half_span`.
+fn parabola_foot(
+    [apex, along, up]: [&Vector3<f64>; 3],
+    [k, l]: [f64; 2],
+    x: &Vector3<f64>,
+    near: f64,
+    r: f64,
+) -> Foot {
+    let rel = x - apex;
+    let (pa, pu) = (rel.dot(along), rel.dot(up));
+    // (x − C(s))·C'(s) = pa − (1 + 2k pu) s − 2k² s³ =: h(s), h' = −D.
+    let c1 = 1.0 + 2.0 * k * pu;
+    let h = |s: f64| {
+        (
+            pa - c1 * s - 2.0 * k * k * s * s * s,
+            -c1 - 6.0 * k * k * s * s,
+        )
+    };
+    let point = |s: f64| apex + along * s - up * (k * s * s);
+    // h decreases except on (−s_c, s_c) when c1 < 0: the minima of the distance are
+    // its roots where it decreases, within [−L, L]; the ends are candidates too.
+    let mut cuts = vec![-l];
+    if c1 < 0.0 {
+        let sc = (-c1 / (6.0 * k * k)).sqrt();
+        cuts.extend([-sc, sc].into_iter().filter(|s| s.abs() < l));
+    }
+    cuts.push(l);
+    let mut best: Option<(f64, f64, bool)> = None;
+    let mut consider = |s: f64, interior: bool| {
+        let d = (x - point(s)).norm_squared();
+        if best.is_none_or(|(bd, _, _)| d < bd) {
+            best = Some((d, s, interior));
+        }
+    };
+    for w in cuts.windows(2) {
+        let (lo, hi) = (w[0], w[1]);
+        if h(0.5 * (lo + hi)).1 < 0.0 && h(lo).0 >= 0.0 && h(hi).0 <= 0.0 {
+            consider(bracketed_newton(h, lo, hi, near), true);
+        }
+    }
+    consider(-l, false);
+    consider(l, false);
+    let (_, s, interior) = best.unwrap_or((0.0, 0.0, true));
+    let w = 2.0 * k * s;
+    let root = (1.0 + w * w).sqrt();
+    let arc = |s: f64| {
+        let w = 2.0 * k * s;
+        (w * (1.0 + w * w).sqrt() + w.asinh()) / (4.0 * k)
+    };
+    let g = arc(s) - arc(-l) + r * (w.atan() + (2.0 * k * l).atan());
+    let c1v = along - up * w;
+    if interior {
+        let g1 = root + 2.0 * k * r / (1.0 + w * w);
+        let g2 = 2.0 * k * w / root - 8.0 * k * k * r * w / ((1.0 + w * w) * (1.0 + w * w));
+        Foot::Smooth {
+            u: s,
+            c: [point(s), c1v, -up * (2.0 * k)],
+            g: [g, g1, g2],
+        }
+    } else {
+        Foot::End {
+            u: s,
+            point: point(s),
+            tangent: c1v / root,
+            g,
+        }
+    }
+}
+
+/// [`Path::foot`] on a polyline: a segment, an end, or an inner vertex's corner zone.
+fn polyline_foot(p: &Polyline, x: &Vector3<f64>, r: f64) -> Foot {
+    // The nearest segment (first of equals), its parameter before clamping.
+    let mut best = (f64::INFINITY, 0, 0.0);
+    for (j, t) in p.tangents.iter().enumerate() {
+        let len = p.length[j + 1] - p.length[j];
+        let tau = (x - p.points[j]).dot(t);
+        let d = (x - (p.points[j] + t * tau.clamp(0.0, len))).norm_squared();
+        if d < best.0 {
+            best = (d, j, tau);
+        }
+    }
+    let (_, j, tau) = best;
+    let len = p.length[j + 1] - p.length[j];
+    let last = p.tangents.len() - 1;
+    let vertex = if tau <= 0.0 {
+        j
+    } else if tau >= len {
+        j + 1
+    } else {
+        let t = p.tangents[j];
+        return Foot::Smooth {
+            u: p.length[j] + tau,
+            c: [p.points[j] + t * tau, t, Vector3::zeros()],
+            g: [p.length[j] + tau + r * p.turn[j], 1.0, 0.0],
+        };
+    };
+    if vertex == 0 || vertex == last + 1 {
+        let s = vertex.min(last);
+        return Foot::End {
+            u: p.length[vertex],
+            point: p.points[vertex],
+            tangent: p.tangents[s],
+            g: p.length[vertex] + r * p.turn[s],
+        };
+    }
+    // An inner vertex: the corner's zone starts at the incoming segment's normal on
+    // the convex side (the side the turn tells; for a straight vertex the node's).
+    let outer = p.tangents[vertex - 1].cross(&p.normal);
+    let delta = p.turn[vertex] - p.turn[vertex - 1];
+    let side = if delta != 0.0 {
+        delta
+    } else {
+        (x - p.points[vertex]).dot(&outer)
+    };
+    Foot::Corner {
+        u: p.length[vertex],
+        point: p.points[vertex],
+        base: p.length[vertex] + r * p.turn[vertex - 1],
+        start: if side >= 0.0 { outer } else { -outer },
     }
 }
 
