@@ -56,8 +56,8 @@ use membrane_contact::mech::patterning::Strip;
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
     ElementCompensation, ElementSettings, Erected, away_from_rails, compensate_elements,
-    cut_metrics, erect_along, erect_through, erect_with_contacts, rail_start_offsets,
-    rail_waypoints, refit_strips, settling_waypoints,
+    cut_metrics, erect_along, erect_through, erect_with_contacts, passed_through_supports,
+    rail_start_offsets, rail_waypoints, refit_strips, settling_waypoints,
 };
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
@@ -1483,4 +1483,74 @@ fn a_cut_heavier_at_the_crown_does_not_lift_the_drum_films_crown_on_the_rail_pat
     let settled = erect(0.0, &settling_waypoints(&alone, 1e-3, 0.7, 12).unwrap());
     eprintln!("settled: {:.4}", fall(&settled));
     assert!((fall(&settled) - 1.0).abs() < 0.05 && fall(&base) < 0.9);
+}
+
+/// A film 1 m × 0.5 m across a tube (radius 30 mm along y through the origin): its middle line
+/// 1 mm above the tube and a contact node of it, its edges held at `x = ±0.5 m` and pulled down
+/// by `drop`; prestressed so that its first iterate is defined.
+fn film_across_a_tube(drop: f64) -> Model {
+    let nodes: Vec<[f64; 3]> = [0.0, 0.5]
+        .iter()
+        .flat_map(|&y| [-0.5, 0.0, 0.5].map(|x| [x, y, 0.031]))
+        .collect();
+    let triangles = vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]];
+    let mut model = film_model("FilmAcrossATube", nodes, triangles);
+    model.material.prestress = ISOTROPIC;
+    let edge = |name: &str, nodes: Vec<usize>| {
+        let mut g = group(name, nodes);
+        g.target = [0.0, 0.0, -drop];
+        g
+    };
+    model.groups = vec![edge("west", vec![0, 3]), edge("east", vec![2, 5])];
+    let tube = serde_json::json!([{ "name": "tube",
+        "centreline": { "line": { "point": [0, 0, 0], "axis": [0, 1, 0] } },
+        "tube_radius": 0.03, "nodes": [1, 4], "normal_stiffness": 1e7,
+        "tangential_stiffness": 1e6, "friction": 0.0 }]);
+    let mut value = serde_json::to_value(&model).unwrap();
+    value["curved_supports"] = tube;
+    Model::from_json(&value.to_string()).unwrap()
+}
+
+#[test]
+fn an_erection_never_ends_with_the_film_through_a_tube_it_retries_with_more_increments_or_refuses()
+{
+    // Pulled 0.2 m down in one increment, the first Newton iterate carries the middle line
+    // 0.2 m down, past the tube's centreline, where the two-sided tube contact pushes it on down:
+    // the film would hang flat under the tube at its prestress (without the check it does). The
+    // erection sees it and erects again with 2 increments, whose 0.1 m steps keep it on top.
+    let model = film_across_a_tube(0.2);
+    let erected = erect_through(model.clone(), 1, &[]).unwrap();
+    for c in &erected.contacts {
+        assert!(
+            c.status != GapStatus::Open && c.normal_force > 1e3,
+            "the film lies on the tube: {c:?}"
+        );
+    }
+    // The film over the tube is stretched: sqrt(0.5² + 0.2²)/0.5 − 1 ≈ 7.7 % more than flat.
+    assert!(
+        erected
+            .elements
+            .iter()
+            .all(|e| e.stress[0] > 10.0 * ISOTROPIC[0])
+    );
+    let nodes = |x: f64| -> Vec<[f64; 3]> {
+        model
+            .nodes
+            .iter()
+            .map(|p| [p[0], p[1], p[2] - x * (0.5 - p[0].abs())])
+            .collect()
+    };
+    assert!(passed_through_supports(&model, &nodes(0.0)).is_empty());
+    let under = passed_through_supports(&model, &nodes(0.2));
+    assert_eq!(
+        under,
+        vec![("tube".to_string(), 1), ("tube".to_string(), 4)]
+    );
+    // Pulled 0.8 m in 1, 2 and 4 increments every try passes through (the film's pull on the
+    // tube is more than its penalty holds at the centreline): refused, naming the nodes.
+    let e = erect_through(film_across_a_tube(0.8), 1, &[]).unwrap_err();
+    assert!(
+        e.contains("tube at node 1") && e.contains("1 to 4 increments"),
+        "{e}"
+    );
 }

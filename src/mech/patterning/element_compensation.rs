@@ -32,6 +32,7 @@ use super::outline::bounds;
 use super::reference::{erection_model, reference_geometry};
 use super::relax::{StrainTerm, relax_flat};
 use super::{StripTriangle, flat_gradient};
+use crate::mech::elements::curved_contact::SurfaceContact;
 use crate::mech::elements::gap::GapStatus;
 use crate::mech::elements::triangle::ElementStress;
 use crate::mech::model::Model;
@@ -183,11 +184,68 @@ pub fn erect_along(
 /// to the next, and last every group to its target; `increments` per leg. Friction makes the
 /// erected state depend on the legs (a node that sticks on one leg keeps its place into the
 /// next); without it only the end counts.
+///
+/// A curved support's contact holds a node off the tube's surface on either side, so a node that
+/// one Newton iteration carries past the tube's centreline ends on its far side: the film passes
+/// through the support and settles in a wrong equilibrium (the vault bay at 48 × 16 cells, 40
+/// increments a leg: the nodes beside the rails under their arches, every element away from the
+/// rails at 2.3–3 times its target). After each leg the nodes are checked ([`passed_through_supports`]); where any
+/// passed, the erection is run again with twice the increments, at most
+/// [`PASSED_THROUGH_RETRIES`] times, then refused naming them.
 pub fn erect_through(
     model: Model,
     increments: usize,
     waypoints: &[Vec<(usize, [f64; 3])>],
 ) -> Result<Erected, String> {
+    let mut n = increments;
+    for _ in 0..PASSED_THROUGH_RETRIES {
+        match erect_through_once(model.clone(), n, waypoints)? {
+            Ok(erected) => return Ok(erected),
+            Err(_) => n *= 2,
+        }
+    }
+    match erect_through_once(model, n, waypoints)? {
+        Ok(erected) => Ok(erected),
+        Err(through) => Err(format!(
+            "erection: the film passed through its supports ({}) with {increments} to {n} \
+             increments a leg: give more increments",
+            through
+                .iter()
+                .map(|(s, v)| format!("{s} at node {v}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}
+
+/// Times [`erect_through`] doubles the increments of an erection that passed through a support.
+pub const PASSED_THROUGH_RETRIES: usize = 2;
+
+/// The curved supports' contact nodes of `model` at `positions` (every node's, m) whose normal
+/// to their support points against the one at the model's own node positions (turned by more
+/// than 90°): nodes carried through the support's tube, as (support name, node).
+pub fn passed_through_supports(model: &Model, positions: &[[f64; 3]]) -> Vec<(String, usize)> {
+    let mut through = Vec::new();
+    for s in &model.curved_supports {
+        for &v in &s.nodes {
+            let c = SurfaceContact::new(s, v);
+            let start = c.project(&Vector3::from(model.nodes[v]), 0.0);
+            let end = c.project(&Vector3::from(positions[v]), start.parameter);
+            if end.normal.dot(&start.normal) < 0.0 {
+                through.push((s.name.clone(), v));
+            }
+        }
+    }
+    through
+}
+
+/// One erection along the legs with `increments` each; Ok(Err(nodes)) where a leg ended with
+/// nodes through their supports ([`passed_through_supports`]).
+fn erect_through_once(
+    model: Model,
+    increments: usize,
+    waypoints: &[Vec<(usize, [f64; 3])>],
+) -> Result<Result<Erected, Vec<(String, usize)>>, String> {
     let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
     let mut legs = Vec::new();
     for offsets in waypoints.iter().filter(|w| !w.is_empty()) {
@@ -205,15 +263,31 @@ pub fn erect_through(
     }
     let mut analysis = Analysis::new(model, SolverSettings::default())
         .map_err(|e| format!("erection model: {e}"))?;
+    let through = |a: &Analysis| {
+        let m = a.model();
+        let x: Vec<[f64; 3]> = (0..m.nodes.len())
+            .map(|v| (Vector3::from(m.nodes[v]) + a.node_displacement(v)).into())
+            .collect();
+        passed_through_supports(m, &x)
+    };
     for (k, leg) in legs.iter().enumerate() {
         analysis
             .step_to(leg, increments)
             .map_err(|e| format!("erection, rails to waypoint {}: {e}", k + 1))?;
+        let nodes = through(&analysis);
+        if !nodes.is_empty() {
+            return Ok(Err(nodes));
+        }
     }
     analysis
         .step_to(&targets, increments)
         .map_err(|e| format!("erection: {e}"))?;
-    Ok(erected(&mut analysis))
+    let nodes = through(&analysis);
+    Ok(if nodes.is_empty() {
+        Ok(erected(&mut analysis))
+    } else {
+        Err(nodes)
+    })
 }
 
 /// The stresses of an erected `analysis` and the nodes friction holds on a support.
