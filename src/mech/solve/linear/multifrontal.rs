@@ -183,13 +183,8 @@ pub(super) fn factorize(
         unreachable!("a tree exists for supernodal analyses only")
     };
     let a = lower.val();
-    let mut slots = Vec::with_capacity(sym.n_supernodes());
-    let mut rest = factor;
-    for w in sym.col_ptr_for_val().windows(2) {
-        let (own, tail) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
-        slots.push(Some(own));
-        rest = tail;
-    }
+    let lengths = sym.col_ptr_for_val().windows(2).map(|w| w[1] - w[0]);
+    let slots = split_into(factor, lengths);
     let job = Job {
         sym,
         tree,
@@ -338,6 +333,19 @@ impl Job<'_, '_> {
     }
 }
 
+/// `whole` cut into consecutive slices of `lengths`, each in a slot a task takes it from (one
+/// supernode's part of the factor or of the solution).
+fn split_into(whole: &mut [f64], lengths: impl Iterator<Item = usize>) -> Vec<Option<&mut [f64]>> {
+    let mut rest = whole;
+    lengths
+        .map(|len| {
+            let (own, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            rest = tail;
+            Some(own)
+        })
+        .collect()
+}
+
 /// Adds a child's update matrix `u` over its pattern `child` into the front of `n`: with
 /// `columns` its columns in the front's columns to the supernode's values `own`, else the
 /// others to the front's update matrix. Rows whose places follow each other are added as one
@@ -413,14 +421,11 @@ pub(super) fn solve(analysed: &Analysed, tree: &Tree, factor: &[f64], rhs: &mut 
     let forward_index = |i: usize| perm.map_or(i, |p| p.arrays().0[i]);
     let b: Vec<f64> = (0..rhs.len()).map(|i| rhs[forward_index(i)]).collect();
     let mut w = vec![0.0; rhs.len()];
-    let mut slots = Vec::with_capacity(sym.n_supernodes());
-    let mut rest = w.as_mut_slice();
-    for s in 0..sym.n_supernodes() {
+    let lengths = (0..sym.n_supernodes()).map(|s| {
         let n = node(sym, s);
-        let (own, tail) = std::mem::take(&mut rest).split_at_mut(n.end - n.begin);
-        slots.push(Some(own));
-        rest = tail;
-    }
+        n.end - n.begin
+    });
+    let slots = split_into(&mut w, lengths);
     let sweep = Sweep {
         sym,
         tree,
