@@ -178,7 +178,7 @@ impl Instance {
             e.message(&SETTING_NAMES)
         );
         match e {
-            StepError::NotConverged { .. } => {
+            StepError::NotConverged { .. } | StepError::LimitPoint { .. } => {
                 let inputs = self.input_values();
                 let repeated = self
                     .discarded

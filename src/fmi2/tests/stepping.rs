@@ -530,3 +530,48 @@ fn orifice_mass_flow_is_the_air_moved_over_the_step_divided_by_the_step() {
     }
     assert!(fmu.real("lower.pressure") > fmu.real("upper.pressure"));
 }
+
+/// Issue 41: a pressure input past the largest pressure the film can carry (an ETFE sphere,
+/// whose pressure peaks where `dτ/dε = 3τ`) is discarded with the limit point's share and
+/// pressure named, and the outputs stay the last converged step's.
+#[test]
+fn a_pressure_past_the_films_limit_point_is_discarded_naming_it() {
+    use crate::mech::elements::plasticity::{Hardening, Plasticity};
+    use crate::specimens::scenarios::InflatedSphere;
+    let mut sphere = InflatedSphere {
+        radius: 1.0,
+        cells: 6,
+        material: crate::specimens::ParallelArch::default().material,
+        pressure: 0.0,
+    };
+    sphere.material.wrinkling = crate::mech::Wrinkling::None;
+    sphere.material.plasticity = Some(Plasticity {
+        hardening: Hardening::new(vec![[0.0, 21e6], [1.4547, 275e6]]).unwrap(),
+    });
+    let stretches: Vec<f64> = (0..=5000).map(|k| 1.0 + k as f64 / 10_000.0).collect();
+    let peak = sphere
+        .closed_form(&stretches)
+        .unwrap()
+        .into_iter()
+        .fold(0.0, f64::max);
+    let u = Unpacked::new("limit point", Source::Model(sphere.model().unwrap()));
+    let log = Log::default();
+    let fmu = Fmu::initialized(&u, &log, &[], &[]);
+    for (k, f) in [0.5, 0.9].into_iter().enumerate() {
+        assert_eq!(fmu.set_real("inside.pressure", f * peak), 0);
+        // Warning: the film yields, as it must to reach a limit point.
+        let status = fmu.step(0.1 * k as f64, 0.1);
+        assert_eq!(status, Status::Warning.raw(), "{:?}", log.take());
+    }
+    let before = fmu.all_values();
+    assert_eq!(fmu.set_real("inside.pressure", 1.2 * peak), 0);
+    assert_eq!(fmu.step(0.2, 0.1), Status::Discard.raw());
+    assert!(
+        log.contains(Status::Discard, "the loads pass a limit point"),
+        "{:?}",
+        log.take()
+    );
+    assert!((fmu.real("time") - 0.2).abs() < 1e-15);
+    assert_eq!(fmu.set_real("inside.pressure", 0.9 * peak), 0);
+    assert_eq!(fmu.all_values(), before);
+}

@@ -3,6 +3,7 @@
 use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
+use crate::mech::solve::arc_length::{ArcEnd, LoadPath};
 use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::newton::max_abs;
 use crate::mech::solve::progress::IncrementNote;
@@ -19,35 +20,58 @@ pub struct Strategy {
     /// The viscous stabilization's damping per unit of the step's pseudo-time (0: none):
     /// the force `c k̄ M ΔU/Δλ` of an increment `Δλ` (`contributions/stabilization.rs`).
     pub damping: f64,
+    /// What the increments are sized by.
+    pub control: Control,
 }
 
-/// The strategy table: Newton with pseudo-transient continuation, then the same with the
-/// viscous stabilization for the rest of a step whose smallest increment it refused (a film
+/// What a row's increments are sized by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Control {
+    /// The share of the step's inputs (load or boundary motion), Newton's iteration.
+    Share,
+    /// The arc length of the displacements, the load factor an unknown (`arc_length.rs`;
+    /// Riks 1979, Crisfield 1981): only for a step whose boundary stands still.
+    ArcLength,
+}
+
+/// The strategy table: Newton with pseudo-transient continuation; for a step whose boundary
+/// stands still, arc-length control from where Newton refused (a limit point of the load); then
+/// Newton with the viscous stabilization for the rest of a step whose smallest increment it refused (a film
 /// without a unique equilibrium), at four dampings, each a hundredfold the last (the fourth,
 /// 1, carries held-out `reversal#0` step 44, refused at 1e-2) ([`SolverSettings::stabilization`] off: the
-/// first row only).
+/// first two rows only).
 ///
 /// [`SolverSettings::stabilization`]: crate::mech::solve::settings::SolverSettings::stabilization
-pub const STRATEGIES: [Strategy; 5] = [
+pub const STRATEGIES: [Strategy; 6] = [
     Strategy {
         name: "Newton",
         damping: 0.0,
+        control: Control::Share,
+    },
+    Strategy {
+        name: "arc-length",
+        damping: 0.0,
+        control: Control::ArcLength,
     },
     Strategy {
         name: "stabilized",
         damping: 1e-6,
+        control: Control::Share,
     },
     Strategy {
         name: "stabilized more",
         damping: 1e-4,
+        control: Control::Share,
     },
     Strategy {
         name: "stabilized most",
         damping: 1e-2,
+        control: Control::Share,
     },
     Strategy {
         name: "stabilized strongest",
         damping: 1.0,
+        control: Control::Share,
     },
 ];
 
@@ -84,6 +108,21 @@ impl StepPath<'_> {
     /// The load levels at the fraction `f` of the step.
     fn levels(&self, f: f64) -> LoadLevels {
         self.base_loads.interpolate(self.loads, f)
+    }
+
+    /// Whether the boundary stands still over the step (its loads alone change).
+    fn boundary_still(&self) -> bool {
+        self.base.as_slice() == self.target && self.base_angles.as_slice() == self.angles
+    }
+}
+
+impl LoadPath for StepPath<'_> {
+    fn still(&self) -> GroupMotion {
+        self.motion(0.0)
+    }
+
+    fn at(&self, lambda: f64) -> LoadLevels {
+        self.levels(lambda)
     }
 }
 
@@ -136,7 +175,7 @@ impl Controller {
             (self.size * ratio.clamp(1.0 / Analysis::GROWTH, Analysis::GROWTH)).min(self.largest);
         // The weakest damping that carries the step: one row back after each converged
         // increment of a stronger one (the work taken out grows with `c`, not with the size).
-        if self.row > 1 {
+        if self.row > 0 && STRATEGIES[self.row - 1].damping > 0.0 {
             self.row -= 1;
         }
     }
@@ -168,12 +207,20 @@ impl Controller {
         if self.can_halve() {
             report.cutbacks += 1;
             self.size /= 2.0;
-        } else if self.row + 1 < self.rows {
-            (self.row, self.size) = (self.row + 1, self.largest);
+            true
         } else {
-            return false;
+            self.next_row()
         }
-        true
+    }
+
+    /// The next row of the table from the largest size; false where none is left.
+    fn next_row(&mut self) -> bool {
+        if self.row + 1 < self.rows {
+            (self.row, self.size) = (self.row + 1, self.largest);
+            true
+        } else {
+            false
+        }
     }
 }
 
@@ -262,15 +309,22 @@ impl Analysis {
         let rows = if self.settings.stabilization {
             STRATEGIES.len()
         } else {
-            1
+            2
         };
         let mut control = Controller::new(increments, self.settings.max_cutbacks, rows);
         let mut current = self.state.clone();
         let mut last_start = None;
-        let mut report = StepReport::default();
+        let (mut report, mut last_failure) = (StepReport::default(), None);
         self.parts.stabilization.start_step();
         while control.done < 1.0 {
             let (from, to, row) = (control.done, control.next(), control.row);
+            if STRATEGIES[row].control == Control::ArcLength {
+                let arc = (&mut current, &mut last_start, &mut report);
+                if self.arc_row(&mut control, &path, arc, &mut last_failure)? {
+                    break;
+                }
+                continue;
+            }
             self.parts
                 .stabilization
                 .set(STRATEGIES[row].damping, to - from);
@@ -281,7 +335,8 @@ impl Analysis {
                 control.keeps(n, state.history_changed_from(&current))
             });
             let how = (STRATEGIES[row].name, kept);
-            self.note_attempt(&mut report, row, (from, to), how, &attempt);
+            let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
+            self.note_attempt(&mut report, row, (from, to), how, outcome);
             match attempt {
                 Ok((state, history)) if kept => {
                     let force = self.account_stabilized(&mut report, &state.displacement);
@@ -298,10 +353,10 @@ impl Analysis {
                     });
                 }
                 Ok(_) => _ = control.refused(&mut report),
-                Err(_) => {}
+                Err(last) => last_failure = Some(last),
             }
         }
-        if control.row > 0 {
+        if STRATEGIES[control.row].damping > 0.0 {
             let release = (control.row, control.last_size);
             self.release_stabilization(&mut current, &mut last_start, &path, &mut report, release);
         }
@@ -311,6 +366,54 @@ impl Analysis {
         self.state = current;
         self.increment_start = last_start;
         Ok(report)
+    }
+
+    /// The arc-length row of a step, from `control`'s share (`arc_length.rs`), for a step whose
+    /// boundary stands still: Ok(true) where it reached the step's end, Ok(false) where the
+    /// next row solves the rest; Err at a limit point, or where no row is left.
+    fn arc_row(
+        &mut self,
+        control: &mut Controller,
+        path: &StepPath,
+        (current, last_start, report): (
+            &mut AnalysisState,
+            &mut Option<AnalysisState>,
+            &mut StepReport,
+        ),
+        last_failure: &mut Option<IncrementFailure>,
+    ) -> Result<bool, StepError> {
+        if path.boundary_still() {
+            let from = (control.done, control.smallest);
+            match self.follow_arc(current, path, from, report, control.row) {
+                ArcEnd::Reached { start } => {
+                    (control.done, *last_start) = (1.0, Some(start));
+                    return Ok(true);
+                }
+                ArcEnd::LimitPoint { peak } => {
+                    let levels = path.levels(peak);
+                    return Err(StepError::LimitPoint {
+                        fraction: peak,
+                        levels,
+                    });
+                }
+                ArcEnd::Failed { at, start, failure } => {
+                    if start.is_some() {
+                        (control.done, *last_start) = (at, start);
+                    }
+                    *last_failure = Some(failure);
+                }
+            }
+        }
+        if control.next_row() {
+            return Ok(false);
+        }
+        Err(StepError::NotConverged {
+            fraction_done: control.done,
+            cutbacks: report.cutbacks,
+            last: last_failure
+                .take()
+                .unwrap_or(IncrementFailure::Diverged { iteration: 0 }),
+        })
     }
 
     /// Checks a step's targets, angles, loads and smallest number of increments.
@@ -349,7 +452,7 @@ impl Analysis {
     /// iterations converge linearly; the iterations the displacement criterion then adds grow
     /// only with the logarithm of the increment, so they do not measure its nonlinearity, and
     /// shrinking the increment for them multiplies the increments without removing them.
-    fn sizing_iterations(&self, history: &[f64]) -> f64 {
+    pub(super) fn sizing_iterations(&self, history: &[f64]) -> f64 {
         if self.converges_linearly() {
             return Self::TARGET_ITERATIONS as f64;
         }
@@ -409,7 +512,8 @@ impl Analysis {
                 // iterations: the march goes on either way.
                 let limit = (!damped).then_some(2 * Self::TARGET_ITERATIONS);
                 let attempt = self.solve_increment(current, &motion, &levels, limit);
-                self.note_attempt(report, row, (1.0, 1.0), (how, true), &attempt);
+                let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
+                self.note_attempt(report, row, (1.0, 1.0), (how, true), outcome);
                 let Ok((state, history)) = attempt else {
                     if damped {
                         (tau, setbacks) = (tau / 2.0, setbacks + 1);
@@ -458,21 +562,20 @@ impl Analysis {
     }
 
     /// The residual tolerance at the last assembly (N).
-    fn residual_tolerance(&self) -> f64 {
+    pub(super) fn residual_tolerance(&self) -> f64 {
         self.settings.residual_tolerance * max_abs(&self.work.internal).max(self.force_floor)
     }
 
     /// Tells the observer (`progress.rs`) how the increment `from → to` of the step solved by
     /// row `row` of [`STRATEGIES`] (named `how`) ended, and lists it in the report's attempts.
-    fn note_attempt(
+    pub(super) fn note_attempt(
         &self,
         report: &mut StepReport,
         row: usize,
         (from, to): (f64, f64),
         (how, kept): (&'static str, bool),
-        attempt: &Result<(AnalysisState, Vec<f64>), IncrementFailure>,
+        outcome: Result<&[f64], &IncrementFailure>,
     ) {
-        let outcome = attempt.as_ref().map(|(_, h)| h.as_slice());
         let iterations = outcome.map_or(0, |h| h.len().saturating_sub(1));
         self.observer.note(|| IncrementNote {
             from,
@@ -492,7 +595,7 @@ impl Analysis {
             from,
             to,
             iterations,
-            converged: attempt.is_ok() && kept,
+            converged: outcome.is_ok() && kept,
         });
     }
 

@@ -19,6 +19,7 @@
 //! | `sensitivity` | [`Analysis::linear_response`]: the converged state's linear response to a [`Seed`] (the FMU's directional derivatives) |
 
 pub mod analysis;
+mod arc_length;
 pub mod assembly;
 mod continuation;
 pub mod contributions;
@@ -34,7 +35,7 @@ pub mod settings;
 pub mod state;
 
 pub use analysis::Analysis;
-pub use increments::{STRATEGIES, Strategy};
+pub use increments::{Control, STRATEGIES, Strategy};
 pub use newton::max_abs;
 pub use progress::{IncrementNote, IncrementObserver};
 pub use report::{

@@ -382,7 +382,7 @@ impl Analysis {
 
     /// The converged iterate `u` of the increment from `start`: the state with the trial history
     /// of every contribution committed.
-    fn commit_increment(
+    pub(super) fn commit_increment(
         &self,
         start: &AnalysisState,
         motion: &GroupMotion,

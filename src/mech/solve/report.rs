@@ -1,6 +1,7 @@
 //! What a step reports: Newton statistics, why an increment failed (with advice naming the
 //! front end's settings), and the errors of a step and of setting an analysis up.
 
+use crate::mech::elements::load::LoadLevels;
 use std::fmt;
 
 use crate::mech::elements::gap::IterationMatrix;
@@ -494,6 +495,14 @@ pub enum StepError {
         cutbacks: usize,
         last: IncrementFailure,
     },
+    /// The step's loads pass a limit point (a largest load) that arc-length control followed
+    /// beyond: no equilibrium at the step's end on this path (`arc_length.rs`).
+    LimitPoint {
+        /// The largest share of the step's load change reached.
+        fraction: f64,
+        /// The load levels there.
+        levels: LoadLevels,
+    },
 }
 
 impl StepError {
@@ -511,6 +520,16 @@ impl StepError {
                  the last converged state is kept. What to change: {}",
                 100.0 * fraction_done,
                 last.advice(names)
+            ),
+            Self::LimitPoint { fraction, levels } => format!(
+                "the loads pass a limit point at {:.2}% of the step (pressures {:?} Pa, forces {:?} N): \
+                 past it the film carries less, and arc-length control followed the path down without \
+                 reaching the step's end; no equilibrium at the step's loads lies on this path. The last \
+                 converged state is kept. What to change: keep the loads below the limit, or stiffen \
+                 the model (a harder material, a support)",
+                100.0 * fraction,
+                levels.pressure,
+                levels.force
             ),
         }
     }

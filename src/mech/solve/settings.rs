@@ -35,7 +35,7 @@ pub struct SolverSettings {
     pub symmetric_factorization: bool,
     /// The viscous stabilization's rows of the strategy table (`increments.rs`) for the rest of
     /// a step whose smallest increment Newton refused; its work is reported and judged against
-    /// the strain energy. false: the first row only (the stabilization-free answer).
+    /// the strain energy. false: the first two rows only, Newton and arc-length (the stabilization-free answer).
     pub stabilization: bool,
     /// Threads of the element assembly and of the LDLᵀ factorizations (each scoped: none
     /// outlives a call); 0 = automatic: the assembly one below

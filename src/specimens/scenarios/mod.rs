@@ -105,6 +105,7 @@ mod grid;
 mod membrane;
 mod panel;
 mod specimen;
+mod sphere;
 mod strip;
 
 pub use arc::{CircularSupport, GapConstants, gaps_on_arc};
@@ -114,6 +115,7 @@ pub use grid::{grid_slice, plastic_paths, robustness_grid};
 pub use membrane::CircularMembrane;
 pub use panel::ArchPanel;
 pub use specimen::{PathShape, SpecimenPath, WrappedSpecimen};
+pub use sphere::InflatedSphere;
 pub use strip::CylinderStrip;
 
 // ------------------------------------------------------------------------------- load paths
