@@ -89,7 +89,9 @@ pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
         }
         // The found model keeps the file's penalties; the steps take them per node.
         let stiffness = support_stiffnesses(&model, a.contact_stiffness)?;
-        eprintln!("{}", stiffness_line(&stiffness));
+        if let Some(line) = stiffness_line(&stiffness) {
+            eprintln!("{line}");
+        }
         let contact_model = with_node_stiffnesses(model.clone(), &stiffness);
         let found = find_shape_with_contact(&contact_model, start, prestress, settings)
             .map_err(|e| e.to_string())?;
@@ -452,8 +454,8 @@ fn erection_path(
     Ok((path, settle))
 }
 
-/// The curved supports' penalties per node in the design loop, one line.
-fn stiffness_line(stiffness: &[SupportStiffness]) -> String {
+/// The curved supports' penalties per node in the design loop, one line (none without any).
+fn stiffness_line(stiffness: &[SupportStiffness]) -> Option<String> {
     let supports: Vec<String> = (stiffness.iter())
         .map(|s| match s.tributary_length {
             Some(l) => format!(
@@ -466,7 +468,7 @@ fn stiffness_line(stiffness: &[SupportStiffness]) -> String {
             ),
         })
         .collect();
-    format!("contact stiffness: {}", supports.join("; "))
+    (!supports.is_empty()).then(|| format!("contact stiffness: {}", supports.join("; ")))
 }
 
 /// The curved supports' penalties per node in the design loop as JSON: name, tributary length
@@ -497,7 +499,9 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let (path, settle) = erection_path(&model, &strips, &compensation, &a)?;
     let path = rail_waypoints(&model, &path);
     let stiffness = support_stiffnesses(&model, a.contact_stiffness)?;
-    eprintln!("{}", stiffness_line(&stiffness));
+    if let Some(line) = stiffness_line(&stiffness) {
+        eprintln!("{line}");
+    }
     let (iterations, tolerance, increments) = a.erect;
     let mut count = 0;
     // Each erection's model is written first (`--erection-models DIR`), then erected.
