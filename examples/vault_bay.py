@@ -15,8 +15,11 @@ waypoints shrinking by 0.7, before they end at their places. On the first two ev
 node off the crown ends sliding towards its rail and the prestress falls from the rails to the
 crown by the capstan's e^(-mu theta), whatever the cut; settled, the contact nodes stick and
 every element away from the rails is within 1.5 MPa +- 5 %. Prints the contact nodes' end
-census (sticking, sliding) per path too. Run: python examples/vault_bay.py [N_PHI N_Y] (about
-20 s; the settled +- 5 % is shown for 24 x 8 to 48 x 16 cells, docs/mechanics.md "Settling")."""
+census (sticking, sliding) per path too. The tubes' penalties are per metre of contact line
+(3.4e7 and 3.4e6 N/m per m: the design loop gives each node that times its spacing, 0.292 m on
+24 x 8 cells; docs/mechanics.md "Contact stiffness in the design loop"). ``SETTLE`` may be
+"auto": the loop then chooses the amplitude (2.99 mm here). Run: python examples/vault_bay.py
+[N_PHI N_Y] (about 20 s; the mesh table is in docs/mechanics.md "Settling")."""
 
 SETTLE = (0.001, 0.7, 12)
 
@@ -43,7 +46,7 @@ def vault_bay(n_phi=24, n_y=8, mu=MU):
             triangles += [[a, b, c], [a, c, d]] if (i < n_phi // 2) == (j % 2 == 0) else [[a, b, d], [b, c, d]]
     arch_rows = [j for j in range(n_y + 1) if (4 * j) % n_y == 0]
     inner = range(1, n_phi)
-    contact = {"normal_stiffness": 1e7, "tangential_stiffness": 1e6, "friction": mu, "tube_radius": TUBE}
+    contact = {"normal_stiffness": 3.4e7, "tangential_stiffness": 3.4e6, "friction": mu, "tube_radius": TUBE}
     supports = [dict(name=f"arch{k}", nodes=[idx(i, j) for i in inner], **contact,
                      centreline={"circle": {"centre": [0, BAY * j / n_y, CENTRE_Z], "axis": [0, 1, 0], "radius": R}})
                 for k, j in enumerate(arch_rows)]
@@ -70,7 +73,8 @@ def main(n_phi=24, n_y=8, mu=MU, paths=((None, 10, None), ((0.10, 0.03), 40, Non
     for rail_path, increments, settle in paths:
         print("rails drawn straight to their places" if rail_path is None
               else f"rails from {rail_path[0]} m up and {rail_path[1]} m in, pulled down and out"
-              + ("" if settle is None else f", settled ({settle[0]} m past, shrinking by {settle[1]}, {settle[2]} waypoints)"))
+              + ("" if settle is None else ", settled (amplitude chosen by the loop)" if settle == "auto"
+                 else f", settled ({settle[0]} m past, shrinking by {settle[1]}, {settle[2]} waypoints)"))
         for name, by_element in (("prestress compensation, per strip", False), ("per element", True)):
             report = pattern(found, seam_planes=seams, erect=4, erect_tolerance=5.0, by_element=by_element,
                              rail_path=rail_path, erect_increments=increments, settle=settle)

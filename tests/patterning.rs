@@ -53,11 +53,14 @@ use membrane_contact::mech::formfinding::update_reference::{
 use membrane_contact::mech::formfinding::{form_found_model, held_dofs};
 use membrane_contact::mech::model::{BoundaryGroup, Model};
 use membrane_contact::mech::patterning::Strip;
+use membrane_contact::mech::patterning::contact_stiffness::{
+    ContactStiffness, support_stiffnesses, tributary_length,
+};
 use membrane_contact::mech::patterning::cut::{Compensation, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
     ElementCompensation, ElementSettings, Erected, away_from_rails, compensate_elements,
     cut_metrics, erect_along, erect_through, erect_with_contacts, passed_through_supports,
-    rail_start_offsets, rail_waypoints, refit_strips, settling_waypoints,
+    rail_start_offsets, rail_waypoints, refit_strips, settling_amplitude, settling_waypoints,
 };
 use membrane_contact::mech::patterning::erection::{compensate_by_erection, erect_by_analysis};
 use membrane_contact::mech::patterning::flatten::conformal_map;
@@ -1290,10 +1293,7 @@ fn a_winding_rail_path_matters_only_with_friction_and_the_compensation_along_it_
         .arg(&best)
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    let json = succeeded_report(&out, &report);
     let first = json["erections"][0]["max_error"].as_f64().unwrap();
     let library = outcome.history[0].max_error.0;
     assert!((first - library).abs() < 1e-9, "{first}");
@@ -1552,5 +1552,151 @@ fn an_erection_never_ends_with_the_film_through_a_tube_it_retries_with_more_incr
     assert!(
         e.contains("tube at node 1") && e.contains("1 to 4 increments"),
         "{e}"
+    );
+}
+
+/// The JSON report a `pattern` run wrote to `report`, the run asserted to have succeeded.
+fn succeeded_report(out: &std::process::Output, report: &std::path::Path) -> serde_json::Value {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(report).unwrap()).unwrap()
+}
+
+/// A film 1 m wide across a tube along y: three node columns at x = −0.5, 0, 0.5 m, `n` cells
+/// along y, the middle column on the tube's top (gap 1 mm, within the line's tolerance);
+/// `contact` of its nodes `j` listed on the tube, at `k` per metre.
+fn film_along_a_tube(n: usize, contact: std::ops::Range<usize>, k: f64) -> Model {
+    let (nodes, triangles) = common::flat_grid(2, n, 1.0, 1.0);
+    let nodes = nodes.iter().map(|p| [p[0] - 0.5, p[1], 0.031]).collect();
+    let mut model = film_model("FilmAlongATube", nodes, triangles);
+    model.material.prestress = ISOTROPIC;
+    let column = |i: usize| (0..=n).map(|j| 3 * j + i).collect();
+    model.groups = vec![group("west", column(0)), group("east", column(2))];
+    let tube = serde_json::json!([{ "name": "tube",
+        "centreline": { "line": { "point": [0, 0, 0], "axis": [0, 1, 0] } },
+        "tube_radius": 0.03, "nodes": contact.map(|j| 3 * j + 1).collect::<Vec<_>>(),
+        "normal_stiffness": k, "tangential_stiffness": 0.1 * k, "friction": 0.3 }]);
+    let mut value = serde_json::to_value(&model).unwrap();
+    value["curved_supports"] = tube;
+    Model::from_json(&value.to_string()).unwrap()
+}
+
+#[test]
+fn contact_stiffness_per_length_gives_a_row_the_same_line_stiffness_on_every_mesh_and_refuses_an_area()
+ {
+    // Contact nodes along the whole 1 m row: each takes half the spacing to each neighbour, the
+    // ends one half, so the row's penalties add up to k' times its 1 m on any mesh.
+    for n in [2, 5, 16] {
+        let model = film_along_a_tube(n, 0..n + 1, 3.0e7);
+        let k = support_stiffnesses(&model, ContactStiffness::PerLength).unwrap();
+        let total = k[0].normal_stiffness * (n + 1) as f64;
+        assert!((total - 3.0e7).abs() < 1e-6 * 3.0e7, "{n} cells: {total}");
+        assert!((k[0].tangential_stiffness - 0.1 * k[0].normal_stiffness).abs() < 1e-6);
+        assert_eq!(
+            k,
+            support_stiffnesses(&model, ContactStiffness::Auto).unwrap()
+        );
+    }
+    // Without the row's end nodes on the support (an arch between rails on its tube): the ends
+    // lie on its line, so every contact node takes the whole spacing.
+    let model = film_along_a_tube(8, 1..8, 3.0e7);
+    let l = tributary_length(&model, 0, &model.nodes).unwrap();
+    assert!((l - 0.125).abs() < 1e-12, "{l}");
+    // Per node: the numbers as given.
+    let k = support_stiffnesses(&model, ContactStiffness::PerNode).unwrap();
+    assert_eq!(
+        (k[0].tributary_length, k[0].normal_stiffness),
+        (None, 3.0e7)
+    );
+    // The drum's film touches it over an area: auto keeps its penalties per node, per-length
+    // refuses it naming the support.
+    let drum = film_over_drum(0.3);
+    let k = support_stiffnesses(&drum, ContactStiffness::Auto).unwrap();
+    assert_eq!((k[0].tributary_length, k[0].normal_stiffness), (None, 1e7));
+    let e = support_stiffnesses(&drum, ContactStiffness::PerLength).unwrap_err();
+    assert!(e.contains("'drum'") && e.contains("side by side"), "{e}");
+}
+
+#[test]
+fn the_chosen_settling_amplitude_is_half_the_prestress_length_change_of_the_longest_strip() {
+    // The flat film's halves, prestress compensation: ε = σ(1 − ν)/E biaxial, each strip a 1 m
+    // square less its compensation ε, so the longest distance across it is its diagonal √2 and
+    // a = ½ ε √2 (to the compensation's relative ε).
+    let model = flat_film();
+    let cut = cut_pattern(&model, halves(&model), Compensation::Prestress).unwrap();
+    let (e, nu, s) = (
+        model.material.youngs_modulus,
+        model.material.poisson_ratio,
+        model.material.prestress[0],
+    );
+    let strain = s * (1.0 - nu) / e;
+    let a = settling_amplitude(&model, &cut).unwrap();
+    let expected = 0.5 * strain * 2f64.sqrt();
+    assert!((a / expected - 1.0).abs() < 1.5 * strain, "{a} {expected}");
+    // No target prestress: nothing to size it by, and the message says what to give.
+    let mut slack = model.clone();
+    slack.material.prestress = [0.0; 3];
+    let e = settling_amplitude(&slack, &cut).unwrap_err();
+    assert!(e.contains("--settle AMPLITUDE,RATIO,CYCLES"), "{e}");
+}
+
+#[test]
+fn settle_auto_chooses_and_reports_its_amplitude_and_settles_the_drum_film_to_its_prestress() {
+    // `--settle auto` on the drum (μ = 0.3, rails down 0.10 m and out 0.03 m): the amplitude is
+    // half the prestress's length change of the strip (reported, with the ratio 0.7 and 12
+    // waypoints), and the film ends sticking everywhere within 5 % away from the rails, where
+    // the path alone leaves it sliding 21 % off (the test above).
+    let drum = format!("{}/examples/drum.json", env!("CARGO_MANIFEST_DIR"));
+    let report = std::env::temp_dir().join(format!("drum-auto-{}.json", std::process::id()));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
+        .args(["pattern", &drum, "--erect", "1", "--by-element"])
+        .args(["--rail-path", "0.10,0.03", "--settle", "auto", "--report"])
+        .arg(&report)
+        .output()
+        .unwrap();
+    let json = succeeded_report(&out, &report);
+    std::fs::remove_file(&report).ok();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    // The strip is the whole film, 1 m wide, its profile 2 × 0.5 m of tangents and 120° of a
+    // 0.5 m arc long: flat, a rectangle whose diagonal is the longest distance across it.
+    let model = drum_example();
+    let (length, width) = (1.0 + std::f64::consts::PI / 3.0, 1.0f64);
+    let m = &model.material;
+    let strain = m.prestress[0] * (1.0 - m.poisson_ratio) / m.youngs_modulus;
+    let expected = 0.5 * strain * length.hypot(width);
+    let settle = &json["settle"];
+    let amplitude = settle["amplitude"].as_f64().unwrap();
+    assert!(
+        (amplitude / expected - 1.0).abs() < 1.5 * strain,
+        "{settle} {expected}"
+    );
+    assert_eq!(settle["chosen"], true);
+    assert_eq!(
+        (settle["ratio"].as_f64(), settle["cycles"].as_u64()),
+        (Some(0.7), Some(12))
+    );
+    assert!(stderr.contains("settling: amplitude"), "{stderr}");
+    let end = &json["erections"][0];
+    assert!(
+        end["max_error"].as_f64().unwrap() < 0.05,
+        "{}",
+        end["max_error"]
+    );
+    let contacts = end["contacts"].as_array().unwrap();
+    let sliding = contacts.iter().filter(|c| c["status"] != "Stick").count();
+    assert_eq!(
+        sliding,
+        0,
+        "{} of {} contact nodes not sticking",
+        sliding,
+        contacts.len()
+    );
+    // The drum's contact is over an area: its penalties stay per node.
+    assert_eq!(
+        json["contact_stiffness"][0]["tributary_length"],
+        serde_json::Value::Null
     );
 }

@@ -49,14 +49,19 @@ def _model_file(model: dict | str | Path, folder: str) -> str:
 
 def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None, tolerance: float | None = None,
               max_steps: int | None = None, force_density_start: bool = False, on_supports: bool = False,
-              stress_tolerance: float | None = None, warp: Sequence[float] | None = None) -> dict:
+              stress_tolerance: float | None = None, warp: Sequence[float] | None = None,
+              contact_stiffness: str | None = None) -> dict:
     """The found model: the geometry in which the film carries ``prestress`` (MPa, ``(sx, sy)`` or
     ``(sx, sy, txy)`` in each element's frame; default the model's) with its boundary held, and
     that prestress as its material's (``membrane-contact form-find``). ``on_supports=True``: against
     the model's curved supports, frictionless (``--on-supports``; ``stress_tolerance`` the largest
     ``|σ − σ*|/|σ*|`` of a step accepted, default 1e-3); start from a geometry near them.
     ``warp=(ax, ay, az)``: each element's frame follows that direction (``--warp``), so
-    ``prestress=(warp, fill)`` is an orthotropic target; the found model has it as ``frame_axis``."""
+    ``prestress=(warp, fill)`` is an orthotropic target; the found model has it as ``frame_axis``.
+    ``contact_stiffness``: how the curved supports' penalties are read with ``on_supports``:
+    ``"auto"`` (the default: per metre of contact line where a support's nodes lie in a row along
+    it, else per node), ``"per-length"`` or ``"per-node"`` (``--contact-stiffness``); the found
+    model keeps the numbers as given."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "found.json"
         args = ["form-find", _model_file(model, tmp), "--out", str(out)]
@@ -74,6 +79,8 @@ def form_find(model: dict | str | Path, prestress: Sequence[float] | None = None
             args += ["--stress-tolerance", repr(float(stress_tolerance))]
         if warp is not None:
             args += ["--warp", ",".join(repr(float(a)) for a in warp)]
+        if contact_stiffness is not None:
+            args += ["--contact-stiffness", str(contact_stiffness)]
         _run(args)
         return json.loads(out.read_text())
 
@@ -88,7 +95,8 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
             svg: str | Path | None = None, erection_model: str | Path | None = None, erect: int = 0,
             erect_tolerance: float = 1.0, erect_increments: int = 10, by_element: bool = False,
             rail_path: Sequence[float] | Sequence[Sequence[float]] | None = None,
-            settle: Sequence[float] | None = None,
+            settle: str | Sequence[float | str] | None = None,
+            contact_stiffness: str | None = None,
             geodesic_from: Sequence[int] | Sequence[Sequence[int]] | None = None,
             strip_width: float | Sequence[float] | None = None,
             erection_models: str | Path | None = None) -> dict[str, Any]:
@@ -113,7 +121,15 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
     out. ``settle=(amplitude, ratio, cycles)`` (with ``rail_path``): then the rails pass their
     places by ``amplitude`` m along the last leg, come back short of them by ``ratio`` times that,
     and so on, ``cycles`` waypoints, and end at their places (``--settle``): the film settles on
-    its frictional supports at a nearly even tension (the vault bay: ``(0.001, 0.5, 8)``).
+    its frictional supports at a nearly even tension (the vault bay: ``(0.001, 0.7, 12)``).
+    ``settle="auto"`` (or ``("auto", ratio, cycles)``): the program chooses the amplitude, half the
+    length change the target prestress asks of the longest strip (ratio 0.7, 12 waypoints); the
+    report's ``settle`` has ``amplitude``, ``ratio``, ``cycles`` and ``chosen``.
+    ``contact_stiffness``: how the curved supports' penalties are read in the erections:
+    ``"auto"`` (the default: per metre of contact line where a support's nodes lie in a row along
+    it, else per node), ``"per-length"`` or ``"per-node"``; the report's ``contact_stiffness`` has
+    each support's ``tributary_length`` (m, None where per node) and the penalties per node it
+    got (``--contact-stiffness``).
 
     ``seam_planes``: ``(px, py, pz, nx, ny, nz)`` each; ``seam_nodes``: node lines;
     ``geodesic_from`` (a line of boundary nodes, or a line across the film from boundary to
@@ -149,9 +165,14 @@ def pattern(model: dict | str | Path, seam_planes: Sequence[Sequence[float]] = (
         if rail_path is not None:
             for waypoint in (rail_path if _nested(rail_path) else [rail_path]):
                 args.append("--rail-path=" + ",".join(repr(float(v)) for v in waypoint))
-        if settle is not None:
+        if settle == "auto":
+            args.append("--settle=auto")
+        elif settle is not None:
             amplitude, ratio, cycles = settle
-            args.append(f"--settle={float(amplitude)!r},{float(ratio)!r},{int(cycles)}")
+            amplitude = "auto" if amplitude == "auto" else repr(float(amplitude))
+            args.append(f"--settle={amplitude},{float(ratio)!r},{int(cycles)}")
+        if contact_stiffness is not None:
+            args += ["--contact-stiffness", str(contact_stiffness)]
         if svg is not None:
             args += ["--svg", str(svg)]
         if erection_model is not None:

@@ -5,6 +5,8 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use membrane_contact::mech::patterning::contact_stiffness::ContactStiffness;
+use membrane_contact::mech::patterning::element_compensation::{SETTLING_CYCLES, SETTLING_RATIO};
 use membrane_contact::mech::results::vtk::Encoding;
 use membrane_contact::mech::solve::DEFAULT_INCREMENTS_PER_STEP;
 use membrane_contact::mech::{FrictionLaw, IterationMatrix};
@@ -101,6 +103,11 @@ pub enum Command {
         /// With --on-supports: the largest |σ − σ*|/|σ*| of a step's equilibrium accepted.
         #[arg(long, value_name = "TOL", default_value_t = 1e-3)]
         stress_tolerance: f64,
+        /// With --on-supports: how the curved supports' penalties are read: `auto` (per metre of
+        /// contact line where a support's nodes lie in a row along it, else per node),
+        /// `per-length` or `per-node` (docs/mechanics.md "Contact stiffness in the design loop").
+        #[arg(long, value_name = "BASIS", default_value = "auto", value_parser = parse_contact_stiffness)]
+        contact_stiffness: ContactStiffness,
     },
     /// Cuts a (form found) model's film into strips along seams, flattens each with the least
     /// distortion, compensates it and prints each strip's size and distortion
@@ -169,9 +176,16 @@ pub enum Command {
         /// Settle the film after the rail path: the rails pass their places by AMPLITUDE m along
         /// the last leg, come back short of them by RATIO times that, and so on, CYCLES
         /// waypoints in all, then end at their places (friction then holds the film at a
-        /// nearly even tension instead of the capstan's fall from the rails).
+        /// nearly even tension instead of the capstan's fall from the rails). AMPLITUDE `auto`
+        /// (or `auto` alone: ratio 0.7, 12 waypoints): half the length change the target
+        /// prestress asks of the longest strip, reported.
         #[arg(long, value_name = "AMPLITUDE,RATIO,CYCLES", value_parser = parse_settle, requires = "rail_path", allow_hyphen_values = true)]
-        settle: Option<(f64, f64, usize)>,
+        settle: Option<(Option<f64>, f64, usize)>,
+        /// How the curved supports' penalties are read in the erections: `auto` (per metre of
+        /// contact line where a support's nodes lie in a row along it, else per node),
+        /// `per-length` or `per-node` (docs/mechanics.md "Contact stiffness in the design loop").
+        #[arg(long, value_name = "BASIS", default_value = "auto", value_parser = parse_contact_stiffness)]
+        contact_stiffness: ContactStiffness,
         /// Increments of each erection.
         #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
         erect_increments: u32,
@@ -395,14 +409,28 @@ fn parse_pair(s: &str) -> Result<[f64; 2], String> {
     }
 }
 
-/// `AMPLITUDE,RATIO,CYCLES` of `--settle`.
-fn parse_settle(s: &str) -> Result<(f64, f64, usize), String> {
-    let expected = "AMPLITUDE,RATIO,CYCLES: a length (m), a ratio and a whole number";
-    let [a, r, n] = parse_numbers::<3>(s, expected)?;
+/// `AMPLITUDE,RATIO,CYCLES` of `--settle`; AMPLITUDE `auto` (None), or `auto` alone.
+fn parse_settle(s: &str) -> Result<(Option<f64>, f64, usize), String> {
+    let expected =
+        "AMPLITUDE,RATIO,CYCLES: a length (m) or auto, a ratio and a whole number; or auto";
+    if s.trim() == "auto" {
+        return Ok((None, SETTLING_RATIO, SETTLING_CYCLES));
+    }
+    let (amplitude, rest) = s.split_once(',').unwrap_or((s, ""));
+    let amplitude = match amplitude.trim() {
+        "auto" => None,
+        a => Some(a.parse::<f64>().map_err(|_| format!("{a:?}: {expected}"))?),
+    };
+    let [r, n] = parse_numbers::<2>(rest, expected)?;
     if n < 0.0 || n.fract() != 0.0 {
         return Err(format!("{n} cycles: {expected}"));
     }
-    Ok((a, r, n as usize))
+    Ok((amplitude, r, n as usize))
+}
+
+/// `--contact-stiffness`: auto, per-length or per-node.
+fn parse_contact_stiffness(s: &str) -> Result<ContactStiffness, String> {
+    s.parse()
 }
 
 fn parse_friction_law(s: &str) -> Result<FrictionLaw, String> {

@@ -9,10 +9,13 @@ use membrane_contact::mech::formfinding::contact::{ContactSettings, find_shape_w
 use membrane_contact::mech::formfinding::force_density::force_density_shape;
 use membrane_contact::mech::formfinding::form_found_model;
 use membrane_contact::mech::formfinding::update_reference::{UpdateSettings, find_shape};
+use membrane_contact::mech::patterning::contact_stiffness::{
+    ContactStiffness, SupportStiffness, support_stiffnesses, with_node_stiffnesses,
+};
 use membrane_contact::mech::patterning::cut::{Compensation, CutStrip, cut_pattern};
 use membrane_contact::mech::patterning::element_compensation::{
     ContactEnd, ElementSettings, ErectContacts, away_from_rails, compensate_elements,
-    erect_through, rail_waypoints, settling_waypoints,
+    erect_through, rail_waypoints, settling_amplitude, settling_waypoints,
 };
 use membrane_contact::mech::patterning::erection::compensate_by_erection;
 use membrane_contact::mech::patterning::geodesic::geodesic_seams;
@@ -34,6 +37,8 @@ pub struct FormFindArgs<'a> {
     pub settings: UpdateSettings,
     /// Against the curved supports (frictionless), with these settings.
     pub on_supports: Option<ContactSettings>,
+    /// How the curved supports' penalties are read ([`ContactStiffness`]).
+    pub contact_stiffness: ContactStiffness,
 }
 
 /// Reads a model file.
@@ -82,7 +87,13 @@ pub fn form_find(a: FormFindArgs<'_>) -> Result<(), String> {
                 settings.homotopy
             ));
         }
-        let found = find_shape_with_contact(&model, start, prestress, settings)
+        // The found model keeps the file's penalties; the steps take them per node.
+        let stiffness = support_stiffnesses(&model, a.contact_stiffness)?;
+        if let Some(line) = stiffness_line(&stiffness) {
+            eprintln!("{line}");
+        }
+        let contact_model = with_node_stiffnesses(model.clone(), &stiffness);
+        let found = find_shape_with_contact(&contact_model, start, prestress, settings)
             .map_err(|e| e.to_string())?;
         eprintln!(
             "form found on the supports: {} reference updates, stress within {:.2e} of the target, {} nodes touching, {:.2?}",
@@ -130,8 +141,11 @@ pub struct PatternArgs<'a> {
     pub by_element: bool,
     /// The rails' offsets `[up, in]` (m) at each waypoint of the erection path.
     pub rail_path: &'a [[f64; 2]],
-    /// Settling after the rail path: amplitude (m), ratio, cycles ([`settling_waypoints`]).
-    pub settle: Option<(f64, f64, usize)>,
+    /// Settling after the rail path: amplitude (m; None: [`settling_amplitude`]), ratio, cycles
+    /// ([`settling_waypoints`]).
+    pub settle: Option<(Option<f64>, f64, usize)>,
+    /// How the curved supports' penalties are read in the erections ([`ContactStiffness`]).
+    pub contact_stiffness: ContactStiffness,
     /// A folder to write each erection's model to (`erection-K.json`), as the loop erects it.
     pub erection_models: Option<&'a PathBuf>,
     /// Where to write the report as JSON.
@@ -404,6 +418,75 @@ fn strip_json(model: &Model, c: &CutStrip) -> serde_json::Value {
     })
 }
 
+/// The rails' waypoints `[up, in]` of the erections: the rail path, settled where asked (the
+/// amplitude chosen by [`settling_amplitude`] on the start's cut where not given, one line on
+/// stderr), and the settling as JSON (null: none).
+fn erection_path(
+    model: &Model,
+    strips: &[Vec<usize>],
+    compensation: &Compensation,
+    a: &PatternArgs<'_>,
+) -> Result<(Vec<[f64; 2]>, serde_json::Value), String> {
+    let Some((amplitude, ratio, cycles)) = a.settle else {
+        return Ok((a.rail_path.to_vec(), serde_json::Value::Null));
+    };
+    let chosen = amplitude.is_none();
+    let amplitude = match amplitude {
+        Some(amplitude) => amplitude,
+        None => settling_amplitude(
+            model,
+            &cut_pattern(model, strips.to_vec(), compensation.clone())?,
+        )?,
+    };
+    let path = settling_waypoints(a.rail_path, amplitude, ratio, cycles)?;
+    eprintln!(
+        "settling: amplitude {:.4} mm ({}), ratio {ratio}, {cycles} waypoints",
+        1e3 * amplitude,
+        if chosen {
+            "chosen: half the prestress's length change of the longest strip"
+        } else {
+            "given"
+        }
+    );
+    let settle = serde_json::json!({
+        "amplitude": amplitude, "ratio": ratio, "cycles": cycles, "chosen": chosen,
+    });
+    Ok((path, settle))
+}
+
+/// The curved supports' penalties per node in the design loop, one line (none without any).
+fn stiffness_line(stiffness: &[SupportStiffness]) -> Option<String> {
+    let supports: Vec<String> = (stiffness.iter())
+        .map(|s| match s.tributary_length {
+            Some(l) => format!(
+                "{} per length × {l:.4} m: k_n {:.4e}, k_s {:.4e} N/m",
+                s.name, s.normal_stiffness, s.tangential_stiffness
+            ),
+            None => format!(
+                "{} per node: k_n {:.4e}, k_s {:.4e} N/m",
+                s.name, s.normal_stiffness, s.tangential_stiffness
+            ),
+        })
+        .collect();
+    (!supports.is_empty()).then(|| format!("contact stiffness: {}", supports.join("; ")))
+}
+
+/// The curved supports' penalties per node in the design loop as JSON: name, tributary length
+/// (m, null where per node), normal and tangential stiffness (N/m).
+fn stiffness_json(stiffness: &[SupportStiffness]) -> serde_json::Value {
+    (stiffness.iter())
+        .map(|s| {
+            serde_json::json!({
+                "support": s.name,
+                "tributary_length": s.tributary_length,
+                "normal_stiffness": s.normal_stiffness,
+                "tangential_stiffness": s.tangential_stiffness,
+            })
+        })
+        .collect::<Vec<_>>()
+        .into()
+}
+
 /// `membrane-contact pattern FILE`: one line per strip on stdout, the outlines as SVG.
 pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     if a.by_element && a.erect.0 == 0 {
@@ -413,13 +496,12 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
     let (model, strips) = strips(read_model(a.file)?, &a)?;
     let mut compensation = compensation(a.compensation)?;
     let mut report = serde_json::json!({ "erections": [] });
-    let path = match a.settle {
-        Some((amplitude, ratio, cycles)) => {
-            settling_waypoints(a.rail_path, amplitude, ratio, cycles)?
-        }
-        None => a.rail_path.to_vec(),
-    };
+    let (path, settle) = erection_path(&model, &strips, &compensation, &a)?;
     let path = rail_waypoints(&model, &path);
+    let stiffness = support_stiffnesses(&model, a.contact_stiffness)?;
+    if let Some(line) = stiffness_line(&stiffness) {
+        eprintln!("{line}");
+    }
     let (iterations, tolerance, increments) = a.erect;
     let mut count = 0;
     // Each erection's model is written first (`--erection-models DIR`), then erected.
@@ -431,6 +513,7 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
         count += 1;
         erect_through(m, increments, &path)
     };
+    let mut erect = |m: Model| erect(with_node_stiffnesses(m, &stiffness));
     if let Some(dir) = a.erection_models {
         std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     }
@@ -459,6 +542,8 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
         cut_pattern(&model, strips, compensation)?
     };
     if let Some(file) = a.report {
+        report["settle"] = settle;
+        report["contact_stiffness"] = stiffness_json(&stiffness);
         report["strips"] = (cut.iter())
             .map(|c| strip_json(&model, c))
             .collect::<Vec<_>>()
@@ -482,7 +567,8 @@ pub fn pattern(a: PatternArgs<'_>) -> Result<(), String> {
         let reference = reference_geometry(&model, &cut)?;
         write_text(
             Some(file),
-            &(erection_model(&model, reference).to_json() + "\n"),
+            &(with_node_stiffnesses(erection_model(&model, reference), &stiffness).to_json()
+                + "\n"),
         )?;
     }
     let labels: Vec<OutlineLabel> = (0..cut.len())

@@ -1175,12 +1175,14 @@ fn main() -> ExitCode {
             on_supports,
             homotopy,
             stress_tolerance,
+            contact_stiffness,
         } => design::form_find(design::FormFindArgs {
             file,
             out: out.as_ref(),
             prestress: *prestress,
             warp: *warp,
             force_density_start: *force_density_start,
+            contact_stiffness: *contact_stiffness,
             on_supports: on_supports.then_some(
                 membrane_contact::mech::formfinding::contact::ContactSettings {
                     tolerance: *stress_tolerance,
@@ -1209,6 +1211,7 @@ fn main() -> ExitCode {
             by_element,
             rail_path,
             settle,
+            contact_stiffness,
             erect_tolerance,
             erect_increments,
             report,
@@ -1226,6 +1229,7 @@ fn main() -> ExitCode {
             by_element: *by_element,
             rail_path: rail_path.as_slice(),
             settle: *settle,
+            contact_stiffness: *contact_stiffness,
             report: report.as_ref(),
         }),
         Command::ExportSpecimen {

@@ -98,6 +98,25 @@ def test_by_element_erections_over_the_drum_with_friction_name_what_friction_hol
     assert report["stalled"] == [] and report["held_by_friction"] == []
 
 
+def test_settle_auto_and_the_contact_stiffness_reach_the_program_and_come_back_in_the_report():
+    """``settle="auto"``: the program chooses the amplitude (``--settle auto``) and reports it with
+    ``chosen``; the same amplitude given explicitly erects the same film. The drum's film touches
+    it over an area, so its penalties stay per node (``tributary_length`` None) and
+    ``contact_stiffness="per-length"`` is refused naming it."""
+    options = dict(erect=1, by_element=True, rail_path=(0.10, 0.03))
+    auto = pattern(DRUM, settle="auto", **options)
+    settle = auto["settle"]
+    assert settle["chosen"] is True and (settle["ratio"], settle["cycles"]) == (0.7, 12)
+    given = pattern(DRUM, settle=(settle["amplitude"], 0.7, 12), **options)
+    assert given["settle"]["chosen"] is False
+    assert given["erections"][0]["stress"] == auto["erections"][0]["stress"]
+    assert auto["erections"][0]["max_error"] < 0.05
+    stiffness = auto["contact_stiffness"]
+    assert stiffness[0]["support"] == "drum" and stiffness[0]["tributary_length"] is None
+    with pytest.raises(DesignError, match="'drum'"):
+        pattern(DRUM, contact_stiffness="per-length", **options)
+
+
 def _vault_bay():
     import importlib.util
     path = Path(__file__).resolve().parents[2] / "examples" / "vault_bay.py"

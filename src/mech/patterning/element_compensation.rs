@@ -162,6 +162,47 @@ pub fn settling_waypoints(
     Ok(waypoints)
 }
 
+/// The ratio of the settling the design loop takes when it chooses the amplitude (`--settle auto`).
+pub const SETTLING_RATIO: f64 = 0.7;
+
+/// The waypoints of the settling the design loop takes when it chooses the amplitude.
+pub const SETTLING_CYCLES: usize = 12;
+
+/// The settling amplitude the design loop chooses: half the length change the target prestress
+/// asks of the longest strip, `a = ½ ε L`, with `ε` the larger normal strain of `D⁻¹σ_target`
+/// (the prestress compensation, `σ(1 − ν)/E` biaxial) and `L` the longest distance across a `cut`
+/// strip (m: between two of its flat nodes, whatever way the flattening turned it). Each rail's first pass then changes the film's tension at the rail by about the
+/// target itself, far over the capstan's `e^{μθ} − 1` that the film must slide back over to reach
+/// the crown, and far under yield (docs/mechanics.md, "Settling the film").
+pub fn settling_amplitude(found: &Model, cut: &[CutStrip]) -> Result<f64, String> {
+    let strain = found
+        .material
+        .elasticity()
+        .try_inverse()
+        .map(|c| c * Vector3::from(found.material.prestress))
+        .map_or(0.0, |e| e.x.abs().max(e.y.abs()));
+    let length = cut.iter().fold(0.0, |l: f64, c| {
+        let flat = &c.strip.flat;
+        (flat.iter().enumerate())
+            .flat_map(|(i, p)| {
+                flat[i + 1..]
+                    .iter()
+                    .map(move |q| (p[0] - q[0]).hypot(p[1] - q[1]))
+            })
+            .fold(l, f64::max)
+    });
+    let amplitude = 0.5 * strain * length;
+    if amplitude.is_finite() && amplitude > 0.0 {
+        Ok(amplitude)
+    } else {
+        Err(format!(
+            "settling: the target prestress {:?} Pa asks no strain of the strips ({length} m) to size \
+             the amplitude by: give --settle AMPLITUDE,RATIO,CYCLES",
+            found.material.prestress
+        ))
+    }
+}
+
 /// Erects `model` (an [`super::reference::erection_model`], one group `node<k>` per held node)
 /// in two stages: first each node `k` of `start` to its target plus its offset (the rails lifted
 /// and drawn in: the film laid on the supports slack), then every group to its target (the rails

@@ -14,6 +14,7 @@
 //! | [`compensate`] | uniform compensation, or from the target prestress `ε = D⁻¹σ` |
 //! | [`erection`] | compensation by erection: erect, compare with the target, correct each strip |
 //! | [`element_compensation`] | compensation by erection element by element: a fixed point on each triangle's reference metric |
+//! | [`contact_stiffness`] | the curved supports' penalties per metre of contact line in the design loop |
 //! | [`outline`] | the strips' outlines as SVG, with dimensions |
 //! | [`reference`] | the film's compensated reference geometry and its erection model |
 //!
@@ -22,6 +23,7 @@
 //! 3-D triangle onto the flat one and `E = ½(FᵀF − I)` is its Green strain.
 
 pub mod compensate;
+pub mod contact_stiffness;
 pub mod cut;
 pub mod distortion;
 pub mod element_compensation;
