@@ -203,6 +203,24 @@ fn add_free(dofs: &[Dof], u: &mut [f64], delta: &[f64]) {
     }
 }
 
+/// Refused before any limit point: the rows below go on from the largest load factor reached
+/// (`peak`: it, and that state with the start of its increment, if any), `current` moved there.
+fn failed_from(
+    current: &mut AnalysisState,
+    peak: (f64, Option<(AnalysisState, AnalysisState)>),
+    failure: IncrementFailure,
+) -> ArcEnd {
+    let start = peak.1.map(|(state, start)| {
+        *current = state;
+        start
+    });
+    ArcEnd::Failed {
+        at: peak.0,
+        start,
+        failure,
+    }
+}
+
 /// `Σ a·b`.
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -244,13 +262,26 @@ impl Analysis {
         for c in self.parts.all_mut() {
             c.restore(current);
         }
+        // The linear response to the whole step's load change; none (a step that changes no
+        // load) leaves no path to follow.
         let whole = match self.load_tangent(&current.displacement, path, from, 0) {
             Ok(b) => dot(&b, &b).sqrt(),
             Err(failure) => {
-                let (at, start) = (from, None);
-                return ArcEnd::Failed { at, start, failure };
+                return ArcEnd::Failed {
+                    at: from,
+                    start: None,
+                    failure,
+                };
             }
         };
+        if !(whole > 0.0 && whole.is_finite()) {
+            let failure = IncrementFailure::Diverged { iteration: 0 };
+            return ArcEnd::Failed {
+                at: from,
+                start: None,
+                failure,
+            };
+        }
         // From the smallest increment's arc: where Newton refused for another reason than a
         // limit point (a contact chattering, a film without a unique equilibrium), the arc is
         // refused at once, at the cost of one increment.
@@ -259,7 +290,8 @@ impl Analysis {
         // The converged state of the largest load factor and the start of its increment.
         let mut peak: (f64, Option<(AnalysisState, AnalysisState)>) = (from, None);
         let limit = Analysis::MAX_TARGET_PER_SIZE * self.length_scale;
-        loop {
+        // At most as many increments as the step has at its smallest size.
+        for _ in 0..1usize << self.settings.max_cutbacks.min(20) {
             let attempt = self.arc_increment(current, path, (lambda, ds), previous.as_deref());
             let to = attempt.as_ref().map_or(lambda, |s| s.lambda);
             let noted = attempt.as_ref().map(|s| s.residuals.as_slice());
@@ -294,14 +326,7 @@ impl Analysis {
                     return ArcEnd::LimitPoint { peak: peak.0 };
                 }
                 Err(failure) if ds / 2.0 < smallest * (1.0 - 1e-9) => {
-                    // Refused before any limit point: the rows below go on from the largest
-                    // load factor reached.
-                    let start = peak.1.map(|(state, start)| {
-                        *current = state;
-                        start
-                    });
-                    let at = peak.0;
-                    return ArcEnd::Failed { at, start, failure };
+                    return failed_from(current, peak, failure);
                 }
                 Err(_) => {
                     report.cutbacks += 1;
@@ -309,6 +334,7 @@ impl Analysis {
                 }
             }
         }
+        failed_from(current, peak, IncrementFailure::Diverged { iteration: 0 })
     }
 
     /// The last increment of an arc that passed the step's end: load-controlled from the

@@ -400,7 +400,8 @@ impl Analysis {
                     if start.is_some() {
                         (control.done, *last_start) = (at, start);
                     }
-                    *last_failure = Some(failure);
+                    // Newton's refusal says more of the step's difficulty than the arc's.
+                    last_failure.get_or_insert(failure);
                 }
             }
         }
