@@ -693,3 +693,44 @@ fn a_prediction_into_the_support_is_moved_back_to_the_converged_gap() {
         assert_eq!(u, predicted);
     }
 }
+
+/// Issue 46: a node remembers its side (the contact direction `s n`) while it is within one tube
+/// radius of the surface, at the start and at every converged state, and none beyond (where it
+/// may go round the support within an increment): a node 1.1 radii off a cylinder that swings
+/// round to the opposite side in one step stays open, one 0.9 radii off is held on its side.
+#[test]
+fn a_node_remembers_its_side_within_one_tube_radius_of_the_surface_only() {
+    let s = CurvedSupport {
+        centreline: Centreline::Line {
+            point: [0.0; 3],
+            axis: [0.0, 1.0, 0.0],
+        },
+        ..support(kinds().remove(0).1, FrictionLaw::Isotropic)
+    };
+    let c = SurfaceContact::new(&s, 0);
+    let r = s.tube_radius;
+    for (off, remembered) in [(0.9, true), (1.1, false)] {
+        let x0 = Vector3::new(0.0, 0.0, r * (1.0 + off));
+        let start = c.initial_history(&x0, 0.3);
+        let committed = SurfaceContacts::commit(&[c.respond(&x0, &start)], &[start])[0];
+        for h in [start, committed] {
+            let side = Vector3::from(h.side);
+            assert_eq!(side != Vector3::zeros(), remembered, "{off} radii off");
+            if remembered {
+                assert!((side - Vector3::z()).norm() < 1e-15);
+            }
+        }
+        // Swung round to the far side, as far from the axis.
+        let far = c.respond(&-x0, &committed);
+        if remembered {
+            assert_eq!(far.status, GapStatus::Stick, "{off}");
+            assert!((far.gap + r * (2.0 + off)).abs() < 1e-12);
+            assert!(-far.residual.z > 0.0, "pushed back up");
+        } else {
+            assert_eq!(
+                (far.status, far.residual),
+                (GapStatus::Open, Vector3::zeros())
+            );
+        }
+    }
+}
