@@ -13,6 +13,15 @@ fn support(centreline: Centreline, law: FrictionLaw) -> CurvedSupport {
     }
 }
 
+/// A cylinder round the y axis (isotropic friction, μ = 0.3).
+fn y_cylinder() -> CurvedSupport {
+    let centreline = Centreline::Line {
+        point: [0.0; 3],
+        axis: [0.0, 1.0, 0.0],
+    };
+    support(centreline, FrictionLaw::Isotropic)
+}
+
 fn ring(angles: Option<[f64; 2]>) -> Centreline {
     Centreline::Circle {
         centre: [0.0, 0.0, -1.0],
@@ -603,12 +612,8 @@ fn walking_over_corners_and_caps_keeps_gap_normal_and_surface_length_continuous(
 #[test]
 fn slip_counts_sliding_in_contact_not_the_approach() {
     let s = CurvedSupport {
-        centreline: Centreline::Line {
-            point: [0.0; 3],
-            axis: [0.0, 1.0, 0.0],
-        },
         friction: 0.0,
-        ..support(kinds().remove(0).1, FrictionLaw::Isotropic)
+        ..y_cylinder()
     };
     let c = SurfaceContact::new(&s, 0);
     let r = s.tube_radius;
@@ -647,13 +652,7 @@ fn slip_counts_sliding_in_contact_not_the_approach() {
 /// is not free and a prediction away from the support are left as predicted.
 #[test]
 fn a_prediction_into_the_support_is_moved_back_to_the_converged_gap() {
-    let s = CurvedSupport {
-        centreline: Centreline::Line {
-            point: [0.0; 3],
-            axis: [0.0, 1.0, 0.0],
-        },
-        ..support(kinds().remove(0).1, FrictionLaw::Isotropic)
-    };
+    let s = y_cylinder();
     let r = s.tube_radius;
     let c = SurfaceContact::new(&s, 0);
     let x0 = Vector3::new(0.0, 0.0, 0.99 * r);
@@ -700,13 +699,7 @@ fn a_prediction_into_the_support_is_moved_back_to_the_converged_gap() {
 /// round to the opposite side in one step stays open, one 0.9 radii off is held on its side.
 #[test]
 fn a_node_remembers_its_side_within_one_tube_radius_of_the_surface_only() {
-    let s = CurvedSupport {
-        centreline: Centreline::Line {
-            point: [0.0; 3],
-            axis: [0.0, 1.0, 0.0],
-        },
-        ..support(kinds().remove(0).1, FrictionLaw::Isotropic)
-    };
+    let s = y_cylinder();
     let c = SurfaceContact::new(&s, 0);
     let r = s.tube_radius;
     for (off, remembered) in [(0.9, true), (1.1, false)] {
