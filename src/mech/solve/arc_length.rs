@@ -35,7 +35,8 @@ use crate::mech::solve::state::{AnalysisState, GroupMotion};
 pub(super) enum ArcEnd {
     /// At the step's end (`λ = 1`); the start of its last increment.
     Reached { start: AnalysisState },
-    /// Past a limit point: the largest share of the step reached.
+    /// Past a limit point: the largest share of the step reached (the converged `current` back
+    /// at the arc's start).
     LimitPoint { peak: f64 },
     /// Refused at the smallest arc length before any limit point, at the share `at` (where
     /// the converged `current` is; the start of its last increment, if any).
@@ -262,6 +263,7 @@ impl Analysis {
         for c in self.parts.all_mut() {
             c.restore(current);
         }
+        let origin = current.clone();
         // The linear response to the whole step's load change; none (a step that changes no
         // load) leaves no path to follow.
         let whole = match self.load_tangent(&current.displacement, path, from, 0) {
@@ -319,10 +321,12 @@ impl Analysis {
                     ds = (ds * ratio.clamp(1.0 / Analysis::GROWTH, Analysis::GROWTH)).min(whole);
                     let passed = lambda < 0.0 || max_abs(&current.displacement) > limit;
                     if passed && peak.0 > from {
+                        *current = origin;
                         return ArcEnd::LimitPoint { peak: peak.0 };
                     }
                 }
                 Err(_) if ds / 2.0 < smallest * (1.0 - 1e-9) && peak.0 > from.max(lambda) => {
+                    *current = origin;
                     return ArcEnd::LimitPoint { peak: peak.0 };
                 }
                 Err(failure) if ds / 2.0 < smallest * (1.0 - 1e-9) => {

@@ -267,6 +267,35 @@ impl Collinear {
     }
 }
 
+/// Why a step's rows refused: the last increment's failure, and the largest share of a limit
+/// point the arc-length row passed.
+#[derive(Default)]
+struct Refusal {
+    failure: Option<IncrementFailure>,
+    limit: Option<f64>,
+}
+
+impl Refusal {
+    /// The step's error with `done` of it converged after `cutbacks` halvings: the limit point
+    /// where the arc passed one, else the last failure.
+    fn error(&mut self, path: &StepPath, done: f64, cutbacks: usize) -> StepError {
+        match self.limit {
+            Some(peak) => StepError::LimitPoint {
+                fraction: peak,
+                levels: path.levels(peak),
+            },
+            None => StepError::NotConverged {
+                fraction_done: done,
+                cutbacks,
+                last: self
+                    .failure
+                    .take()
+                    .unwrap_or(IncrementFailure::Diverged { iteration: 0 }),
+            },
+        }
+    }
+}
+
 /// The first iteration (at least 1) whose residual in `history` (one per iterate, the
 /// predictor's first) is within `tolerance`; the last where none is.
 fn first_within(history: &[f64], tolerance: f64) -> usize {
@@ -314,13 +343,13 @@ impl Analysis {
         let mut control = Controller::new(increments, self.settings.max_cutbacks, rows);
         let mut current = self.state.clone();
         let mut last_start = None;
-        let (mut report, mut last_failure) = (StepReport::default(), None);
+        let (mut report, mut refusal) = (StepReport::default(), Refusal::default());
         self.parts.stabilization.start_step();
         while control.done < 1.0 {
             let (from, to, row) = (control.done, control.next(), control.row);
             if STRATEGIES[row].control == Control::ArcLength {
                 let arc = (&mut current, &mut last_start, &mut report);
-                if self.arc_row(&mut control, &path, arc, &mut last_failure)? {
+                if self.arc_row(&mut control, &path, arc, &mut refusal)? {
                     break;
                 }
                 continue;
@@ -346,14 +375,11 @@ impl Analysis {
                 }
                 Err(last) if !control.refused(&mut report) => {
                     self.parts.stabilization.set(0.0, 1.0);
-                    return Err(StepError::NotConverged {
-                        fraction_done: control.done,
-                        cutbacks: report.cutbacks,
-                        last,
-                    });
+                    refusal.failure = Some(last);
+                    return Err(refusal.error(&path, control.done, report.cutbacks));
                 }
                 Ok(_) => _ = control.refused(&mut report),
-                Err(last) => last_failure = Some(last),
+                Err(last) => refusal.failure = Some(last),
             }
         }
         if STRATEGIES[control.row].damping > 0.0 {
@@ -363,6 +389,11 @@ impl Analysis {
         self.parts.stabilization.set(0.0, 1.0);
         report.strain_energy = self.strain_energy_at(&current.displacement);
         report.pseudo_time_work = std::mem::take(&mut self.work.pseudo_time_work);
+        // Past a limit point the stabilization reaches the step's loads only by a state the
+        // damping made where it took out more than the film stores: the limit stands.
+        if refusal.limit.is_some() && report.stabilization_dissipated > report.strain_energy {
+            return Err(refusal.error(&path, control.done, report.cutbacks));
+        }
         self.state = current;
         self.increment_start = last_start;
         Ok(report)
@@ -370,7 +401,9 @@ impl Analysis {
 
     /// The arc-length row of a step, from `control`'s share (`arc_length.rs`), for a step whose
     /// boundary stands still: Ok(true) where it reached the step's end, Ok(false) where the
-    /// next row solves the rest; Err at a limit point, or where no row is left.
+    /// next row solves the rest (after a limit point too, noted in `refusal`: a snap-through
+    /// the arc did not follow back may still end at the step's loads); Err where no row is
+    /// left.
     fn arc_row(
         &mut self,
         control: &mut Controller,
@@ -380,7 +413,7 @@ impl Analysis {
             &mut Option<AnalysisState>,
             &mut StepReport,
         ),
-        last_failure: &mut Option<IncrementFailure>,
+        refusal: &mut Refusal,
     ) -> Result<bool, StepError> {
         if path.boundary_still() {
             let from = (control.done, control.smallest);
@@ -389,32 +422,20 @@ impl Analysis {
                     (control.done, *last_start) = (1.0, Some(start));
                     return Ok(true);
                 }
-                ArcEnd::LimitPoint { peak } => {
-                    let levels = path.levels(peak);
-                    return Err(StepError::LimitPoint {
-                        fraction: peak,
-                        levels,
-                    });
-                }
+                ArcEnd::LimitPoint { peak } => refusal.limit = Some(peak),
                 ArcEnd::Failed { at, start, failure } => {
                     if start.is_some() {
                         (control.done, *last_start) = (at, start);
                     }
                     // Newton's refusal says more of the step's difficulty than the arc's.
-                    last_failure.get_or_insert(failure);
+                    refusal.failure.get_or_insert(failure);
                 }
             }
         }
         if control.next_row() {
             return Ok(false);
         }
-        Err(StepError::NotConverged {
-            fraction_done: control.done,
-            cutbacks: report.cutbacks,
-            last: last_failure
-                .take()
-                .unwrap_or(IncrementFailure::Diverged { iteration: 0 }),
-        })
+        Err(refusal.error(path, control.done, report.cutbacks))
     }
 
     /// Checks a step's targets, angles, loads and smallest number of increments.

@@ -524,8 +524,9 @@ impl StepError {
             Self::LimitPoint { fraction, levels } => format!(
                 "the loads pass a limit point at {:.2}% of the step (pressures {:?} Pa, forces {:?} N): \
                  past it the film carries less, and arc-length control followed the path down without \
-                 reaching the step's end; no equilibrium at the step's loads lies on this path. The last \
-                 converged state is kept. What to change: keep the loads below the limit, or stiffen \
+                 reaching the step's end; no equilibrium at the step's loads lies on this path, and the \
+                 viscous stabilization reached none without taking out more work than the film stores. \
+                 The last converged state is kept. What to change: keep the loads below the limit, or stiffen \
                  the model (a harder material, a support)",
                 100.0 * fraction,
                 levels.pressure,
