@@ -135,14 +135,18 @@ impl Analysis {
             dl += theta;
             last = Some(record);
         }
-        Err(IncrementFailure::MaxIterations {
-            first_residual: residuals[0],
-            last: last.expect("max_iterations ≥ 1"),
-            matrix: self.settings.iteration_matrix,
-            chattering: vec![],
-            flipping: vec![],
-            compressed: vec![],
-        })
+        Err(
+            last.map_or(IncrementFailure::Diverged { iteration: 0 }, |last| {
+                IncrementFailure::MaxIterations {
+                    first_residual: residuals[0],
+                    last,
+                    matrix: self.settings.iteration_matrix,
+                    chattering: vec![],
+                    flipping: vec![],
+                    compressed: vec![],
+                }
+            }),
+        )
     }
 
     /// `b = K⁻¹ q` at `(u, λ)`, `q = −∂R/∂λ` by a forward difference of the residual over the
