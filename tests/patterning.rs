@@ -1511,50 +1511,13 @@ fn film_across_a_tube(drop: f64) -> Model {
     Model::from_json(&value.to_string()).unwrap()
 }
 
-/// The film across a tube pulled down `drop` in `increments` by an analysis: the contact nodes'
-/// heights (m; the tube's centreline is at z = 0), the nodes `passed_through_supports` names and
-/// the contacts' normal forces (N).
-fn pulled_across_a_tube(
-    model: &Model,
-    increments: usize,
-) -> ([f64; 2], Vec<(String, usize)>, Vec<f64>) {
-    let targets: Vec<[f64; 3]> = model.groups.iter().map(|g| g.target).collect();
-    let mut analysis = Analysis::new(model.clone(), SolverSettings::default()).unwrap();
-    analysis.step_to(&targets, increments).unwrap();
-    let x: Vec<[f64; 3]> = (0..model.nodes.len())
-        .map(|v| (Vector3::from(model.nodes[v]) + analysis.node_displacement(v)).into())
-        .collect();
-    let forces = analysis
-        .results()
-        .surface_contacts
-        .iter()
-        .map(|c| c.normal_force)
-        .collect();
-    (
-        [x[1][2], x[4][2]],
-        passed_through_supports(model, &x),
-        forces,
-    )
-}
-
-/// Issue 46: pulled 0.2 m down in one increment, the first Newton iterate carries the film's
-/// middle line 0.2 m down, past the tube's centreline; the contact remembers the side its nodes
-/// started on and pushes them back up (a plain distance law pushed them on down: the film hung
-/// flat under the tube at its prestress), so one increment ends with the film on the tube,
-/// pressed 0.4 mm in, and nothing passed through.
 #[test]
-fn a_film_pulled_past_a_tubes_centreline_in_one_increment_is_pushed_back_on_top_of_it() {
-    let (heights, through, forces) = pulled_across_a_tube(&film_across_a_tube(0.2), 1);
-    assert!(through.is_empty(), "{through:?}");
-    for (z, n) in heights.iter().zip(&forces) {
-        assert!(*z > 0.029 && *z < 0.03, "on the tube: z = {z}");
-        assert!(*n > 1e3, "pressed on it: {n} N");
-    }
-}
-
-#[test]
-fn an_erection_never_ends_with_the_film_through_a_tube_and_refuses_one_its_contact_cannot_hold() {
-    // 0.2 m down in one increment: on the tube at once (the contact's side memory), no retry.
+fn an_erection_never_ends_with_the_film_through_a_tube_it_retries_with_more_increments_or_refuses()
+{
+    // Pulled 0.2 m down in one increment, the first Newton iterate carries the middle line
+    // 0.2 m down, past the tube's centreline, where the two-sided tube contact pushes it on down:
+    // the film would hang flat under the tube at its prestress (without the check it does). The
+    // erection sees it and erects again with 2 increments, whose 0.1 m steps keep it on top.
     let model = film_across_a_tube(0.2);
     let erected = erect_through(model.clone(), 1, &[]).unwrap();
     for c in &erected.contacts {
@@ -1583,15 +1546,9 @@ fn an_erection_never_ends_with_the_film_through_a_tube_and_refuses_one_its_conta
         under,
         vec![("tube".to_string(), 1), ("tube".to_string(), 4)]
     );
-    // Pulled 0.8 m against a penalty of 1e6 N/m: the film pulls the tube's nodes with more than
-    // the k_n r = 3e4 N the contact holds at the centreline, so they end past it, pressed in
-    // by more than the tube's radius, at 1, 2 and 4 increments: refused, naming the nodes.
-    let mut soft = film_across_a_tube(0.8);
-    soft.curved_supports[0].normal_stiffness = 1e6;
-    let (heights, through, forces) = pulled_across_a_tube(&soft, 1);
-    assert!(heights.iter().all(|z| *z < 0.0) && forces.iter().all(|n| *n > 3e4));
-    assert_eq!(through.len(), 2);
-    let e = erect_through(soft, 1, &[]).unwrap_err();
+    // Pulled 0.8 m in 1, 2 and 4 increments every try passes through (the film's pull on the
+    // tube is more than its penalty holds at the centreline): refused, naming the nodes.
+    let e = erect_through(film_across_a_tube(0.8), 1, &[]).unwrap_err();
     assert!(
         e.contains("tube at node 1") && e.contains("1 to 4 increments"),
         "{e}"

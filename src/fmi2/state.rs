@@ -63,11 +63,6 @@ const VERSION: u32 = 7;
 pub fn serialize(snapshot: &Snapshot, guid: &str) -> Vec<u8> {
     let payload =
         serde_json::to_vec(snapshot).expect("a snapshot holds only finite numbers and serializes");
-    framed(&payload, guid)
-}
-
-/// A JSON `payload` behind the header (magic, version, GUID, length, CRC) of the FMU `guid`.
-pub(crate) fn framed(payload: &[u8], guid: &str) -> Vec<u8> {
     let mut out = Vec::with_capacity(payload.len() + guid.len() + 32);
     out.extend_from_slice(MAGIC);
     out.extend_from_slice(&VERSION.to_le_bytes());
@@ -76,9 +71,9 @@ pub(crate) fn framed(payload: &[u8], guid: &str) -> Vec<u8> {
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     let mut crc = crc32fast::Hasher::new();
     crc.update(&out);
-    crc.update(payload);
+    crc.update(&payload);
     out.extend_from_slice(&crc.finalize().to_le_bytes());
-    out.extend_from_slice(payload);
+    out.extend_from_slice(&payload);
     out
 }
 

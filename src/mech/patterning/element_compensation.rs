@@ -226,15 +226,13 @@ pub fn erect_along(
 /// erected state depend on the legs (a node that sticks on one leg keeps its place into the
 /// next); without it only the end counts.
 ///
-/// A curved support's contact remembers the side of its tube a node is on (issue 46; the
-/// contact module's "Side memory"), so a Newton iterate that carries a node past the tube's
-/// centreline is pushed back, not on through. What can still end a leg with a node through its
-/// support: a film that pulls a node with more than the `k_n r` its contact holds at the
-/// centreline (the node converges past it, pressed in by more than the radius), or a node more
-/// than one tube radius off the surface at the leg's last converged state (no side remembered)
-/// carried through in one increment. After each leg the nodes are checked
-/// ([`passed_through_supports`]); where any passed, the erection is run again with twice the
-/// increments, at most [`PASSED_THROUGH_RETRIES`] times, then refused naming them.
+/// A curved support's contact holds a node off the tube's surface on either side, so a node that
+/// one Newton iteration carries past the tube's centreline ends on its far side: the film passes
+/// through the support and settles in a wrong equilibrium (the vault bay at 48 × 16 cells, 40
+/// increments a leg: the nodes beside the rails under their arches, every element away from the
+/// rails at 2.3–3 times its target). After each leg the nodes are checked ([`passed_through_supports`]); where any
+/// passed, the erection is run again with twice the increments, at most
+/// [`PASSED_THROUGH_RETRIES`] times, then refused naming them.
 pub fn erect_through(
     model: Model,
     increments: usize,
@@ -251,8 +249,7 @@ pub fn erect_through(
         Ok(erected) => Ok(erected),
         Err(through) => Err(format!(
             "erection: the film passed through its supports ({}) with {increments} to {n} \
-             increments a leg: give more increments, or a normal_stiffness × tube_radius above \
-             the film's pull on those nodes (the force their contact holds at its centreline)",
+             increments a leg: give more increments",
             through
                 .iter()
                 .map(|(s, v)| format!("{s} at node {v}"))
@@ -267,10 +264,7 @@ pub const PASSED_THROUGH_RETRIES: usize = 2;
 
 /// The curved supports' contact nodes of `model` at `positions` (every node's, m) whose normal
 /// to their support points against the one at the model's own node positions (turned by more
-/// than 90°): nodes carried through the support's tube, as (support name, node). The contact's
-/// side memory keeps a Newton iterate from doing it; a node still ends there where the film
-/// pulls it past the centreline with more than its contact's `k_n r`, or where it was more
-/// than a tube radius off the surface before the increment that carried it through.
+/// than 90°): nodes carried through the support's tube, as (support name, node).
 pub fn passed_through_supports(model: &Model, positions: &[[f64; 3]]) -> Vec<(String, usize)> {
     let mut through = Vec::new();
     for s in &model.curved_supports {

@@ -32,7 +32,7 @@ pub struct AnalysisState {
     pub friction: Vec<f64>,
     /// Status of each gap at convergence.
     pub status: Vec<GapStatus>,
-    /// History of each curved-support contact ([`crate::mech::elements::curved_contact`]): anchor, angle, status, μ, side.
+    /// History of each curved-support contact ([`crate::mech::elements::curved_contact`]): anchor, angle, status, μ.
     #[serde(default)]
     pub contacts: Vec<ContactHistory>,
     /// Displacement change of the last converged increment (empty before the first): the
@@ -105,7 +105,6 @@ impl AnalysisState {
             && self.contacts.iter().all(|c| {
                 [c.anchor[0], c.anchor[1], c.angle, c.origin, c.friction]
                     .iter()
-                    .chain(&c.side)
                     .all(|v| v.is_finite())
             })
             && self.layer_contacts.iter().all(|c| {

@@ -35,55 +35,15 @@
 //! vertex's angle `Δ` at once and `ξ1` jumps by `2d tan(|Δ|/2) ∓ r|Δ|` (`−` on the `t × p`
 //! side, `+` on the other); use finer polylines or a parabola where a film slides there.
 //!
-//! Normal: gap `g = s d − r`, contact force `λN = k_n ⟨−g⟩` along `s n` (the paper's penalty
-//! with the side memory below; `s = +1` on the side the node is on).
-//!
-//! **Side memory** (issue 46). With `g = d − r` alone the tube is two-sided: a node that one
-//! Newton iterate carries past the centreline sees `n` turn round and is pushed on through.
-//! The history keeps the committed side `n̄` ([`ContactHistory::side`]): the contact direction
-//! `s n` at the last converged state, at the start the node's own `n`, kept where the node is
-//! within one tube radius of the surface (`g ≤ r`), else none (`n̄ = 0`). With
-//! `s = sign(w·n̄)` (`+1` where `w·n̄ ≥ 0` or `n̄ = 0`): `g = s d − r`, force `λN s n`. Past the
-//! centreline (`s = −1`) `g = −d − r < 0`: never open, pushed back along `s n` toward the
-//! committed side, the harder the farther it went.
-//!
-//! * *Continuity through the centreline.* On a path `x = C + t v` through a centreline point `C`
-//!   (`v` not along the centreline), `w = t m + O(t²)`, `m` the part of `v` normal to the
-//!   centreline, so near `t = 0`: `s = sign(t) sign(m·n̄)`, `s d = t |m| sign(m·n̄) + O(t²)` and
-//!   `s n = sign(m·n̄) m/|m| + O(t)`. `g = s d − r` passes through `−r` linearly and the force
-//!   `k_n (r − s d) s n` tends to `k_n r sign(m·n̄) m/|m|` from both sides: both continuous,
-//!   where `n` alone reverses (`gap_force_and_surface_coordinates_are_continuous_through_the_
-//!   centreline`). Away from the centreline the border `w·n̄ = 0` of the two regimes is a jump
-//!   (`g` by `2d`, the force reversed); a node reaches it only by going a quarter turn round
-//!   the tube within one increment, which is why a node farther than a radius off the surface
-//!   remembers no side (a distant node may swing round a support; one carried through from
-//!   there is not held back).
-//! * *Tangent.* `s` is constant within a regime: `∇g = s n`, `∂(s n)/∂x = s ∂n/∂x`,
-//!   `∇λN = −k_n s n`, so the tangent below holds with `n → s n`, `∂n/∂x → s ∂n/∂x`:
-//!   `k_n n⊗n − λN s ∂n/∂x − …` (`(s n)⊗(s n) = n⊗n`); checked against central differences
-//!   past the centreline in every status (`tangent_matches_finite_differences_past_the_
-//!   centreline_in_every_status`).
-//! * *Friction coordinates.* A node past the centreline slides in the committed side's `ξ`,
-//!   continuously through the centreline, so its anchor keeps its meaning. `ξ1 = g(u)` on a
-//!   smooth part, `ξ1(E) + t_E·w` on a cap and `ξ2` are functions of the closest point and of
-//!   `x` that do not see `s`: continuous through the centreline as they are. Round a cylinder
-//!   and a polyline's corner `ξ1` is an angle of `w` round the centreline, which jumps by `π`
-//!   where `w` reverses: it is taken of `s w` instead (the angle of the committed side's point
-//!   the node is pushed to), constant along a path through the centreline; `φ(−q) = φ(q) ± π`,
-//!   so `∇ξ1`, `∇²ξ1` are the formulas above with the node's own `q` (a node past the
-//!   centreline moving along `T` moves that point the other way: `∇ξ1 = (r/ρ) T` with `T`
-//!   reversed). The cylinder's stored angle is that of `s q`. Near a polyline's vertex a node
-//!   past the centreline may project on a segment (the crease side): `ξ1` differs there from
-//!   the corner's by up to `r|Δ|`, as at the crease.
-//!
+//! Normal: gap `g = d − r`, contact force `λN = k_n ⟨−g⟩` along `n` (the paper's penalty).
 //! Friction (penalty `k_s`, history `ξ̄` of the last converged state): trial
 //! `f = −k_s (ξ − ξ̄)`; `isotropic`: Coulomb cone `|f| ≤ μλN`, returned to it along `f`;
 //! `sliding-direction` (the paper's law): `ξ1` slides at `|f1| = μλN`, `ξ2` stays elastic up to
 //! the cross hold `|f2| ≤ κλN` (`FrictionLaw::CROSS_HOLD`; the gap module's "cross hold at
 //! lift-off": the hold goes to zero with the normal force).
-//! Force on the film `F = λN s n + Σ fα ∇ξα`; consistent tangent of `−F`:
-//! `k_n n⊗n − λN s ∂n/∂x − Σ (∂fα/∂ξβ) ∇ξα⊗∇ξβ − Σ (∂fα/∂λN) ∇ξα⊗∇λN − Σ fα ∇²ξα`
-//! (`∇λN = −k_n s n`), checked against central differences in every status and region
+//! Force on the film `F = λN n + Σ fα ∇ξα`; consistent tangent of `−F`:
+//! `k_n n⊗n − λN ∂n/∂x − Σ (∂fα/∂ξβ) ∇ξα⊗∇ξβ − Σ (∂fα/∂λN) ∇ξα⊗∇λN − Σ fα ∇²ξα`
+//! (`∇λN = −k_n n`), checked against central differences in every status and region
 //! (`tangent_matches_finite_differences_in_every_status`). The slip reported is `ξ1 − ξ1(0)`:
 //! the length the node has travelled along the support, as the experiment measured it.
 //! Source of the formulas: the project's note on node-to-curve contact (derived and
@@ -134,12 +94,6 @@ pub struct ContactHistory {
     pub status: GapStatus,
     /// Friction coefficient.
     pub friction: f64,
-    /// Outward unit normal `n̄` of the side the node was on at the converged state (the contact
-    /// direction `s n` there; module doc, "Side memory"); zero where none is remembered (the
-    /// node was more than one tube radius off the surface, or the state was written before
-    /// issue 46): then `s = +1`.
-    #[serde(default)]
-    pub side: [f64; 3],
 }
 
 /// Force on the film, tangent and status of a contact at one iterate.
@@ -162,15 +116,6 @@ pub struct ContactResponse {
     pub next_anchor: Vector2<f64>,
     /// [`Projection::parameter`] at this iterate.
     pub angle: f64,
-    /// The side to commit if it converges ([`ContactHistory::side`]): the contact direction
-    /// `s n`, or zero more than one tube radius off the surface.
-    pub side: Vector3<f64>,
-}
-
-/// `s = sign(w·n̄)`: −1 where `w` points against the committed side `n̄`, else +1 (also
-/// where none is remembered, `n̄ = 0`).
-fn side_sign(w: &Vector3<f64>, side: &Vector3<f64>) -> f64 {
-    if w.dot(side) < 0.0 { -1.0 } else { 1.0 }
 }
 
 /// `e⊗T + T⊗e`.
@@ -243,23 +188,12 @@ impl SurfaceContact {
         }
     }
 
-    /// The projection of the point `x` on the side it is on (`s = +1`), an angle unwrapped
-    /// toward `near` (the last converged [`Projection::parameter`]): the plain geometry.
+    /// The projection of the point `x`, an angle unwrapped toward `near` (the last converged
+    /// [`Projection::parameter`]).
     pub fn project(&self, x: &Vector3<f64>, near: f64) -> Projection {
-        self.project_on_side(x, near, &Vector3::zeros())
-    }
-
-    /// The projection of `x` from the converged `history`: its angle, and its side `n̄`
-    /// (`s = sign(w·n̄)`; module doc, "Side memory").
-    pub fn project_from(&self, x: &Vector3<f64>, history: &ContactHistory) -> Projection {
-        self.project_on_side(x, history.angle, &Vector3::from(history.side))
-    }
-
-    /// [`Self::project`] with the committed side `side` (zero: none, `s = +1`).
-    fn project_on_side(&self, x: &Vector3<f64>, near: f64, side: &Vector3<f64>) -> Projection {
         let r = self.tube_radius;
         let (path, p, origin) = match &self.shape {
-            Shape::Cylinder(f) => return self.project_on_cylinder(f, x, near, side),
+            Shape::Cylinder(f) => return self.project_on_cylinder(f, x, near),
             Shape::Curve {
                 path,
                 normal,
@@ -275,7 +209,6 @@ impl SurfaceContact {
         let w = x - point;
         let d = w.norm();
         let n = w / d;
-        let sign = side_sign(&w, side);
         let nn = n * n.transpose();
         let (parameter, region, dn, xi1, grad1, hessian1) = match foot {
             Foot::Smooth { u, c, g } => {
@@ -294,14 +227,12 @@ impl SurfaceContact {
                 )
             }
             Foot::Corner { u, base, start, .. } => {
-                // ξ1 = base + r ψ, ψ the angle of s w's in-plane part about p from `start`
-                // (ψ(−q) = ψ(q) ± π: the same derivatives).
+                // ξ1 = base + r ψ, ψ the angle of w's in-plane part about p from `start`.
                 let q = w - p * p.dot(&w);
                 let rho = q.norm();
                 let e = q / rho;
                 let t = p.cross(&e);
-                let sq = q * sign;
-                let psi = start.cross(&sq).dot(p).atan2(start.dot(&sq));
+                let psi = start.cross(&q).dot(p).atan2(start.dot(&q));
                 (
                     u,
                     Region::Corner,
@@ -321,11 +252,10 @@ impl SurfaceContact {
             ),
         };
         Projection {
-            gap: sign * d - r,
-            normal: n * sign,
-            side: sign,
+            gap: d - r,
+            normal: n,
             parameter,
-            normal_derivative: dn * sign,
+            normal_derivative: dn,
             xi: Vector2::new(xi1, p.dot(&(x - origin))),
             grad: [grad1, *p],
             hessian: [hessian1, Matrix3::zeros()],
@@ -333,30 +263,21 @@ impl SurfaceContact {
         }
     }
 
-    /// A cylinder: `ξ1 = r φ` round the axis (`φ` the angle of `s q`: `φ(−q) = φ(q) + π`,
-    /// the same derivatives), `ξ2` along it; `side` the committed side.
-    fn project_on_cylinder(
-        &self,
-        f: &Frame,
-        x: &Vector3<f64>,
-        near: f64,
-        side: &Vector3<f64>,
-    ) -> Projection {
+    /// A cylinder: `ξ1 = r φ` round the axis, `ξ2` along it.
+    fn project_on_cylinder(&self, f: &Frame, x: &Vector3<f64>, near: f64) -> Projection {
         let a = f.a;
         let rel = x - f.centre;
         let q = rel - a * a.dot(&rel);
         let rho = q.norm();
         let e_rho = q / rho;
         let t = a.cross(&e_rho);
-        let sign = side_sign(&q, side);
-        let angle = unwrapped_angle(f, &(q * sign), near);
+        let angle = unwrapped_angle(f, &q, near);
         let r = self.tube_radius;
         Projection {
-            gap: sign * rho - r,
-            normal: e_rho * sign,
-            side: sign,
+            gap: rho - r,
+            normal: e_rho,
             parameter: angle,
-            normal_derivative: t * t.transpose() * (sign / rho),
+            normal_derivative: t * t.transpose() / rho,
             xi: Vector2::new(r * angle, a.dot(&rel)),
             grad: [t * (r / rho), a],
             hessian: [sym(&e_rho, &t) * (-r / (rho * rho)), Matrix3::zeros()],
@@ -378,10 +299,9 @@ impl SurfaceContact {
         history: &ContactHistory,
         held: Option<GapStatus>,
     ) -> ContactResponse {
-        let p = self.project_from(x, history);
+        let p = self.project(x, history.angle);
         let anchor = Vector2::from(history.anchor);
         let lambda = -self.kn * p.gap;
-        let side = self.side_to_remember(&p);
         let limit = history.friction * lambda;
         let trial = -(p.xi - anchor) * self.ks;
         let cross = FrictionLaw::cross_limit(lambda, history.friction);
@@ -406,7 +326,6 @@ impl SurfaceContact {
             // An open contact forgets its anchor: it sticks where it touches down next.
             next_anchor: p.xi,
             angle: p.parameter,
-            side,
         };
         if status == GapStatus::Open {
             return open;
@@ -478,17 +397,6 @@ impl SurfaceContact {
             // f = −k_s (ξ − ξ̄_new): the anchor the committed friction force implies.
             next_anchor: p.xi + f / self.ks,
             angle: p.parameter,
-            side,
-        }
-    }
-
-    /// The side a node at projection `p` commits: the contact direction `s n` within one tube
-    /// radius of the surface (`g ≤ r`), else none (zero).
-    fn side_to_remember(&self, p: &Projection) -> Vector3<f64> {
-        if p.gap <= self.tube_radius {
-            p.normal
-        } else {
-            Vector3::zeros()
         }
     }
 
@@ -516,17 +424,8 @@ impl SurfaceContact {
         length_tolerance: f64,
         force_tolerance: f64,
     ) -> Result<(), String> {
-        let gap = self.project_from(x, history).gap;
+        let gap = self.project(x, history.angle).gap;
         let r = self.respond(x, history);
-        let side = Vector3::from(history.side);
-        // The side a converged state commits is the one it is on (zero: none remembered).
-        if side != Vector3::zeros() && (side - r.side).norm() > 1e-9 {
-            return Err(format!(
-                "its committed side {:?} is not the side the node is on ({:?})",
-                history.side,
-                r.side.as_slice()
-            ));
-        }
         let anchor = Vector2::from(history.anchor);
         let moved = (r.next_anchor - anchor).norm() * self.ks;
         let trial = -(r.xi - anchor) * self.ks;
@@ -561,8 +460,6 @@ impl SurfaceContact {
     pub fn initial_history(&self, x0: &Vector3<f64>, mu: f64) -> ContactHistory {
         let p = self.project(x0, 0.0);
         ContactHistory {
-            // The side the node starts on.
-            side: self.side_to_remember(&p).into(),
             anchor: p.xi.into(),
             angle: p.parameter,
             origin: p.xi.x,
@@ -677,8 +574,8 @@ impl SurfaceContacts {
             if h.status == GapStatus::Open || !free(c.node) {
                 continue;
             }
-            let before = c.project_from(&self.position(c, start), h).gap;
-            let now = c.project_from(&self.position(c, u), h);
+            let before = c.project(&self.position(c, start), h.angle).gap;
+            let now = c.project(&self.position(c, u), h.angle);
             if now.gap < before {
                 for k in 0..3 {
                     u[3 * c.node + k] += now.normal[k] * (before - now.gap);
@@ -747,7 +644,6 @@ impl SurfaceContacts {
             .map(|(r, h)| ContactHistory {
                 anchor: r.next_anchor.into(),
                 angle: r.angle,
-                side: r.side.into(),
                 status: r.status,
                 // Slip is sliding in contact: a step that starts open (where the anchor is the
                 // node's `ξ1`) moves the origin with the node, so its travel is not counted.
@@ -771,7 +667,7 @@ impl SurfaceContacts {
     ) -> Result<(), (usize, String)> {
         for (k, (c, h)) in self.contacts.iter().zip(histories).enumerate() {
             let x = self.position(c, u);
-            let lambda = c.kn * (-c.project_from(&x, h).gap).max(0.0);
+            let lambda = c.kn * (-c.project(&x, h.angle).gap).max(0.0);
             let force = 1e-6 * (h.friction * lambda).max(c.ks * 1e-9 * size);
             c.check_committed(&x, h, 1e-9 * size, force)
                 .map_err(|e| (k, e))?;
@@ -785,7 +681,7 @@ impl SurfaceContacts {
             .iter()
             .zip(histories)
             .filter(|(_, h)| h.status != GapStatus::Open)
-            .map(|(c, h)| -c.project_from(&self.position(c, u), h).gap)
+            .map(|(c, h)| -c.project(&self.position(c, u), h.angle).gap)
             .fold(0.0, f64::max)
     }
 
@@ -796,7 +692,7 @@ impl SurfaceContacts {
             .zip(histories)
             .map(|(c, h)| {
                 let x = self.position(c, u);
-                let p = c.project_from(&x, h);
+                let p = c.project(&x, h.angle);
                 let x0 = c.project(&self.reference[c.node], 0.0);
                 let r = c.respond(&x, h);
                 SurfaceContactResult {

@@ -171,17 +171,14 @@ pub enum Region {
 /// Where a node is relative to a support.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Projection {
-    /// Gap `g = s d − r` (negative: penetration).
+    /// Gap `g = d − r` (negative: penetration).
     pub gap: f64,
-    /// Contact direction `s n`: the outward unit normal of the support's surface at the point
-    /// on the committed side the node is pushed to.
+    /// Outward unit normal of the support at the closest point.
     pub normal: Vector3<f64>,
-    /// `s = sign(w·n̄)`: +1 on the committed side (or none committed), −1 past the centreline.
-    pub side: f64,
     /// Unwrapped angle `φ` about the axis (cylinder, circle), the parameter `s` of the closest
     /// point (parabola) or its arc length from the first point (polyline).
     pub parameter: f64,
-    /// `∂(s n)/∂x = s ∂n/∂x`.
+    /// `∂n/∂x`.
     pub normal_derivative: Matrix3<f64>,
     /// Surface coordinates `[ξ1, ξ2]` and their gradients and Hessians.
     pub xi: Vector2<f64>,
