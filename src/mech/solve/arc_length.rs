@@ -22,14 +22,13 @@
 //!
 //! [`StepError::LimitPoint`]: crate::mech::solve::report::StepError::LimitPoint
 
-use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
 use crate::mech::solve::assembly::Dof;
-use crate::mech::solve::increments::STRATEGIES;
+use crate::mech::solve::increments::{STRATEGIES, StepPath};
 use crate::mech::solve::newton::max_abs;
 use crate::mech::solve::report::StepReport;
 use crate::mech::solve::report::{IncrementFailure, IterationRecord};
-use crate::mech::solve::state::{AnalysisState, GroupMotion};
+use crate::mech::solve::state::AnalysisState;
 
 /// How the arc-length row ended a step's path.
 pub(super) enum ArcEnd {
@@ -56,14 +55,6 @@ pub(super) struct ArcStep {
     pub residuals: Vec<f64>,
 }
 
-/// The path of the load factor: the boundary's motion (still) and the levels at each `λ`.
-pub(super) trait LoadPath {
-    /// The boundary motion (the same at every `λ`).
-    fn still(&self) -> GroupMotion;
-    /// The load levels at `λ`.
-    fn at(&self, lambda: f64) -> LoadLevels;
-}
-
 impl Analysis {
     /// One arc-length increment of length `ds` from the converged `start` at `lambda`,
     /// continuing the direction of the last converged `previous` `ΔU` (None: towards larger
@@ -71,14 +62,14 @@ impl Analysis {
     pub(super) fn arc_increment(
         &mut self,
         start: &AnalysisState,
-        path: &dyn LoadPath,
+        path: &StepPath,
         (lambda, ds): (f64, f64),
         previous: Option<&[f64]>,
     ) -> Result<ArcStep, IncrementFailure> {
         for c in self.parts.all_mut() {
             c.restore(start);
         }
-        let motion = path.still();
+        let motion = path.motion(0.0);
         let mut u = start.displacement.clone();
         let b = self.load_tangent(&u, path, lambda, 0)?;
         let b_norm = dot(&b, &b).sqrt();
@@ -118,7 +109,7 @@ impl Analysis {
             if record.residual <= record.residual_tolerance
                 && record.correction <= record.correction_tolerance
             {
-                let levels = path.at(lambda + dl);
+                let levels = path.levels(lambda + dl);
                 let (state, residuals) =
                     self.commit_increment(start, &motion, &levels, u, residuals, iteration)?;
                 return Ok(ArcStep {
@@ -155,14 +146,14 @@ impl Analysis {
     fn load_tangent(
         &mut self,
         u: &[f64],
-        path: &dyn LoadPath,
+        path: &StepPath,
         lambda: f64,
         iteration: usize,
     ) -> Result<Vec<f64>, IncrementFailure> {
         let h = 1e-6 * lambda.abs().max(1.0);
-        self.assemble_at(u, &path.at(lambda + h), None);
+        self.assemble_at(u, &path.levels(lambda + h), None);
         let shifted = self.work.internal.clone();
-        self.assemble_at(u, &path.at(lambda), Some(iteration));
+        self.assemble_at(u, &path.levels(lambda), Some(iteration));
         for (i, d) in self.system.dofs.iter().enumerate() {
             if let Dof::Free(eq) = d {
                 self.work.rhs[*eq] = (self.work.internal[i] - shifted[i]) / h;
@@ -259,7 +250,7 @@ impl Analysis {
     pub(super) fn follow_arc(
         &mut self,
         current: &mut AnalysisState,
-        path: &dyn LoadPath,
+        path: &StepPath,
         (from, smallest): (f64, f64),
         report: &mut StepReport,
         row: usize,
@@ -351,12 +342,12 @@ impl Analysis {
     fn finish_arc(
         &mut self,
         current: &mut AnalysisState,
-        path: &dyn LoadPath,
+        path: &StepPath,
         report: &mut StepReport,
         row: usize,
         lambda: f64,
     ) -> Option<AnalysisState> {
-        let attempt = self.solve_increment(current, &path.still(), &path.at(1.0), None);
+        let attempt = self.solve_increment(current, &path.motion(0.0), &path.levels(1.0), None);
         let noted = attempt.as_ref().map(|(_, h)| h.as_slice());
         self.note_attempt(
             report,

@@ -3,7 +3,7 @@
 use crate::mech::elements::gap::IterationMatrix;
 use crate::mech::elements::load::LoadLevels;
 use crate::mech::solve::analysis::Analysis;
-use crate::mech::solve::arc_length::{ArcEnd, LoadPath};
+use crate::mech::solve::arc_length::ArcEnd;
 use crate::mech::solve::assembly::Dof;
 use crate::mech::solve::newton::max_abs;
 use crate::mech::solve::progress::IncrementNote;
@@ -77,7 +77,7 @@ pub const STRATEGIES: [Strategy; 6] = [
 
 /// The straight path of a step in the inputs: groups, angles and load levels from the converged
 /// state's to the step's targets.
-struct StepPath<'a> {
+pub(super) struct StepPath<'a> {
     base: Vec<[f64; 3]>,
     base_angles: Vec<f64>,
     base_loads: LoadLevels,
@@ -88,7 +88,7 @@ struct StepPath<'a> {
 
 impl StepPath<'_> {
     /// The group translations and angles at the fraction `f` of the step.
-    fn motion(&self, f: f64) -> GroupMotion {
+    pub(super) fn motion(&self, f: f64) -> GroupMotion {
         GroupMotion {
             translation: self
                 .base
@@ -106,23 +106,13 @@ impl StepPath<'_> {
     }
 
     /// The load levels at the fraction `f` of the step.
-    fn levels(&self, f: f64) -> LoadLevels {
+    pub(super) fn levels(&self, f: f64) -> LoadLevels {
         self.base_loads.interpolate(self.loads, f)
     }
 
     /// Whether the boundary stands still over the step (its loads alone change).
     fn boundary_still(&self) -> bool {
         self.base.as_slice() == self.target && self.base_angles.as_slice() == self.angles
-    }
-}
-
-impl LoadPath for StepPath<'_> {
-    fn still(&self) -> GroupMotion {
-        self.motion(0.0)
-    }
-
-    fn at(&self, lambda: f64) -> LoadLevels {
-        self.levels(lambda)
     }
 }
 
