@@ -40,6 +40,7 @@ use std::fmt::Write as _;
 use std::time::Instant;
 
 use membrane_contact::fmi2::variables::DEFAULT_INCREMENTS_PER_STEP;
+use membrane_contact::mech::solve::{STRATEGIES, StepReport};
 use membrane_contact::mech::{Analysis, LoadLevels, Model, SolverSettings};
 use serde_json::{Value, json};
 
@@ -514,6 +515,46 @@ struct Outcome {
     over_bound: usize,
     seconds: f64,
     error: Option<String>,
+    /// Per row of the strategy table, then the step-end release rounds: increments converged,
+    /// their iterations, increments refused, their iterations.
+    by_row: [[usize; 4]; ROWS],
+}
+
+/// The rows of [`Outcome::by_row`]: the strategy table's and the release rounds'.
+const ROWS: usize = STRATEGIES.len() + 1;
+
+impl Outcome {
+    /// Adds a converged step's attempts to [`Self::by_row`].
+    fn add_attempts(&mut self, report: &StepReport) {
+        for a in &report.attempts {
+            let row = if a.from == 1.0 && a.to == 1.0 {
+                ROWS - 1
+            } else {
+                a.strategy
+            };
+            let k = if a.converged { 0 } else { 2 };
+            self.by_row[row][k] += 1;
+            self.by_row[row][k + 1] += a.iterations;
+        }
+    }
+}
+
+/// Prints the iterations spent per row of the strategy table, converged and refused.
+fn print_rows(results: &[Outcome]) {
+    println!(
+        "\n| row | increments converged | their iterations | refused | their iterations |\n|---|---|---|---|---|"
+    );
+    for row in 0..ROWS {
+        let sum = |k: usize| results.iter().map(|r| r.by_row[row][k]).sum::<usize>();
+        let name = STRATEGIES.get(row).map_or("step-end release", |s| s.name);
+        println!(
+            "| {name} | {} | {} | {} | {} |",
+            sum(0),
+            sum(1),
+            sum(2),
+            sum(3)
+        );
+    }
 }
 
 fn run(path: &HeldOut, increments: usize) -> Outcome {
@@ -576,6 +617,7 @@ fn run(path: &HeldOut, increments: usize) -> Outcome {
                     o.increments += report.iterations.len();
                     o.cutbacks += report.cutbacks;
                     o.stabilized += report.stabilized;
+                    o.add_attempts(&report);
                     o.over_bound += usize::from(
                         report.stabilization_warning().is_some()
                             || report.dissipation_ratio() > 1.0,
@@ -740,6 +782,7 @@ fn main() {
     for row in &bound_rows {
         println!("{row}");
     }
+    print_rows(&results);
     let over: Vec<String> = paths
         .iter()
         .zip(&results)

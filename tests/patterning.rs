@@ -1647,8 +1647,10 @@ fn the_chosen_settling_amplitude_is_half_the_prestress_length_change_of_the_long
 fn settle_auto_chooses_and_reports_its_amplitude_and_settles_the_drum_film_to_its_prestress() {
     // `--settle auto` on the drum (μ = 0.3, rails down 0.10 m and out 0.03 m): the amplitude is
     // half the prestress's length change of the strip (reported, with the ratio 0.7 and 12
-    // waypoints), and the film ends sticking everywhere within 5 % away from the rails, where
-    // the path alone leaves it sliding 21 % off (the test above).
+    // waypoints), and the film ends sticking everywhere within 6 % away from the rails, where
+    // the path alone leaves it sliding 21 % off (the test above). The friction's answer depends
+    // on the path: 5.48 % with these 10 increments an erection, 5.64 % with 40 (the path
+    // followed finely; 4.64 % at 10 before hopeless increments were refused early, issue 41).
     let drum = format!("{}/examples/drum.json", env!("CARGO_MANIFEST_DIR"));
     let report = std::env::temp_dir().join(format!("drum-auto-{}.json", std::process::id()));
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_membrane-contact"))
@@ -1681,7 +1683,7 @@ fn settle_auto_chooses_and_reports_its_amplitude_and_settles_the_drum_film_to_it
     assert!(stderr.contains("settling: amplitude"), "{stderr}");
     let end = &json["erections"][0];
     assert!(
-        end["max_error"].as_f64().unwrap() < 0.05,
+        end["max_error"].as_f64().unwrap() < 0.06,
         "{}",
         end["max_error"]
     );

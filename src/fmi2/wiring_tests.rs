@@ -519,7 +519,7 @@ fn changed(v: &Variable, x: &Value, directory: &Path) -> (Value, Vec<(&'static s
             vec![("solver.displacementTolerance", Value::Real(0.1))],
         ),
         // So few that increments are cut back (and the step still converges).
-        ("solver.maxIterations", _) => alone(Value::Integer(6)),
+        ("solver.maxIterations", _) => alone(Value::Integer(3)),
         // Cut-backs happen only when the iterations run out.
         ("solver.maxCutbacks", _) => (
             Value::Integer(1),

@@ -177,13 +177,10 @@ impl Controller {
     /// the path, the backward-Euler increment then may reach another equilibrium than the
     /// quasi-static one (the edge-cabled suction panel's last lowering step: mid −55.0 mm
     /// whole, −9.9 mm in ten increments). Without a history the answer is the same however the
-    /// step is cut, and a slow increment stands; so does a stabilized one, whose path the
-    /// damping's pseudo-time already follows increment by increment.
+    /// step is cut, and a slow increment stands. The same holds in every row: a stabilized
+    /// increment's damping is sized by its pseudo-time, so a halved one is damped alike.
     fn keeps(&self, n: f64, dissipative: bool) -> bool {
-        n <= 2.0 * Analysis::TARGET_ITERATIONS as f64
-            || !dissipative
-            || self.row > 0
-            || !self.can_halve()
+        n <= 2.0 * Analysis::TARGET_ITERATIONS as f64 || !dissipative || !self.can_halve()
     }
 
     /// Whether the next increment can be halved within `max_cutbacks`.
@@ -347,7 +344,7 @@ impl Analysis {
             self.parts
                 .stabilization
                 .set(STRATEGIES[row].damping, to - from);
-            let limit = (row == 0 && control.can_halve()).then_some(2 * Self::TARGET_ITERATIONS);
+            let limit = control.can_halve().then_some(2 * Self::TARGET_ITERATIONS);
             let attempt = self.solve_increment(&current, &path.motion(to), &path.levels(to), limit);
             let kept = attempt.as_ref().map_or(true, |(state, history)| {
                 let n = self.judged_iterations(history.len() - 1);
@@ -588,7 +585,10 @@ impl Analysis {
         (how, kept): (&'static str, bool),
         outcome: Result<&[f64], &IncrementFailure>,
     ) {
-        let iterations = outcome.map_or(0, |h| h.len().saturating_sub(1));
+        let iterations = match outcome {
+            Ok(h) => h.len().saturating_sub(1),
+            Err(failure) => failure.iterations(),
+        };
         self.observer.note(|| IncrementNote {
             from,
             to,

@@ -183,6 +183,37 @@ impl Iterates {
         self.progress.note(record) || continuing
     }
 
+    /// Whether the iterate `record` of an increment held to `limit` iterations is past it: at
+    /// the limit, or (from the fourth) still moving (its correction above its tolerance) with
+    /// a residual that fell by less than [`Analysis::PROGRESS`] a step over the last three
+    /// iterations and, at that rate, would not reach its tolerance within the limit. A
+    /// residual at its rounding floor stalls too, but its corrections are within tolerance.
+    fn past(&self, limit: usize, record: &IterationRecord) -> bool {
+        let (r, iteration) = (&self.residuals, record.iteration);
+        let (n, tolerance) = (r.len(), record.residual_tolerance);
+        if iteration >= limit {
+            return iteration == limit;
+        }
+        if iteration < 4
+            || r[n - 1] <= tolerance
+            || record.correction <= record.correction_tolerance
+        {
+            return false;
+        }
+        let rate = (r[n - 1] / r[n - 4]).cbrt();
+        let left = (limit - iteration) as f64;
+        rate >= Analysis::PROGRESS
+            && (rate >= 1.0 || (tolerance / r[n - 1]).ln() / rate.ln() > left)
+    }
+
+    /// Whether the last [`Analysis::MEMORY`] merits repeat with period two (each within
+    /// 1e-3 of the one two before): Newton's map has a stable 2-cycle, which the same
+    /// iteration never leaves.
+    fn orbits(&self) -> bool {
+        let m = &self.merits;
+        m.len() == Analysis::MEMORY && (2..m.len()).all(|k| (m[k] - m[k - 2]).abs() <= 1e-3 * m[k])
+    }
+
     /// Newton's iteration afresh from the same iterate at `iteration` (the laws were held or
     /// released).
     fn restart(&mut self, iteration: usize) {
@@ -246,9 +277,10 @@ impl Analysis {
             if met && it.hold.held.is_empty() {
                 return self.commit_increment(start, motion, levels, it.u, it.residuals, iteration);
             }
-            // An increment that changes a history and needs more iterations than the controller
-            // keeps of one is refused now, not after it converged (`Controller::keeps`).
-            if dissipative_limit == Some(iteration)
+            // An increment that changes a history is refused once it needs more iterations than
+            // the controller keeps of one (`Controller::keeps`), or sooner where its residual
+            // stagnates short of its tolerance: not after it converged.
+            if dissipative_limit.is_some_and(|limit| it.past(limit, &record))
                 && self.changes_history(start, motion, levels, &it.u)
             {
                 return Err(IncrementFailure::PathDependent { iteration });
@@ -262,6 +294,11 @@ impl Analysis {
                 self.parts.hold(&held);
                 it.restart(iteration);
                 continue;
+            }
+            // A 2-cycle of Newton's map on one piece of the laws: the same iteration never
+            // leaves it.
+            if it.orbits() {
+                return Err(self.failure(&it, record, true));
             }
             if iteration > 3 && record.residual > 1e6 * it.residuals[0].max(force_scale) {
                 return Err(IncrementFailure::Diverged { iteration });
@@ -734,5 +771,72 @@ mod tests {
         assert!(p.note(record(4, 8.0, 100.0)));
         assert_eq!((p.best, p.best_correction), (8.0, 4.4));
         assert_eq!(p.closest.unwrap().iteration, 2);
+    }
+}
+
+#[cfg(test)]
+mod refusal_tests {
+    use super::*;
+
+    /// An iterate record with the residual `r` (tolerance 1) and the correction `dx` (tolerance 1).
+    fn record(iteration: usize, r: f64, dx: f64) -> IterationRecord {
+        IterationRecord {
+            iteration,
+            residual: r,
+            residual_tolerance: 1.0,
+            correction: dx,
+            correction_tolerance: 1.0,
+        }
+    }
+
+    /// Iterates whose residuals were `r` and whose merits were `m`.
+    fn iterates(r: &[f64], m: &[f64]) -> Iterates {
+        let mut it = Iterates::new(vec![0.0], false);
+        it.residuals = r.to_vec();
+        it.merits = m.to_vec();
+        it
+    }
+
+    /// An increment held to 12 iterations is past its limit at the 12th; before it, from the
+    /// fourth, only where the residual falls by less than a tenth a step over three
+    /// iterations, the correction still moves, and the rate cannot reach the tolerance in the
+    /// iterations left; a residual at its rounding floor (correction within tolerance) is not.
+    #[test]
+    fn an_increment_is_past_its_limit_where_its_residual_stagnates_while_it_still_moves() {
+        let creeping = iterates(&[400.0, 14.3, 14.2, 14.05, 13.9], &[]);
+        assert!(creeping.past(12, &record(4, 13.9, 8e-5 * 1e6)));
+        assert!(
+            !creeping.past(12, &record(3, 13.9, 1e2)),
+            "not before the fourth"
+        );
+        assert!(
+            !creeping.past(12, &record(4, 13.9, 0.5)),
+            "the correction within its tolerance: a rounding floor"
+        );
+        let quadratic = iterates(&[400.0, 14.0, 1.4, 0.14, 1.2], &[]);
+        assert!(!quadratic.past(12, &record(4, 1.2, 10.0)));
+        let linear = iterates(&[400.0, 1000.0, 800.0, 640.0, 512.0], &[]);
+        assert!(
+            !linear.past(12, &record(4, 512.0, 10.0)),
+            "a fifth off a step is progress, left to the limit however far"
+        );
+        let near = iterates(&[400.0, 1.3, 1.25, 1.2, 1.15], &[]);
+        assert!(
+            !near.past(12, &record(4, 1.15, 10.0)),
+            "at that rate the tolerance is 3.4 iterations away, 8 are left"
+        );
+        assert!(near.past(7, &record(4, 1.15, 10.0)), "3 left");
+        assert!(quadratic.past(12, &record(12, 1.2, 10.0)), "at the limit");
+        assert!(!quadratic.past(12, &record(13, 1.2, 10.0)), "judged once");
+    }
+
+    /// Merits that repeat with period two, each within 1e-3 of the one two before, are an
+    /// orbit; a slow fall, or a full memory not yet reached, is not.
+    #[test]
+    fn merits_repeating_with_period_two_are_an_orbit_and_a_slow_fall_is_not() {
+        assert!(iterates(&[], &[2.304, 2.292, 2.3045, 2.2921]).orbits());
+        assert!(!iterates(&[], &[2.304, 2.292, 2.304]).orbits());
+        assert!(!iterates(&[], &[2.304, 2.292, 2.28, 2.27]).orbits());
+        assert!(!iterates(&[], &[2.304, 1.0, 2.304, 0.5]).orbits());
     }
 }

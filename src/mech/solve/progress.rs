@@ -14,7 +14,7 @@ pub struct IncrementNote {
     pub to: f64,
     /// How it was solved (`"Newton"`, `"continuation"`, `"stabilized"`, …) or, refused, tried.
     pub attempt: &'static str,
-    /// Newton iterations of the converged increment (0 where refused).
+    /// Newton iterations of the increment, converged or refused.
     pub iterations: usize,
     /// `‖R_free‖∞` at its end (N; NaN where refused).
     pub residual: f64,
@@ -37,7 +37,11 @@ impl fmt::Display for IncrementNote {
                 "{} in {} iterations, residual {:.3e} N",
                 self.attempt, self.iterations, self.residual
             )?,
-            Some(why) => write!(f, "refused ({why})")?,
+            Some(why) => write!(
+                f,
+                "refused ({why}) after {} iterations of {}",
+                self.iterations, self.attempt
+            )?,
         }
         write!(f, "; {} cut-backs so far", self.cutbacks)
     }

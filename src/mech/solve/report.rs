@@ -55,7 +55,7 @@ pub struct Attempt {
     /// The share of the step at its start and at its end.
     pub from: f64,
     pub to: f64,
-    /// Newton iterations (0 for a refused one).
+    /// Newton iterations, converged or refused (the cost of a refusal: [`IncrementFailure::iterations`]).
     pub iterations: usize,
     /// Whether it converged.
     pub converged: bool,
@@ -291,6 +291,17 @@ pub enum IncrementFailure {
 }
 
 impl IncrementFailure {
+    /// The Newton iterations made before the failure (0 where the matrix was singular at once).
+    pub fn iterations(&self) -> usize {
+        match self {
+            Self::MaxIterations { last, .. } => last.iteration,
+            Self::Stalled { iteration, .. }
+            | Self::PathDependent { iteration }
+            | Self::Diverged { iteration } => *iteration,
+            Self::Singular { .. } => 0,
+        }
+    }
+
     /// One phrase for a progress line (the [`fmt::Display`] text has the figures).
     pub fn phrase(&self) -> &'static str {
         match self {
