@@ -296,8 +296,9 @@ impl Analysis {
                 continue;
             }
             // A 2-cycle of Newton's map on one piece of the laws: the same iteration never
-            // leaves it.
-            if it.orbits() {
+            // leaves it (not at a residual within its tolerance: rounding, where the correction
+            // decides).
+            if it.orbits() && record.residual > record.residual_tolerance {
                 return Err(self.failure(&it, record, true));
             }
             if iteration > 3 && record.residual > 1e6 * it.residuals[0].max(force_scale) {
