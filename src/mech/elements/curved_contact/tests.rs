@@ -102,19 +102,24 @@ fn sampled_range(shape: &Shape) -> [f64; 2] {
     }
 }
 
+/// Uniform numbers in [−1, 1) from a 64-bit linear congruential generator seeded with `seed`
+/// (Knuth's MMIX constants): the same sequence on every platform.
+fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
 /// Central differences of the residual against the tangent, for random positions near the
 /// support (in every region of its surface: tube, polyline corners, end caps) and anchors
 /// chosen to give each status, for both friction laws.
 #[test]
 fn tangent_matches_finite_differences_in_every_status() {
     let mut seen = std::collections::HashSet::new();
-    let mut seed = 7u64;
-    let mut rand = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
+    let mut rand = uniform(7);
     for law in FrictionLaw::ALL {
         for (kind, centreline) in kinds() {
             let s = support(centreline, law);
@@ -238,13 +243,7 @@ fn tangent_matches_finite_differences_in_every_status() {
 /// reports the held status; nothing held is the law itself, and an open contact stays open.
 #[test]
 fn held_laws_tangent_matches_finite_differences_in_both_held_statuses() {
-    let mut seed = 11u64;
-    let mut rand = || {
-        seed = seed
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    };
+    let mut rand = uniform(11);
     let mut checked = std::collections::HashSet::new();
     for law in FrictionLaw::ALL {
         let s = support(ring(None), law);
