@@ -156,13 +156,16 @@ impl Controller {
     }
 
     /// After the increment to `to` converged in `n` iterations: `Δλ (N*/N)^½`, within a factor
-    /// [`Analysis::GROWTH`] of it and at most the largest.
+    /// [`Analysis::GROWTH`] of it, at most the largest and at least the smallest: where Newton
+    /// needs more than `N*` iterations however small the increment (a contact or film state
+    /// that changes within it), the rule would shrink it without end, a step in thousands of
+    /// increments that a halving would have refused to make.
     fn converged(&mut self, to: f64, n: f64) {
         self.last_size = to - self.done;
         self.done = to;
         let ratio = (Analysis::TARGET_ITERATIONS as f64 / n).sqrt();
-        self.size =
-            (self.size * ratio.clamp(1.0 / Analysis::GROWTH, Analysis::GROWTH)).min(self.largest);
+        self.size = (self.size * ratio.clamp(1.0 / Analysis::GROWTH, Analysis::GROWTH))
+            .clamp(self.smallest, self.largest);
         // The weakest damping that carries the step: one row back after each converged
         // increment of a stronger one (the work taken out grows with `c`, not with the size).
         if self.row > 0 && STRATEGIES[self.row - 1].damping > 0.0 {
@@ -842,6 +845,26 @@ mod tests {
         assert_eq!(first_within(&linear_tail, 1e-9), 6);
         assert_eq!(first_within(&[1e-6], 1e-5), 1, "a model without free DOFs");
         assert_eq!(first_within(&[1.0, 2e-6], 1e-5), 1);
+    }
+
+    /// The sizing rule `Δλ (N*/N)^½` shrinks an increment that needs many iterations, but
+    /// never below the smallest a halving reaches (else a step whose increments all need
+    /// `2 N*` iterations is cut into thousands), and never grows one above the largest.
+    #[test]
+    fn increments_are_sized_between_the_smallest_halving_and_the_largest() {
+        let mut control = Controller::new(4, 3, 2);
+        let slow = 2.0 * Analysis::TARGET_ITERATIONS as f64;
+        for _ in 0..40 {
+            let to = control.next();
+            control.converged(to, slow);
+        }
+        assert_eq!(control.size, 0.25 / 8.0, "held at the smallest increment");
+        assert!(!control.can_halve());
+        for _ in 0..40 {
+            let to = control.next();
+            control.converged(to, 1.0);
+        }
+        assert_eq!(control.size, 0.25, "grown back to the largest, not past it");
     }
 
     /// A moving boundary extrapolates by its ratio where it keeps the direction (within 8°) of
