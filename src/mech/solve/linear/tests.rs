@@ -156,16 +156,34 @@ fn failing_fast_paths_are_skipped_for_twice_as_many_solves_after_each_failure() 
     assert_eq!(solver.counts()[0], 16, "every solve by the LU");
     // After a success the next solve tries them again.
     let mut b = FastBackoff::default();
-    b.note(false);
+    b.note(false, 0);
     assert!(!b.tries(true) && b.tries(true));
-    b.note(true);
+    b.note(true, 0);
     assert!(b.tries(true));
-    (0..10).for_each(|_| b.note(false));
+    (0..10).for_each(|_| b.note(false, 0));
     assert_eq!(b.skip, 31, "at most 31 skipped");
     assert!(
         b.tries(false),
         "always tried where the LU is not affordable"
     );
+}
+
+/// A GMRES solution that took more iterations than an LU costs counts as a failure of the fast
+/// paths (the next solve goes to the LU); one within that count, or off GMRES's path, clears it.
+#[test]
+fn a_gmres_solution_dearer_than_the_lu_counts_as_a_failure_of_the_fast_paths() {
+    let mut b = FastBackoff::default();
+    b.note(true, GMRES_AS_DEAR_AS_LU + 1);
+    assert!(!b.tries(true), "the next solve skips the fast paths");
+    assert!(b.tries(true));
+    b.note(true, GMRES_AS_DEAR_AS_LU);
+    assert!(
+        b.tries(true),
+        "a solution within the count clears the record"
+    );
+    b.note(false, 0);
+    b.note(true, 0);
+    assert!(b.tries(true), "a direct or Woodbury solution clears it too");
 }
 
 /// A diagonally dominant symmetric matrix on the six equations plus `skew` (row, column,
