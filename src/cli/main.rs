@@ -468,9 +468,10 @@ impl Tally {
             );
         }
         let [lu, ldlt, redone, gmres] = analysis.factorization_counts();
+        let pivoted = analysis.solve_profile().lu_pivoted;
         out!(
-            "linear solves: {lu} LU, {ldlt} LDLᵀ, {gmres} GMRES on the symmetric part's LDLᵀ, \
-             {redone} of these redone by LU"
+            "linear solves: {lu} LU ({pivoted} with global pivoting), {ldlt} LDLᵀ, {gmres} GMRES \
+             on the symmetric part's LDLᵀ, {redone} of these redone by LU"
         );
     }
 }

@@ -20,9 +20,12 @@
 //!   so a Newton iteration costs one LDLᵀ and a block solve and keeps its quadratic convergence;
 //! * every solution is checked, `‖A x − b‖∞ ≤ 1e-9 (‖A‖∞‖x‖∞ + ‖b‖∞)` in every row; one that
 //!   fails (an indefinite matrix the unpivoted LDLᵀ cannot take, a Krylov space too small) is
-//!   redone by LU with partial pivoting (`faer` `SymbolicLu`, counted in
-//!   [`LinearSolver::counts`]). The LU's symbolic analysis is built at its first use: at 1 M DOF
-//!   it alone is larger than the LDLᵀ factor, and the fast paths usually never need it.
+//!   redone by LU (counted in [`LinearSolver::counts`]): on a structurally symmetric pattern
+//!   the multifrontal LU with pivoting inside its fronts (`frontal_lu.rs`), its solution
+//!   checked the same way, and where a front refuses a pivot or the check fails `faer`'s LU
+//!   with global partial pivoting (`SymbolicLu`, counted in [`SolveProfile::lu_pivoted`]).
+//!   The LU's symbolic analysis is built at its first use, and the fast paths usually never
+//!   need it.
 //!
 //! The factor of the last factorization is held: [`LinearSolver::solve_held`] solves another
 //! right-hand side with it (the same path, the Woodbury block `W` reused, every solution
@@ -43,7 +46,8 @@
 //! | `ldlt` | LDLᵀ of the symmetric part and the dispatch of a solve on it |
 //! | `woodbury` | the Woodbury correction for a skew part on few DOFs |
 //! | `gmres` | GMRES right-preconditioned by that LDLᵀ |
-//! | `lu` | LU with partial pivoting, the checked fallback |
+//! | `lu` | the LU, the checked fallback: frontal, else with global partial pivoting |
+//! | `frontal_lu` | the multifrontal LU on the symmetric pattern's tree, pivoting inside its fronts |
 //! | `ordering` | the fill-reducing ordering of the LDLᵀ analyses: AMD, or nested dissection from 100 k equations |
 //! | `pool` | the LDLᵀ numeric factorization on a scoped thread pool ([`LinearSolver::set_threads`]) |
 //! | `tests` | the solver's tests |
@@ -59,6 +63,7 @@ use faer::{Conj, MatMut, Par};
 
 use crate::mech::solve::assembly::{Dof, System};
 
+mod frontal_lu;
 mod gmres;
 mod ldlt;
 mod lu;
@@ -126,6 +131,9 @@ pub struct SolveProfile {
     pub lu: Duration,
     /// Number of LU factorizations.
     pub lu_count: usize,
+    /// Of these, the ones redone with global partial pivoting after the frontal LU refused a
+    /// pivot or its solution failed the check.
+    pub lu_pivoted: usize,
     /// Solves with a held factor ([`LinearSolver::solve_held`]), no factorization.
     pub held_solves: usize,
 }
@@ -202,6 +210,8 @@ pub struct LinearSolver {
     factor_id: u64,
     /// Threads of the numeric LDLᵀ factorizations (resolved: at least 1).
     threads: usize,
+    /// The fill-reducing ordering of the LDLᵀ and frontal LU analyses.
+    ordering: FillOrdering,
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -222,9 +232,7 @@ impl Clone for LinearSolver {
                 factor: vec![0.0; factor.len()],
             },
             Kind::Full { lu, symmetric } => Kind::Full {
-                lu: lu
-                    .as_ref()
-                    .map(|l| Box::new(LuPart::new(l.symbolic.clone()))),
+                lu: lu.as_ref().map(|l| Box::new(l.fresh_copy())),
                 symmetric: symmetric.as_ref().map(|p| Box::new(p.fresh_copy())),
             },
         };
@@ -242,6 +250,7 @@ impl Clone for LinearSolver {
             held: Held::None,
             factor_id: 0,
             threads: self.threads,
+            ordering: self.ordering,
         }
     }
 }
@@ -281,7 +290,7 @@ impl LinearSolver {
             }
         } else {
             Kind::Full {
-                lu: Some(Box::new(LuPart::analyse(system.pattern())?)),
+                lu: Some(Box::new(LuPart::analyse(system.pattern(), ordering)?)),
                 symmetric: None,
             }
         };
@@ -306,6 +315,7 @@ impl LinearSolver {
             held: Held::None,
             factor_id: 0,
             threads: 1,
+            ordering,
         };
         solver.scratch = MemBuffer::new(solver.scratch_req());
         solver.profile.symbolic = started.elapsed();
@@ -416,12 +426,15 @@ impl LinearSolver {
         krylov
             + match &self.kind {
                 Kind::Ldlt { factor, .. } => factor.len() * f,
-                Kind::Full { symmetric, .. } => symmetric.as_ref().map_or(0, |p| {
-                    (p.factor.len() + p.symmetric_values.len() + p.block.len()) * f
-                        + p.transpose.len() * std::mem::size_of::<u32>()
-                        + (p.lower.col_ptr().len() + p.lower.row_idx().len())
-                            * std::mem::size_of::<usize>()
-                }),
+                Kind::Full { symmetric, lu } => {
+                    lu.as_ref().map_or(0, |l| l.factor_len() * f)
+                        + symmetric.as_ref().map_or(0, |p| {
+                            (p.factor.len() + p.symmetric_values.len() + p.block.len()) * f
+                                + p.transpose.len() * std::mem::size_of::<u32>()
+                                + (p.lower.col_ptr().len() + p.lower.row_idx().len())
+                                    * std::mem::size_of::<usize>()
+                        })
+                }
             }
     }
 
@@ -645,7 +658,6 @@ impl LinearSolver {
         matrix: SparseColMatRef<'_, usize, f64>,
         rhs: &mut [f64],
     ) -> Result<(), FactorizationError> {
-        let n = rhs.len();
         let limit = match self.method {
             UnsymmetricMethod::Auto => self.woodbury_limit(),
             UnsymmetricMethod::Gmres => 0,
@@ -687,29 +699,18 @@ impl LinearSolver {
                     rhs.copy_from_slice(&part.rhs);
                 }
                 if lu.is_none() {
+                    let ordering = self.ordering;
                     let analysed = timed(&mut self.profile.symbolic, || {
-                        LuPart::analyse(matrix.symbolic())
+                        LuPart::analyse(matrix.symbolic(), ordering)
                     })?;
                     *lu = Some(Box::new(analysed));
                 }
                 let lu = lu.as_mut().expect("analysed above");
                 self.counts[0] += 1;
                 self.profile.lu_count += 1;
-                let start = Instant::now();
-                let stack = MemStack::new(&mut lu.scratch);
-                let factored = lu
-                    .symbolic
-                    .factorize_numeric_lu(
-                        &mut lu.numeric,
-                        matrix,
-                        Par::Seq,
-                        stack,
-                        Default::default(),
-                    )
-                    .map_err(|e| FactorizationError(format!("LU: {e:?}")))?;
-                let x = MatMut::from_column_major_slice_mut(rhs, n, 1);
-                factored.solve_in_place_with_conj(Conj::No, x, Par::Seq, stack);
-                self.profile.lu += start.elapsed();
+                let pivoted = lu.pivoted;
+                timed(&mut self.profile.lu, || lu.factorize_and_solve(matrix, rhs))?;
+                self.profile.lu_pivoted += lu.pivoted - pivoted;
                 self.held = Held::Lu;
             }
         }

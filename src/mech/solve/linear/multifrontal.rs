@@ -70,19 +70,36 @@ pub(super) struct Tree {
     gather: Vec<(u32, u32)>,
 }
 /// A supernode's columns `begin..end` and off-diagonal row pattern.
-struct Node<'a> {
-    begin: usize,
-    end: usize,
-    pattern: &'a [usize],
+pub(super) struct Node<'a> {
+    pub(super) begin: usize,
+    pub(super) end: usize,
+    pub(super) pattern: &'a [usize],
 }
 
-fn node(sym: &SymbolicSupernodalCholesky<usize>, s: usize) -> Node<'_> {
+/// Supernode `s` of a supernodal analysis.
+pub(super) fn node(sym: &SymbolicSupernodalCholesky<usize>, s: usize) -> Node<'_> {
     let start = sym.col_ptr_for_row_idx()[s];
     Node {
         begin: sym.supernode_begin()[s],
         end: sym.supernode_end()[s],
         pattern: &sym.row_idx()[start..start + sym.nnz_per_super()[s]],
     }
+}
+
+/// The supernodes of a supernodal analysis and the supernode of each column; None for a
+/// simplicial analysis.
+pub(super) fn supernodes(
+    symbolic: &SymbolicCholesky<usize>,
+) -> Option<(&SymbolicSupernodalCholesky<usize>, Vec<usize>)> {
+    let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+        return None;
+    };
+    let mut of_column = vec![0; sym.nrows()];
+    for s in 0..sym.n_supernodes() {
+        let n = node(sym, s);
+        of_column[n.begin..n.end].fill(s);
+    }
+    Some((sym, of_column))
 }
 
 impl Tree {
@@ -92,15 +109,8 @@ impl Tree {
         symbolic: &SymbolicCholesky<usize>,
         lower: SymbolicSparseColMatRef<'_, usize>,
     ) -> Option<Self> {
-        let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
-            return None;
-        };
+        let (sym, of_column) = supernodes(symbolic)?;
         let count = sym.n_supernodes();
-        let mut of_column = vec![0; sym.nrows()];
-        for s in 0..count {
-            let n = node(sym, s);
-            of_column[n.begin..n.end].fill(s);
-        }
         let mut tree = Self {
             children: vec![Vec::new(); count],
             roots: Vec::new(),

@@ -20,9 +20,10 @@
 use faer::Side;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
-    SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
+    CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{FaerError, SymbolicSparseColMatRef};
 
@@ -472,20 +473,30 @@ pub(super) fn analyse(
     lower: SymbolicSparseColMatRef<'_, usize>,
     ordering: FillOrdering,
 ) -> Result<SymbolicCholesky<usize>, FaerError> {
+    analyse_with(lower, ordering, Default::default())
+}
+
+/// [`analyse`], supernodal whatever the size (the frontal LU's tree).
+pub(super) fn analyse_supernodal(
+    lower: SymbolicSparseColMatRef<'_, usize>,
+    ordering: FillOrdering,
+) -> Result<SymbolicCholesky<usize>, FaerError> {
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    analyse_with(lower, ordering, params)
+}
+
+fn analyse_with(
+    lower: SymbolicSparseColMatRef<'_, usize>,
+    ordering: FillOrdering,
+    params: CholeskySymbolicParams<'_>,
+) -> Result<SymbolicCholesky<usize>, FaerError> {
     if !ordering.dissects(lower.ncols()) {
-        return factorize_symbolic_cholesky(
-            lower,
-            Side::Lower,
-            SymmetricOrdering::Amd,
-            Default::default(),
-        );
+        return factorize_symbolic_cholesky(lower, Side::Lower, SymmetricOrdering::Amd, params);
     }
     let (order, inverse) = nested_dissection(lower);
     let perm = PermRef::new_checked(&order, &inverse, lower.ncols());
-    factorize_symbolic_cholesky(
-        lower,
-        Side::Lower,
-        SymmetricOrdering::Custom(perm),
-        Default::default(),
-    )
+    factorize_symbolic_cholesky(lower, Side::Lower, SymmetricOrdering::Custom(perm), params)
 }
