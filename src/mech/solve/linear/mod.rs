@@ -412,8 +412,9 @@ impl LinearSolver {
 
     /// Whether an LU of this system is cheap enough to replace the fast paths after they failed
     /// ([`FastBackoff`]): the symmetric part's LDLᵀ factor holds at most [`LU_AFFORDABLE`]
-    /// values (the LU of the unsymmetric pattern was measured at about 6× the LDLᵀ's memory
-    /// and 4–6× its time on the refined specimens).
+    /// values (faer's LU of the unsymmetric pattern was measured at about 6× the LDLᵀ's memory
+    /// and 4–6× its time on the refined specimens; the frontal LU holds about twice the
+    /// supernodal LDLᵀ's values).
     pub fn lu_affordable(&self) -> bool {
         self.factor_len() <= LU_AFFORDABLE
     }
@@ -752,9 +753,10 @@ impl FastBackoff {
 }
 
 /// GMRES iterations beyond which a solve on the symmetric part's LDLᵀ costs more than an LU of
-/// the same matrix: the LDLᵀ is about half the LU, and each iteration (a preconditioner solve, a
-/// product, the orthogonalization) about a twentieth of the LDLᵀ (the 7 k-DOF suction panel:
-/// LU 6.3 ms, LDLᵀ 3.3 ms, 0.3 ms an iteration); the share of an iteration falls with the size.
+/// the same matrix: the LDLᵀ was about half faer's LU, and each iteration (a preconditioner
+/// solve, a product, the orthogonalization) about a twentieth of the LDLᵀ (the 3.5 k-equation
+/// suction panel: faer's LU 6.3 ms, LDLᵀ 3.3 ms, 0.3 ms an iteration); the share of an
+/// iteration falls with the size. The frontal LU (2.3 ms there) makes it an upper bound.
 const GMRES_AS_DEAR_AS_LU: usize = 10;
 
 /// Most DOFs of the skew part for the Woodbury correction (its dense `|C| × |C|` system).
