@@ -184,7 +184,11 @@ impl FrontalLu {
             for c in 0..m {
                 u12[c * k..(c + 1) * k].copy_from_slice(&rest[c * r..c * r + k]);
             }
-            self.updates[s] = rest;
+            if m > 0 {
+                self.updates[s] = rest;
+            } else {
+                self.spare.push(rest);
+            }
         }
         Ok(())
     }
