@@ -263,7 +263,8 @@ impl LinearSolver {
         Self::with_ordering(system, symmetric_when_possible, FillOrdering::Auto)
     }
 
-    /// [`Self::new`] with the LDLᵀ analyses under `ordering` (the LU keeps faer's COLAMD).
+    /// [`Self::new`] with the LDLᵀ and frontal LU analyses under `ordering` (faer's LU with
+    /// global pivoting keeps its COLAMD).
     pub fn with_ordering(
         system: &System,
         symmetric_when_possible: bool,
