@@ -20,8 +20,9 @@ use std::sync::Arc;
 use super::multifrontal::{node, supernodes};
 
 /// Threshold partial pivoting's `u`: a pivot is taken where it is at least this share of the
-/// largest entry of its column below it (Duff, Erisman & Reid 2017, §5.4: 0.1 keeps the
-/// growth of each step below 10); else the front refuses.
+/// largest entry of its column below it, else the front refuses: UMFPACK's default for its
+/// symmetric strategy (Davis 2004), which bounds the growth of each step by `1/u`; the
+/// solution's accuracy check decides the rest.
 pub(super) const PIVOT_THRESHOLD: f64 = 1e-3;
 
 /// Why a numeric factorization refused: the pivot at this permuted column was too small.

@@ -17,6 +17,7 @@ use crate::mech::solve::linear::ordering::{self, FillOrdering};
 use faer::dyn_stack::MemStack;
 use faer::dyn_stack::{MemBuffer, StackReq};
 use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::cholesky::SymbolicCholesky;
 use faer::sparse::linalg::lu::LuRef;
 use faer::sparse::linalg::lu::{LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
@@ -135,10 +136,39 @@ impl LuPart {
         if let Some(lower) = lower_of_symmetric(pattern) {
             let symbolic = ordering::analyse_supernodal(lower.as_ref(), ordering)
                 .map_err(|e| FactorizationError(format!("symbolic analysis: {e:?}")))?;
-            if let Some(analysis) = FrontalAnalysis::new(symbolic, pattern) {
-                return Ok(Self::with(Some(FrontalLu::new(Arc::new(analysis))), None));
-            }
+            return Self::frontal_or_pivoting(symbolic, pattern);
         }
+        Self::pivoting_only(pattern)
+    }
+
+    /// The analysis of the structurally symmetric `pattern` whose lower triangle `lower` an
+    /// LDLᵀ analysis `ordered` already ordered: the frontal LU's under the same ordering (no
+    /// second fill-reducing ordering of the same pattern).
+    pub(super) fn analyse_ordered(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+        lower: SymbolicSparseColMatRef<'_, usize>,
+        ordered: &SymbolicCholesky<usize>,
+    ) -> Result<Self, FactorizationError> {
+        let symbolic = ordering::analyse_supernodal_with(lower, ordered.perm())
+            .map_err(|e| FactorizationError(format!("symbolic analysis: {e:?}")))?;
+        Self::frontal_or_pivoting(symbolic, pattern)
+    }
+
+    /// The frontal LU on `symbolic` where it is supernodal and its indices fit, else faer's.
+    fn frontal_or_pivoting(
+        symbolic: SymbolicCholesky<usize>,
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Result<Self, FactorizationError> {
+        match FrontalAnalysis::new(symbolic, pattern) {
+            Some(analysis) => Ok(Self::with(Some(FrontalLu::new(Arc::new(analysis))), None)),
+            None => Self::pivoting_only(pattern),
+        }
+    }
+
+    /// faer's LU alone (a pattern that is not structurally symmetric).
+    fn pivoting_only(
+        pattern: SymbolicSparseColMatRef<'_, usize>,
+    ) -> Result<Self, FactorizationError> {
         Ok(Self::with(None, Some(PivotingLu::analyse(pattern)?)))
     }
 

@@ -210,8 +210,6 @@ pub struct LinearSolver {
     factor_id: u64,
     /// Threads of the numeric LDLᵀ factorizations (resolved: at least 1).
     threads: usize,
-    /// The fill-reducing ordering of the LDLᵀ and frontal LU analyses.
-    ordering: FillOrdering,
 }
 
 impl std::fmt::Debug for LinearSolver {
@@ -250,7 +248,6 @@ impl Clone for LinearSolver {
             held: Held::None,
             factor_id: 0,
             threads: self.threads,
-            ordering: self.ordering,
         }
     }
 }
@@ -316,7 +313,6 @@ impl LinearSolver {
             held: Held::None,
             factor_id: 0,
             threads: 1,
-            ordering,
         };
         solver.scratch = MemBuffer::new(solver.scratch_req());
         solver.profile.symbolic = started.elapsed();
@@ -701,9 +697,15 @@ impl LinearSolver {
                     rhs.copy_from_slice(&part.rhs);
                 }
                 if lu.is_none() {
-                    let ordering = self.ordering;
+                    // Without a symmetric part the LU was analysed at creation.
+                    let part = symmetric.as_ref().expect("a symmetric part");
                     let analysed = timed(&mut self.profile.symbolic, || {
-                        LuPart::analyse(matrix.symbolic(), ordering)
+                        if part.structural {
+                            let lower = part.lower.as_ref().as_ref();
+                            LuPart::analyse_ordered(matrix.symbolic(), lower, &part.symbolic)
+                        } else {
+                            LuPart::analyse(matrix.symbolic(), FillOrdering::Auto)
+                        }
                     })?;
                     *lu = Some(Box::new(analysed));
                 }

@@ -488,6 +488,20 @@ pub(super) fn analyse_supernodal(
     analyse_with(lower, ordering, params)
 }
 
+/// The supernodal analysis of `lower` under the permutation `perm` an earlier analysis of it
+/// chose (None: the identity).
+pub(super) fn analyse_supernodal_with(
+    lower: SymbolicSparseColMatRef<'_, usize>,
+    perm: Option<PermRef<'_, usize>>,
+) -> Result<SymbolicCholesky<usize>, FaerError> {
+    let params = CholeskySymbolicParams {
+        supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+        ..Default::default()
+    };
+    let ordering = perm.map_or(SymmetricOrdering::Identity, SymmetricOrdering::Custom);
+    factorize_symbolic_cholesky(lower, Side::Lower, ordering, params)
+}
+
 fn analyse_with(
     lower: SymbolicSparseColMatRef<'_, usize>,
     ordering: FillOrdering,
